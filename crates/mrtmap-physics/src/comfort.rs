@@ -1,0 +1,169 @@
+//! Operative temperature (ISO 7726 / ASHRAE 55), PMV and PPD (ISO 7730), radiant asymmetry.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{PhysicsError, finite, in_range};
+use crate::units::Temperature;
+
+/// How to weight air and mean radiant temperature in the operative temperature.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OperativeMethod {
+    /// ISO 7726: to = (ta·√(10v) + tr) / (1 + √(10v)).
+    Iso,
+    /// ASHRAE 55: to = A·ta + (1 − A)·tr, A = 0.5 / 0.6 / 0.7 below 0.2 / 0.6 / 1.0 m/s.
+    Ashrae55,
+}
+
+/// Operative temperature from air temperature, mean radiant temperature and air speed.
+pub fn operative_temperature(
+    air: Temperature,
+    mrt: Temperature,
+    air_speed_m_s: f64,
+    method: OperativeMethod,
+) -> Result<Temperature, PhysicsError> {
+    finite("air temperature", air.kelvin())?;
+    finite("mean radiant temperature", mrt.kelvin())?;
+    let (ta, tr) = (air.kelvin(), mrt.kelvin());
+    let to = match method {
+        OperativeMethod::Iso => {
+            let v = in_range("air speed (m/s)", air_speed_m_s, 0.0, 100.0)?;
+            let s = (10.0 * v).sqrt();
+            (ta * s + tr) / (1.0 + s)
+        }
+        OperativeMethod::Ashrae55 => {
+            let v = in_range("air speed (m/s) for ASHRAE 55 weights", air_speed_m_s, 0.0, 1.0 - 1e-12)?;
+            let a = if v < 0.2 {
+                0.5
+            } else if v < 0.6 {
+                0.6
+            } else {
+                0.7
+            };
+            a * ta + (1.0 - a) * tr
+        }
+    };
+    Ok(Temperature::from_kelvin(to))
+}
+
+/// Inputs of Fanger's PMV model (ISO 7730).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PmvInputs {
+    /// Air temperature.
+    pub air: Temperature,
+    /// Mean radiant temperature.
+    pub mrt: Temperature,
+    /// Relative air speed (m/s).
+    pub relative_air_speed_m_s: f64,
+    /// Relative humidity (%).
+    pub relative_humidity_pct: f64,
+    /// Metabolic rate (met).
+    pub met: f64,
+    /// Clothing insulation (clo).
+    pub clo: f64,
+    /// External work (met), usually 0.
+    pub external_work_met: f64,
+}
+
+/// PMV and PPD, and whether the inputs lie in ISO 7730's validity ranges.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pmv {
+    /// Predicted mean vote.
+    pub pmv: f64,
+    /// Predicted percentage dissatisfied (%).
+    pub ppd_pct: f64,
+    /// Whether every input and the PMV lie within ISO 7730's ranges (10 ≤ ta ≤ 30, 10 ≤ tr ≤ 40,
+    /// 0 ≤ vr ≤ 1, 0.8 ≤ met ≤ 4, 0 ≤ clo ≤ 2, −2 ≤ PMV ≤ 2).
+    pub within_iso_ranges: bool,
+}
+
+/// PPD (%) from PMV: 100 − 95·exp(−0.03353·PMV⁴ − 0.2179·PMV²).
+pub fn ppd_from_pmv(pmv: f64) -> f64 {
+    100.0 - 95.0 * (-0.03353 * pmv.powi(4) - 0.2179 * pmv.powi(2)).exp()
+}
+
+/// Fanger's PMV/PPD as printed in ISO 7730 (annex D; 273 as the Kelvin offset, like the standard).
+pub fn pmv_ppd(inp: &PmvInputs) -> Result<Pmv, PhysicsError> {
+    let ta = in_range("air temperature (°C)", inp.air.celsius(), -50.0, 100.0)?;
+    let tr = in_range("mean radiant temperature (°C)", inp.mrt.celsius(), -50.0, 150.0)?;
+    let vr = in_range("relative air speed (m/s)", inp.relative_air_speed_m_s, 0.0, 10.0)?;
+    let rh = in_range("relative humidity (%)", inp.relative_humidity_pct, 0.0, 100.0)?;
+    let met = in_range("metabolic rate (met)", inp.met, 0.1, 10.0)?;
+    let clo = in_range("clothing (clo)", inp.clo, 0.0, 5.0)?;
+    let wme = in_range("external work (met)", inp.external_work_met, 0.0, 10.0)?;
+
+    let pa = rh * 10.0 * (16.6536 - 4030.183 / (ta + 235.0)).exp();
+    let icl = 0.155 * clo;
+    let m = met * 58.15;
+    let w = wme * 58.15;
+    let mw = m - w;
+    let fcl = if icl <= 0.078 { 1.0 + 1.29 * icl } else { 1.05 + 0.645 * icl };
+    let hcf = 12.1 * vr.sqrt();
+    let taa = ta + 273.0;
+    let tra = tr + 273.0;
+    let tcla = taa + (35.5 - ta) / (3.5 * icl + 0.1);
+    let p1 = icl * fcl;
+    let p2 = p1 * 3.96;
+    let p3 = p1 * 100.0;
+    let p4 = p1 * taa;
+    let p5 = 308.7 - 0.028 * mw + p2 * (tra / 100.0).powi(4);
+    let mut xn = tcla / 100.0;
+    let mut xf = tcla / 50.0;
+    let mut hc = hcf;
+    let mut converged = false;
+    for _ in 0..150 {
+        xf = (xf + xn) / 2.0;
+        let hcn = 2.38 * (100.0 * xf - taa).abs().powf(0.25);
+        hc = hcf.max(hcn);
+        xn = (p5 + p4 * hc - p2 * xf.powi(4)) / (100.0 + p3 * hc);
+        if (xn - xf).abs() <= 0.00015 {
+            converged = true;
+            break;
+        }
+    }
+    if !converged {
+        return Err(PhysicsError::NoConvergence { what: "clothing surface temperature (PMV)" });
+    }
+    let tcl = 100.0 * xn - 273.0;
+    let hl1 = 3.05e-3 * (5733.0 - 6.99 * mw - pa);
+    let hl2 = if mw > 58.15 { 0.42 * (mw - 58.15) } else { 0.0 };
+    let hl3 = 1.7e-5 * m * (5867.0 - pa);
+    let hl4 = 0.0014 * m * (34.0 - ta);
+    let hl5 = 3.96 * fcl * (xn.powi(4) - (tra / 100.0).powi(4));
+    let hl6 = fcl * hc * (tcl - ta);
+    let ts = 0.303 * (-0.036 * m).exp() + 0.028;
+    let pmv = ts * (mw - hl1 - hl2 - hl3 - hl4 - hl5 - hl6);
+    let within = (10.0..=30.0).contains(&ta)
+        && (10.0..=40.0).contains(&tr)
+        && (0.0..=1.0).contains(&vr)
+        && (0.8..=4.0).contains(&met)
+        && (0.0..=2.0).contains(&clo)
+        && (-2.0..=2.0).contains(&pmv);
+    Ok(Pmv { pmv, ppd_pct: ppd_from_pmv(pmv), within_iso_ranges: within })
+}
+
+/// The four radiant-asymmetry situations of ISO 7730 (figure 4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AsymmetryKind {
+    /// Warm ceiling.
+    WarmCeiling,
+    /// Cool wall.
+    CoolWall,
+    /// Cool ceiling.
+    CoolCeiling,
+    /// Warm wall.
+    WarmWall,
+}
+
+/// Percentage dissatisfied (%) from a radiant temperature asymmetry Δtpr (K), ISO 7730.
+pub fn radiant_asymmetry_ppd(kind: AsymmetryKind, delta_k: f64) -> Result<f64, PhysicsError> {
+    let dt = in_range("radiant asymmetry (K)", delta_k, 0.0, 100.0)?;
+    let pd = match kind {
+        AsymmetryKind::WarmCeiling => 100.0 / (1.0 + (2.84 - 0.174 * dt).exp()) - 5.5,
+        AsymmetryKind::CoolWall => 100.0 / (1.0 + (6.61 - 0.345 * dt).exp()),
+        AsymmetryKind::CoolCeiling => 100.0 / (1.0 + (9.93 - 0.50 * dt).exp()),
+        AsymmetryKind::WarmWall => 100.0 / (1.0 + (3.72 - 0.052 * dt).exp()) - 3.5,
+    };
+    Ok(pd.max(0.0))
+}

@@ -1,0 +1,48 @@
+//! # mrtmap-physics
+//!
+//! The comfort physics of mrtmap, with no I/O: temperature units that keep absolute temperature
+//! and temperature difference apart, the ISO 7726 mean radiant temperature (MRT) from view factors,
+//! globe thermometer conversions both ways, operative temperature, PMV/PPD and radiant asymmetry.
+//!
+//! ```text
+//!  view factors + surface temperatures ──► mean_radiant_temperature ──► Tr
+//!  globe Tg, air Ta, air speed v       ──► mrt_from_globe           ──► Tr
+//!  Tr, Ta, v                           ──► globe_temperature        ──► Tg (what a globe would read)
+//!  Ta, Tr, v, RH, met, clo             ──► pmv_ppd                  ──► PMV, PPD
+//! ```
+//!
+//! ```
+//! use mrtmap_physics::*;
+//! let c = Temperature::from_celsius;
+//! // A room seen as two halves: a cold window wall and the rest.
+//! let mrt = mean_radiant_temperature(&[
+//!     RadiantSource::black(0.2, c(12.0)),
+//!     RadiantSource::black(0.8, c(21.0)),
+//! ]).unwrap();
+//! // What a standard globe would read there in still air at 21 °C, and back again.
+//! let tg = globe_temperature(&Globe::STANDARD, mrt.temperature, c(21.0), 0.0, GlobeMethod::ISO).unwrap();
+//! let back = mrt_from_globe(
+//!     &Globe::STANDARD,
+//!     &GlobeReading { globe: tg, air: c(21.0), air_speed_m_s: 0.0 },
+//!     GlobeMethod::ISO,
+//! ).unwrap();
+//! assert!((back.mrt - mrt.temperature).kelvin().abs() < 1e-5);
+//! ```
+
+mod comfort;
+mod error;
+mod globe;
+mod mrt;
+mod units;
+
+pub use comfort::{
+    AsymmetryKind, OperativeMethod, Pmv, PmvInputs, operative_temperature, pmv_ppd, ppd_from_pmv,
+    radiant_asymmetry_ppd,
+};
+pub use error::PhysicsError;
+pub use globe::{
+    Convection, Globe, GlobeFormula, GlobeMethod, GlobeMrt, GlobeReading, STEFAN_BOLTZMANN,
+    globe_convection, globe_temperature, mrt_from_globe,
+};
+pub use mrt::{MeanRadiant, RadiantAverage, RadiantSource, mean_radiant_temperature};
+pub use units::{Temperature, TemperatureDelta, ZERO_CELSIUS_K};

@@ -1,0 +1,95 @@
+use mrtmap_physics::{
+    AsymmetryKind, OperativeMethod, PmvInputs, Temperature, operative_temperature, pmv_ppd, ppd_from_pmv,
+    radiant_asymmetry_ppd,
+};
+
+fn c(x: f64) -> Temperature {
+    Temperature::from_celsius(x)
+}
+
+#[test]
+fn operative_ashrae_vectors() {
+    for (v, expect) in [(0.1, 25.0), (0.3, 24.0), (0.7, 23.0)] {
+        let to = operative_temperature(c(20.0), c(30.0), v, OperativeMethod::Ashrae55).unwrap();
+        assert!((to.celsius() - expect).abs() < 1e-9, "v {v}: {}", to.celsius());
+    }
+    assert!(operative_temperature(c(20.0), c(30.0), 1.2, OperativeMethod::Ashrae55).is_err());
+}
+
+#[test]
+fn operative_iso_vectors() {
+    for (ta, tr, v, expect) in [(25.0, 30.0, 0.3, 26.83), (20.0, 30.0, 0.3, 23.66)] {
+        let to = operative_temperature(c(ta), c(tr), v, OperativeMethod::Iso).unwrap();
+        assert!((to.celsius() - expect).abs() < 5e-3, "{}", to.celsius());
+    }
+}
+
+fn pmv(ta: f64, tr: f64, rh: f64, vr: f64, met: f64, clo: f64) -> mrtmap_physics::Pmv {
+    pmv_ppd(&PmvInputs {
+        air: c(ta),
+        mrt: c(tr),
+        relative_air_speed_m_s: vr,
+        relative_humidity_pct: rh,
+        met,
+        clo,
+        external_work_met: 0.0,
+    })
+    .unwrap()
+}
+
+/// ISO 7730 table values: PMV ±0.1, PPD ±1.
+#[test]
+fn pmv_ppd_table_vectors() {
+    let table = [
+        (22.0, 22.0, 60.0, 0.1, 1.2, 0.5, -0.8, 16.9),
+        (27.0, 27.0, 60.0, 0.1, 1.2, 0.5, 0.8, 17.3),
+        (27.0, 27.0, 60.0, 0.3, 1.2, 0.5, 0.4, 8.9),
+        (23.5, 25.5, 60.0, 0.1, 1.2, 0.5, -0.0, 5.0),
+        (23.5, 25.5, 60.0, 0.3, 1.2, 0.5, -0.6, 11.4),
+        (19.0, 19.0, 40.0, 0.1, 1.2, 1.0, -0.6, 12.5),
+    ];
+    for (ta, tr, rh, vr, met, clo, p, d) in table {
+        let r = pmv(ta, tr, rh, vr, met, clo);
+        assert!((r.pmv - p).abs() <= 0.1, "{ta} {tr} {vr}: PMV {} vs {p}", r.pmv);
+        assert!((r.ppd_pct - d).abs() <= 1.0, "{ta} {tr} {vr}: PPD {} vs {d}", r.ppd_pct);
+        assert!(r.within_iso_ranges);
+    }
+}
+
+/// Unrounded: ta = tr = 25, vr 0.1, rh 50, met 1.1, clo 0.5 → −0.13201636.
+#[test]
+fn pmv_unrounded_vector() {
+    let r = pmv(25.0, 25.0, 50.0, 0.1, 1.1, 0.5);
+    assert!((r.pmv - -0.13201636).abs() < 1e-6, "{}", r.pmv);
+}
+
+#[test]
+fn ppd_is_five_at_neutral_and_symmetric() {
+    assert!((ppd_from_pmv(0.0) - 5.0).abs() < 1e-12);
+    assert!((ppd_from_pmv(1.3) - ppd_from_pmv(-1.3)).abs() < 1e-12);
+}
+
+#[test]
+fn radiant_asymmetry_curves() {
+    let at = |k, dt| radiant_asymmetry_ppd(k, dt).unwrap();
+    // The formulas of physics.md, evaluated independently.
+    let logistic = |a: f64, b: f64, dt: f64| 100.0 / (1.0 + (a - b * dt).exp());
+    assert!((at(AsymmetryKind::WarmCeiling, 8.0) - (logistic(2.84, 0.174, 8.0) - 5.5)).abs() < 1e-12);
+    assert!((at(AsymmetryKind::CoolWall, 12.0) - logistic(6.61, 0.345, 12.0)).abs() < 1e-12);
+    assert!((at(AsymmetryKind::CoolCeiling, 15.0) - logistic(9.93, 0.50, 15.0)).abs() < 1e-12);
+    assert!((at(AsymmetryKind::WarmWall, 30.0) - (logistic(3.72, 0.052, 30.0) - 3.5)).abs() < 1e-12);
+    // ISO 7730 category B limits (PD < 5 %) are rounded readings of these curves:
+    // 5 K warm ceiling, 10 K cool wall, 14 K cool ceiling, 23 K warm wall, all within 2 points of 5 %.
+    for (k, dt) in [
+        (AsymmetryKind::WarmCeiling, 5.0),
+        (AsymmetryKind::CoolWall, 10.0),
+        (AsymmetryKind::CoolCeiling, 14.0),
+        (AsymmetryKind::WarmWall, 23.0),
+    ] {
+        assert!((at(k, dt) - 5.0).abs() < 2.0, "{k:?} at {dt} K: {}", at(k, dt));
+    }
+    // Clamped at zero for small asymmetries, increasing beyond.
+    assert_eq!(at(AsymmetryKind::WarmWall, 0.0), 0.0);
+    assert!(at(AsymmetryKind::CoolWall, 15.0) > at(AsymmetryKind::CoolWall, 10.0));
+    assert!(radiant_asymmetry_ppd(AsymmetryKind::CoolWall, -1.0).is_err());
+}

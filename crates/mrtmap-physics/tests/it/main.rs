@@ -1,0 +1,7 @@
+//! Physics tests: every published vector of `shared/reference/physics.md`, plus properties.
+#![allow(clippy::unwrap_used)]
+
+mod comfort;
+mod globe;
+mod mrt;
+mod units;
