@@ -1,0 +1,445 @@
+//! View factors from a point and the mean radiant temperature there, by two engines.
+//!
+//! - **Exact**: each polygon's solid angle (Van Oosterom–Strackee), each feature's view factor
+//!   subtracted from its host's (the seed paper's Algorithm 1). Valid when every surface is fully
+//!   visible from the point: no occluders, and no surface hiding another. The second condition is
+//!   checked: seen from inside a closed room the solid angles tile the sphere exactly once, so a sum
+//!   above 1 means some surface hides another (a non-convex room seen from this point).
+//! - **Monte Carlo**: rays in N directions against a BVH of every triangle (surfaces and
+//!   occluders); a hit on a surface is assigned to the feature whose polygon contains the hit
+//!   point, else to the surface. The directions come in R independent replicates (R random
+//!   rotations of a Fibonacci lattice, or R batches of uniform random directions); standard errors
+//!   are the spread between replicates over √R, an honest estimate for either direction set.
+
+use mrtmap_geometry::nalgebra::{Point3, Vector3};
+use mrtmap_geometry::polygon::point_in_polygon_fast;
+use mrtmap_geometry::sampling::{self, DirectionSet};
+use mrtmap_geometry::{RayCaster, sphere_view_factor};
+use mrtmap_physics::{PhysicsError, RadiantSource, Temperature, mean_radiant_temperature};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+use crate::scene::{RadiantScene, SurfaceKind};
+
+/// Tolerance on Σ F above 1 before the exact engine declares that surfaces hide each other.
+pub const EXACT_OVERLAP_TOLERANCE: f64 = 1e-6;
+
+/// What a view factor belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PatchKind {
+    /// A surface net of its features.
+    Surface,
+    /// A feature on a surface.
+    Feature,
+    /// An occluder.
+    Occluder,
+}
+
+/// A radiating element as seen from points: a surface (net of its features), a feature or an
+/// occluder, with its temperature.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Patch {
+    /// The element's id.
+    pub id: String,
+    /// Its label.
+    pub label: String,
+    /// Surface, feature or occluder.
+    pub kind: PatchKind,
+    /// For surfaces, the surface kind.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub surface_kind: Option<SurfaceKind>,
+    /// For features, the host surface's id.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub host: Option<String>,
+    /// Radiant temperature.
+    pub temperature: Temperature,
+    /// Emissivity.
+    pub emissivity: f64,
+    /// Temperature uncertainty (K, 0 when unknown).
+    pub temperature_std_k: f64,
+}
+
+/// The patches of a scene, in a fixed order: each surface followed by its features, then the
+/// occluders.
+pub fn patches(scene: &RadiantScene) -> Vec<Patch> {
+    let mut out = Vec::new();
+    for s in &scene.surfaces {
+        out.push(Patch {
+            id: s.id.clone(),
+            label: s.label.clone(),
+            kind: PatchKind::Surface,
+            surface_kind: Some(s.kind),
+            host: None,
+            temperature: s.temperature,
+            emissivity: s.emissivity,
+            temperature_std_k: s.temperature_std_k.unwrap_or(0.0),
+        });
+        for f in &s.features {
+            out.push(Patch {
+                id: f.id.clone(),
+                label: f.label.clone(),
+                kind: PatchKind::Feature,
+                surface_kind: None,
+                host: Some(s.id.clone()),
+                temperature: f.temperature,
+                emissivity: f.emissivity,
+                temperature_std_k: f.temperature_std_k.unwrap_or(0.0),
+            });
+        }
+    }
+    for o in &scene.occluders {
+        out.push(Patch {
+            id: o.id.clone(),
+            label: o.label.clone(),
+            kind: PatchKind::Occluder,
+            surface_kind: None,
+            host: None,
+            temperature: o.temperature,
+            emissivity: o.emissivity,
+            temperature_std_k: 0.0,
+        });
+    }
+    out
+}
+
+/// Monte Carlo settings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct MonteCarlo {
+    /// Rays per point (rounded up to a multiple of `replicates`).
+    pub rays: usize,
+    /// Seed; each point draws from its own stream of it, so results do not depend on threading.
+    pub seed: u64,
+    /// Direction set.
+    pub directions: DirectionSet,
+    /// Independent replicates used for the standard errors (≥ 2).
+    pub replicates: usize,
+}
+
+impl Default for MonteCarlo {
+    fn default() -> Self {
+        Self { rays: 20_000, seed: 1, directions: DirectionSet::Fibonacci, replicates: 8 }
+    }
+}
+
+/// Which engine.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "engine")]
+pub enum Method {
+    /// Exact solid angles (no occluders).
+    Exact,
+    /// Monte Carlo ray tracing.
+    MonteCarlo(MonteCarlo),
+}
+
+impl Method {
+    /// Short name.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Method::Exact => "exact",
+            Method::MonteCarlo(_) => "montecarlo",
+        }
+    }
+}
+
+/// Why an MRT could not be computed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum MrtError {
+    /// Exact view factors asked for a scene with occluders.
+    #[error(
+        "the scene has {count} occluder(s) (first: '{first}'), which exact solid angles cannot handle: use the Monte Carlo method"
+    )]
+    OccludersNeedRayTracing {
+        /// How many.
+        count: usize,
+        /// The first one's id.
+        first: String,
+    },
+    /// Surfaces hide each other from the point.
+    #[error(
+        "point {point:?}: the surfaces' solid angles sum to {sum:.6} of the sphere (> 1), so some surface hides another from here (the room is not convex from this point): use the Monte Carlo method"
+    )]
+    SurfacesHidden {
+        /// The point.
+        point: [f64; 3],
+        /// Σ F.
+        sum: f64,
+    },
+    /// The point lies inside an occluder.
+    #[error("point {point:?} lies inside occluder '{id}'")]
+    InsideOccluder {
+        /// The point.
+        point: [f64; 3],
+        /// The occluder.
+        id: String,
+    },
+    /// Too few rays for the replicates.
+    #[error("{rays} rays cannot make {replicates} replicates: use at least {min} rays")]
+    TooFewRays {
+        /// Rays asked for.
+        rays: usize,
+        /// Replicates.
+        replicates: usize,
+        /// Minimum.
+        min: usize,
+    },
+    /// The comfort formula failed (e.g. nothing seen).
+    #[error("point {point:?}: {source}")]
+    Physics {
+        /// The point.
+        point: [f64; 3],
+        /// Why.
+        source: PhysicsError,
+    },
+}
+
+/// MRT at one point with its view factors and uncertainty.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PointMrt {
+    /// The point.
+    pub point: Point3<f64>,
+    /// Mean radiant temperature.
+    pub mrt: Temperature,
+    /// Total standard error (K): sampling and temperature uncertainties combined in quadrature.
+    pub std_error_k: f64,
+    /// Part of the error from Monte Carlo sampling (0 for exact).
+    pub sampling_std_error_k: f64,
+    /// Part of the error from the patches' temperature uncertainties.
+    pub temperature_std_error_k: f64,
+    /// View factor per patch (order of [`patches`]).
+    pub view_factors: Vec<f64>,
+    /// Standard error per view factor (0 for exact).
+    pub view_factor_std_errors: Vec<f64>,
+    /// Σ F: 1 for a closed room; below 1 where rays escape or the scene is open.
+    pub view_factor_sum: f64,
+    /// Rays traced (0 for exact).
+    pub rays: usize,
+}
+
+enum Owner {
+    Surface(usize),
+    Occluder(usize),
+}
+
+struct Tracer {
+    caster: Box<dyn RayCaster>,
+    owner: Vec<Owner>,
+}
+
+/// A scene made ready for MRT queries with one method: patch list, and for Monte Carlo the BVH.
+pub struct MrtEngine<'a> {
+    scene: &'a RadiantScene,
+    patches: Vec<Patch>,
+    /// Index of each surface's own patch; its features follow it.
+    surface_patch: Vec<usize>,
+    occluder_patch0: usize,
+    method: Method,
+    tracer: Option<Tracer>,
+}
+
+fn caster(tris: &[mrtmap_geometry::Tri]) -> Box<dyn RayCaster> {
+    #[cfg(feature = "embree")]
+    {
+        Box::new(mrtmap_geometry::EmbreeRayCaster::new(tris))
+    }
+    #[cfg(not(feature = "embree"))]
+    {
+        Box::new(mrtmap_geometry::BvhRayCaster::new(tris))
+    }
+}
+
+fn arr(p: &Point3<f64>) -> [f64; 3] {
+    [p.x, p.y, p.z]
+}
+
+impl<'a> MrtEngine<'a> {
+    /// Prepares `scene` for `method`. Exact refuses scenes with occluders.
+    pub fn new(scene: &'a RadiantScene, method: Method) -> Result<Self, MrtError> {
+        let patches = patches(scene);
+        let mut surface_patch = Vec::with_capacity(scene.surfaces.len());
+        let mut k = 0;
+        for s in &scene.surfaces {
+            surface_patch.push(k);
+            k += 1 + s.features.len();
+        }
+        let tracer = match method {
+            Method::Exact => {
+                if let Some(o) = scene.occluders.first() {
+                    return Err(MrtError::OccludersNeedRayTracing { count: scene.occluders.len(), first: o.id.clone() });
+                }
+                None
+            }
+            Method::MonteCarlo(mc) => {
+                if mc.replicates < 2 || mc.rays < 2 * mc.replicates {
+                    let r = mc.replicates.max(2);
+                    return Err(MrtError::TooFewRays { rays: mc.rays, replicates: mc.replicates, min: 2 * r });
+                }
+                let mut tris = Vec::new();
+                let mut owner = Vec::new();
+                for (t, si) in scene.surface_triangles() {
+                    tris.push(t);
+                    owner.push(Owner::Surface(si));
+                }
+                for (oi, o) in scene.occluders.iter().enumerate() {
+                    for t in o.triangles() {
+                        tris.push(t);
+                        owner.push(Owner::Occluder(oi));
+                    }
+                }
+                Some(Tracer { caster: caster(&tris), owner })
+            }
+        };
+        Ok(Self { scene, patches, surface_patch, occluder_patch0: k, method, tracer })
+    }
+
+    /// The patches, in the order of every result's view factors.
+    pub fn patches(&self) -> &[Patch] {
+        &self.patches
+    }
+
+    /// The method.
+    pub fn method(&self) -> Method {
+        self.method
+    }
+
+    /// The scene.
+    pub fn scene(&self) -> &RadiantScene {
+        self.scene
+    }
+
+    /// The ray-casting engine's name, for Monte Carlo.
+    pub fn ray_engine(&self) -> Option<&'static str> {
+        self.tracer.as_ref().map(|t| t.caster.engine())
+    }
+
+    /// MRT at `p`. `stream` selects the point's random stream (use the point's index).
+    pub fn at(&self, p: &Point3<f64>, stream: u64) -> Result<PointMrt, MrtError> {
+        if let Some(o) = self.scene.occluders.iter().find(|o| o.contains(p)) {
+            return Err(MrtError::InsideOccluder { point: arr(p), id: o.id.clone() });
+        }
+        let (f, se, rays, replicate_f) = match self.method {
+            Method::Exact => {
+                let f = self.exact_view_factors(p);
+                let sum: f64 = f.iter().sum();
+                if sum > 1.0 + EXACT_OVERLAP_TOLERANCE {
+                    return Err(MrtError::SurfacesHidden { point: arr(p), sum });
+                }
+                let n = f.len();
+                (f, vec![0.0; n], 0, Vec::new())
+            }
+            Method::MonteCarlo(mc) => self.monte_carlo(p, &mc, stream),
+        };
+        let mrt_of = |f: &[f64]| {
+            let src: Vec<RadiantSource> = self
+                .patches
+                .iter()
+                .zip(f)
+                .filter(|(_, f)| **f > 0.0)
+                .map(|(pa, &f)| RadiantSource {
+                    view_factor: f.min(1.0),
+                    temperature: pa.temperature,
+                    emissivity: pa.emissivity,
+                    temperature_std_k: pa.temperature_std_k,
+                })
+                .collect();
+            mean_radiant_temperature(&src)
+        };
+        let m = mrt_of(&f).map_err(|source| MrtError::Physics { point: arr(p), source })?;
+        let sampling = if replicate_f.len() >= 2 {
+            let vals: Vec<f64> = replicate_f.iter().filter_map(|g| mrt_of(g).ok()).map(|m| m.temperature.kelvin()).collect();
+            std_error(&vals)
+        } else {
+            0.0
+        };
+        Ok(PointMrt {
+            point: *p,
+            mrt: m.temperature,
+            std_error_k: sampling.hypot(m.std_from_temperatures_k),
+            sampling_std_error_k: sampling,
+            temperature_std_error_k: m.std_from_temperatures_k,
+            view_factor_sum: f.iter().sum(),
+            view_factors: f,
+            view_factor_std_errors: se,
+            rays,
+        })
+    }
+
+    fn exact_view_factors(&self, p: &Point3<f64>) -> Vec<f64> {
+        let mut f = vec![0.0; self.patches.len()];
+        for (si, s) in self.scene.surfaces.iter().enumerate() {
+            let k = self.surface_patch[si];
+            let mut net = sphere_view_factor(p, &s.polygon);
+            for (fi, feat) in s.features.iter().enumerate() {
+                let ff = sphere_view_factor(p, &feat.polygon);
+                f[k + 1 + fi] = ff;
+                net -= ff;
+            }
+            f[k] = net.max(0.0);
+        }
+        f
+    }
+
+    /// (pooled view factors, their standard errors, rays traced, per-replicate view factors)
+    fn monte_carlo(&self, p: &Point3<f64>, mc: &MonteCarlo, stream: u64) -> (Vec<f64>, Vec<f64>, usize, Vec<Vec<f64>>) {
+        let Some(tracer) = &self.tracer else {
+            return (vec![0.0; self.patches.len()], vec![0.0; self.patches.len()], 0, Vec::new());
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(mc.seed);
+        rng.set_stream(stream);
+        let r = mc.replicates;
+        let per = mc.rays.div_ceil(r);
+        let n = self.patches.len();
+        let mut reps = Vec::with_capacity(r);
+        for _ in 0..r {
+            let mut counts = vec![0u32; n];
+            for d in sampling::directions(mc.directions, per, &mut rng) {
+                if let Some(k) = self.trace(tracer, p, &d) {
+                    counts[k] += 1;
+                }
+            }
+            reps.push(counts.iter().map(|&c| c as f64 / per as f64).collect::<Vec<f64>>());
+        }
+        let mut f = vec![0.0; n];
+        let mut se = vec![0.0; n];
+        for k in 0..n {
+            let vals: Vec<f64> = reps.iter().map(|g| g[k]).collect();
+            f[k] = vals.iter().sum::<f64>() / r as f64;
+            se[k] = std_error(&vals);
+        }
+        (f, se, per * r, reps)
+    }
+
+    fn trace(&self, tracer: &Tracer, p: &Point3<f64>, d: &Vector3<f64>) -> Option<usize> {
+        let hit = tracer.caster.cast(p, d, f64::INFINITY)?;
+        match tracer.owner[hit.triangle as usize] {
+            Owner::Occluder(oi) => Some(self.occluder_patch0 + oi),
+            Owner::Surface(si) => {
+                let s = &self.scene.surfaces[si];
+                let k = self.surface_patch[si];
+                if !s.features.is_empty() {
+                    let q = s.frame.to_2d(&(p + d * hit.t));
+                    for (fi, feat) in s.features.iter().enumerate() {
+                        let (lo, hi) = feat.bounds_2d;
+                        if q.x >= lo.x && q.x <= hi.x && q.y >= lo.y && q.y <= hi.y && point_in_polygon_fast(&q, &feat.polygon_2d) {
+                            return Some(k + 1 + fi);
+                        }
+                    }
+                }
+                Some(k)
+            }
+        }
+    }
+}
+
+/// Standard error of the mean of `vals` (sample standard deviation / √n).
+fn std_error(vals: &[f64]) -> f64 {
+    let n = vals.len() as f64;
+    if vals.len() < 2 {
+        return 0.0;
+    }
+    let mean = vals.iter().sum::<f64>() / n;
+    let var = vals.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (var / n).sqrt()
+}

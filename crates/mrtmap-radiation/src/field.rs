@@ -1,0 +1,258 @@
+//! MRT on a horizontal grid over the floor: the map frame, grid nodes, and the computed field.
+//!
+//! The map frame lies in the floor's plane with its normal along up. Its axes (u, v) are the world
+//! axes when up is within 1° of a world axis (x, y for a z-up scene), otherwise u runs along the
+//! floor polygon's longest edge; v = up × u. Its origin is the world origin projected onto the
+//! floor, so for a z-up scene (u, v) are simply (x, y).
+
+use mrtmap_geometry::PlaneFrame;
+use mrtmap_geometry::nalgebra::{Point2, Point3, Unit, Vector3};
+use mrtmap_geometry::polygon::{Containment, point_in_polygon};
+use mrtmap_physics::Temperature;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::engine::{MrtEngine, MrtError, PointMrt};
+use crate::scene::RadiantScene;
+
+/// Why no map frame exists.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum FieldError {
+    /// Neither `up` nor a floor.
+    #[error("the scene has no floor surface, so there is no floor to map over (add a surface of kind \"floor\")")]
+    NoFloor,
+    /// The floor is parallel to up.
+    #[error("the floor surface '{id}' is not horizontal with respect to `up`")]
+    FloorNotHorizontal {
+        /// Floor id.
+        id: String,
+    },
+    /// A grid that makes no sense.
+    #[error("invalid grid: {0}")]
+    BadGrid(String),
+}
+
+/// The horizontal frame maps are drawn in.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MapFrame {
+    /// Origin on the floor plane; u, v horizontal; normal = up.
+    pub plane: PlaneFrame,
+    /// The floor polygon in map coordinates.
+    pub floor_uv: Vec<Point2<f64>>,
+    /// Id of the floor surface.
+    pub floor_id: String,
+}
+
+impl MapFrame {
+    /// The map frame of a scene (needs a floor).
+    pub fn of_scene(scene: &RadiantScene) -> Result<Self, FieldError> {
+        let floor = scene.floor().ok_or(FieldError::NoFloor)?;
+        let up = scene.up().ok_or(FieldError::NoFloor)?;
+        let cos = floor.frame.normal.dot(&up).abs();
+        if cos < 0.9 {
+            return Err(FieldError::FloorNotHorizontal { id: floor.id.clone() });
+        }
+        // The floor plane along up through the floor polygon's mean height.
+        let h = floor.polygon.iter().map(|p| up.dot(&p.coords)).sum::<f64>() / floor.polygon.len() as f64;
+        let origin = Point3::from(up.as_ref() * h);
+        // Up within 1° of a world axis: u is the first world axis perpendicular to it.
+        let axes = [Vector3::x(), Vector3::y(), Vector3::z()];
+        let aligned = axes.iter().any(|a| a.dot(&up).abs() > 1f64.to_radians().cos());
+        let u_hint = match axes.into_iter().find(|a| aligned && a.dot(&up).abs() < 1f64.to_radians().sin()) {
+            Some(a) => a,
+            None => {
+                let n = floor.polygon.len();
+                (0..n)
+                    .map(|i| floor.polygon[(i + 1) % n] - floor.polygon[i])
+                    .max_by(|a, b| a.norm().total_cmp(&b.norm()))
+                    .unwrap_or_else(Vector3::x)
+            }
+        };
+        let plane = PlaneFrame::new(origin, up, &u_hint);
+        let floor_uv = floor.polygon.iter().map(|p| plane.to_2d(p)).collect();
+        Ok(Self { plane, floor_uv, floor_id: floor.id.clone() })
+    }
+
+    /// Up.
+    pub fn up(&self) -> Unit<Vector3<f64>> {
+        self.plane.normal
+    }
+
+    /// The 3D point at map coordinates `uv` and `height_m` above the floor.
+    pub fn point(&self, uv: &Point2<f64>, height_m: f64) -> Point3<f64> {
+        self.plane.to_3d(uv) + self.plane.normal.as_ref() * height_m
+    }
+
+    /// Map coordinates of a 3D point (projected along up).
+    pub fn uv(&self, p: &Point3<f64>) -> Point2<f64> {
+        self.plane.to_2d(p)
+    }
+
+    /// Height of a 3D point above the floor.
+    pub fn height(&self, p: &Point3<f64>) -> f64 {
+        self.plane.signed_distance(p)
+    }
+
+    /// Bounds of the floor in map coordinates: (min, max).
+    pub fn floor_bounds(&self) -> (Point2<f64>, Point2<f64>) {
+        let mut lo = Point2::new(f64::INFINITY, f64::INFINITY);
+        let mut hi = Point2::new(f64::NEG_INFINITY, f64::NEG_INFINITY);
+        for p in &self.floor_uv {
+            lo = Point2::new(lo.x.min(p.x), lo.y.min(p.y));
+            hi = Point2::new(hi.x.max(p.x), hi.y.max(p.y));
+        }
+        (lo, hi)
+    }
+}
+
+/// Grid settings.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GridSpec {
+    /// Nodes along u.
+    pub nx: usize,
+    /// Nodes along v.
+    pub ny: usize,
+    /// Height above the floor (m); 1.1 m is seated head height.
+    pub height_m: f64,
+    /// Distance kept from the floor outline (m).
+    pub margin_m: f64,
+}
+
+impl Default for GridSpec {
+    fn default() -> Self {
+        Self { nx: 20, ny: 20, height_m: 1.1, margin_m: 0.1 }
+    }
+}
+
+/// One grid node.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GridNode {
+    /// Column (along u).
+    pub i: usize,
+    /// Row (along v).
+    pub j: usize,
+    /// Map coordinates.
+    pub uv: Point2<f64>,
+    /// 3D point (scene frame).
+    pub point: Point3<f64>,
+    /// The MRT there, or why not.
+    pub result: Result<PointMrt, MrtError>,
+}
+
+/// Summary of a field: extremes and mean with where they are.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FieldSummary {
+    /// Nodes computed.
+    pub nodes: usize,
+    /// Nodes skipped (inside occluders or failed).
+    pub skipped: usize,
+    /// Lowest MRT (°C) and its node.
+    pub min: Extreme,
+    /// Highest MRT (°C) and its node.
+    pub max: Extreme,
+    /// Mean MRT over the nodes (°C).
+    pub mean_c: f64,
+    /// Largest standard error (K).
+    pub max_std_error_k: f64,
+}
+
+/// A value at a place.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Extreme {
+    /// MRT (°C).
+    pub mrt_c: f64,
+    /// Scene coordinates.
+    pub xyz: [f64; 3],
+    /// Map coordinates.
+    pub uv: [f64; 2],
+}
+
+/// MRT over a grid.
+pub struct MrtField {
+    /// The frame.
+    pub frame: MapFrame,
+    /// The grid.
+    pub spec: GridSpec,
+    /// Node coordinates along u.
+    pub u: Vec<f64>,
+    /// Node coordinates along v.
+    pub v: Vec<f64>,
+    /// Nodes inside the floor outline (row-major: j then i).
+    pub nodes: Vec<GridNode>,
+}
+
+fn linspace(a: f64, b: f64, n: usize) -> Vec<f64> {
+    if n == 1 {
+        return vec![(a + b) / 2.0];
+    }
+    (0..n).map(|k| a + (b - a) * k as f64 / (n - 1) as f64).collect()
+}
+
+impl MrtField {
+    /// Computes the field on `spec` (in parallel; results do not depend on the thread count).
+    pub fn compute(engine: &MrtEngine<'_>, frame: MapFrame, spec: GridSpec) -> Result<Self, FieldError> {
+        if spec.nx == 0 || spec.ny == 0 || spec.nx * spec.ny > 4_000_000 {
+            return Err(FieldError::BadGrid(format!("{}×{} nodes", spec.nx, spec.ny)));
+        }
+        if !(spec.height_m.is_finite() && spec.margin_m.is_finite() && spec.margin_m >= 0.0) {
+            return Err(FieldError::BadGrid(format!("height {} m, margin {} m", spec.height_m, spec.margin_m)));
+        }
+        let (lo, hi) = frame.floor_bounds();
+        let m = spec.margin_m;
+        if hi.x - lo.x <= 2.0 * m || hi.y - lo.y <= 2.0 * m {
+            return Err(FieldError::BadGrid(format!("a margin of {m} m leaves no floor to map")));
+        }
+        let u = linspace(lo.x + m, hi.x - m, spec.nx);
+        let v = linspace(lo.y + m, hi.y - m, spec.ny);
+        let tol = (m - 1e-6).max(0.0);
+        let mut places = Vec::new();
+        for (j, &vv) in v.iter().enumerate() {
+            for (i, &uu) in u.iter().enumerate() {
+                let uv = Point2::new(uu, vv);
+                if point_in_polygon(&uv, &frame.floor_uv, tol) == Containment::Inside {
+                    places.push((i, j, uv));
+                }
+            }
+        }
+        let nx = spec.nx;
+        let nodes = places
+            .into_par_iter()
+            .map(|(i, j, uv)| {
+                let point = frame.point(&uv, spec.height_m);
+                let result = engine.at(&point, (j * nx + i) as u64);
+                GridNode { i, j, uv, point, result }
+            })
+            .collect();
+        Ok(Self { frame, spec, u, v, nodes })
+    }
+
+    /// Extremes and mean; `None` when no node was computed.
+    pub fn summary(&self) -> Option<FieldSummary> {
+        let ok: Vec<(&GridNode, &PointMrt)> = self.nodes.iter().filter_map(|n| n.result.as_ref().ok().map(|r| (n, r))).collect();
+        if ok.is_empty() {
+            return None;
+        }
+        let ext = |(n, r): &(&GridNode, &PointMrt)| Extreme {
+            mrt_c: r.mrt.celsius(),
+            xyz: [n.point.x, n.point.y, n.point.z],
+            uv: [n.uv.x, n.uv.y],
+        };
+        let key = |x: &&(&GridNode, &PointMrt)| x.1.mrt.kelvin();
+        let min = ok.iter().min_by(|a, b| key(a).total_cmp(&key(b)))?;
+        let max = ok.iter().max_by(|a, b| key(a).total_cmp(&key(b)))?;
+        Some(FieldSummary {
+            nodes: ok.len(),
+            skipped: self.nodes.len() - ok.len(),
+            min: ext(min),
+            max: ext(max),
+            mean_c: ok.iter().map(|x| x.1.mrt.celsius()).sum::<f64>() / ok.len() as f64,
+            max_std_error_k: ok.iter().map(|x| x.1.std_error_k).fold(0.0, f64::max),
+        })
+    }
+
+    /// The MRT at node (i, j), if computed.
+    pub fn value(&self, i: usize, j: usize) -> Option<Temperature> {
+        self.nodes.iter().find(|n| n.i == i && n.j == j).and_then(|n| n.result.as_ref().ok()).map(|r| r.mrt)
+    }
+}

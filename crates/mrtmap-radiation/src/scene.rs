@@ -1,0 +1,795 @@
+//! The radiant scene file (`scene.json`, format `mrtmap-scene/1`) and its validated model.
+//!
+//! [`SceneFile`] is the file as data (serde, every key of the spec plus the optional ones);
+//! [`RadiantScene`] is a scene that passed every rule of `shared/spec/scene.md`, with each
+//! surface's plane frame computed once. Conversion goes through [`RadiantScene::new`], whose
+//! errors name the surface, feature or occluder id and the rule broken.
+
+use std::collections::HashSet;
+use std::path::Path;
+
+use mrtmap_geometry::nalgebra::{Point2, Point3, Unit, Vector3};
+use mrtmap_geometry::polygon::{self, NotSimple, PlaneFrame};
+use mrtmap_geometry::{Tri, box_triangles};
+use mrtmap_physics::Temperature;
+use serde::{Deserialize, Serialize};
+
+/// The `format` value of version 1.
+pub const SCENE_FORMAT: &str = "mrtmap-scene/1";
+/// Largest distance of a vertex from its polygon's best-fit plane (m).
+pub const PLANARITY_TOLERANCE_M: f64 = 1e-3;
+/// Distance within which a feature counts as lying in its host's plane, and within which points
+/// count as on a polygon's boundary (m).
+pub const FEATURE_PLANE_TOLERANCE_M: f64 = 1e-3;
+/// Valid surface temperatures (°C).
+pub const TEMPERATURE_RANGE_C: (f64, f64) = (-60.0, 200.0);
+
+fn one() -> f64 {
+    1.0
+}
+
+fn is_one(x: &f64) -> bool {
+    *x == 1.0
+}
+
+/// `scene.json` as data.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SceneFile {
+    /// Must be `mrtmap-scene/1`.
+    pub format: String,
+    /// Optional up direction (unit vector); without it, the floor's normal into the room.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub up: Option<[f64; 3]>,
+    /// The room's surfaces.
+    pub surfaces: Vec<SurfaceFile>,
+    /// Optional occluders (boxes or triangle meshes).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub occluders: Vec<OccluderFile>,
+}
+
+/// One surface in the file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SurfaceFile {
+    /// Unique id.
+    pub id: String,
+    /// `floor`, `ceiling`, `wall` or `other`.
+    pub kind: String,
+    /// Free-text semantic label.
+    #[serde(default)]
+    pub label: String,
+    /// Planar simple polygon, ≥ 3 vertices, metres.
+    pub polygon: Vec<[f64; 3]>,
+    /// Radiant temperature (°C).
+    pub temperature_c: f64,
+    /// Emissivity (default 1).
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub emissivity: f64,
+    /// Standard uncertainty of the temperature (K), written by segmentation.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub temperature_std_k: Option<f64>,
+    /// Observed fraction of the surface, 0…1, written by segmentation.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub observed_fraction: Option<f64>,
+    /// Features on this surface.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub features: Vec<FeatureFile>,
+}
+
+/// One feature (window, light, painting…) in the file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FeatureFile {
+    /// Unique id.
+    pub id: String,
+    /// Free-text semantic label.
+    #[serde(default)]
+    pub label: String,
+    /// Polygon in the host's plane and inside the host.
+    pub polygon: Vec<[f64; 3]>,
+    /// Radiant temperature (°C).
+    pub temperature_c: f64,
+    /// Emissivity (default 1).
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub emissivity: f64,
+    /// Standard uncertainty of the temperature (K).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub temperature_std_k: Option<f64>,
+}
+
+/// An axis-aligned box.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BoxFile {
+    /// Lower corner.
+    pub min: [f64; 3],
+    /// Upper corner.
+    pub max: [f64; 3],
+}
+
+/// One occluder in the file: a `box`, or `vertices` with `triangles`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct OccluderFile {
+    /// Unique id.
+    pub id: String,
+    /// Free-text label.
+    #[serde(default)]
+    pub label: String,
+    /// Radiant temperature (°C).
+    pub temperature_c: f64,
+    /// Emissivity (default 1).
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub emissivity: f64,
+    /// A box…
+    #[serde(default, rename = "box", skip_serializing_if = "Option::is_none")]
+    pub box_: Option<BoxFile>,
+    /// …or a triangle mesh.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vertices: Option<Vec<[f64; 3]>>,
+    /// Vertex index triples of the mesh.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub triangles: Option<Vec<[usize; 3]>>,
+}
+
+/// What kind of surface.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SurfaceKind {
+    /// Floor.
+    Floor,
+    /// Ceiling.
+    Ceiling,
+    /// Wall.
+    Wall,
+    /// Anything else (a column, a soffit…).
+    Other,
+}
+
+impl SurfaceKind {
+    /// The spec's name.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Floor => "floor",
+            Self::Ceiling => "ceiling",
+            Self::Wall => "wall",
+            Self::Other => "other",
+        }
+    }
+
+    fn parse(s: &str) -> Option<Self> {
+        Some(match s {
+            "floor" => Self::Floor,
+            "ceiling" => Self::Ceiling,
+            "wall" => Self::Wall,
+            "other" => Self::Other,
+            _ => return None,
+        })
+    }
+}
+
+/// Why a scene is invalid. Each message names the element and the rule.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SceneError {
+    /// Not JSON, or JSON not of the scene's shape.
+    #[error("not a valid scene file: {message} (line {line}, column {column})")]
+    Json {
+        /// serde_json's message.
+        message: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+    },
+    /// Wrong or missing `format`.
+    #[error("unsupported format {found:?}: expected \"{SCENE_FORMAT}\"")]
+    Format {
+        /// What the file says.
+        found: String,
+    },
+    /// No surfaces at all.
+    #[error("the scene has no surfaces")]
+    NoSurfaces,
+    /// An id used twice.
+    #[error("duplicate id '{id}'")]
+    DuplicateId {
+        /// The id.
+        id: String,
+    },
+    /// An id that is empty.
+    #[error("{element} has an empty id")]
+    EmptyId {
+        /// Which element (e.g. "surface 3").
+        element: String,
+    },
+    /// Unknown surface kind.
+    #[error("surface '{id}': unknown kind '{kind}' (expected floor, ceiling, wall or other)")]
+    UnknownKind {
+        /// Surface id.
+        id: String,
+        /// The kind given.
+        kind: String,
+    },
+    /// A polygon with fewer than three vertices.
+    #[error("{element} '{id}': polygon has {count} vertices; at least 3 are needed")]
+    TooFewVertices {
+        /// "surface" or "feature".
+        element: &'static str,
+        /// Its id.
+        id: String,
+        /// Vertex count.
+        count: usize,
+    },
+    /// A coordinate or value that is NaN or infinite.
+    #[error("{element} '{id}': {what} is not a finite number")]
+    NotFinite {
+        /// Element kind.
+        element: &'static str,
+        /// Its id.
+        id: String,
+        /// Which value.
+        what: &'static str,
+    },
+    /// A polygon that is not planar.
+    #[error(
+        "{element} '{id}': polygon is not planar (a vertex lies {deviation_mm:.1} mm off the best-fit plane; the limit is 1 mm)"
+    )]
+    NonPlanar {
+        /// Element kind.
+        element: &'static str,
+        /// Its id.
+        id: String,
+        /// Largest vertex distance from the plane, mm.
+        deviation_mm: f64,
+    },
+    /// A polygon that is not simple.
+    #[error("{element} '{id}': polygon is not simple ({detail})")]
+    NotSimple {
+        /// Element kind.
+        element: &'static str,
+        /// Its id.
+        id: String,
+        /// What is wrong.
+        detail: String,
+    },
+    /// A feature off its host's plane.
+    #[error("feature '{id}' does not lie in the plane of its host surface '{host}' ({distance_mm:.1} mm off; the limit is 1 mm)")]
+    FeatureOffPlane {
+        /// Feature id.
+        id: String,
+        /// Host id.
+        host: String,
+        /// Largest distance, mm.
+        distance_mm: f64,
+    },
+    /// A feature not inside its host polygon.
+    #[error("feature '{id}' is not inside the polygon of its host surface '{host}'")]
+    FeatureOutsideHost {
+        /// Feature id.
+        id: String,
+        /// Host id.
+        host: String,
+    },
+    /// Two features of one surface overlap.
+    #[error("features '{a}' and '{b}' of surface '{host}' overlap")]
+    FeaturesOverlap {
+        /// First feature.
+        a: String,
+        /// Second feature.
+        b: String,
+        /// Host surface.
+        host: String,
+    },
+    /// A temperature outside −60…200 °C.
+    #[error("{element} '{id}': temperature {value} °C is outside −60…200 °C")]
+    Temperature {
+        /// Element kind.
+        element: &'static str,
+        /// Its id.
+        id: String,
+        /// Value, °C.
+        value: f64,
+    },
+    /// An emissivity outside (0, 1].
+    #[error("{element} '{id}': emissivity {value} is outside 0 < ε ≤ 1")]
+    Emissivity {
+        /// Element kind.
+        element: &'static str,
+        /// Its id.
+        id: String,
+        /// Value.
+        value: f64,
+    },
+    /// A bad optional value (uncertainty, observed fraction).
+    #[error("{element} '{id}': {what} = {value} is invalid ({rule})")]
+    BadValue {
+        /// Element kind.
+        element: &'static str,
+        /// Its id.
+        id: String,
+        /// Which key.
+        what: &'static str,
+        /// Value.
+        value: f64,
+        /// The rule.
+        rule: &'static str,
+    },
+    /// `up` is zero or not finite.
+    #[error("`up` must be a non-zero finite vector, got {value:?}")]
+    BadUp {
+        /// What the file gives.
+        value: [f64; 3],
+    },
+    /// A malformed occluder.
+    #[error("occluder '{id}': {detail}")]
+    BadOccluder {
+        /// Occluder id.
+        id: String,
+        /// What is wrong.
+        detail: String,
+    },
+}
+
+/// A scene file that could not be loaded: its path and why.
+#[derive(Debug, thiserror::Error)]
+#[error("{path}: {kind}")]
+pub struct SceneLoadError {
+    /// The file.
+    pub path: String,
+    /// Why.
+    pub kind: SceneLoadErrorKind,
+}
+
+/// Why a scene file could not be loaded.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SceneLoadErrorKind {
+    /// Reading failed.
+    #[error("cannot read the file: {0}")]
+    Io(#[from] std::io::Error),
+    /// The content is invalid.
+    #[error("{0}")]
+    Invalid(#[from] SceneError),
+}
+
+/// A validated surface.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Surface {
+    /// Unique id.
+    pub id: String,
+    /// Kind.
+    pub kind: SurfaceKind,
+    /// Semantic label.
+    pub label: String,
+    /// Vertices (m).
+    pub polygon: Vec<Point3<f64>>,
+    /// Radiant temperature.
+    pub temperature: Temperature,
+    /// Emissivity.
+    pub emissivity: f64,
+    /// Temperature uncertainty (K), if known.
+    pub temperature_std_k: Option<f64>,
+    /// Observed fraction, if known.
+    pub observed_fraction: Option<f64>,
+    /// Features on it.
+    pub features: Vec<Feature>,
+    /// The polygon's plane frame (normal by the polygon's winding).
+    pub frame: PlaneFrame,
+    /// The polygon in `frame`'s 2D coordinates.
+    pub polygon_2d: Vec<Point2<f64>>,
+}
+
+/// A validated feature.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Feature {
+    /// Unique id.
+    pub id: String,
+    /// Semantic label.
+    pub label: String,
+    /// Vertices (m).
+    pub polygon: Vec<Point3<f64>>,
+    /// Radiant temperature.
+    pub temperature: Temperature,
+    /// Emissivity.
+    pub emissivity: f64,
+    /// Temperature uncertainty (K), if known.
+    pub temperature_std_k: Option<f64>,
+    /// The polygon in the host's 2D frame.
+    pub polygon_2d: Vec<Point2<f64>>,
+    /// Axis-aligned bounds of `polygon_2d`: (min, max).
+    pub bounds_2d: (Point2<f64>, Point2<f64>),
+}
+
+/// A validated occluder.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Occluder {
+    /// Unique id.
+    pub id: String,
+    /// Label.
+    pub label: String,
+    /// Radiant temperature.
+    pub temperature: Temperature,
+    /// Emissivity.
+    pub emissivity: f64,
+    /// Shape.
+    pub shape: OccluderShape,
+}
+
+/// An occluder's shape.
+#[derive(Clone, Debug, PartialEq)]
+pub enum OccluderShape {
+    /// Axis-aligned box.
+    Box {
+        /// Lower corner.
+        min: Point3<f64>,
+        /// Upper corner.
+        max: Point3<f64>,
+    },
+    /// Triangle mesh.
+    Mesh {
+        /// Vertices.
+        vertices: Vec<Point3<f64>>,
+        /// Index triples.
+        triangles: Vec<[usize; 3]>,
+    },
+}
+
+impl Occluder {
+    /// Its triangles.
+    pub fn triangles(&self) -> Vec<Tri> {
+        match &self.shape {
+            OccluderShape::Box { min, max } => box_triangles(min, max),
+            OccluderShape::Mesh { vertices, triangles } => {
+                triangles.iter().map(|t| [vertices[t[0]], vertices[t[1]], vertices[t[2]]]).collect()
+            }
+        }
+    }
+
+    /// Whether `p` lies strictly inside (boxes only; meshes answer false).
+    pub fn contains(&self, p: &Point3<f64>) -> bool {
+        match &self.shape {
+            OccluderShape::Box { min, max } => (0..3).all(|i| p[i] > min[i] && p[i] < max[i]),
+            OccluderShape::Mesh { .. } => false,
+        }
+    }
+}
+
+/// A validated radiant scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RadiantScene {
+    /// Up as given in the file, if any.
+    pub up_given: Option<Unit<Vector3<f64>>>,
+    /// Surfaces.
+    pub surfaces: Vec<Surface>,
+    /// Occluders.
+    pub occluders: Vec<Occluder>,
+}
+
+fn point(v: &[f64; 3]) -> Point3<f64> {
+    Point3::new(v[0], v[1], v[2])
+}
+
+fn arr(p: &Point3<f64>) -> [f64; 3] {
+    [p.x, p.y, p.z]
+}
+
+fn check_temperature(element: &'static str, id: &str, c: f64) -> Result<Temperature, SceneError> {
+    if !c.is_finite() {
+        return Err(SceneError::NotFinite { element, id: id.into(), what: "temperature_c" });
+    }
+    if !(TEMPERATURE_RANGE_C.0..=TEMPERATURE_RANGE_C.1).contains(&c) {
+        return Err(SceneError::Temperature { element, id: id.into(), value: c });
+    }
+    Ok(Temperature::from_celsius(c))
+}
+
+fn check_emissivity(element: &'static str, id: &str, e: f64) -> Result<f64, SceneError> {
+    if !(e > 0.0 && e <= 1.0) {
+        return Err(SceneError::Emissivity { element, id: id.into(), value: e });
+    }
+    Ok(e)
+}
+
+fn check_std(element: &'static str, id: &str, s: Option<f64>) -> Result<Option<f64>, SceneError> {
+    match s {
+        Some(v) if !(v.is_finite() && v >= 0.0) => Err(SceneError::BadValue {
+            element,
+            id: id.into(),
+            what: "temperature_std_k",
+            value: v,
+            rule: "a finite value ≥ 0",
+        }),
+        _ => Ok(s),
+    }
+}
+
+fn check_polygon(element: &'static str, id: &str, poly: &[[f64; 3]]) -> Result<Vec<Point3<f64>>, SceneError> {
+    if poly.len() < 3 {
+        return Err(SceneError::TooFewVertices { element, id: id.into(), count: poly.len() });
+    }
+    if poly.iter().flatten().any(|c| !c.is_finite()) {
+        return Err(SceneError::NotFinite { element, id: id.into(), what: "a polygon coordinate" });
+    }
+    Ok(poly.iter().map(point).collect())
+}
+
+fn not_simple(element: &'static str, id: &str, why: NotSimple) -> SceneError {
+    let detail = match why {
+        NotSimple::TooFewVertices => "fewer than 3 distinct vertices".to_string(),
+        NotSimple::ZeroLengthEdge(i) => format!("vertices {} and {} coincide", i, i + 1),
+        NotSimple::EdgesIntersect(i, j) => format!("edge {i} intersects edge {j}"),
+        NotSimple::ZeroArea => "it encloses no area".to_string(),
+    };
+    SceneError::NotSimple { element, id: id.into(), detail }
+}
+
+fn bounds(poly: &[Point2<f64>]) -> (Point2<f64>, Point2<f64>) {
+    let mut lo = Point2::new(f64::INFINITY, f64::INFINITY);
+    let mut hi = Point2::new(f64::NEG_INFINITY, f64::NEG_INFINITY);
+    for p in poly {
+        lo = Point2::new(lo.x.min(p.x), lo.y.min(p.y));
+        hi = Point2::new(hi.x.max(p.x), hi.y.max(p.y));
+    }
+    (lo, hi)
+}
+
+impl RadiantScene {
+    /// Validates a scene file against every rule of the spec.
+    pub fn new(file: &SceneFile) -> Result<Self, SceneError> {
+        if file.format != SCENE_FORMAT {
+            return Err(SceneError::Format { found: file.format.clone() });
+        }
+        if file.surfaces.is_empty() {
+            return Err(SceneError::NoSurfaces);
+        }
+        let up_given = match file.up {
+            None => None,
+            Some(u) => {
+                let v = Vector3::new(u[0], u[1], u[2]);
+                if !v.iter().all(|c| c.is_finite()) {
+                    return Err(SceneError::BadUp { value: u });
+                }
+                Some(Unit::try_new(v, 1e-9).ok_or(SceneError::BadUp { value: u })?)
+            }
+        };
+        let mut ids = HashSet::new();
+        let mut claim = |id: &str, element: String| -> Result<(), SceneError> {
+            if id.is_empty() {
+                return Err(SceneError::EmptyId { element });
+            }
+            if !ids.insert(id.to_string()) {
+                return Err(SceneError::DuplicateId { id: id.into() });
+            }
+            Ok(())
+        };
+        let mut surfaces = Vec::with_capacity(file.surfaces.len());
+        for (si, s) in file.surfaces.iter().enumerate() {
+            claim(&s.id, format!("surface {}", si + 1))?;
+            let kind = SurfaceKind::parse(&s.kind)
+                .ok_or_else(|| SceneError::UnknownKind { id: s.id.clone(), kind: s.kind.clone() })?;
+            let poly = check_polygon("surface", &s.id, &s.polygon)?;
+            let dev = polygon::planarity_deviation(&poly);
+            if dev > PLANARITY_TOLERANCE_M {
+                return Err(SceneError::NonPlanar { element: "surface", id: s.id.clone(), deviation_mm: dev * 1e3 });
+            }
+            let frame = PlaneFrame::of_polygon(&poly)
+                .ok_or_else(|| not_simple("surface", &s.id, NotSimple::ZeroArea))?;
+            let poly2: Vec<Point2<f64>> = poly.iter().map(|p| frame.to_2d(p)).collect();
+            polygon::check_simple(&poly2, 1e-6).map_err(|e| not_simple("surface", &s.id, e))?;
+            let temperature = check_temperature("surface", &s.id, s.temperature_c)?;
+            let emissivity = check_emissivity("surface", &s.id, s.emissivity)?;
+            let temperature_std_k = check_std("surface", &s.id, s.temperature_std_k)?;
+            if let Some(f) = s.observed_fraction
+                && !(0.0..=1.0).contains(&f)
+            {
+                return Err(SceneError::BadValue {
+                    element: "surface",
+                    id: s.id.clone(),
+                    what: "observed_fraction",
+                    value: f,
+                    rule: "between 0 and 1",
+                });
+            }
+            let mut features: Vec<Feature> = Vec::with_capacity(s.features.len());
+            for (fi, f) in s.features.iter().enumerate() {
+                claim(&f.id, format!("feature {} of surface '{}'", fi + 1, s.id))?;
+                let fpoly = check_polygon("feature", &f.id, &f.polygon)?;
+                let off = fpoly.iter().map(|p| frame.signed_distance(p).abs()).fold(0.0, f64::max);
+                if off > FEATURE_PLANE_TOLERANCE_M {
+                    return Err(SceneError::FeatureOffPlane {
+                        id: f.id.clone(),
+                        host: s.id.clone(),
+                        distance_mm: off * 1e3,
+                    });
+                }
+                let f2: Vec<Point2<f64>> = fpoly.iter().map(|p| frame.to_2d(p)).collect();
+                polygon::check_simple(&f2, 1e-6).map_err(|e| not_simple("feature", &f.id, e))?;
+                if !polygon::polygon_inside(&f2, &poly2, FEATURE_PLANE_TOLERANCE_M) {
+                    return Err(SceneError::FeatureOutsideHost { id: f.id.clone(), host: s.id.clone() });
+                }
+                if let Some(other) =
+                    features.iter().find(|o| polygon::polygons_overlap(&o.polygon_2d, &f2, FEATURE_PLANE_TOLERANCE_M))
+                {
+                    return Err(SceneError::FeaturesOverlap { a: other.id.clone(), b: f.id.clone(), host: s.id.clone() });
+                }
+                features.push(Feature {
+                    id: f.id.clone(),
+                    label: f.label.clone(),
+                    polygon: fpoly,
+                    temperature: check_temperature("feature", &f.id, f.temperature_c)?,
+                    emissivity: check_emissivity("feature", &f.id, f.emissivity)?,
+                    temperature_std_k: check_std("feature", &f.id, f.temperature_std_k)?,
+                    bounds_2d: bounds(&f2),
+                    polygon_2d: f2,
+                });
+            }
+            surfaces.push(Surface {
+                id: s.id.clone(),
+                kind,
+                label: s.label.clone(),
+                polygon: poly,
+                temperature,
+                emissivity,
+                temperature_std_k,
+                observed_fraction: s.observed_fraction,
+                features,
+                frame,
+                polygon_2d: poly2,
+            });
+        }
+        let mut occluders = Vec::with_capacity(file.occluders.len());
+        for (oi, o) in file.occluders.iter().enumerate() {
+            claim(&o.id, format!("occluder {}", oi + 1))?;
+            let bad = |detail: String| SceneError::BadOccluder { id: o.id.clone(), detail };
+            let shape = match (&o.box_, &o.vertices, &o.triangles) {
+                (Some(b), None, None) => {
+                    if b.min.iter().chain(b.max.iter()).any(|c| !c.is_finite()) {
+                        return Err(bad("box corners must be finite".into()));
+                    }
+                    if (0..3).any(|i| b.min[i] >= b.max[i]) {
+                        return Err(bad(format!("box min {:?} is not below max {:?} on every axis", b.min, b.max)));
+                    }
+                    OccluderShape::Box { min: point(&b.min), max: point(&b.max) }
+                }
+                (None, Some(v), Some(t)) => {
+                    if v.iter().flatten().any(|c| !c.is_finite()) {
+                        return Err(bad("mesh vertices must be finite".into()));
+                    }
+                    if t.is_empty() {
+                        return Err(bad("mesh has no triangles".into()));
+                    }
+                    if let Some((k, tri)) = t.iter().enumerate().find(|(_, tri)| tri.iter().any(|&i| i >= v.len())) {
+                        return Err(bad(format!(
+                            "triangle {k} {tri:?} refers to a vertex beyond the {} given",
+                            v.len()
+                        )));
+                    }
+                    OccluderShape::Mesh { vertices: v.iter().map(point).collect(), triangles: t.clone() }
+                }
+                _ => return Err(bad("give either `box` or both `vertices` and `triangles`".into())),
+            };
+            occluders.push(Occluder {
+                id: o.id.clone(),
+                label: o.label.clone(),
+                temperature: check_temperature("occluder", &o.id, o.temperature_c)?,
+                emissivity: check_emissivity("occluder", &o.id, o.emissivity)?,
+                shape,
+            });
+        }
+        Ok(Self { up_given, surfaces, occluders })
+    }
+
+    /// Parses and validates JSON text.
+    pub fn from_json(text: &str) -> Result<Self, SceneError> {
+        let file: SceneFile = serde_json::from_str(text).map_err(|e| SceneError::Json {
+            message: e.to_string().split(" at line ").next().unwrap_or_default().to_string(),
+            line: e.line(),
+            column: e.column(),
+        })?;
+        Self::new(&file)
+    }
+
+    /// Reads, parses and validates a scene file.
+    pub fn load(path: &Path) -> Result<Self, SceneLoadError> {
+        let wrap = |kind| SceneLoadError { path: path.display().to_string(), kind };
+        let text = std::fs::read_to_string(path).map_err(|e| wrap(SceneLoadErrorKind::Io(e)))?;
+        Self::from_json(&text).map_err(|e| wrap(SceneLoadErrorKind::Invalid(e)))
+    }
+
+    /// The scene as file data (round-trips through [`RadiantScene::new`]).
+    pub fn to_file(&self) -> SceneFile {
+        SceneFile {
+            format: SCENE_FORMAT.into(),
+            up: self.up_given.map(|u| [u.x, u.y, u.z]),
+            surfaces: self
+                .surfaces
+                .iter()
+                .map(|s| SurfaceFile {
+                    id: s.id.clone(),
+                    kind: s.kind.as_str().into(),
+                    label: s.label.clone(),
+                    polygon: s.polygon.iter().map(arr).collect(),
+                    temperature_c: s.temperature.celsius(),
+                    emissivity: s.emissivity,
+                    temperature_std_k: s.temperature_std_k,
+                    observed_fraction: s.observed_fraction,
+                    features: s
+                        .features
+                        .iter()
+                        .map(|f| FeatureFile {
+                            id: f.id.clone(),
+                            label: f.label.clone(),
+                            polygon: f.polygon.iter().map(arr).collect(),
+                            temperature_c: f.temperature.celsius(),
+                            emissivity: f.emissivity,
+                            temperature_std_k: f.temperature_std_k,
+                        })
+                        .collect(),
+                })
+                .collect(),
+            occluders: self
+                .occluders
+                .iter()
+                .map(|o| {
+                    let (box_, vertices, triangles) = match &o.shape {
+                        OccluderShape::Box { min, max } => (Some(BoxFile { min: arr(min), max: arr(max) }), None, None),
+                        OccluderShape::Mesh { vertices, triangles } => {
+                            (None, Some(vertices.iter().map(arr).collect()), Some(triangles.clone()))
+                        }
+                    };
+                    OccluderFile {
+                        id: o.id.clone(),
+                        label: o.label.clone(),
+                        temperature_c: o.temperature.celsius(),
+                        emissivity: o.emissivity,
+                        box_,
+                        vertices,
+                        triangles,
+                    }
+                })
+                .collect(),
+        }
+    }
+
+    /// Pretty JSON text of the scene.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(&self.to_file()).unwrap_or_default()
+    }
+
+    /// The largest floor surface, if any.
+    pub fn floor(&self) -> Option<&Surface> {
+        self.surfaces
+            .iter()
+            .filter(|s| s.kind == SurfaceKind::Floor)
+            .max_by(|a, b| polygon::area_3d(&a.polygon).total_cmp(&polygon::area_3d(&b.polygon)))
+    }
+
+    /// Up: as given, else the floor's normal pointing into the room (towards the mean of the other
+    /// surfaces' vertices). `None` without either.
+    pub fn up(&self) -> Option<Unit<Vector3<f64>>> {
+        if let Some(u) = self.up_given {
+            return Some(u);
+        }
+        let floor = self.floor()?;
+        let others: Vec<Point3<f64>> = self
+            .surfaces
+            .iter()
+            .filter(|s| !std::ptr::eq(*s, floor))
+            .flat_map(|s| s.polygon.iter().copied())
+            .collect();
+        let n = floor.frame.normal;
+        if others.is_empty() {
+            return Some(n);
+        }
+        let side = floor.frame.signed_distance(&polygon::centroid(&others));
+        Some(if side >= 0.0 { n } else { -n })
+    }
+
+    /// Every surface and feature triangle, with its owner.
+    pub(crate) fn surface_triangles(&self) -> Vec<(Tri, usize)> {
+        let mut out = Vec::new();
+        for (si, s) in self.surfaces.iter().enumerate() {
+            if let Ok(tris) = polygon::triangulate(&s.polygon_2d) {
+                out.extend(tris.iter().map(|t| ([s.polygon[t[0]], s.polygon[t[1]], s.polygon[t[2]]], si)));
+            }
+        }
+        out
+    }
+}
