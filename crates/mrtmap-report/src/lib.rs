@@ -1,0 +1,26 @@
+//! # mrtmap-report
+//!
+//! What people look at: the MRT heatmap with labelled contours (PNG and SVG from one drawing
+//! routine), the grid as CSV, and the map summary.
+//!
+//! ```text
+//!  MrtField + RadiantScene + marks ──► render_png / render_svg ──► mrt_map.png / mrt_map.svg
+//!  MrtField                        ──► grid_csv                ──► mrt_grid.csv
+//! ```
+//!
+//! Nothing here writes files or prints: functions return bytes and text for the caller to write.
+
+mod map;
+mod tables;
+
+pub use map::{MapInput, MapMark, contour_step, render_png, render_svg};
+pub use tables::{MapAxes, MapSummary, grid_csv};
+
+/// Errors of report rendering.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ReportError {
+    /// Drawing or encoding failed.
+    #[error("drawing the map failed: {0}")]
+    Draw(String),
+}

@@ -1,0 +1,70 @@
+//! Grid CSV and map summary.
+
+use mrtmap_radiation::{FieldSummary, MrtField};
+use serde::{Deserialize, Serialize};
+
+/// `mrt_grid.csv`: one row per grid node inside the floor: x, y, z (scene frame), mrt_c,
+/// std_error_k, then i, j (grid indices) and u_m, v_m (map coordinates). A node that could not be
+/// computed (inside an occluder) has empty mrt_c and std_error_k and the reason in `note`.
+pub fn grid_csv(field: &MrtField) -> String {
+    let mut s = String::from("x,y,z,mrt_c,std_error_k,i,j,u_m,v_m,note\n");
+    for n in &field.nodes {
+        let (m, e, note) = match &n.result {
+            Ok(r) => (format!("{:.4}", r.mrt.celsius()), format!("{:.4}", r.std_error_k), String::new()),
+            Err(err) => (String::new(), String::new(), format!("\"{}\"", err.to_string().replace('"', "'"))),
+        };
+        s.push_str(&format!(
+            "{:.4},{:.4},{:.4},{m},{e},{},{},{:.4},{:.4},{note}\n",
+            n.point.x, n.point.y, n.point.z, n.i, n.j, n.uv.x, n.uv.y
+        ));
+    }
+    s
+}
+
+/// `summary.json` of a map.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MapSummary {
+    /// Height above the floor (m).
+    pub height_m: f64,
+    /// Grid nodes along u and v.
+    pub grid: [usize; 2],
+    /// Margin from the outline (m).
+    pub margin_m: f64,
+    /// "exact" or "montecarlo".
+    pub method: String,
+    /// Rays per point (Monte Carlo).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rays: Option<usize>,
+    /// Seed (Monte Carlo).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+    /// Map axes in scene coordinates: u, v, up.
+    pub axes: MapAxes,
+    /// Extremes, mean and counts (absent when nothing was computed).
+    #[serde(flatten)]
+    pub field: Option<FieldSummary>,
+    /// Wall-clock time of the computation (s).
+    pub compute_secs: f64,
+}
+
+/// The map frame's axes in scene coordinates.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MapAxes {
+    /// Origin of map coordinates (on the floor).
+    pub origin: [f64; 3],
+    /// u axis.
+    pub u: [f64; 3],
+    /// v axis.
+    pub v: [f64; 3],
+    /// Up.
+    pub up: [f64; 3],
+}
+
+impl MapAxes {
+    /// The axes of a field's frame.
+    pub fn of(field: &MrtField) -> Self {
+        let p = &field.frame.plane;
+        let a = |v: &mrtmap_geometry::nalgebra::Vector3<f64>| [v.x, v.y, v.z];
+        Self { origin: [p.origin.x, p.origin.y, p.origin.z], u: a(&p.u), v: a(&p.v), up: a(&p.normal) }
+    }
+}

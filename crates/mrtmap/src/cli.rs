@@ -1,0 +1,234 @@
+//! Command-line arguments. The doc comments are the `--help` text.
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+
+/// Map the mean radiant temperature (MRT) of a room.
+///
+/// MRT is the uniform surrounding temperature that would exchange as much radiant heat with a
+/// person as the real room does (ISO 7726). mrtmap computes it from a radiant scene: the room's
+/// surfaces with their temperatures (`scene.json`), exactly from solid angles or by Monte Carlo
+/// ray tracing, at points or over a grid at head height.
+#[derive(Debug, Parser)]
+#[command(name = "mrtmap", version, about, long_about)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// Subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Map MRT over a grid at a height above the floor: CSV, PNG and SVG heatmaps, summary.
+    Map(MapArgs),
+    /// MRT at points, with the view-factor table behind each.
+    Mrt(MrtArgs),
+    /// Convert a black-globe reading to MRT (ISO 7726, or mixed convection), or back.
+    Globe(GlobeArgs),
+    /// Write the built-in example scene (an office with a cold window) as scene.json.
+    ExampleScene(ExampleSceneArgs),
+}
+
+/// Where the scene comes from.
+#[derive(Debug, Args, Clone)]
+pub struct SceneArgs {
+    /// The radiant scene file (`scene.json`, format mrtmap-scene/1). Without it, the built-in
+    /// example office (see `mrtmap example-scene`).
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
+}
+
+/// How view factors are computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum MethodArg {
+    /// Exact when the scene has no occluders, else Monte Carlo.
+    Auto,
+    /// Exact solid angles (Van Oosterom–Strackee), features subtracted from their host.
+    Exact,
+    /// Monte Carlo ray tracing against a BVH (handles occluders and non-convex rooms).
+    Montecarlo,
+}
+
+/// Direction sets for Monte Carlo.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum DirectionsArg {
+    /// Randomly rotated spherical Fibonacci lattices (converges faster).
+    Fibonacci,
+    /// Independent uniform random directions.
+    Random,
+}
+
+/// View-factor settings shared by `mrt` and `map`.
+#[derive(Debug, Args, Clone)]
+pub struct MethodArgs {
+    /// View-factor method.
+    #[arg(long, value_enum, default_value_t = MethodArg::Auto)]
+    pub method: MethodArg,
+    /// Monte Carlo: rays per point.
+    #[arg(long, default_value_t = 20_000)]
+    pub rays: usize,
+    /// Monte Carlo: random seed (results are reproducible from it).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Monte Carlo: direction set.
+    #[arg(long, value_enum, default_value_t = DirectionsArg::Fibonacci)]
+    pub directions: DirectionsArg,
+    /// Monte Carlo: independent replicates the standard errors come from.
+    #[arg(long, default_value_t = 8)]
+    pub replicates: usize,
+}
+
+/// `mrtmap map`.
+#[derive(Debug, Args)]
+pub struct MapArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Height of the map above the floor (m); 1.1 m is seated head height, 1.7 m standing.
+    #[arg(long, default_value_t = 1.1)]
+    pub height: f64,
+    /// Grid nodes as COLSxROWS over the floor's bounding rectangle (nodes outside the floor are left out).
+    #[arg(long, default_value = "20x20", value_parser = parse_grid)]
+    pub grid: (usize, usize),
+    /// Distance kept from the floor outline (m).
+    #[arg(long = "margin-m", default_value_t = 0.1)]
+    pub margin_m: f64,
+    /// A point to mark and report, NAME=U,V in map coordinates (x,y for a z-up scene) or
+    /// NAME=X,Y,Z in scene coordinates. Repeatable.
+    #[arg(long = "mark", value_name = "NAME=U,V", value_parser = parse_mark)]
+    pub marks: Vec<(String, Vec<f64>)>,
+    #[command(flatten)]
+    pub method: MethodArgs,
+    /// Output folder for mrt_grid.csv, mrt_map.png, mrt_map.svg and summary.json.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+}
+
+/// `mrtmap mrt`.
+#[derive(Debug, Args)]
+pub struct MrtArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// A point X,Y,Z in the scene file's frame (m). Repeatable.
+    #[arg(long = "at", value_name = "X,Y,Z", required = true, value_parser = parse_point)]
+    pub at: Vec<[f64; 3]>,
+    #[command(flatten)]
+    pub method: MethodArgs,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Globe conversion formula.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum GlobeMethodArg {
+    /// ISO 7726 general formula (any diameter and emissivity).
+    Iso,
+    /// ISO 7726 closed forms for the standard globe (0.15 m, ε 0.95), as printed in the seed paper.
+    IsoClosedForm,
+    /// Mixed-convection correction (Teitelbaum et al. 2022), 0.04–0.15 m globes.
+    Mixed,
+}
+
+/// Convection regime for the ISO formulas.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ConvectionArg {
+    /// The larger of natural and forced (ISO 7726).
+    Larger,
+    /// Natural convection only.
+    Natural,
+    /// Forced convection only.
+    Forced,
+}
+
+/// `mrtmap globe`.
+#[derive(Debug, Args)]
+#[command(group(clap::ArgGroup::new("reading").required(true).args(["tg", "tr"])))]
+pub struct GlobeArgs {
+    /// Globe temperature (°C): converts to MRT.
+    #[arg(long, allow_negative_numbers = true)]
+    pub tg: Option<f64>,
+    /// Mean radiant temperature (°C): gives the temperature the globe would read (the inverse).
+    #[arg(long, allow_negative_numbers = true)]
+    pub tr: Option<f64>,
+    /// Air temperature (°C).
+    #[arg(long, allow_negative_numbers = true)]
+    pub ta: f64,
+    /// Air speed (m/s).
+    #[arg(long, default_value_t = 0.0)]
+    pub va: f64,
+    /// Globe diameter (m).
+    #[arg(long, default_value_t = 0.15)]
+    pub diameter: f64,
+    /// Globe emissivity.
+    #[arg(long, default_value_t = 0.95)]
+    pub emissivity: f64,
+    /// Formula.
+    #[arg(long, value_enum, default_value_t = GlobeMethodArg::Iso)]
+    pub method: GlobeMethodArg,
+    /// Convection regime for the ISO formulas.
+    #[arg(long, value_enum, default_value_t = ConvectionArg::Larger)]
+    pub convection: ConvectionArg,
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `mrtmap example-scene`.
+#[derive(Debug, Args)]
+pub struct ExampleSceneArgs {
+    /// Write to this file instead of standard output.
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+}
+
+fn numbers(s: &str, n: &[usize], what: &str) -> Result<Vec<f64>, String> {
+    let v: Result<Vec<f64>, _> = s.split(',').map(|x| x.trim().parse::<f64>()).collect();
+    match v {
+        Ok(v) if n.contains(&v.len()) && v.iter().all(|x| x.is_finite()) => Ok(v),
+        _ => Err(format!("expected {what}, got '{s}'")),
+    }
+}
+
+fn parse_point(s: &str) -> Result<[f64; 3], String> {
+    let v = numbers(s, &[3], "X,Y,Z (three numbers in metres)")?;
+    Ok([v[0], v[1], v[2]])
+}
+
+fn parse_grid(s: &str) -> Result<(usize, usize), String> {
+    let bad = || format!("expected COLSxROWS such as 20x20, got '{s}'");
+    let (a, b) = s.split_once(['x', 'X', '×']).ok_or_else(bad)?;
+    let (a, b) = (a.trim().parse::<usize>().map_err(|_| bad())?, b.trim().parse::<usize>().map_err(|_| bad())?);
+    if a == 0 || b == 0 || a * b > 1_000_000 {
+        return Err(format!("a grid of {a}×{b} nodes is not allowed (1 to 1,000,000 nodes)"));
+    }
+    Ok((a, b))
+}
+
+fn parse_mark(s: &str) -> Result<(String, Vec<f64>), String> {
+    let (name, rest) = s.split_once('=').ok_or_else(|| format!("expected NAME=U,V or NAME=X,Y,Z, got '{s}'"))?;
+    if name.trim().is_empty() {
+        return Err(format!("the mark '{s}' has no name"));
+    }
+    Ok((name.trim().to_string(), numbers(rest, &[2, 3], "U,V or X,Y,Z after the name")?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parsers_accept_and_refuse() {
+        assert_eq!(parse_grid("20x20"), Ok((20, 20)));
+        assert_eq!(parse_grid("3×4"), Ok((3, 4)));
+        assert!(parse_grid("0x5").is_err());
+        assert!(parse_grid("20").is_err());
+        assert_eq!(parse_point("1, 2,3.5"), Ok([1.0, 2.0, 3.5]));
+        assert!(parse_point("1,2").is_err());
+        assert!(parse_point("1,2,nan").is_err());
+        assert_eq!(parse_mark("A=1,2"), Ok(("A".into(), vec![1.0, 2.0])));
+        assert!(parse_mark("=1,2").is_err());
+        assert!(parse_mark("A=1").is_err());
+    }
+}

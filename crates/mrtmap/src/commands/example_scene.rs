@@ -1,0 +1,17 @@
+//! `mrtmap example-scene`: the built-in example as scene.json.
+
+use mrtmap_radiation::EXAMPLE_OFFICE_JSON;
+
+use crate::cli::ExampleSceneArgs;
+use crate::output::write_atomic;
+
+pub fn run(args: &ExampleSceneArgs) -> anyhow::Result<()> {
+    match &args.out {
+        Some(p) => {
+            write_atomic(p, EXAMPLE_OFFICE_JSON.as_bytes())?;
+            println!("wrote {}", p.display());
+        }
+        None => print!("{EXAMPLE_OFFICE_JSON}"),
+    }
+    Ok(())
+}

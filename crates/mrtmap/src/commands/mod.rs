@@ -1,0 +1,69 @@
+//! One module per subcommand, and the settings they share.
+
+mod example_scene;
+mod globe;
+mod map;
+mod mrt;
+
+use anyhow::bail;
+use mrtmap_geometry::sampling::DirectionSet;
+use mrtmap_radiation::{Method, MonteCarlo, RadiantScene, example_office};
+
+use crate::cli::{Cli, Command, DirectionsArg, MethodArg, MethodArgs, SceneArgs};
+
+/// Runs a parsed command line.
+pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Map(a) => map::run(&a),
+        Command::Mrt(a) => mrt::run(&a),
+        Command::Globe(a) => globe::run(&a),
+        Command::ExampleScene(a) => example_scene::run(&a),
+    }
+}
+
+/// The scene the user named, or the built-in example; the string says which.
+pub(crate) fn load_scene(args: &SceneArgs) -> anyhow::Result<(RadiantScene, String)> {
+    Ok(match &args.scene {
+        Some(p) => (RadiantScene::load(p)?, p.display().to_string()),
+        None => (example_office(), "the built-in example office".to_string()),
+    })
+}
+
+/// The method from flags: `auto` picks exact unless the scene has occluders.
+pub(crate) fn resolve_method(args: &MethodArgs, scene: &RadiantScene) -> anyhow::Result<Method> {
+    let mc = || MonteCarlo {
+        rays: args.rays,
+        seed: args.seed,
+        directions: match args.directions {
+            DirectionsArg::Fibonacci => DirectionSet::Fibonacci,
+            DirectionsArg::Random => DirectionSet::Random,
+        },
+        replicates: args.replicates,
+    };
+    if args.rays == 0 {
+        bail!("--rays must be at least 1");
+    }
+    Ok(match args.method {
+        MethodArg::Exact => Method::Exact,
+        MethodArg::Montecarlo => Method::MonteCarlo(mc()),
+        MethodArg::Auto if scene.occluders.is_empty() => Method::Exact,
+        MethodArg::Auto => Method::MonteCarlo(mc()),
+    })
+}
+
+/// A line describing a method for people.
+pub(crate) fn describe_method(method: &Method, engine: Option<&str>) -> String {
+    match method {
+        Method::Exact => "exact view factors (solid angles)".to_string(),
+        Method::MonteCarlo(mc) => format!(
+            "Monte Carlo view factors ({} rays per point, {:?} directions in {} replicates, seed {}{})",
+            mc.rays,
+            mc.directions,
+            mc.replicates,
+            mc.seed,
+            engine.map(|e| format!(", {e}")).unwrap_or_default()
+        )
+        .replace("Fibonacci", "Fibonacci-lattice")
+        .replace("Random", "random"),
+    }
+}

@@ -1,0 +1,11 @@
+//! The `mrtmap` command line.
+
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    mrtmap::logging();
+    match mrtmap::run() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => mrtmap::report_error(&e),
+    }
+}
