@@ -25,9 +25,9 @@ mod solid_angle;
 
 pub use nalgebra;
 pub use polygon::{Containment, NotSimple, PlaneFrame};
-pub use ray::{BvhRayCaster, RayCaster, RayHit, Tri, box_triangles};
 #[cfg(feature = "embree")]
 pub use ray::EmbreeRayCaster;
+pub use ray::{BvhRayCaster, RayCaster, RayHit, Tri, box_triangles};
 pub use sampling::DirectionSet;
 pub use solid_angle::{polygon_solid_angle, sphere_view_factor, triangle_solid_angle};
 

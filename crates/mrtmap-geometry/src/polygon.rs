@@ -21,7 +21,9 @@ pub fn newell_normal(vertices: &[Point3<f64>]) -> Vector3<f64> {
 /// Vertex mean.
 pub fn centroid(vertices: &[Point3<f64>]) -> Point3<f64> {
     let n = vertices.len().max(1) as f64;
-    let s = vertices.iter().fold(Vector3::zeros(), |acc, p| acc + p.coords);
+    let s = vertices
+        .iter()
+        .fold(Vector3::zeros(), |acc, p| acc + p.coords);
     Point3::from(s / n)
 }
 
@@ -44,12 +46,21 @@ impl PlaneFrame {
     pub fn new(origin: Point3<f64>, normal: Unit<Vector3<f64>>, u_hint: &Vector3<f64>) -> Self {
         let mut u = u_hint - normal.as_ref() * normal.dot(u_hint);
         if u.norm() < 1e-9 {
-            let a = if normal.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
+            let a = if normal.x.abs() < 0.9 {
+                Vector3::x()
+            } else {
+                Vector3::y()
+            };
             u = a - normal.as_ref() * normal.dot(&a);
         }
         let u = Unit::new_normalize(u);
         let v = Unit::new_normalize(normal.cross(&u));
-        Self { origin, u, v, normal }
+        Self {
+            origin,
+            u,
+            v,
+            normal,
+        }
     }
 
     /// The frame of a polygon: Newell normal (winding's right hand), origin at the vertex mean, u
@@ -60,7 +71,11 @@ impl PlaneFrame {
         }
         let n = newell_normal(vertices);
         let normal = Unit::try_new(n, 1e-12)?;
-        Some(Self::new(centroid(vertices), normal, &(vertices[1] - vertices[0])))
+        Some(Self::new(
+            centroid(vertices),
+            normal,
+            &(vertices[1] - vertices[0]),
+        ))
     }
 
     /// Signed distance of `p` from the plane along the normal.
@@ -83,7 +98,10 @@ impl PlaneFrame {
 /// Largest distance of a vertex from the polygon's Newell plane (m).
 pub fn planarity_deviation(vertices: &[Point3<f64>]) -> f64 {
     match PlaneFrame::of_polygon(vertices) {
-        Some(f) => vertices.iter().map(|p| f.signed_distance(p).abs()).fold(0.0, f64::max),
+        Some(f) => vertices
+            .iter()
+            .map(|p| f.signed_distance(p).abs())
+            .fold(0.0, f64::max),
         None => 0.0,
     }
 }
@@ -118,7 +136,11 @@ pub enum Containment {
 pub fn point_segment_distance(q: &Point2<f64>, a: &Point2<f64>, b: &Point2<f64>) -> f64 {
     let ab = b - a;
     let l2 = ab.norm_squared();
-    let t = if l2 > 0.0 { ((q - a).dot(&ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
+    let t = if l2 > 0.0 {
+        ((q - a).dot(&ab) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     (q - (a + ab * t)).norm()
 }
 
@@ -139,7 +161,11 @@ pub fn point_in_polygon(q: &Point2<f64>, poly: &[Point2<f64>], tol: f64) -> Cont
             }
         }
     }
-    if inside { Containment::Inside } else { Containment::Outside }
+    if inside {
+        Containment::Inside
+    } else {
+        Containment::Outside
+    }
 }
 
 /// Fast inside test without a boundary band (crossing number), for hot loops.
@@ -163,18 +189,31 @@ fn orient(a: &Point2<f64>, b: &Point2<f64>, c: &Point2<f64>) -> f64 {
 
 /// Whether segments ab and cd cross properly: each strictly straddles the other's line by more
 /// than `tol` (touching and collinear overlap are not proper crossings).
-pub fn segments_cross(a: &Point2<f64>, b: &Point2<f64>, c: &Point2<f64>, d: &Point2<f64>, tol: f64) -> bool {
+pub fn segments_cross(
+    a: &Point2<f64>,
+    b: &Point2<f64>,
+    c: &Point2<f64>,
+    d: &Point2<f64>,
+    tol: f64,
+) -> bool {
     let lab = (b - a).norm().max(1e-300);
     let lcd = (d - c).norm().max(1e-300);
     let d1 = orient(a, b, c) / lab;
     let d2 = orient(a, b, d) / lab;
     let d3 = orient(c, d, a) / lcd;
     let d4 = orient(c, d, b) / lcd;
-    ((d1 > tol && d2 < -tol) || (d1 < -tol && d2 > tol)) && ((d3 > tol && d4 < -tol) || (d3 < -tol && d4 > tol))
+    ((d1 > tol && d2 < -tol) || (d1 < -tol && d2 > tol))
+        && ((d3 > tol && d4 < -tol) || (d3 < -tol && d4 > tol))
 }
 
 /// Whether closed segments ab and cd come within `tol` of each other.
-pub fn segments_touch(a: &Point2<f64>, b: &Point2<f64>, c: &Point2<f64>, d: &Point2<f64>, tol: f64) -> bool {
+pub fn segments_touch(
+    a: &Point2<f64>,
+    b: &Point2<f64>,
+    c: &Point2<f64>,
+    d: &Point2<f64>,
+    tol: f64,
+) -> bool {
     segments_cross(a, b, c, d, 0.0)
         || point_segment_distance(a, c, d) <= tol
         || point_segment_distance(b, c, d) <= tol
@@ -216,7 +255,9 @@ pub fn check_simple(poly: &[Point2<f64>], tol: f64) -> Result<(), NotSimple> {
                 // Shared vertex: b == c (j = i+1) or a == d (wrap). Fold-back: the far end of one
                 // edge lies on the other.
                 let (far_ab, far_cd) = if j == i + 1 { (a, d) } else { (b, c) };
-                if point_segment_distance(far_ab, c, d) <= tol || point_segment_distance(far_cd, a, b) <= tol {
+                if point_segment_distance(far_ab, c, d) <= tol
+                    || point_segment_distance(far_cd, a, b) <= tol
+                {
                     return Err(NotSimple::EdgesIntersect(i, j));
                 }
             } else if segments_touch(a, b, c, d, tol) {
@@ -233,9 +274,13 @@ pub fn check_simple(poly: &[Point2<f64>], tol: f64) -> Result<(), NotSimple> {
 /// Triangulates a simple 2D polygon (ear clipping, earcut): vertex index triples.
 pub fn triangulate(poly: &[Point2<f64>]) -> Result<Vec<[usize; 3]>, GeometryError> {
     let flat: Vec<f64> = poly.iter().flat_map(|p| [p.x, p.y]).collect();
-    let idx = earcutr::earcut(&flat, &[], 2).map_err(|_| GeometryError::Triangulation { vertices: poly.len() })?;
+    let idx = earcutr::earcut(&flat, &[], 2).map_err(|_| GeometryError::Triangulation {
+        vertices: poly.len(),
+    })?;
     if idx.len() != 3 * (poly.len() - 2) {
-        return Err(GeometryError::Triangulation { vertices: poly.len() });
+        return Err(GeometryError::Triangulation {
+            vertices: poly.len(),
+        });
     }
     Ok(idx.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect())
 }
@@ -243,9 +288,13 @@ pub fn triangulate(poly: &[Point2<f64>]) -> Result<Vec<[usize; 3]>, GeometryErro
 fn sample_points(poly: &[Point2<f64>]) -> Vec<Point2<f64>> {
     // Edge midpoints and triangle centroids: interior witnesses for containment and overlap.
     let n = poly.len();
-    let mut pts: Vec<Point2<f64>> = (0..n).map(|i| nalgebra::center(&poly[i], &poly[(i + 1) % n])).collect();
+    let mut pts: Vec<Point2<f64>> = (0..n)
+        .map(|i| nalgebra::center(&poly[i], &poly[(i + 1) % n]))
+        .collect();
     if let Ok(tris) = triangulate(poly) {
-        pts.extend(tris.iter().map(|t| Point2::from((poly[t[0]].coords + poly[t[1]].coords + poly[t[2]].coords) / 3.0)));
+        pts.extend(tris.iter().map(|t| {
+            Point2::from((poly[t[0]].coords + poly[t[1]].coords + poly[t[2]].coords) / 3.0)
+        }));
     }
     pts
 }
@@ -261,7 +310,9 @@ pub fn polygon_inside(inner: &[Point2<f64>], outer: &[Point2<f64>], tol: f64) ->
 
 fn edges_cross(a: &[Point2<f64>], b: &[Point2<f64>], tol: f64) -> bool {
     let (na, nb) = (a.len(), b.len());
-    (0..na).any(|i| (0..nb).any(|j| segments_cross(&a[i], &a[(i + 1) % na], &b[j], &b[(j + 1) % nb], tol)))
+    (0..na).any(|i| {
+        (0..nb).any(|j| segments_cross(&a[i], &a[(i + 1) % na], &b[j], &b[(j + 1) % nb], tol))
+    })
 }
 
 /// Whether the interiors of two polygons overlap (sharing only boundary within `tol` does not count).
@@ -269,7 +320,12 @@ pub fn polygons_overlap(a: &[Point2<f64>], b: &[Point2<f64>], tol: f64) -> bool 
     if edges_cross(a, b, tol) {
         return true;
     }
-    let strictly_in = |q: &Point2<f64>, p: &[Point2<f64>]| point_in_polygon(q, p, tol) == Containment::Inside;
-    a.iter().chain(sample_points(a).iter()).any(|q| strictly_in(q, b))
-        || b.iter().chain(sample_points(b).iter()).any(|q| strictly_in(q, a))
+    let strictly_in =
+        |q: &Point2<f64>, p: &[Point2<f64>]| point_in_polygon(q, p, tol) == Containment::Inside;
+    a.iter()
+        .chain(sample_points(a).iter())
+        .any(|q| strictly_in(q, b))
+        || b.iter()
+            .chain(sample_points(b).iter())
+            .any(|q| strictly_in(q, a))
 }

@@ -61,27 +61,53 @@ impl BvhRayCaster {
     /// Builds the BVH over `triangles`.
     pub fn new(triangles: &[Tri]) -> Self {
         if triangles.is_empty() {
-            return Self { bvh: None, tris: Vec::new(), ids: Vec::new(), len: 0 };
+            return Self {
+                bvh: None,
+                tris: Vec::new(),
+                ids: Vec::new(),
+                len: 0,
+            };
         }
         let tris: Vec<Triangle> = triangles
             .iter()
-            .map(|t| Triangle { v0: v3a(&t[0]), v1: v3a(&t[1]), v2: v3a(&t[2]) })
+            .map(|t| Triangle {
+                v0: v3a(&t[0]),
+                v1: v3a(&t[1]),
+                v2: v3a(&t[2]),
+            })
             .collect();
-        let bvh = build_cwbvh_from_tris(&tris, BvhBuildParams::medium_build(), &mut std::time::Duration::default());
-        let rt = bvh.primitive_indices.iter().map(|&i| RtTriangle::from(&tris[i as usize])).collect();
+        let bvh = build_cwbvh_from_tris(
+            &tris,
+            BvhBuildParams::medium_build(),
+            &mut std::time::Duration::default(),
+        );
+        let rt = bvh
+            .primitive_indices
+            .iter()
+            .map(|&i| RtTriangle::from(&tris[i as usize]))
+            .collect();
         let ids = bvh.primitive_indices.clone();
-        Self { bvh: Some(bvh), tris: rt, ids, len: triangles.len() }
+        Self {
+            bvh: Some(bvh),
+            tris: rt,
+            ids,
+            len: triangles.len(),
+        }
     }
 }
 
 impl RayCaster for BvhRayCaster {
+    #[inline]
     fn cast(&self, origin: &Point3<f64>, dir: &Vector3<f64>, t_max: f64) -> Option<RayHit> {
         let bvh = self.bvh.as_ref()?;
         let d = Vec3A::new(dir.x as f32, dir.y as f32, dir.z as f32);
-        let ray = ORay::new(v3a(origin), d, 0.0, t_max.min(f32::MAX as f64) as f32);
+        let ray = ORay::new(v3a(origin), d, 0.0, t_max as f32);
         let mut hit = OHit::none();
         if bvh.ray_traverse(ray, &mut hit, |r, id| self.tris[id].intersect(r)) {
-            Some(RayHit { t: hit.t as f64, triangle: self.ids[hit.primitive_id as usize] })
+            Some(RayHit {
+                t: hit.t as f64,
+                triangle: self.ids[hit.primitive_id as usize],
+            })
         } else {
             None
         }
@@ -162,7 +188,11 @@ mod embree_caster {
                     sys::rtcReleaseGeometry(geom);
                 }
                 sys::rtcCommitScene(scene);
-                Self { device, scene, len: triangles.len() }
+                Self {
+                    device,
+                    scene,
+                    len: triangles.len(),
+                }
             }
         }
     }
@@ -202,7 +232,10 @@ mod embree_caster {
             };
             // SAFETY: the scene is committed and alive for &self; rh and ctx are valid for the call.
             unsafe { sys::rtcIntersect1(self.scene, &mut ctx, &mut rh) };
-            (rh.hit.geomID != u32::MAX).then_some(RayHit { t: rh.ray.tfar as f64, triangle: rh.hit.primID })
+            (rh.hit.geomID != u32::MAX).then_some(RayHit {
+                t: rh.ray.tfar as f64,
+                triangle: rh.hit.primID,
+            })
         }
 
         fn len(&self) -> usize {
@@ -235,7 +268,16 @@ pub fn box_triangles(min: &Point3<f64>, max: &Point3<f64>) -> Vec<Tri> {
         )
     };
     // Faces as quads of corner indices (bit 0 = x, bit 1 = y, bit 2 = z).
-    const FACES: [[usize; 4]; 6] =
-        [[0, 2, 6, 4], [1, 5, 7, 3], [0, 4, 5, 1], [2, 3, 7, 6], [0, 1, 3, 2], [4, 6, 7, 5]];
-    FACES.iter().flat_map(|f| [[c(f[0]), c(f[1]), c(f[2])], [c(f[0]), c(f[2]), c(f[3])]]).collect()
+    const FACES: [[usize; 4]; 6] = [
+        [0, 2, 6, 4],
+        [1, 5, 7, 3],
+        [0, 4, 5, 1],
+        [2, 3, 7, 6],
+        [0, 1, 3, 2],
+        [4, 6, 7, 5],
+    ];
+    FACES
+        .iter()
+        .flat_map(|f| [[c(f[0]), c(f[1]), c(f[2])], [c(f[0]), c(f[2]), c(f[3])]])
+        .collect()
 }

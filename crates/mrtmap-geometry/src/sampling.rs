@@ -33,7 +33,12 @@ pub fn uniform_rotation<R: Rng + ?Sized>(rng: &mut R) -> UnitQuaternion<f64> {
     let (u1, u2, u3): (f64, f64, f64) = (rng.random(), rng.random(), rng.random());
     let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
     let (t2, t3) = (std::f64::consts::TAU * u2, std::f64::consts::TAU * u3);
-    UnitQuaternion::from_quaternion(Quaternion::new(b * t3.cos(), a * t2.sin(), a * t2.cos(), b * t3.sin()))
+    UnitQuaternion::from_quaternion(Quaternion::new(
+        b * t3.cos(),
+        a * t2.sin(),
+        a * t2.cos(),
+        b * t3.sin(),
+    ))
 }
 
 /// The `n`-point spherical Fibonacci lattice: z = 1 − (2i + 1)/n, φ = 2πi/ϕ.

@@ -10,7 +10,12 @@ use nalgebra::Point3;
 ///
 /// tan(Ω/2) = a·(b×c) / (|a||b||c| + (a·b)|c| + (a·c)|b| + (b·c)|a|), evaluated with atan2 so
 /// that Ω covers the whole range (−2π, 2π).
-pub fn triangle_solid_angle(p: &Point3<f64>, a: &Point3<f64>, b: &Point3<f64>, c: &Point3<f64>) -> f64 {
+pub fn triangle_solid_angle(
+    p: &Point3<f64>,
+    a: &Point3<f64>,
+    b: &Point3<f64>,
+    c: &Point3<f64>,
+) -> f64 {
     let (a, b, c) = (a - p, b - p, c - p);
     let (la, lb, lc) = (a.norm(), b.norm(), c.norm());
     let num = a.dot(&b.cross(&c));
@@ -26,7 +31,11 @@ pub fn polygon_solid_angle(p: &Point3<f64>, vertices: &[Point3<f64>]) -> f64 {
         return 0.0;
     }
     let v0 = &vertices[0];
-    vertices.windows(2).skip(1).map(|w| triangle_solid_angle(p, v0, &w[0], &w[1])).sum()
+    vertices
+        .windows(2)
+        .skip(1)
+        .map(|w| triangle_solid_angle(p, v0, &w[0], &w[1]))
+        .sum()
 }
 
 /// View factor from a small sphere at `p` to a planar polygon: |Ω| / 4π.

@@ -32,7 +32,12 @@ pub fn operative_temperature(
             (ta * s + tr) / (1.0 + s)
         }
         OperativeMethod::Ashrae55 => {
-            let v = in_range("air speed (m/s) for ASHRAE 55 weights", air_speed_m_s, 0.0, 1.0 - 1e-12)?;
+            let v = in_range(
+                "air speed (m/s) for ASHRAE 55 weights",
+                air_speed_m_s,
+                0.0,
+                1.0 - 1e-12,
+            )?;
             let a = if v < 0.2 {
                 0.5
             } else if v < 0.6 {
@@ -85,9 +90,24 @@ pub fn ppd_from_pmv(pmv: f64) -> f64 {
 /// Fanger's PMV/PPD as printed in ISO 7730 (annex D; 273 as the Kelvin offset, like the standard).
 pub fn pmv_ppd(inp: &PmvInputs) -> Result<Pmv, PhysicsError> {
     let ta = in_range("air temperature (°C)", inp.air.celsius(), -50.0, 100.0)?;
-    let tr = in_range("mean radiant temperature (°C)", inp.mrt.celsius(), -50.0, 150.0)?;
-    let vr = in_range("relative air speed (m/s)", inp.relative_air_speed_m_s, 0.0, 10.0)?;
-    let rh = in_range("relative humidity (%)", inp.relative_humidity_pct, 0.0, 100.0)?;
+    let tr = in_range(
+        "mean radiant temperature (°C)",
+        inp.mrt.celsius(),
+        -50.0,
+        150.0,
+    )?;
+    let vr = in_range(
+        "relative air speed (m/s)",
+        inp.relative_air_speed_m_s,
+        0.0,
+        10.0,
+    )?;
+    let rh = in_range(
+        "relative humidity (%)",
+        inp.relative_humidity_pct,
+        0.0,
+        100.0,
+    )?;
     let met = in_range("metabolic rate (met)", inp.met, 0.1, 10.0)?;
     let clo = in_range("clothing (clo)", inp.clo, 0.0, 5.0)?;
     let wme = in_range("external work (met)", inp.external_work_met, 0.0, 10.0)?;
@@ -97,7 +117,11 @@ pub fn pmv_ppd(inp: &PmvInputs) -> Result<Pmv, PhysicsError> {
     let m = met * 58.15;
     let w = wme * 58.15;
     let mw = m - w;
-    let fcl = if icl <= 0.078 { 1.0 + 1.29 * icl } else { 1.05 + 0.645 * icl };
+    let fcl = if icl <= 0.078 {
+        1.0 + 1.29 * icl
+    } else {
+        1.05 + 0.645 * icl
+    };
     let hcf = 12.1 * vr.sqrt();
     let taa = ta + 273.0;
     let tra = tr + 273.0;
@@ -122,7 +146,9 @@ pub fn pmv_ppd(inp: &PmvInputs) -> Result<Pmv, PhysicsError> {
         }
     }
     if !converged {
-        return Err(PhysicsError::NoConvergence { what: "clothing surface temperature (PMV)" });
+        return Err(PhysicsError::NoConvergence {
+            what: "clothing surface temperature (PMV)",
+        });
     }
     let tcl = 100.0 * xn - 273.0;
     let hl1 = 3.05e-3 * (5733.0 - 6.99 * mw - pa);
@@ -139,7 +165,11 @@ pub fn pmv_ppd(inp: &PmvInputs) -> Result<Pmv, PhysicsError> {
         && (0.8..=4.0).contains(&met)
         && (0.0..=2.0).contains(&clo)
         && (-2.0..=2.0).contains(&pmv);
-    Ok(Pmv { pmv, ppd_pct: ppd_from_pmv(pmv), within_iso_ranges: within })
+    Ok(Pmv {
+        pmv,
+        ppd_pct: ppd_from_pmv(pmv),
+        within_iso_ranges: within,
+    })
 }
 
 /// The four radiant-asymmetry situations of ISO 7730 (figure 4).

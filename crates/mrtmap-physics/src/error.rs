@@ -46,10 +46,20 @@ pub(crate) fn finite(name: &'static str, value: f64) -> Result<f64, PhysicsError
     }
 }
 
-pub(crate) fn in_range(name: &'static str, value: f64, min: f64, max: f64) -> Result<f64, PhysicsError> {
+pub(crate) fn in_range(
+    name: &'static str,
+    value: f64,
+    min: f64,
+    max: f64,
+) -> Result<f64, PhysicsError> {
     finite(name, value)?;
     if value < min || value > max {
-        Err(PhysicsError::OutOfRange { name, value, min, max })
+        Err(PhysicsError::OutOfRange {
+            name,
+            value,
+            min,
+            max,
+        })
     } else {
         Ok(value)
     }

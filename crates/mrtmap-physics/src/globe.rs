@@ -30,7 +30,10 @@ pub struct Globe {
 
 impl Globe {
     /// The standard globe of ISO 7726: 0.15 m, ε = 0.95.
-    pub const STANDARD: Globe = Globe { diameter_m: 0.15, emissivity: 0.95 };
+    pub const STANDARD: Globe = Globe {
+        diameter_m: 0.15,
+        emissivity: 0.95,
+    };
 
     fn is_standard(&self) -> bool {
         (self.diameter_m - 0.15).abs() < 1e-9 && (self.emissivity - 0.95).abs() < 1e-9
@@ -75,7 +78,9 @@ pub enum GlobeMethod {
 
 impl GlobeMethod {
     /// ISO 7726 general formula with the larger coefficient: the default.
-    pub const ISO: GlobeMethod = GlobeMethod::Iso { convection: Convection::Larger };
+    pub const ISO: GlobeMethod = GlobeMethod::Iso {
+        convection: Convection::Larger,
+    };
 }
 
 /// The formula that produced a result (for methods that choose, the branch that won).
@@ -98,7 +103,9 @@ impl GlobeFormula {
     /// A human description with the formula.
     pub fn describe(self) -> &'static str {
         match self {
-            Self::IsoNatural => "ISO 7726 general formula, natural convection: h = 1.4·(|Tg−Ta|/D)^¼",
+            Self::IsoNatural => {
+                "ISO 7726 general formula, natural convection: h = 1.4·(|Tg−Ta|/D)^¼"
+            }
             Self::IsoForced => "ISO 7726 general formula, forced convection: h = 6.3·v^0.6/D^0.4",
             Self::IsoClosedFormNatural => {
                 "ISO 7726 standard-globe closed form, natural convection: Tr⁴ = Tg⁴ + 0.4×10⁸·|Tg−Ta|^¼·(Tg−Ta)"
@@ -138,7 +145,12 @@ fn check(globe: &Globe, reading: &GlobeReading) -> Result<(), PhysicsError> {
     in_range("globe diameter (m)", globe.diameter_m, 1e-3, 1.0)?;
     in_range("globe emissivity", globe.emissivity, 0.01, 1.0)?;
     in_range("air speed (m/s)", reading.air_speed_m_s, 0.0, 100.0)?;
-    in_range("globe temperature (°C)", reading.globe.celsius(), -100.0, 300.0)?;
+    in_range(
+        "globe temperature (°C)",
+        reading.globe.celsius(),
+        -100.0,
+        300.0,
+    )?;
     in_range("air temperature (°C)", reading.air.celsius(), -100.0, 300.0)?;
     Ok(())
 }
@@ -169,7 +181,13 @@ pub fn globe_convection(
         GlobeMethod::Iso { convection } => {
             let hn = 1.4 * (dt.abs() / d).powf(0.25);
             let hf = 6.3 * v.powf(0.6) / d.powf(0.4);
-            pick(convection, hn, hf, GlobeFormula::IsoNatural, GlobeFormula::IsoForced)
+            pick(
+                convection,
+                hn,
+                hf,
+                GlobeFormula::IsoNatural,
+                GlobeFormula::IsoForced,
+            )
         }
         GlobeMethod::IsoClosedForm { convection } => {
             if !globe.is_standard() {
@@ -203,7 +221,8 @@ pub fn globe_convection(
             let n = 1.27 * d + 0.57;
             let ra = G * BETA * dt.abs() * d.powi(3) / (NU * ALPHA);
             let re = v * d / NU;
-            let nu_nat = 2.0 + 0.589 * ra.powf(0.25) / (1.0 + (0.469 / pr).powf(9.0 / 16.0)).powf(4.0 / 9.0);
+            let nu_nat =
+                2.0 + 0.589 * ra.powf(0.25) / (1.0 + (0.469 / pr).powf(9.0 / 16.0)).powf(4.0 / 9.0);
             let nu_forced = 2.0 + (0.4 * re.sqrt() + 0.06 * re.powf(2.0 / 3.0)) * pr.powf(0.4);
             let h = (nu_forced.powf(n) + nu_nat.powf(n)).powf(1.0 / n) * K / d;
             (h, GlobeFormula::MixedConvection)
@@ -239,7 +258,11 @@ pub fn mrt_from_globe(
             max: f64::INFINITY,
         });
     }
-    Ok(GlobeMrt { mrt: Temperature::from_fourth_power(t4), formula, h_w_m2k: h })
+    Ok(GlobeMrt {
+        mrt: Temperature::from_fourth_power(t4),
+        formula,
+        h_w_m2k: h,
+    })
 }
 
 /// The temperature a globe would read at mean radiant temperature `mrt`, air temperature `air` and
@@ -278,5 +301,7 @@ pub fn globe_temperature(
             return Ok(Temperature::from_kelvin(0.5 * (lo + hi)));
         }
     }
-    Err(PhysicsError::NoConvergence { what: "globe temperature from MRT" })
+    Err(PhysicsError::NoConvergence {
+        what: "globe temperature from MRT",
+    })
 }

@@ -23,7 +23,12 @@ pub struct RadiantSource {
 impl RadiantSource {
     /// A black (ε = 1) source with an exact temperature.
     pub fn black(view_factor: f64, temperature: Temperature) -> Self {
-        Self { view_factor, temperature, emissivity: 1.0, temperature_std_k: 0.0 }
+        Self {
+            view_factor,
+            temperature,
+            emissivity: 1.0,
+            temperature_std_k: 0.0,
+        }
     }
 }
 
@@ -83,7 +88,11 @@ pub fn mean_radiant_temperature(sources: &[RadiantSource]) -> Result<MeanRadiant
             (d * s.temperature_std_k).powi(2)
         })
         .sum();
-    Ok(MeanRadiant { temperature: tr, weight, std_from_temperatures_k: var.sqrt() })
+    Ok(MeanRadiant {
+        temperature: tr,
+        weight,
+        std_from_temperatures_k: var.sqrt(),
+    })
 }
 
 /// Running radiant average of weighted temperature samples: (Σ wₖTₖ⁴ / Σ wₖ)^¼.
@@ -154,13 +163,21 @@ impl RadiantAverage {
         let var = (self.sum_wtt / self.sum_w - mean * mean).max(0.0);
         // Reliability-weights correction: V1² / (V1² − V2).
         let denom = self.sum_w * self.sum_w - self.sum_w2;
-        let corr = if denom > 0.0 { self.sum_w * self.sum_w / denom } else { 1.0 };
+        let corr = if denom > 0.0 {
+            self.sum_w * self.sum_w / denom
+        } else {
+            1.0
+        };
         Some((var * corr).sqrt())
     }
 
     /// Effective number of samples (Kish): (Σw)² / Σw².
     pub fn effective_count(&self) -> f64 {
-        if self.sum_w2 > 0.0 { self.sum_w * self.sum_w / self.sum_w2 } else { 0.0 }
+        if self.sum_w2 > 0.0 {
+            self.sum_w * self.sum_w / self.sum_w2
+        } else {
+            0.0
+        }
     }
 
     /// Standard error of the mean (K): standard deviation / √(effective count).

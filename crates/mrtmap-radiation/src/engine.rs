@@ -119,7 +119,12 @@ pub struct MonteCarlo {
 
 impl Default for MonteCarlo {
     fn default() -> Self {
-        Self { rays: 20_000, seed: 1, directions: DirectionSet::Fibonacci, replicates: 8 }
+        Self {
+            rays: 20_000,
+            seed: 1,
+            directions: DirectionSet::Fibonacci,
+            replicates: 8,
+        }
     }
 }
 
@@ -267,14 +272,21 @@ impl<'a> MrtEngine<'a> {
         let tracer = match method {
             Method::Exact => {
                 if let Some(o) = scene.occluders.first() {
-                    return Err(MrtError::OccludersNeedRayTracing { count: scene.occluders.len(), first: o.id.clone() });
+                    return Err(MrtError::OccludersNeedRayTracing {
+                        count: scene.occluders.len(),
+                        first: o.id.clone(),
+                    });
                 }
                 None
             }
             Method::MonteCarlo(mc) => {
                 if mc.replicates < 2 || mc.rays < 2 * mc.replicates {
                     let r = mc.replicates.max(2);
-                    return Err(MrtError::TooFewRays { rays: mc.rays, replicates: mc.replicates, min: 2 * r });
+                    return Err(MrtError::TooFewRays {
+                        rays: mc.rays,
+                        replicates: mc.replicates,
+                        min: 2 * r,
+                    });
                 }
                 let mut tris = Vec::new();
                 let mut owner = Vec::new();
@@ -288,10 +300,20 @@ impl<'a> MrtEngine<'a> {
                         owner.push(Owner::Occluder(oi));
                     }
                 }
-                Some(Tracer { caster: caster(&tris), owner })
+                Some(Tracer {
+                    caster: caster(&tris),
+                    owner,
+                })
             }
         };
-        Ok(Self { scene, patches, surface_patch, occluder_patch0: k, method, tracer })
+        Ok(Self {
+            scene,
+            patches,
+            surface_patch,
+            occluder_patch0: k,
+            method,
+            tracer,
+        })
     }
 
     /// The patches, in the order of every result's view factors.
@@ -317,7 +339,10 @@ impl<'a> MrtEngine<'a> {
     /// MRT at `p`. `stream` selects the point's random stream (use the point's index).
     pub fn at(&self, p: &Point3<f64>, stream: u64) -> Result<PointMrt, MrtError> {
         if let Some(o) = self.scene.occluders.iter().find(|o| o.contains(p)) {
-            return Err(MrtError::InsideOccluder { point: arr(p), id: o.id.clone() });
+            return Err(MrtError::InsideOccluder {
+                point: arr(p),
+                id: o.id.clone(),
+            });
         }
         let (f, se, rays, replicate_f) = match self.method {
             Method::Exact => {
@@ -346,9 +371,16 @@ impl<'a> MrtEngine<'a> {
                 .collect();
             mean_radiant_temperature(&src)
         };
-        let m = mrt_of(&f).map_err(|source| MrtError::Physics { point: arr(p), source })?;
+        let m = mrt_of(&f).map_err(|source| MrtError::Physics {
+            point: arr(p),
+            source,
+        })?;
         let sampling = if replicate_f.len() >= 2 {
-            let vals: Vec<f64> = replicate_f.iter().filter_map(|g| mrt_of(g).ok()).map(|m| m.temperature.kelvin()).collect();
+            let vals: Vec<f64> = replicate_f
+                .iter()
+                .filter_map(|g| mrt_of(g).ok())
+                .map(|m| m.temperature.kelvin())
+                .collect();
             std_error(&vals)
         } else {
             0.0
@@ -382,9 +414,19 @@ impl<'a> MrtEngine<'a> {
     }
 
     /// (pooled view factors, their standard errors, rays traced, per-replicate view factors)
-    fn monte_carlo(&self, p: &Point3<f64>, mc: &MonteCarlo, stream: u64) -> (Vec<f64>, Vec<f64>, usize, Vec<Vec<f64>>) {
+    fn monte_carlo(
+        &self,
+        p: &Point3<f64>,
+        mc: &MonteCarlo,
+        stream: u64,
+    ) -> (Vec<f64>, Vec<f64>, usize, Vec<Vec<f64>>) {
         let Some(tracer) = &self.tracer else {
-            return (vec![0.0; self.patches.len()], vec![0.0; self.patches.len()], 0, Vec::new());
+            return (
+                vec![0.0; self.patches.len()],
+                vec![0.0; self.patches.len()],
+                0,
+                Vec::new(),
+            );
         };
         let mut rng = ChaCha8Rng::seed_from_u64(mc.seed);
         rng.set_stream(stream);
@@ -399,7 +441,12 @@ impl<'a> MrtEngine<'a> {
                     counts[k] += 1;
                 }
             }
-            reps.push(counts.iter().map(|&c| c as f64 / per as f64).collect::<Vec<f64>>());
+            reps.push(
+                counts
+                    .iter()
+                    .map(|&c| c as f64 / per as f64)
+                    .collect::<Vec<f64>>(),
+            );
         }
         let mut f = vec![0.0; n];
         let mut se = vec![0.0; n];
@@ -422,7 +469,12 @@ impl<'a> MrtEngine<'a> {
                     let q = s.frame.to_2d(&(p + d * hit.t));
                     for (fi, feat) in s.features.iter().enumerate() {
                         let (lo, hi) = feat.bounds_2d;
-                        if q.x >= lo.x && q.x <= hi.x && q.y >= lo.y && q.y <= hi.y && point_in_polygon_fast(&q, &feat.polygon_2d) {
+                        if q.x >= lo.x
+                            && q.x <= hi.x
+                            && q.y >= lo.y
+                            && q.y <= hi.y
+                            && point_in_polygon_fast(&q, &feat.polygon_2d)
+                        {
                             return Some(k + 1 + fi);
                         }
                     }

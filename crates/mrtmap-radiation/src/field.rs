@@ -20,7 +20,9 @@ use crate::scene::RadiantScene;
 #[non_exhaustive]
 pub enum FieldError {
     /// Neither `up` nor a floor.
-    #[error("the scene has no floor surface, so there is no floor to map over (add a surface of kind \"floor\")")]
+    #[error(
+        "the scene has no floor surface, so there is no floor to map over (add a surface of kind \"floor\")"
+    )]
     NoFloor,
     /// The floor is parallel to up.
     #[error("the floor surface '{id}' is not horizontal with respect to `up`")]
@@ -51,15 +53,23 @@ impl MapFrame {
         let up = scene.up().ok_or(FieldError::NoFloor)?;
         let cos = floor.frame.normal.dot(&up).abs();
         if cos < 0.9 {
-            return Err(FieldError::FloorNotHorizontal { id: floor.id.clone() });
+            return Err(FieldError::FloorNotHorizontal {
+                id: floor.id.clone(),
+            });
         }
         // The floor plane along up through the floor polygon's mean height.
-        let h = floor.polygon.iter().map(|p| up.dot(&p.coords)).sum::<f64>() / floor.polygon.len() as f64;
+        let h = floor.polygon.iter().map(|p| up.dot(&p.coords)).sum::<f64>()
+            / floor.polygon.len() as f64;
         let origin = Point3::from(up.as_ref() * h);
         // Up within 1° of a world axis: u is the first world axis perpendicular to it.
         let axes = [Vector3::x(), Vector3::y(), Vector3::z()];
-        let aligned = axes.iter().any(|a| a.dot(&up).abs() > 1f64.to_radians().cos());
-        let u_hint = match axes.into_iter().find(|a| aligned && a.dot(&up).abs() < 1f64.to_radians().sin()) {
+        let aligned = axes
+            .iter()
+            .any(|a| a.dot(&up).abs() > 1f64.to_radians().cos());
+        let u_hint = match axes
+            .into_iter()
+            .find(|a| aligned && a.dot(&up).abs() < 1f64.to_radians().sin())
+        {
             Some(a) => a,
             None => {
                 let n = floor.polygon.len();
@@ -71,7 +81,11 @@ impl MapFrame {
         };
         let plane = PlaneFrame::new(origin, up, &u_hint);
         let floor_uv = floor.polygon.iter().map(|p| plane.to_2d(p)).collect();
-        Ok(Self { plane, floor_uv, floor_id: floor.id.clone() })
+        Ok(Self {
+            plane,
+            floor_uv,
+            floor_id: floor.id.clone(),
+        })
     }
 
     /// Up.
@@ -121,7 +135,12 @@ pub struct GridSpec {
 
 impl Default for GridSpec {
     fn default() -> Self {
-        Self { nx: 20, ny: 20, height_m: 1.1, margin_m: 0.1 }
+        Self {
+            nx: 20,
+            ny: 20,
+            height_m: 1.1,
+            margin_m: 0.1,
+        }
     }
 }
 
@@ -186,22 +205,36 @@ fn linspace(a: f64, b: f64, n: usize) -> Vec<f64> {
     if n == 1 {
         return vec![(a + b) / 2.0];
     }
-    (0..n).map(|k| a + (b - a) * k as f64 / (n - 1) as f64).collect()
+    (0..n)
+        .map(|k| a + (b - a) * k as f64 / (n - 1) as f64)
+        .collect()
 }
 
 impl MrtField {
     /// Computes the field on `spec` (in parallel; results do not depend on the thread count).
-    pub fn compute(engine: &MrtEngine<'_>, frame: MapFrame, spec: GridSpec) -> Result<Self, FieldError> {
+    pub fn compute(
+        engine: &MrtEngine<'_>,
+        frame: MapFrame,
+        spec: GridSpec,
+    ) -> Result<Self, FieldError> {
         if spec.nx == 0 || spec.ny == 0 || spec.nx * spec.ny > 4_000_000 {
-            return Err(FieldError::BadGrid(format!("{}×{} nodes", spec.nx, spec.ny)));
+            return Err(FieldError::BadGrid(format!(
+                "{}×{} nodes",
+                spec.nx, spec.ny
+            )));
         }
         if !(spec.height_m.is_finite() && spec.margin_m.is_finite() && spec.margin_m >= 0.0) {
-            return Err(FieldError::BadGrid(format!("height {} m, margin {} m", spec.height_m, spec.margin_m)));
+            return Err(FieldError::BadGrid(format!(
+                "height {} m, margin {} m",
+                spec.height_m, spec.margin_m
+            )));
         }
         let (lo, hi) = frame.floor_bounds();
         let m = spec.margin_m;
         if hi.x - lo.x <= 2.0 * m || hi.y - lo.y <= 2.0 * m {
-            return Err(FieldError::BadGrid(format!("a margin of {m} m leaves no floor to map")));
+            return Err(FieldError::BadGrid(format!(
+                "a margin of {m} m leaves no floor to map"
+            )));
         }
         let u = linspace(lo.x + m, hi.x - m, spec.nx);
         let v = linspace(lo.y + m, hi.y - m, spec.ny);
@@ -221,15 +254,31 @@ impl MrtField {
             .map(|(i, j, uv)| {
                 let point = frame.point(&uv, spec.height_m);
                 let result = engine.at(&point, (j * nx + i) as u64);
-                GridNode { i, j, uv, point, result }
+                GridNode {
+                    i,
+                    j,
+                    uv,
+                    point,
+                    result,
+                }
             })
             .collect();
-        Ok(Self { frame, spec, u, v, nodes })
+        Ok(Self {
+            frame,
+            spec,
+            u,
+            v,
+            nodes,
+        })
     }
 
     /// Extremes and mean; `None` when no node was computed.
     pub fn summary(&self) -> Option<FieldSummary> {
-        let ok: Vec<(&GridNode, &PointMrt)> = self.nodes.iter().filter_map(|n| n.result.as_ref().ok().map(|r| (n, r))).collect();
+        let ok: Vec<(&GridNode, &PointMrt)> = self
+            .nodes
+            .iter()
+            .filter_map(|n| n.result.as_ref().ok().map(|r| (n, r)))
+            .collect();
         if ok.is_empty() {
             return None;
         }
@@ -253,6 +302,10 @@ impl MrtField {
 
     /// The MRT at node (i, j), if computed.
     pub fn value(&self, i: usize, j: usize) -> Option<Temperature> {
-        self.nodes.iter().find(|n| n.i == i && n.j == j).and_then(|n| n.result.as_ref().ok()).map(|r| r.mrt)
+        self.nodes
+            .iter()
+            .find(|n| n.i == i && n.j == j)
+            .and_then(|n| n.result.as_ref().ok())
+            .map(|r| r.mrt)
     }
 }

@@ -25,13 +25,14 @@ mod field;
 mod scene;
 
 pub use engine::{
-    EXACT_OVERLAP_TOLERANCE, Method, MonteCarlo, MrtEngine, MrtError, Patch, PatchKind, PointMrt, patches,
+    EXACT_OVERLAP_TOLERANCE, Method, MonteCarlo, MrtEngine, MrtError, Patch, PatchKind, PointMrt,
+    patches,
 };
 pub use field::{Extreme, FieldError, FieldSummary, GridNode, GridSpec, MapFrame, MrtField};
 pub use scene::{
-    BoxFile, FEATURE_PLANE_TOLERANCE_M, Feature, FeatureFile, Occluder, OccluderFile, OccluderShape,
-    PLANARITY_TOLERANCE_M, RadiantScene, SCENE_FORMAT, SceneError, SceneFile, SceneLoadError, SceneLoadErrorKind,
-    Surface, SurfaceFile, SurfaceKind, TEMPERATURE_RANGE_C,
+    BoxFile, FEATURE_PLANE_TOLERANCE_M, Feature, FeatureFile, Occluder, OccluderFile,
+    OccluderShape, PLANARITY_TOLERANCE_M, RadiantScene, SCENE_FORMAT, SceneError, SceneFile,
+    SceneLoadError, SceneLoadErrorKind, Surface, SurfaceFile, SurfaceKind, TEMPERATURE_RANGE_C,
 };
 
 use serde::{Deserialize, Serialize};

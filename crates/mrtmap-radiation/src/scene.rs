@@ -250,7 +250,9 @@ pub enum SceneError {
         detail: String,
     },
     /// A feature off its host's plane.
-    #[error("feature '{id}' does not lie in the plane of its host surface '{host}' ({distance_mm:.1} mm off; the limit is 1 mm)")]
+    #[error(
+        "feature '{id}' does not lie in the plane of its host surface '{host}' ({distance_mm:.1} mm off; the limit is 1 mm)"
+    )]
     FeatureOffPlane {
         /// Feature id.
         id: String,
@@ -436,9 +438,13 @@ impl Occluder {
     pub fn triangles(&self) -> Vec<Tri> {
         match &self.shape {
             OccluderShape::Box { min, max } => box_triangles(min, max),
-            OccluderShape::Mesh { vertices, triangles } => {
-                triangles.iter().map(|t| [vertices[t[0]], vertices[t[1]], vertices[t[2]]]).collect()
-            }
+            OccluderShape::Mesh {
+                vertices,
+                triangles,
+            } => triangles
+                .iter()
+                .map(|t| [vertices[t[0]], vertices[t[1]], vertices[t[2]]])
+                .collect(),
         }
     }
 
@@ -472,17 +478,29 @@ fn arr(p: &Point3<f64>) -> [f64; 3] {
 
 fn check_temperature(element: &'static str, id: &str, c: f64) -> Result<Temperature, SceneError> {
     if !c.is_finite() {
-        return Err(SceneError::NotFinite { element, id: id.into(), what: "temperature_c" });
+        return Err(SceneError::NotFinite {
+            element,
+            id: id.into(),
+            what: "temperature_c",
+        });
     }
     if !(TEMPERATURE_RANGE_C.0..=TEMPERATURE_RANGE_C.1).contains(&c) {
-        return Err(SceneError::Temperature { element, id: id.into(), value: c });
+        return Err(SceneError::Temperature {
+            element,
+            id: id.into(),
+            value: c,
+        });
     }
     Ok(Temperature::from_celsius(c))
 }
 
 fn check_emissivity(element: &'static str, id: &str, e: f64) -> Result<f64, SceneError> {
     if !(e > 0.0 && e <= 1.0) {
-        return Err(SceneError::Emissivity { element, id: id.into(), value: e });
+        return Err(SceneError::Emissivity {
+            element,
+            id: id.into(),
+            value: e,
+        });
     }
     Ok(e)
 }
@@ -500,12 +518,24 @@ fn check_std(element: &'static str, id: &str, s: Option<f64>) -> Result<Option<f
     }
 }
 
-fn check_polygon(element: &'static str, id: &str, poly: &[[f64; 3]]) -> Result<Vec<Point3<f64>>, SceneError> {
+fn check_polygon(
+    element: &'static str,
+    id: &str,
+    poly: &[[f64; 3]],
+) -> Result<Vec<Point3<f64>>, SceneError> {
     if poly.len() < 3 {
-        return Err(SceneError::TooFewVertices { element, id: id.into(), count: poly.len() });
+        return Err(SceneError::TooFewVertices {
+            element,
+            id: id.into(),
+            count: poly.len(),
+        });
     }
     if poly.iter().flatten().any(|c| !c.is_finite()) {
-        return Err(SceneError::NotFinite { element, id: id.into(), what: "a polygon coordinate" });
+        return Err(SceneError::NotFinite {
+            element,
+            id: id.into(),
+            what: "a polygon coordinate",
+        });
     }
     Ok(poly.iter().map(point).collect())
 }
@@ -517,7 +547,11 @@ fn not_simple(element: &'static str, id: &str, why: NotSimple) -> SceneError {
         NotSimple::EdgesIntersect(i, j) => format!("edge {i} intersects edge {j}"),
         NotSimple::ZeroArea => "it encloses no area".to_string(),
     };
-    SceneError::NotSimple { element, id: id.into(), detail }
+    SceneError::NotSimple {
+        element,
+        id: id.into(),
+        detail,
+    }
 }
 
 fn bounds(poly: &[Point2<f64>]) -> (Point2<f64>, Point2<f64>) {
@@ -534,7 +568,9 @@ impl RadiantScene {
     /// Validates a scene file against every rule of the spec.
     pub fn new(file: &SceneFile) -> Result<Self, SceneError> {
         if file.format != SCENE_FORMAT {
-            return Err(SceneError::Format { found: file.format.clone() });
+            return Err(SceneError::Format {
+                found: file.format.clone(),
+            });
         }
         if file.surfaces.is_empty() {
             return Err(SceneError::NoSurfaces);
@@ -562,12 +598,18 @@ impl RadiantScene {
         let mut surfaces = Vec::with_capacity(file.surfaces.len());
         for (si, s) in file.surfaces.iter().enumerate() {
             claim(&s.id, format!("surface {}", si + 1))?;
-            let kind = SurfaceKind::parse(&s.kind)
-                .ok_or_else(|| SceneError::UnknownKind { id: s.id.clone(), kind: s.kind.clone() })?;
+            let kind = SurfaceKind::parse(&s.kind).ok_or_else(|| SceneError::UnknownKind {
+                id: s.id.clone(),
+                kind: s.kind.clone(),
+            })?;
             let poly = check_polygon("surface", &s.id, &s.polygon)?;
             let dev = polygon::planarity_deviation(&poly);
             if dev > PLANARITY_TOLERANCE_M {
-                return Err(SceneError::NonPlanar { element: "surface", id: s.id.clone(), deviation_mm: dev * 1e3 });
+                return Err(SceneError::NonPlanar {
+                    element: "surface",
+                    id: s.id.clone(),
+                    deviation_mm: dev * 1e3,
+                });
             }
             let frame = PlaneFrame::of_polygon(&poly)
                 .ok_or_else(|| not_simple("surface", &s.id, NotSimple::ZeroArea))?;
@@ -591,7 +633,10 @@ impl RadiantScene {
             for (fi, f) in s.features.iter().enumerate() {
                 claim(&f.id, format!("feature {} of surface '{}'", fi + 1, s.id))?;
                 let fpoly = check_polygon("feature", &f.id, &f.polygon)?;
-                let off = fpoly.iter().map(|p| frame.signed_distance(p).abs()).fold(0.0, f64::max);
+                let off = fpoly
+                    .iter()
+                    .map(|p| frame.signed_distance(p).abs())
+                    .fold(0.0, f64::max);
                 if off > FEATURE_PLANE_TOLERANCE_M {
                     return Err(SceneError::FeatureOffPlane {
                         id: f.id.clone(),
@@ -602,12 +647,19 @@ impl RadiantScene {
                 let f2: Vec<Point2<f64>> = fpoly.iter().map(|p| frame.to_2d(p)).collect();
                 polygon::check_simple(&f2, 1e-6).map_err(|e| not_simple("feature", &f.id, e))?;
                 if !polygon::polygon_inside(&f2, &poly2, FEATURE_PLANE_TOLERANCE_M) {
-                    return Err(SceneError::FeatureOutsideHost { id: f.id.clone(), host: s.id.clone() });
+                    return Err(SceneError::FeatureOutsideHost {
+                        id: f.id.clone(),
+                        host: s.id.clone(),
+                    });
                 }
-                if let Some(other) =
-                    features.iter().find(|o| polygon::polygons_overlap(&o.polygon_2d, &f2, FEATURE_PLANE_TOLERANCE_M))
-                {
-                    return Err(SceneError::FeaturesOverlap { a: other.id.clone(), b: f.id.clone(), host: s.id.clone() });
+                if let Some(other) = features.iter().find(|o| {
+                    polygon::polygons_overlap(&o.polygon_2d, &f2, FEATURE_PLANE_TOLERANCE_M)
+                }) {
+                    return Err(SceneError::FeaturesOverlap {
+                        a: other.id.clone(),
+                        b: f.id.clone(),
+                        host: s.id.clone(),
+                    });
                 }
                 features.push(Feature {
                     id: f.id.clone(),
@@ -637,16 +689,25 @@ impl RadiantScene {
         let mut occluders = Vec::with_capacity(file.occluders.len());
         for (oi, o) in file.occluders.iter().enumerate() {
             claim(&o.id, format!("occluder {}", oi + 1))?;
-            let bad = |detail: String| SceneError::BadOccluder { id: o.id.clone(), detail };
+            let bad = |detail: String| SceneError::BadOccluder {
+                id: o.id.clone(),
+                detail,
+            };
             let shape = match (&o.box_, &o.vertices, &o.triangles) {
                 (Some(b), None, None) => {
                     if b.min.iter().chain(b.max.iter()).any(|c| !c.is_finite()) {
                         return Err(bad("box corners must be finite".into()));
                     }
                     if (0..3).any(|i| b.min[i] >= b.max[i]) {
-                        return Err(bad(format!("box min {:?} is not below max {:?} on every axis", b.min, b.max)));
+                        return Err(bad(format!(
+                            "box min {:?} is not below max {:?} on every axis",
+                            b.min, b.max
+                        )));
                     }
-                    OccluderShape::Box { min: point(&b.min), max: point(&b.max) }
+                    OccluderShape::Box {
+                        min: point(&b.min),
+                        max: point(&b.max),
+                    }
                 }
                 (None, Some(v), Some(t)) => {
                     if v.iter().flatten().any(|c| !c.is_finite()) {
@@ -655,15 +716,26 @@ impl RadiantScene {
                     if t.is_empty() {
                         return Err(bad("mesh has no triangles".into()));
                     }
-                    if let Some((k, tri)) = t.iter().enumerate().find(|(_, tri)| tri.iter().any(|&i| i >= v.len())) {
+                    if let Some((k, tri)) = t
+                        .iter()
+                        .enumerate()
+                        .find(|(_, tri)| tri.iter().any(|&i| i >= v.len()))
+                    {
                         return Err(bad(format!(
                             "triangle {k} {tri:?} refers to a vertex beyond the {} given",
                             v.len()
                         )));
                     }
-                    OccluderShape::Mesh { vertices: v.iter().map(point).collect(), triangles: t.clone() }
+                    OccluderShape::Mesh {
+                        vertices: v.iter().map(point).collect(),
+                        triangles: t.clone(),
+                    }
                 }
-                _ => return Err(bad("give either `box` or both `vertices` and `triangles`".into())),
+                _ => {
+                    return Err(bad(
+                        "give either `box` or both `vertices` and `triangles`".into()
+                    ));
+                }
             };
             occluders.push(Occluder {
                 id: o.id.clone(),
@@ -673,13 +745,22 @@ impl RadiantScene {
                 shape,
             });
         }
-        Ok(Self { up_given, surfaces, occluders })
+        Ok(Self {
+            up_given,
+            surfaces,
+            occluders,
+        })
     }
 
     /// Parses and validates JSON text.
     pub fn from_json(text: &str) -> Result<Self, SceneError> {
         let file: SceneFile = serde_json::from_str(text).map_err(|e| SceneError::Json {
-            message: e.to_string().split(" at line ").next().unwrap_or_default().to_string(),
+            message: e
+                .to_string()
+                .split(" at line ")
+                .next()
+                .unwrap_or_default()
+                .to_string(),
             line: e.line(),
             column: e.column(),
         })?;
@@ -688,7 +769,10 @@ impl RadiantScene {
 
     /// Reads, parses and validates a scene file.
     pub fn load(path: &Path) -> Result<Self, SceneLoadError> {
-        let wrap = |kind| SceneLoadError { path: path.display().to_string(), kind };
+        let wrap = |kind| SceneLoadError {
+            path: path.display().to_string(),
+            kind,
+        };
         let text = std::fs::read_to_string(path).map_err(|e| wrap(SceneLoadErrorKind::Io(e)))?;
         Self::from_json(&text).map_err(|e| wrap(SceneLoadErrorKind::Invalid(e)))
     }
@@ -729,10 +813,22 @@ impl RadiantScene {
                 .iter()
                 .map(|o| {
                     let (box_, vertices, triangles) = match &o.shape {
-                        OccluderShape::Box { min, max } => (Some(BoxFile { min: arr(min), max: arr(max) }), None, None),
-                        OccluderShape::Mesh { vertices, triangles } => {
-                            (None, Some(vertices.iter().map(arr).collect()), Some(triangles.clone()))
-                        }
+                        OccluderShape::Box { min, max } => (
+                            Some(BoxFile {
+                                min: arr(min),
+                                max: arr(max),
+                            }),
+                            None,
+                            None,
+                        ),
+                        OccluderShape::Mesh {
+                            vertices,
+                            triangles,
+                        } => (
+                            None,
+                            Some(vertices.iter().map(arr).collect()),
+                            Some(triangles.clone()),
+                        ),
                     };
                     OccluderFile {
                         id: o.id.clone(),
@@ -787,7 +883,10 @@ impl RadiantScene {
         let mut out = Vec::new();
         for (si, s) in self.surfaces.iter().enumerate() {
             if let Ok(tris) = polygon::triangulate(&s.polygon_2d) {
-                out.extend(tris.iter().map(|t| ([s.polygon[t[0]], s.polygon[t[1]], s.polygon[t[2]]], si)));
+                out.extend(
+                    tris.iter()
+                        .map(|t| ([s.polygon[t[0]], s.polygon[t[1]], s.polygon[t[2]]], si)),
+                );
             }
         }
         out

@@ -57,7 +57,7 @@ fn palette(t: f64) -> RGBColor {
 
 /// A "nice" contour step for a range: 1, 2, 2.5 or 5 × 10ⁿ giving about 6–12 levels.
 pub fn contour_step(range_k: f64) -> f64 {
-    if !(range_k > 0.0) {
+    if range_k.is_nan() || range_k <= 0.0 {
         return 0.1;
     }
     let raw = range_k / 8.0;
@@ -72,7 +72,9 @@ pub fn contour_step(range_k: f64) -> f64 {
 
 fn decimals(step: f64) -> usize {
     let mut d = 0;
-    while d < 3 && ((step * 10f64.powi(d as i32)).round() - step * 10f64.powi(d as i32)).abs() > 1e-6 {
+    while d < 3
+        && ((step * 10f64.powi(d as i32)).round() - step * 10f64.powi(d as i32)).abs() > 1e-6
+    {
         d += 1;
     }
     d
@@ -101,17 +103,30 @@ fn layout(field: &MrtField) -> Layout {
     let (du, dv) = ((hi.x - lo.x).max(1e-3), (hi.y - lo.y).max(1e-3));
     let s = 620.0 / du.max(dv);
     let (pw, ph) = ((du * s).round().max(240.0), (dv * s).round().max(240.0));
-    Layout { w: pw as u32 + 90 + 150, h: ph as u32 + 110 + 60 }
+    Layout {
+        w: pw as u32 + 90 + 150,
+        h: ph as u32 + 110 + 60,
+    }
 }
 
 /// The parts of a polyline whose segments' midpoints lie inside `poly` and that do not run along
 /// the contour grid's border `(lo, hi)` (where contour rings are closed), as separate runs.
-fn runs_inside(pts: &[contour::Pt], poly: &[Point2<f64>], lo: (f64, f64), hi: (f64, f64)) -> Vec<Vec<(f64, f64)>> {
+fn runs_inside(
+    pts: &[contour::Pt],
+    poly: &[Point2<f64>],
+    lo: (f64, f64),
+    hi: (f64, f64),
+) -> Vec<Vec<(f64, f64)>> {
     let eps = 1e-9 * (1.0 + hi.0.abs().max(hi.1.abs()));
     let on_border = |a: &contour::Pt, b: &contour::Pt| {
-        [(a.x, b.x, lo.0), (a.x, b.x, hi.0), (a.y, b.y, lo.1), (a.y, b.y, hi.1)]
-            .iter()
-            .any(|&(p, q, edge)| (p - edge).abs() < eps && (q - edge).abs() < eps)
+        [
+            (a.x, b.x, lo.0),
+            (a.x, b.x, hi.0),
+            (a.y, b.y, lo.1),
+            (a.y, b.y, hi.1),
+        ]
+        .iter()
+        .any(|&(p, q, edge)| (p - edge).abs() < eps && (q - edge).abs() < eps)
     };
     let mut runs = Vec::new();
     let mut run: Vec<(f64, f64)> = Vec::new();
@@ -134,26 +149,50 @@ fn runs_inside(pts: &[contour::Pt], poly: &[Point2<f64>], lo: (f64, f64), hi: (f
     runs
 }
 
-fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, input: &MapInput<'_>) -> Result<(), String> {
+fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    input: &MapInput<'_>,
+) -> Result<(), String> {
     let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
     register_font();
     let field = input.field;
     let frame = &field.frame;
     root.fill(&WHITE).map_err(e)?;
     let (w, _h) = root.dim_in_pixel();
-    let title = format!("Mean radiant temperature at {:.2} m above the floor (°C)", field.spec.height_m);
-    root.draw(&Text::new(title, (20, 12), (FONT_FAMILY, 22).into_font().color(&BLACK))).map_err(e)?;
-    root.draw(&Text::new(input.subtitle.clone(), (20, 42), (FONT_FAMILY, 14).into_font().color(&RGBColor(80, 80, 80))))
-        .map_err(e)?;
+    let title = format!(
+        "Mean radiant temperature at {:.2} m above the floor (°C)",
+        field.spec.height_m
+    );
+    root.draw(&Text::new(
+        title,
+        (20, 12),
+        (FONT_FAMILY, 22).into_font().color(&BLACK),
+    ))
+    .map_err(e)?;
+    root.draw(&Text::new(
+        input.subtitle.clone(),
+        (20, 42),
+        (FONT_FAMILY, 14).into_font().color(&RGBColor(80, 80, 80)),
+    ))
+    .map_err(e)?;
     let body = root.margin(70, 10, 10, 10);
     let (map_area, bar_area) = body.split_horizontally(w as i32 - 20 - 140);
 
     let ok: Vec<(usize, usize, Point2<f64>, f64)> = field
         .nodes
         .iter()
-        .filter_map(|n| n.result.as_ref().ok().map(|r| (n.i, n.j, n.uv, r.mrt.celsius())))
+        .filter_map(|n| {
+            n.result
+                .as_ref()
+                .ok()
+                .map(|r| (n.i, n.j, n.uv, r.mrt.celsius()))
+        })
         .collect();
-    let (vmin, vmax) = ok.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x.3), b.max(x.3)));
+    let (vmin, vmax) = ok
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+            (a.min(x.3), b.max(x.3))
+        });
     let (vmin, vmax) = if ok.is_empty() {
         (0.0, 1.0)
     } else if vmax - vmin < 0.05 {
@@ -165,7 +204,10 @@ fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, input: &MapInput<'_>) 
 
     let (lo, hi) = frame.floor_bounds();
     let pad = 0.02 * (hi.x - lo.x).max(hi.y - lo.y);
-    let (u_name, v_name) = (axis_name(&frame.plane.u, "u"), axis_name(&frame.plane.v, "v"));
+    let (u_name, v_name) = (
+        axis_name(&frame.plane.u, "u"),
+        axis_name(&frame.plane.v, "v"),
+    );
     let mut chart = ChartBuilder::on(&map_area)
         .margin(8)
         .x_label_area_size(40)
@@ -184,14 +226,21 @@ fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, input: &MapInput<'_>) 
 
     // Heat cells, centred on the nodes, clipped to the floor's bounds.
     let half = |c: &[f64], k: usize| {
-        let d = if c.len() > 1 { (c[c.len() - 1] - c[0]) / (c.len() - 1) as f64 } else { hi.x - lo.x };
+        let d = if c.len() > 1 {
+            (c[c.len() - 1] - c[0]) / (c.len() - 1) as f64
+        } else {
+            hi.x - lo.x
+        };
         (c[k] - d / 2.0, c[k] + d / 2.0)
     };
     chart
         .draw_series(ok.iter().map(|&(i, j, _, v)| {
             let (u0, u1) = half(&field.u, i);
             let (v0, v1) = half(&field.v, j);
-            Rectangle::new([(u0.max(lo.x), v0.max(lo.y)), (u1.min(hi.x), v1.min(hi.y))], palette(norm(v)).filled())
+            Rectangle::new(
+                [(u0.max(lo.x), v0.max(lo.y)), (u1.min(hi.x), v1.min(hi.y))],
+                palette(norm(v)).filled(),
+            )
         }))
         .map_err(e)?;
 
@@ -247,30 +296,50 @@ fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, input: &MapInput<'_>) 
         if let Ok(lines) = builder.lines(&filled, &levels) {
             for line in lines {
                 let level = line.threshold();
-                let runs: Vec<Vec<(f64, f64)>> =
-                    line.geometry().0.iter().flat_map(|ls| runs_inside(&ls.0, &frame.floor_uv, grid_box.0, grid_box.1)).collect();
+                let runs: Vec<Vec<(f64, f64)>> = line
+                    .geometry()
+                    .0
+                    .iter()
+                    .flat_map(|ls| runs_inside(&ls.0, &frame.floor_uv, grid_box.0, grid_box.1))
+                    .collect();
                 chart
-                    .draw_series(runs.iter().map(|r| PathElement::new(r.clone(), BLACK.mix(0.75).stroke_width(1))))
+                    .draw_series(
+                        runs.iter()
+                            .map(|r| PathElement::new(r.clone(), BLACK.mix(0.75).stroke_width(1))),
+                    )
                     .map_err(e)?;
                 // Label: along the longer runs first, at the first spot clear of earlier labels and marks.
                 let label = format!("{level:.dec$}");
                 let tw = 7 * label.len() as i32 + 6;
                 let mut sorted: Vec<&Vec<(f64, f64)>> = runs.iter().collect();
-                sorted.sort_by(|a, b| b.len().cmp(&a.len()));
-                let spot = sorted.iter().flat_map(|r| [0.5, 0.3, 0.7, 0.15, 0.85].map(|t| r[((r.len() - 1) as f64 * t) as usize])).find_map(|at| {
-                    let (px, py) = chart.backend_coord(&at);
-                    let rect = (px - tw / 2 - 2, py - 10, px + tw / 2 + 2, py + 10);
-                    let clear = placed.iter().all(|b: &(i32, i32, i32, i32)| rect.2 < b.0 || rect.0 > b.2 || rect.3 < b.1 || rect.1 > b.3);
-                    clear.then_some((px, py, rect))
-                });
+                sorted.sort_by_key(|r| std::cmp::Reverse(r.len()));
+                let spot = sorted
+                    .iter()
+                    .flat_map(|r| {
+                        [0.5, 0.3, 0.7, 0.15, 0.85].map(|t| r[((r.len() - 1) as f64 * t) as usize])
+                    })
+                    .find_map(|at| {
+                        let (px, py) = chart.backend_coord(&at);
+                        let rect = (px - tw / 2 - 2, py - 10, px + tw / 2 + 2, py + 10);
+                        let clear = placed.iter().all(|b: &(i32, i32, i32, i32)| {
+                            rect.2 < b.0 || rect.0 > b.2 || rect.3 < b.1 || rect.1 > b.3
+                        });
+                        clear.then_some((px, py, rect))
+                    });
                 if let Some((px, py, rect)) = spot {
                     placed.push(rect);
-                    root.draw(&Rectangle::new([(px - tw / 2, py - 8), (px + tw / 2, py + 8)], WHITE.mix(0.85).filled()))
-                        .map_err(e)?;
+                    root.draw(&Rectangle::new(
+                        [(px - tw / 2, py - 8), (px + tw / 2, py + 8)],
+                        WHITE.mix(0.85).filled(),
+                    ))
+                    .map_err(e)?;
                     root.draw(&Text::new(
                         label,
                         (px, py),
-                        (FONT_FAMILY, 12).into_font().color(&BLACK).pos(Pos::new(HPos::Center, VPos::Center)),
+                        (FONT_FAMILY, 12)
+                            .into_font()
+                            .color(&BLACK)
+                            .pos(Pos::new(HPos::Center, VPos::Center)),
                     ))
                     .map_err(e)?;
                 }
@@ -283,15 +352,29 @@ fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, input: &MapInput<'_>) 
     if let Some(first) = outline.first().copied() {
         outline.push(first);
     }
-    chart.draw_series(std::iter::once(PathElement::new(outline, BLACK.stroke_width(3)))).map_err(e)?;
+    chart
+        .draw_series(std::iter::once(PathElement::new(
+            outline,
+            BLACK.stroke_width(3),
+        )))
+        .map_err(e)?;
 
     // Features: on walls as bands along the wall, on floor and ceiling as outlines.
     let label_font = (FONT_FAMILY, 12).into_font().color(&RGBColor(20, 20, 20));
     for s in &input.scene.surfaces {
         for f in &s.features {
-            let uv: Vec<(f64, f64)> = f.polygon.iter().map(|p| frame.uv(p)).map(|q| (q.x, q.y)).collect();
+            let uv: Vec<(f64, f64)> = f
+                .polygon
+                .iter()
+                .map(|p| frame.uv(p))
+                .map(|q| (q.x, q.y))
+                .collect();
             let colour = palette(norm(f.temperature.celsius()));
-            let name = if f.label.is_empty() { f.id.clone() } else { f.label.clone() };
+            let name = if f.label.is_empty() {
+                f.id.clone()
+            } else {
+                f.label.clone()
+            };
             let text = format!("{name} {:.1}°", f.temperature.celsius());
             match s.kind {
                 SurfaceKind::Wall | SurfaceKind::Other => {
@@ -307,29 +390,53 @@ fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, input: &MapInput<'_>) 
                     };
                     if let (Some(a), Some(b)) = (far(c), far(far(c).unwrap_or(c))) {
                         chart
-                            .draw_series(std::iter::once(PathElement::new(vec![a, b], colour.stroke_width(7))))
+                            .draw_series(std::iter::once(PathElement::new(
+                                vec![a, b],
+                                colour.stroke_width(7),
+                            )))
                             .map_err(e)?;
                         chart
-                            .draw_series(std::iter::once(PathElement::new(vec![a, b], BLACK.stroke_width(1))))
+                            .draw_series(std::iter::once(PathElement::new(
+                                vec![a, b],
+                                BLACK.stroke_width(1),
+                            )))
                             .map_err(e)?;
                         // Label just inside the room from the band's middle.
                         let mid = Point2::new((a.0 + b.0) / 2.0, (a.1 + b.1) / 2.0);
-                        let centre = frame.floor_uv.iter().fold(Point2::origin(), |acc, p| acc + p.coords / frame.floor_uv.len() as f64);
+                        let centre = frame.floor_uv.iter().fold(Point2::origin(), |acc, p| {
+                            acc + p.coords / frame.floor_uv.len() as f64
+                        });
                         let inward = (centre - mid).try_normalize(1e-9).unwrap_or_default();
                         let at = mid + inward * (0.06 * (hi.x - lo.x).max(hi.y - lo.y));
                         let (px, py) = chart.backend_coord(&(at.x, at.y));
-                        root.draw(&Text::new(text, (px, py), label_font.clone().pos(Pos::new(HPos::Center, VPos::Center))))
-                            .map_err(e)?;
+                        root.draw(&Text::new(
+                            text,
+                            (px, py),
+                            label_font.clone().pos(Pos::new(HPos::Center, VPos::Center)),
+                        ))
+                        .map_err(e)?;
                     }
                 }
                 SurfaceKind::Ceiling | SurfaceKind::Floor => {
                     let mut ring = uv.clone();
                     ring.push(uv[0]);
-                    let style = if s.kind == SurfaceKind::Ceiling { colour.stroke_width(2) } else { colour.stroke_width(3) };
-                    chart.draw_series(std::iter::once(PathElement::new(ring, style))).map_err(e)?;
-                    let c = uv.iter().fold((0.0, 0.0), |a, p| (a.0 + p.0 / uv.len() as f64, a.1 + p.1 / uv.len() as f64));
+                    let style = if s.kind == SurfaceKind::Ceiling {
+                        colour.stroke_width(2)
+                    } else {
+                        colour.stroke_width(3)
+                    };
+                    chart
+                        .draw_series(std::iter::once(PathElement::new(ring, style)))
+                        .map_err(e)?;
+                    let c = uv.iter().fold((0.0, 0.0), |a, p| {
+                        (a.0 + p.0 / uv.len() as f64, a.1 + p.1 / uv.len() as f64)
+                    });
                     let (px, py) = chart.backend_coord(&c);
-                    let where_ = if s.kind == SurfaceKind::Ceiling { " (ceiling)" } else { " (floor)" };
+                    let where_ = if s.kind == SurfaceKind::Ceiling {
+                        " (ceiling)"
+                    } else {
+                        " (floor)"
+                    };
                     root.draw(&Text::new(
                         format!("{text}{where_}"),
                         (px, py),
@@ -355,23 +462,54 @@ fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, input: &MapInput<'_>) 
             OccluderShape::Mesh { vertices, .. } => vertices.iter().map(|p| frame.uv(p)).collect(),
         };
         let (a, b) = corners.iter().fold(
-            ((f64::INFINITY, f64::INFINITY), (f64::NEG_INFINITY, f64::NEG_INFINITY)),
+            (
+                (f64::INFINITY, f64::INFINITY),
+                (f64::NEG_INFINITY, f64::NEG_INFINITY),
+            ),
             |(a, b), p| ((a.0.min(p.x), a.1.min(p.y)), (b.0.max(p.x), b.1.max(p.y))),
         );
-        chart.draw_series(std::iter::once(Rectangle::new([a, b], RGBColor(90, 90, 90).mix(0.35).filled()))).map_err(e)?;
-        chart.draw_series(std::iter::once(Rectangle::new([a, b], RGBColor(60, 60, 60).stroke_width(1)))).map_err(e)?;
+        chart
+            .draw_series(std::iter::once(Rectangle::new(
+                [a, b],
+                RGBColor(90, 90, 90).mix(0.35).filled(),
+            )))
+            .map_err(e)?;
+        chart
+            .draw_series(std::iter::once(Rectangle::new(
+                [a, b],
+                RGBColor(60, 60, 60).stroke_width(1),
+            )))
+            .map_err(e)?;
         let (px, py) = chart.backend_coord(&((a.0 + b.0) / 2.0, (a.1 + b.1) / 2.0));
-        let name = if o.label.is_empty() { o.id.clone() } else { o.label.clone() };
-        root.draw(&Text::new(name, (px, py), label_font.clone().pos(Pos::new(HPos::Center, VPos::Center)))).map_err(e)?;
+        let name = if o.label.is_empty() {
+            o.id.clone()
+        } else {
+            o.label.clone()
+        };
+        root.draw(&Text::new(
+            name,
+            (px, py),
+            label_font.clone().pos(Pos::new(HPos::Center, VPos::Center)),
+        ))
+        .map_err(e)?;
     }
 
     // Marked points.
     for m in input.marks {
         let (px, py) = chart.backend_coord(&(m.uv.x, m.uv.y));
-        root.draw(&Circle::new((px, py), 6, WHITE.filled())).map_err(e)?;
-        root.draw(&Circle::new((px, py), 6, BLACK.stroke_width(2))).map_err(e)?;
-        root.draw(&Text::new(m.name.clone(), (px + 9, py - 9), (FONT_FAMILY, 15).into_font().color(&BLACK).pos(Pos::new(HPos::Left, VPos::Center))))
+        root.draw(&Circle::new((px, py), 6, WHITE.filled()))
             .map_err(e)?;
+        root.draw(&Circle::new((px, py), 6, BLACK.stroke_width(2)))
+            .map_err(e)?;
+        root.draw(&Text::new(
+            m.name.clone(),
+            (px + 9, py - 9),
+            (FONT_FAMILY, 15)
+                .into_font()
+                .color(&BLACK)
+                .pos(Pos::new(HPos::Left, VPos::Center)),
+        ))
+        .map_err(e)?;
     }
 
     // Colour bar.
@@ -382,19 +520,47 @@ fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, input: &MapInput<'_>) 
         let t = 1.0 - k as f64 / steps as f64;
         let ya = y0 + k * bar_h / steps;
         let yb = y0 + (k + 1) * bar_h / steps;
-        bar_area.draw(&Rectangle::new([(x0, ya), (x0 + 24, yb + 1)], palette(t).filled())).map_err(e)?;
+        bar_area
+            .draw(&Rectangle::new(
+                [(x0, ya), (x0 + 24, yb + 1)],
+                palette(t).filled(),
+            ))
+            .map_err(e)?;
     }
-    bar_area.draw(&Rectangle::new([(x0, y0), (x0 + 24, y0 + bar_h)], BLACK.stroke_width(1))).map_err(e)?;
-    bar_area.draw(&Text::new("°C", (x0, y0 - 26), (FONT_FAMILY, 15).into_font().color(&BLACK))).map_err(e)?;
+    bar_area
+        .draw(&Rectangle::new(
+            [(x0, y0), (x0 + 24, y0 + bar_h)],
+            BLACK.stroke_width(1),
+        ))
+        .map_err(e)?;
+    bar_area
+        .draw(&Text::new(
+            "°C",
+            (x0, y0 - 26),
+            (FONT_FAMILY, 15).into_font().color(&BLACK),
+        ))
+        .map_err(e)?;
     let step = contour_step(vmax - vmin);
     let dec = decimals(step).max(1);
     let first = (vmin / step).ceil() * step;
     let mut l = first;
     while l <= vmax + 1e-9 {
         let y = y0 + ((1.0 - norm(l)) * bar_h as f64).round() as i32;
-        bar_area.draw(&PathElement::new(vec![(x0 + 24, y), (x0 + 30, y)], BLACK.stroke_width(1))).map_err(e)?;
         bar_area
-            .draw(&Text::new(format!("{l:.dec$}"), (x0 + 34, y), (FONT_FAMILY, 12).into_font().color(&BLACK).pos(Pos::new(HPos::Left, VPos::Center))))
+            .draw(&PathElement::new(
+                vec![(x0 + 24, y), (x0 + 30, y)],
+                BLACK.stroke_width(1),
+            ))
+            .map_err(e)?;
+        bar_area
+            .draw(&Text::new(
+                format!("{l:.dec$}"),
+                (x0 + 34, y),
+                (FONT_FAMILY, 12)
+                    .into_font()
+                    .color(&BLACK)
+                    .pos(Pos::new(HPos::Left, VPos::Center)),
+            ))
             .map_err(e)?;
         l += step;
     }
@@ -409,11 +575,13 @@ pub fn render_png(input: &MapInput<'_>) -> Result<Vec<u8>, ReportError> {
     let mut buf = vec![255u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
-        draw(root, input).map_err(ReportError::Draw)?;
+        draw(&root, input).map_err(ReportError::Draw)?;
     }
-    let img = image::RgbImage::from_raw(w, h, buf).ok_or_else(|| ReportError::Draw("image buffer size".into()))?;
+    let img = image::RgbImage::from_raw(w, h, buf)
+        .ok_or_else(|| ReportError::Draw("image buffer size".into()))?;
     let mut out = std::io::Cursor::new(Vec::new());
-    img.write_to(&mut out, image::ImageFormat::Png).map_err(|x| ReportError::Draw(x.to_string()))?;
+    img.write_to(&mut out, image::ImageFormat::Png)
+        .map_err(|x| ReportError::Draw(x.to_string()))?;
     Ok(out.into_inner())
 }
 
@@ -423,7 +591,7 @@ pub fn render_svg(input: &MapInput<'_>) -> Result<String, ReportError> {
     let mut s = String::new();
     {
         let root = SVGBackend::with_string(&mut s, (w, h)).into_drawing_area();
-        draw(root, input).map_err(ReportError::Draw)?;
+        draw(&root, input).map_err(ReportError::Draw)?;
     }
     Ok(s)
 }

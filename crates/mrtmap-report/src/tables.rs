@@ -10,8 +10,16 @@ pub fn grid_csv(field: &MrtField) -> String {
     let mut s = String::from("x,y,z,mrt_c,std_error_k,i,j,u_m,v_m,note\n");
     for n in &field.nodes {
         let (m, e, note) = match &n.result {
-            Ok(r) => (format!("{:.4}", r.mrt.celsius()), format!("{:.4}", r.std_error_k), String::new()),
-            Err(err) => (String::new(), String::new(), format!("\"{}\"", err.to_string().replace('"', "'"))),
+            Ok(r) => (
+                format!("{:.4}", r.mrt.celsius()),
+                format!("{:.4}", r.std_error_k),
+                String::new(),
+            ),
+            Err(err) => (
+                String::new(),
+                String::new(),
+                format!("\"{}\"", err.to_string().replace('"', "'")),
+            ),
         };
         s.push_str(&format!(
             "{:.4},{:.4},{:.4},{m},{e},{},{},{:.4},{:.4},{note}\n",
@@ -65,6 +73,11 @@ impl MapAxes {
     pub fn of(field: &MrtField) -> Self {
         let p = &field.frame.plane;
         let a = |v: &mrtmap_geometry::nalgebra::Vector3<f64>| [v.x, v.y, v.z];
-        Self { origin: [p.origin.x, p.origin.y, p.origin.z], u: a(&p.u), v: a(&p.v), up: a(&p.normal) }
+        Self {
+            origin: [p.origin.x, p.origin.y, p.origin.z],
+            u: a(&p.u),
+            v: a(&p.v),
+            up: a(&p.normal),
+        }
     }
 }

@@ -199,19 +199,29 @@ fn parse_point(s: &str) -> Result<[f64; 3], String> {
 fn parse_grid(s: &str) -> Result<(usize, usize), String> {
     let bad = || format!("expected COLSxROWS such as 20x20, got '{s}'");
     let (a, b) = s.split_once(['x', 'X', '×']).ok_or_else(bad)?;
-    let (a, b) = (a.trim().parse::<usize>().map_err(|_| bad())?, b.trim().parse::<usize>().map_err(|_| bad())?);
+    let (a, b) = (
+        a.trim().parse::<usize>().map_err(|_| bad())?,
+        b.trim().parse::<usize>().map_err(|_| bad())?,
+    );
     if a == 0 || b == 0 || a * b > 1_000_000 {
-        return Err(format!("a grid of {a}×{b} nodes is not allowed (1 to 1,000,000 nodes)"));
+        return Err(format!(
+            "a grid of {a}×{b} nodes is not allowed (1 to 1,000,000 nodes)"
+        ));
     }
     Ok((a, b))
 }
 
 fn parse_mark(s: &str) -> Result<(String, Vec<f64>), String> {
-    let (name, rest) = s.split_once('=').ok_or_else(|| format!("expected NAME=U,V or NAME=X,Y,Z, got '{s}'"))?;
+    let (name, rest) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected NAME=U,V or NAME=X,Y,Z, got '{s}'"))?;
     if name.trim().is_empty() {
         return Err(format!("the mark '{s}' has no name"));
     }
-    Ok((name.trim().to_string(), numbers(rest, &[2, 3], "U,V or X,Y,Z after the name")?))
+    Ok((
+        name.trim().to_string(),
+        numbers(rest, &[2, 3], "U,V or X,Y,Z after the name")?,
+    ))
 }
 
 #[cfg(test)]

@@ -29,8 +29,18 @@ fn brute(tris: &[Tri], o: &Point3<f64>, d: &Vector3<f64>) -> Option<(f64, u32)> 
 fn random_soup(n: usize, rng: &mut ChaCha8Rng) -> Vec<Tri> {
     (0..n)
         .map(|_| {
-            let c = Point3::new(rng.random_range(-5.0..5.0), rng.random_range(-5.0..5.0), rng.random_range(-5.0..5.0));
-            let mut v = || c + Vector3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+            let c = Point3::new(
+                rng.random_range(-5.0..5.0),
+                rng.random_range(-5.0..5.0),
+                rng.random_range(-5.0..5.0),
+            );
+            let mut v = || {
+                c + Vector3::new(
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                )
+            };
             [v(), v(), v()]
         })
         .collect()
@@ -45,17 +55,27 @@ fn bvh_agrees_with_brute_force() {
     assert_eq!(bvh.len(), 500);
     let mut hits = 0;
     for _ in 0..2000 {
-        let o = Point3::new(rng.random_range(-6.0..6.0), rng.random_range(-6.0..6.0), rng.random_range(-6.0..6.0));
+        let o = Point3::new(
+            rng.random_range(-6.0..6.0),
+            rng.random_range(-6.0..6.0),
+            rng.random_range(-6.0..6.0),
+        );
         let d = uniform_direction(&mut rng);
         let a = bvh.cast(&o, &d, f64::INFINITY);
         let b = brute(&tris, &o, &d);
         match (a, b) {
             (Some(a), Some(b)) => {
                 hits += 1;
-                assert!((a.t - b.0).abs() < 1e-4 * b.0.max(1.0), "t {} vs {}", a.t, b.0);
+                assert!(
+                    (a.t - b.0).abs() < 1e-4 * b.0.max(1.0),
+                    "t {} vs {}",
+                    a.t,
+                    b.0
+                );
                 // Ties between triangles at the same distance may pick either.
                 if a.triangle != b.1 {
-                    let other = brute(&tris[a.triangle as usize..=a.triangle as usize], &o, &d).unwrap();
+                    let other =
+                        brute(&tris[a.triangle as usize..=a.triangle as usize], &o, &d).unwrap();
                     assert!((other.0 - b.0).abs() < 1e-4);
                 }
             }
@@ -84,7 +104,11 @@ fn box_from_inside_always_hits_and_t_max_limits() {
     let up = bvh.cast(&o, &Vector3::z(), f64::INFINITY).unwrap();
     assert!((up.t - 3.0).abs() < 1e-5);
     assert!(bvh.cast(&o, &Vector3::z(), 2.5).is_none());
-    assert!(BvhRayCaster::new(&[]).cast(&o, &Vector3::z(), 10.0).is_none());
+    assert!(
+        BvhRayCaster::new(&[])
+            .cast(&o, &Vector3::z(), 10.0)
+            .is_none()
+    );
 }
 
 #[cfg(feature = "embree")]
@@ -95,9 +119,16 @@ fn embree_agrees_with_bvh() {
     let bvh = BvhRayCaster::new(&tris);
     let emb = mrtmap_geometry::EmbreeRayCaster::new(&tris);
     for _ in 0..2000 {
-        let o = Point3::new(rng.random_range(-6.0..6.0), rng.random_range(-6.0..6.0), rng.random_range(-6.0..6.0));
+        let o = Point3::new(
+            rng.random_range(-6.0..6.0),
+            rng.random_range(-6.0..6.0),
+            rng.random_range(-6.0..6.0),
+        );
         let d = uniform_direction(&mut rng);
-        let (a, b) = (bvh.cast(&o, &d, f64::INFINITY), emb.cast(&o, &d, f64::INFINITY));
+        let (a, b) = (
+            bvh.cast(&o, &d, f64::INFINITY),
+            emb.cast(&o, &d, f64::INFINITY),
+        );
         assert_eq!(a.is_some(), b.is_some());
         if let (Some(a), Some(b)) = (a, b) {
             assert!((a.t - b.t).abs() < 1e-4 * a.t.max(1.0));

@@ -12,7 +12,11 @@ fn directions_are_unit_and_balanced() {
         assert!(d.iter().all(|v| (v.norm() - 1.0).abs() < 1e-12));
         let mean = d.iter().fold(Vector3::zeros(), |a, v| a + v) / d.len() as f64;
         // Random: |mean| ~ 1/√(3N) ≈ 0.004 per axis; the lattice is far tighter.
-        let limit = if set == DirectionSet::Random { 0.03 } else { 1e-3 };
+        let limit = if set == DirectionSet::Random {
+            0.03
+        } else {
+            1e-3
+        };
         assert!(mean.norm() < limit, "{set:?}: {}", mean.norm());
         // Fraction in the upper hemisphere of an arbitrary axis: 1/2.
         let up = d.iter().filter(|v| v.x + 0.3 * v.y > 0.0).count() as f64 / d.len() as f64;

@@ -9,20 +9,31 @@ fn p(x: f64, y: f64, z: f64) -> Point3<f64> {
 }
 
 fn rect(a: f64, b: f64) -> [Point3<f64>; 4] {
-    [p(0.0, 0.0, 0.0), p(a, 0.0, 0.0), p(a, b, 0.0), p(0.0, b, 0.0)]
+    [
+        p(0.0, 0.0, 0.0),
+        p(a, 0.0, 0.0),
+        p(a, b, 0.0),
+        p(0.0, b, 0.0),
+    ]
 }
 
 /// physics.md: corner-aligned rectangle a × b at distance c: Ω = atan(ab / (c√(a²+b²+c²))).
 #[test]
 fn corner_aligned_rectangles_published_vectors() {
-    for (a, b, c, f) in [(1.0, 1.0, 1.0, 0.0416667), (2.0, 1.0, 1.0, 0.0544882), (3.0, 2.0, 1.5, 0.0634550)] {
+    for (a, b, c, f) in [
+        (1.0, 1.0, 1.0, 0.0416667),
+        (2.0, 1.0, 1.0, 0.0544882),
+        (3.0, 2.0, 1.5, 0.0634550),
+    ] {
         let got = sphere_view_factor(&p(0.0, 0.0, c), &rect(a, b));
         assert!((got - f).abs() < 5e-8, "{a}×{b} at {c}: {got} vs {f}");
         let omega: f64 = (a * b / (c * (a * a + b * b + c * c).sqrt())).atan();
         assert!((got - omega / (4.0 * PI)).abs() < 1e-14);
     }
     // (1, 1, 1) → Ω = π/6 exactly.
-    assert!((polygon_solid_angle(&p(0.0, 0.0, 1.0), &rect(1.0, 1.0)).abs() - PI / 6.0).abs() < 1e-14);
+    assert!(
+        (polygon_solid_angle(&p(0.0, 0.0, 1.0), &rect(1.0, 1.0)).abs() - PI / 6.0).abs() < 1e-14
+    );
 }
 
 /// Cube centre: each face 1/6.
@@ -56,7 +67,10 @@ fn disk_formula() {
             .collect();
         let exact = (1.0 - h / (h * h + r * r).sqrt()) / 2.0;
         let got = sphere_view_factor(&p(0.0, 0.0, h), &poly);
-        assert!((got - exact).abs() / exact < 1e-7, "R {r} h {h}: {got} vs {exact}");
+        assert!(
+            (got - exact).abs() / exact < 1e-7,
+            "R {r} h {h}: {got} vs {exact}"
+        );
     }
 }
 
@@ -76,7 +90,14 @@ fn signs_and_hemisphere_limit() {
 /// An L-shaped (non-convex) polygon equals the sum of its two rectangles, both windings.
 #[test]
 fn non_convex_polygon_is_additive() {
-    let l = [p(0., 0., 0.), p(2., 0., 0.), p(2., 1., 0.), p(1., 1., 0.), p(1., 2., 0.), p(0., 2., 0.)];
+    let l = [
+        p(0., 0., 0.),
+        p(2., 0., 0.),
+        p(2., 1., 0.),
+        p(1., 1., 0.),
+        p(1., 2., 0.),
+        p(0., 2., 0.),
+    ];
     let q = p(0.3, 0.4, 0.8);
     let r1 = [p(0., 0., 0.), p(2., 0., 0.), p(2., 1., 0.), p(0., 1., 0.)];
     let r2 = [p(0., 1., 0.), p(1., 1., 0.), p(1., 2., 0.), p(0., 2., 0.)];

@@ -1,6 +1,6 @@
 use mrtmap_physics::{
-    AsymmetryKind, OperativeMethod, PmvInputs, Temperature, operative_temperature, pmv_ppd, ppd_from_pmv,
-    radiant_asymmetry_ppd,
+    AsymmetryKind, OperativeMethod, PmvInputs, Temperature, operative_temperature, pmv_ppd,
+    ppd_from_pmv, radiant_asymmetry_ppd,
 };
 
 fn c(x: f64) -> Temperature {
@@ -11,7 +11,11 @@ fn c(x: f64) -> Temperature {
 fn operative_ashrae_vectors() {
     for (v, expect) in [(0.1, 25.0), (0.3, 24.0), (0.7, 23.0)] {
         let to = operative_temperature(c(20.0), c(30.0), v, OperativeMethod::Ashrae55).unwrap();
-        assert!((to.celsius() - expect).abs() < 1e-9, "v {v}: {}", to.celsius());
+        assert!(
+            (to.celsius() - expect).abs() < 1e-9,
+            "v {v}: {}",
+            to.celsius()
+        );
     }
     assert!(operative_temperature(c(20.0), c(30.0), 1.2, OperativeMethod::Ashrae55).is_err());
 }
@@ -50,8 +54,16 @@ fn pmv_ppd_table_vectors() {
     ];
     for (ta, tr, rh, vr, met, clo, p, d) in table {
         let r = pmv(ta, tr, rh, vr, met, clo);
-        assert!((r.pmv - p).abs() <= 0.1, "{ta} {tr} {vr}: PMV {} vs {p}", r.pmv);
-        assert!((r.ppd_pct - d).abs() <= 1.0, "{ta} {tr} {vr}: PPD {} vs {d}", r.ppd_pct);
+        assert!(
+            (r.pmv - p).abs() <= 0.1,
+            "{ta} {tr} {vr}: PMV {} vs {p}",
+            r.pmv
+        );
+        assert!(
+            (r.ppd_pct - d).abs() <= 1.0,
+            "{ta} {tr} {vr}: PPD {} vs {d}",
+            r.ppd_pct
+        );
         assert!(r.within_iso_ranges);
     }
 }
@@ -74,10 +86,14 @@ fn radiant_asymmetry_curves() {
     let at = |k, dt| radiant_asymmetry_ppd(k, dt).unwrap();
     // The formulas of physics.md, evaluated independently.
     let logistic = |a: f64, b: f64, dt: f64| 100.0 / (1.0 + (a - b * dt).exp());
-    assert!((at(AsymmetryKind::WarmCeiling, 8.0) - (logistic(2.84, 0.174, 8.0) - 5.5)).abs() < 1e-12);
+    assert!(
+        (at(AsymmetryKind::WarmCeiling, 8.0) - (logistic(2.84, 0.174, 8.0) - 5.5)).abs() < 1e-12
+    );
     assert!((at(AsymmetryKind::CoolWall, 12.0) - logistic(6.61, 0.345, 12.0)).abs() < 1e-12);
     assert!((at(AsymmetryKind::CoolCeiling, 15.0) - logistic(9.93, 0.50, 15.0)).abs() < 1e-12);
-    assert!((at(AsymmetryKind::WarmWall, 30.0) - (logistic(3.72, 0.052, 30.0) - 3.5)).abs() < 1e-12);
+    assert!(
+        (at(AsymmetryKind::WarmWall, 30.0) - (logistic(3.72, 0.052, 30.0) - 3.5)).abs() < 1e-12
+    );
     // ISO 7730 category B limits (PD < 5 %) are rounded readings of these curves:
     // 5 K warm ceiling, 10 K cool wall, 14 K cool ceiling, 23 K warm wall, all within 2 points of 5 %.
     for (k, dt) in [
@@ -86,7 +102,11 @@ fn radiant_asymmetry_curves() {
         (AsymmetryKind::CoolCeiling, 14.0),
         (AsymmetryKind::WarmWall, 23.0),
     ] {
-        assert!((at(k, dt) - 5.0).abs() < 2.0, "{k:?} at {dt} K: {}", at(k, dt));
+        assert!(
+            (at(k, dt) - 5.0).abs() < 2.0,
+            "{k:?} at {dt} K: {}",
+            at(k, dt)
+        );
     }
     // Clamped at zero for small asymmetries, increasing beyond.
     assert_eq!(at(AsymmetryKind::WarmWall, 0.0), 0.0);

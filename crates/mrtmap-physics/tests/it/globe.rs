@@ -1,25 +1,44 @@
 use mrtmap_physics::{
-    Convection, Globe, GlobeFormula, GlobeMethod, GlobeReading, Temperature, globe_temperature, mrt_from_globe,
+    Convection, Globe, GlobeFormula, GlobeMethod, GlobeReading, Temperature, globe_temperature,
+    mrt_from_globe,
 };
 use proptest::prelude::*;
 
 fn reading(tg: f64, ta: f64, v: f64) -> GlobeReading {
-    GlobeReading { globe: Temperature::from_celsius(tg), air: Temperature::from_celsius(ta), air_speed_m_s: v }
+    GlobeReading {
+        globe: Temperature::from_celsius(tg),
+        air: Temperature::from_celsius(ta),
+        air_speed_m_s: v,
+    }
 }
 
 fn mrt(globe: Globe, tg: f64, ta: f64, v: f64, method: GlobeMethod) -> f64 {
-    mrt_from_globe(&globe, &reading(tg, ta, v), method).unwrap().mrt.celsius()
+    mrt_from_globe(&globe, &reading(tg, ta, v), method)
+        .unwrap()
+        .mrt
+        .celsius()
 }
 
-const CLOSED_NATURAL: GlobeMethod = GlobeMethod::IsoClosedForm { convection: Convection::Natural };
-const CLOSED_FORCED: GlobeMethod = GlobeMethod::IsoClosedForm { convection: Convection::Forced };
+const CLOSED_NATURAL: GlobeMethod = GlobeMethod::IsoClosedForm {
+    convection: Convection::Natural,
+};
+const CLOSED_FORCED: GlobeMethod = GlobeMethod::IsoClosedForm {
+    convection: Convection::Forced,
+};
 
 /// ISO 7726 / seed paper closed forms (natural): 26.479, 20.452, 32.649 °C.
 #[test]
 fn closed_form_natural_vectors() {
-    for (tg, ta, expect) in [(25.0, 22.0, 26.479), (22.0, 25.0, 20.452), (30.0, 25.0, 32.649)] {
+    for (tg, ta, expect) in [
+        (25.0, 22.0, 26.479),
+        (22.0, 25.0, 20.452),
+        (30.0, 25.0, 32.649),
+    ] {
         let got = mrt(Globe::STANDARD, tg, ta, 0.0, CLOSED_NATURAL);
-        assert!((got - expect).abs() < 1e-3, "Tg {tg} Ta {ta}: {got} vs {expect}");
+        assert!(
+            (got - expect).abs() < 1e-3,
+            "Tg {tg} Ta {ta}: {got} vs {expect}"
+        );
     }
 }
 
@@ -32,7 +51,9 @@ fn closed_form_forced_vector() {
     let r = mrt_from_globe(
         &Globe::STANDARD,
         &reading(25.0, 22.0, 0.1),
-        GlobeMethod::IsoClosedForm { convection: Convection::Larger },
+        GlobeMethod::IsoClosedForm {
+            convection: Convection::Larger,
+        },
     )
     .unwrap();
     assert_eq!(r.formula, GlobeFormula::IsoClosedFormForced);
@@ -41,10 +62,20 @@ fn closed_form_forced_vector() {
 /// pythermalcomfort `mean_radiant_tmp(..., standard="ISO")` vectors (±0.1).
 #[test]
 fn pythermalcomfort_iso_vectors() {
-    let g = |d| Globe { diameter_m: d, emissivity: 0.95 };
-    for (tg, ta, v, d, expect) in [(53.2, 30.0, 0.3, 0.1, 74.8), (55.0, 30.0, 0.3, 0.1, 77.8), (55.0, 30.0, 0.1, 0.1, 71.9)] {
+    let g = |d| Globe {
+        diameter_m: d,
+        emissivity: 0.95,
+    };
+    for (tg, ta, v, d, expect) in [
+        (53.2, 30.0, 0.3, 0.1, 74.8),
+        (55.0, 30.0, 0.3, 0.1, 77.8),
+        (55.0, 30.0, 0.1, 0.1, 71.9),
+    ] {
         let got = mrt(g(d), tg, ta, v, GlobeMethod::ISO);
-        assert!((got - expect).abs() < 0.1, "tg {tg} v {v}: {got} vs {expect}");
+        assert!(
+            (got - expect).abs() < 0.1,
+            "tg {tg} v {v}: {got} vs {expect}"
+        );
     }
     // v = 0, standard globe: 26.543 and 20.383 (to the printed three decimals).
     assert!((mrt(Globe::STANDARD, 25.0, 22.0, 0.0, GlobeMethod::ISO) - 26.543).abs() < 1.5e-3);
@@ -55,32 +86,84 @@ fn pythermalcomfort_iso_vectors() {
 #[test]
 fn closed_form_and_general_formula_differ_slightly() {
     let a = mrt(Globe::STANDARD, 25.0, 22.0, 0.0, CLOSED_NATURAL);
-    let b = mrt(Globe::STANDARD, 25.0, 22.0, 0.0, GlobeMethod::Iso { convection: Convection::Natural });
+    let b = mrt(
+        Globe::STANDARD,
+        25.0,
+        22.0,
+        0.0,
+        GlobeMethod::Iso {
+            convection: Convection::Natural,
+        },
+    );
     assert!((a - b).abs() > 0.03 && (a - b).abs() < 0.1, "{a} {b}");
 }
 
 #[test]
 fn closed_form_refuses_a_non_standard_globe() {
-    let r = mrt_from_globe(&Globe { diameter_m: 0.1, emissivity: 0.95 }, &reading(25.0, 22.0, 0.0), CLOSED_NATURAL);
+    let r = mrt_from_globe(
+        &Globe {
+            diameter_m: 0.1,
+            emissivity: 0.95,
+        },
+        &reading(25.0, 22.0, 0.0),
+        CLOSED_NATURAL,
+    );
     assert!(r.is_err());
 }
 
 /// Teitelbaum et al. mixed convection: tg 25.42, tdb 26.10, v 0.1931, d 0.1 → 24.2 (±0.1).
 #[test]
 fn mixed_convection_vector_and_validity() {
-    let g = Globe { diameter_m: 0.1, emissivity: 0.95 };
+    let g = Globe {
+        diameter_m: 0.1,
+        emissivity: 0.95,
+    };
     let got = mrt(g, 25.42, 26.10, 0.1931, GlobeMethod::MixedConvection);
     assert!((got - 24.2).abs() < 0.1, "{got}");
-    let too_big = Globe { diameter_m: 0.2, emissivity: 0.95 };
-    assert!(mrt_from_globe(&too_big, &reading(25.0, 22.0, 0.1), GlobeMethod::MixedConvection).is_err());
-    let too_small = Globe { diameter_m: 0.03, emissivity: 0.95 };
-    assert!(mrt_from_globe(&too_small, &reading(25.0, 22.0, 0.1), GlobeMethod::MixedConvection).is_err());
+    let too_big = Globe {
+        diameter_m: 0.2,
+        emissivity: 0.95,
+    };
+    assert!(
+        mrt_from_globe(
+            &too_big,
+            &reading(25.0, 22.0, 0.1),
+            GlobeMethod::MixedConvection
+        )
+        .is_err()
+    );
+    let too_small = Globe {
+        diameter_m: 0.03,
+        emissivity: 0.95,
+    };
+    assert!(
+        mrt_from_globe(
+            &too_small,
+            &reading(25.0, 22.0, 0.1),
+            GlobeMethod::MixedConvection
+        )
+        .is_err()
+    );
 }
 
 #[test]
 fn invalid_readings_are_errors() {
-    assert!(mrt_from_globe(&Globe::STANDARD, &reading(f64::NAN, 22.0, 0.0), GlobeMethod::ISO).is_err());
-    assert!(mrt_from_globe(&Globe::STANDARD, &reading(25.0, 22.0, -1.0), GlobeMethod::ISO).is_err());
+    assert!(
+        mrt_from_globe(
+            &Globe::STANDARD,
+            &reading(f64::NAN, 22.0, 0.0),
+            GlobeMethod::ISO
+        )
+        .is_err()
+    );
+    assert!(
+        mrt_from_globe(
+            &Globe::STANDARD,
+            &reading(25.0, 22.0, -1.0),
+            GlobeMethod::ISO
+        )
+        .is_err()
+    );
 }
 
 proptest! {

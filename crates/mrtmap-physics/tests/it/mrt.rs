@@ -1,4 +1,6 @@
-use mrtmap_physics::{PhysicsError, RadiantAverage, RadiantSource, Temperature, mean_radiant_temperature};
+use mrtmap_physics::{
+    PhysicsError, RadiantAverage, RadiantSource, Temperature, mean_radiant_temperature,
+};
 use proptest::prelude::*;
 
 fn c(x: f64) -> Temperature {
@@ -8,15 +10,33 @@ fn c(x: f64) -> Temperature {
 /// EnergyPlus `ThermalComfort_CalcAngleFactorMRT`: 16.9 °C (formula 16.902).
 #[test]
 fn energyplus_angle_factor_vector() {
-    let src = |f, t, e| RadiantSource { view_factor: f, temperature: c(t), emissivity: e, temperature_std_k: 0.0 };
-    let mrt = mean_radiant_temperature(&[src(0.5, 20.0, 1.0), src(0.3, 15.0, 0.9), src(0.2, 10.0, 0.8)]).unwrap();
-    assert!((mrt.temperature.celsius() - 16.902).abs() < 5e-4, "{}", mrt.temperature.celsius());
+    let src = |f, t, e| RadiantSource {
+        view_factor: f,
+        temperature: c(t),
+        emissivity: e,
+        temperature_std_k: 0.0,
+    };
+    let mrt = mean_radiant_temperature(&[
+        src(0.5, 20.0, 1.0),
+        src(0.3, 15.0, 0.9),
+        src(0.2, 10.0, 0.8),
+    ])
+    .unwrap();
+    assert!(
+        (mrt.temperature.celsius() - 16.902).abs() < 5e-4,
+        "{}",
+        mrt.temperature.celsius()
+    );
     assert!((mrt.weight - (0.5 + 0.27 + 0.16)).abs() < 1e-12);
 }
 
 #[test]
 fn black_form_is_fourth_power_average_not_linear() {
-    let mrt = mean_radiant_temperature(&[RadiantSource::black(0.5, c(0.0)), RadiantSource::black(0.5, c(40.0))]).unwrap();
+    let mrt = mean_radiant_temperature(&[
+        RadiantSource::black(0.5, c(0.0)),
+        RadiantSource::black(0.5, c(40.0)),
+    ])
+    .unwrap();
     let expect = ((273.15f64.powi(4) + 313.15f64.powi(4)) / 2.0).powf(0.25);
     assert!((mrt.temperature.kelvin() - expect).abs() < 1e-9);
     // The fourth-power mean is above the linear mean (20 °C) by about 0.34 K.
@@ -25,7 +45,10 @@ fn black_form_is_fourth_power_average_not_linear() {
 
 #[test]
 fn bad_inputs_are_errors() {
-    assert!(matches!(mean_radiant_temperature(&[]), Err(PhysicsError::NothingSeen { .. })));
+    assert!(matches!(
+        mean_radiant_temperature(&[]),
+        Err(PhysicsError::NothingSeen { .. })
+    ));
     assert!(mean_radiant_temperature(&[RadiantSource::black(f64::NAN, c(20.0))]).is_err());
     assert!(mean_radiant_temperature(&[RadiantSource::black(1.5, c(20.0))]).is_err());
     let mut s = RadiantSource::black(1.0, c(20.0));
@@ -42,8 +65,14 @@ fn temperature_uncertainty_propagates() {
     assert!((m.std_from_temperatures_k - 0.3).abs() < 1e-12);
     // Two equal halves with independent errors: σ/√2.
     let m = mean_radiant_temperature(&[
-        RadiantSource { view_factor: 0.5, ..s },
-        RadiantSource { view_factor: 0.5, ..s },
+        RadiantSource {
+            view_factor: 0.5,
+            ..s
+        },
+        RadiantSource {
+            view_factor: 0.5,
+            ..s
+        },
     ])
     .unwrap();
     assert!((m.std_from_temperatures_k - 0.3 / 2f64.sqrt()).abs() < 1e-9);

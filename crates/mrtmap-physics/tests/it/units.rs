@@ -9,7 +9,12 @@ fn celsius_round_trip_and_delta_arithmetic() {
     assert!((d.kelvin() - 5.0).abs() < 1e-12);
     let t2 = t + d * 2.0;
     assert!((t2.celsius() - 31.3).abs() < 1e-12);
-    assert!(((t2 - TemperatureDelta::from_kelvin(10.0)) - t).kelvin().abs() < 1e-12);
+    assert!(
+        ((t2 - TemperatureDelta::from_kelvin(10.0)) - t)
+            .kelvin()
+            .abs()
+            < 1e-12
+    );
 }
 
 #[test]
@@ -21,5 +26,8 @@ fn fourth_power_round_trip() {
 #[test]
 fn display_uses_celsius_at_the_edge() {
     assert_eq!(format!("{:.1}", Temperature::from_kelvin(300.0)), "26.9 °C");
-    assert_eq!(format!("{:.2}", TemperatureDelta::from_kelvin(-0.25)), "-0.25 K");
+    assert_eq!(
+        format!("{:.2}", TemperatureDelta::from_kelvin(-0.25)),
+        "-0.25 K"
+    );
 }

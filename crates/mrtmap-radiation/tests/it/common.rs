@@ -1,6 +1,8 @@
 //! Scene builders shared by the tests.
 
-use mrtmap_radiation::{FeatureFile, OccluderFile, RadiantScene, SCENE_FORMAT, SceneFile, SurfaceFile};
+use mrtmap_radiation::{
+    FeatureFile, OccluderFile, RadiantScene, SCENE_FORMAT, SceneFile, SurfaceFile,
+};
 use proptest::test_runner::{Config, RngAlgorithm, RngSeed};
 
 /// Deterministic proptest settings: a fixed seed so a "within k standard errors" property cannot
@@ -30,7 +32,14 @@ pub fn surface(id: &str, kind: &str, polygon: Vec<[f64; 3]>, t: f64) -> SurfaceF
 }
 
 pub fn feature(id: &str, polygon: Vec<[f64; 3]>, t: f64) -> FeatureFile {
-    FeatureFile { id: id.into(), label: "window".into(), polygon, temperature_c: t, emissivity: 1.0, temperature_std_k: None }
+    FeatureFile {
+        id: id.into(),
+        label: "window".into(),
+        polygon,
+        temperature_c: t,
+        emissivity: 1.0,
+        temperature_std_k: None,
+    }
 }
 
 pub fn box_occluder(id: &str, min: [f64; 3], max: [f64; 3], t: f64) -> OccluderFile {
@@ -51,12 +60,42 @@ pub fn box_room(sx: f64, sy: f64, sz: f64, t: [f64; 6]) -> SceneFile {
         format: SCENE_FORMAT.into(),
         up: None,
         surfaces: vec![
-            surface("floor", "floor", vec![[0., 0., 0.], [sx, 0., 0.], [sx, sy, 0.], [0., sy, 0.]], t[0]),
-            surface("ceiling", "ceiling", vec![[0., 0., sz], [sx, 0., sz], [sx, sy, sz], [0., sy, sz]], t[1]),
-            surface("wall-s", "wall", vec![[0., 0., 0.], [sx, 0., 0.], [sx, 0., sz], [0., 0., sz]], t[2]),
-            surface("wall-e", "wall", vec![[sx, 0., 0.], [sx, sy, 0.], [sx, sy, sz], [sx, 0., sz]], t[3]),
-            surface("wall-n", "wall", vec![[sx, sy, 0.], [0., sy, 0.], [0., sy, sz], [sx, sy, sz]], t[4]),
-            surface("wall-w", "wall", vec![[0., sy, 0.], [0., 0., 0.], [0., 0., sz], [0., sy, sz]], t[5]),
+            surface(
+                "floor",
+                "floor",
+                vec![[0., 0., 0.], [sx, 0., 0.], [sx, sy, 0.], [0., sy, 0.]],
+                t[0],
+            ),
+            surface(
+                "ceiling",
+                "ceiling",
+                vec![[0., 0., sz], [sx, 0., sz], [sx, sy, sz], [0., sy, sz]],
+                t[1],
+            ),
+            surface(
+                "wall-s",
+                "wall",
+                vec![[0., 0., 0.], [sx, 0., 0.], [sx, 0., sz], [0., 0., sz]],
+                t[2],
+            ),
+            surface(
+                "wall-e",
+                "wall",
+                vec![[sx, 0., 0.], [sx, sy, 0.], [sx, sy, sz], [sx, 0., sz]],
+                t[3],
+            ),
+            surface(
+                "wall-n",
+                "wall",
+                vec![[sx, sy, 0.], [0., sy, 0.], [0., sy, sz], [sx, sy, sz]],
+                t[4],
+            ),
+            surface(
+                "wall-w",
+                "wall",
+                vec![[0., sy, 0.], [0., 0., 0.], [0., 0., sz], [0., sy, sz]],
+                t[5],
+            ),
         ],
         occluders: Vec::new(),
     }
@@ -67,19 +106,39 @@ pub fn l_room() -> SceneFile {
     let plan = [[0., 0.], [6., 0.], [6., 2.], [3., 2.], [3., 4.], [0., 4.]];
     let h = 2.5;
     let mut surfaces = vec![
-        surface("floor", "floor", plan.iter().map(|p| [p[0], p[1], 0.0]).collect(), 20.0),
-        surface("ceiling", "ceiling", plan.iter().map(|p| [p[0], p[1], h]).collect(), 24.0),
+        surface(
+            "floor",
+            "floor",
+            plan.iter().map(|p| [p[0], p[1], 0.0]).collect(),
+            20.0,
+        ),
+        surface(
+            "ceiling",
+            "ceiling",
+            plan.iter().map(|p| [p[0], p[1], h]).collect(),
+            24.0,
+        ),
     ];
     for i in 0..plan.len() {
         let (a, b) = (plan[i], plan[(i + 1) % plan.len()]);
         surfaces.push(surface(
             &format!("wall-{i}"),
             "wall",
-            vec![[a[0], a[1], 0.0], [b[0], b[1], 0.0], [b[0], b[1], h], [a[0], a[1], h]],
+            vec![
+                [a[0], a[1], 0.0],
+                [b[0], b[1], 0.0],
+                [b[0], b[1], h],
+                [a[0], a[1], h],
+            ],
             18.0 + i as f64,
         ));
     }
-    SceneFile { format: SCENE_FORMAT.into(), up: None, surfaces, occluders: Vec::new() }
+    SceneFile {
+        format: SCENE_FORMAT.into(),
+        up: None,
+        surfaces,
+        occluders: Vec::new(),
+    }
 }
 
 pub fn scene(file: &SceneFile) -> RadiantScene {

@@ -7,7 +7,12 @@ use proptest::prelude::*;
 use crate::common::*;
 
 fn mc(rays: usize, seed: u64, directions: DirectionSet, replicates: usize) -> Method {
-    Method::MonteCarlo(MonteCarlo { rays, seed, directions, replicates })
+    Method::MonteCarlo(MonteCarlo {
+        rays,
+        seed,
+        directions,
+        replicates,
+    })
 }
 
 /// Adds a rectangular feature at fractions (s0..s1, t0..t1) of surface `si`'s two first edges.
@@ -21,7 +26,11 @@ fn add_feature(f: &mut SceneFile, si: usize, s: (f64, f64), t: (f64, f64), temp:
         p
     };
     let id = format!("feat-{si}-{}", f.surfaces[si].features.len());
-    f.surfaces[si].features.push(feature(&id, vec![at(s.0, t.0), at(s.1, t.0), at(s.1, t.1), at(s.0, t.1)], temp));
+    f.surfaces[si].features.push(feature(
+        &id,
+        vec![at(s.0, t.0), at(s.1, t.0), at(s.1, t.1), at(s.0, t.1)],
+        temp,
+    ));
 }
 
 #[test]
@@ -36,7 +45,10 @@ fn exact_closed_room_with_features_sums_to_one_and_subtracts_features() {
     assert!((r.view_factor_sum - 1.0).abs() < 1e-9);
     let patches = e.patches();
     let east = patches.iter().position(|p| p.id == "wall-e").unwrap();
-    let win = patches.iter().position(|p| p.kind == PatchKind::Feature && p.host.as_deref() == Some("wall-e")).unwrap();
+    let win = patches
+        .iter()
+        .position(|p| p.kind == PatchKind::Feature && p.host.as_deref() == Some("wall-e"))
+        .unwrap();
     let host_whole = sphere_view_factor(&p, &s.surfaces[3].polygon);
     let win_alone = sphere_view_factor(&p, &s.surfaces[3].features[0].polygon);
     assert!((r.view_factors[win] - win_alone).abs() < 1e-15);
@@ -48,8 +60,15 @@ fn exact_closed_room_with_features_sums_to_one_and_subtracts_features() {
 #[test]
 fn uniform_room_gives_its_temperature_with_zero_sampling_error() {
     let s = scene(&box_room(5.0, 4.0, 3.0, [23.0; 6]));
-    for m in [Method::Exact, mc(4000, 3, DirectionSet::Fibonacci, 8), mc(4000, 3, DirectionSet::Random, 8)] {
-        let r = MrtEngine::new(&s, m).unwrap().at(&Point3::new(1.0, 3.0, 2.0), 0).unwrap();
+    for m in [
+        Method::Exact,
+        mc(4000, 3, DirectionSet::Fibonacci, 8),
+        mc(4000, 3, DirectionSet::Random, 8),
+    ] {
+        let r = MrtEngine::new(&s, m)
+            .unwrap()
+            .at(&Point3::new(1.0, 3.0, 2.0), 0)
+            .unwrap();
         assert!((r.mrt.celsius() - 23.0).abs() < 1e-9, "{}", m.name());
         assert!(r.sampling_std_error_k < 1e-9);
     }
@@ -60,16 +79,28 @@ fn temperature_uncertainty_is_carried_into_the_mrt() {
     let mut f = box_room(4.0, 4.0, 4.0, [20.0; 6]);
     f.surfaces[3].temperature_std_k = Some(0.6);
     let s = scene(&f);
-    let r = MrtEngine::new(&s, Method::Exact).unwrap().at(&Point3::new(2.0, 2.0, 2.0), 0).unwrap();
+    let r = MrtEngine::new(&s, Method::Exact)
+        .unwrap()
+        .at(&Point3::new(2.0, 2.0, 2.0), 0)
+        .unwrap();
     // Cube centre: F = 1/6 and ∂Tr/∂T = 1/6 at uniform temperature.
-    assert!((r.temperature_std_error_k - 0.1).abs() < 1e-9, "{}", r.temperature_std_error_k);
+    assert!(
+        (r.temperature_std_error_k - 0.1).abs() < 1e-9,
+        "{}",
+        r.temperature_std_error_k
+    );
     assert!((r.std_error_k - 0.1).abs() < 1e-9);
 }
 
 #[test]
 fn exact_refuses_occluders_with_a_clear_message() {
     let mut f = box_room(4.0, 4.0, 3.0, [20.0; 6]);
-    f.occluders.push(box_occluder("desk-1", [1.0, 1.0, 0.0], [2.2, 1.8, 0.75], 21.0));
+    f.occluders.push(box_occluder(
+        "desk-1",
+        [1.0, 1.0, 0.0],
+        [2.2, 1.8, 0.75],
+        21.0,
+    ));
     let s = scene(&f);
     let e = MrtEngine::new(&s, Method::Exact).err().unwrap();
     assert_eq!(
@@ -77,7 +108,10 @@ fn exact_refuses_occluders_with_a_clear_message() {
         "the scene has 1 occluder(s) (first: 'desk-1'), which exact solid angles cannot handle: use the Monte Carlo method"
     );
     let engine = MrtEngine::new(&s, mc(2000, 1, DirectionSet::Fibonacci, 8)).unwrap();
-    assert!(matches!(engine.at(&Point3::new(1.5, 1.5, 0.5), 0), Err(MrtError::InsideOccluder { .. })));
+    assert!(matches!(
+        engine.at(&Point3::new(1.5, 1.5, 0.5), 0),
+        Err(MrtError::InsideOccluder { .. })
+    ));
 }
 
 /// A box between the point and a wall reduces that wall's factor by the box's solid angle.
@@ -85,7 +119,10 @@ fn exact_refuses_occluders_with_a_clear_message() {
 fn occluding_box_takes_its_solid_angle_from_the_wall() {
     let base = box_room(5.0, 4.0, 3.0, [20.0, 20.0, 20.0, 15.0, 20.0, 20.0]);
     let p = Point3::new(1.0, 2.0, 1.2);
-    let exact = MrtEngine::new(&scene(&base), Method::Exact).unwrap().at(&p, 0).unwrap();
+    let exact = MrtEngine::new(&scene(&base), Method::Exact)
+        .unwrap()
+        .at(&p, 0)
+        .unwrap();
     let (lo, hi) = ([3.0, 1.5, 0.9], [3.5, 2.5, 1.5]);
     let mut f = base.clone();
     f.occluders.push(box_occluder("cabinet", lo, hi, 30.0));
@@ -95,9 +132,11 @@ fn occluding_box_takes_its_solid_angle_from_the_wall() {
         .chunks(2)
         .filter(|q| {
             let n = (q[0][1] - q[0][0]).cross(&(q[0][2] - q[0][0]));
-            let c = Point3::from((lo[0] + hi[0]) / 2.0 * mrtmap_geometry::nalgebra::Vector3::x()
-                + (lo[1] + hi[1]) / 2.0 * mrtmap_geometry::nalgebra::Vector3::y()
-                + (lo[2] + hi[2]) / 2.0 * mrtmap_geometry::nalgebra::Vector3::z());
+            let c = Point3::from(
+                (lo[0] + hi[0]) / 2.0 * mrtmap_geometry::nalgebra::Vector3::x()
+                    + (lo[1] + hi[1]) / 2.0 * mrtmap_geometry::nalgebra::Vector3::y()
+                    + (lo[2] + hi[2]) / 2.0 * mrtmap_geometry::nalgebra::Vector3::z(),
+            );
             let outward = if n.dot(&(q[0][0] - c)) > 0.0 { n } else { -n };
             outward.dot(&(p - q[0][0])) > 0.0
         })
@@ -109,11 +148,24 @@ fn occluding_box_takes_its_solid_angle_from_the_wall() {
     let ip = |id: &str| e.patches().iter().position(|x| x.id == id).unwrap();
     let (east, cab) = (ip("wall-e"), ip("cabinet"));
     let expect_east = exact.view_factors[east] - box_f;
-    assert!((r.view_factors[east] - expect_east).abs() < 4.0 * r.view_factor_std_errors[east] + 1e-4, "{} vs {}", r.view_factors[east], expect_east);
-    assert!((r.view_factors[cab] - box_f).abs() < 4.0 * r.view_factor_std_errors[cab] + 1e-4, "{} vs {}", r.view_factors[cab], box_f);
+    assert!(
+        (r.view_factors[east] - expect_east).abs() < 4.0 * r.view_factor_std_errors[east] + 1e-4,
+        "{} vs {}",
+        r.view_factors[east],
+        expect_east
+    );
+    assert!(
+        (r.view_factors[cab] - box_f).abs() < 4.0 * r.view_factor_std_errors[cab] + 1e-4,
+        "{} vs {}",
+        r.view_factors[cab],
+        box_f
+    );
     // The other walls do not change.
     let west = ip("wall-w");
-    assert!((r.view_factors[west] - exact.view_factors[west]).abs() < 4.0 * r.view_factor_std_errors[west] + 1e-4);
+    assert!(
+        (r.view_factors[west] - exact.view_factors[west]).abs()
+            < 4.0 * r.view_factor_std_errors[west] + 1e-4
+    );
     assert!((r.view_factor_sum - 1.0).abs() < 1e-3);
 }
 
@@ -126,11 +178,18 @@ fn non_convex_room_exact_checks_visibility_and_monte_carlo_sums_to_one() {
     assert!((r.view_factor_sum - 1.0).abs() < 1e-9);
     // In the far leg: walls hide walls and exact refuses.
     let e = exact.at(&Point3::new(5.0, 1.0, 1.2), 0).unwrap_err();
-    assert!(matches!(e, MrtError::SurfacesHidden { sum, .. } if sum > 1.0 + 1e-3), "{e}");
+    assert!(
+        matches!(e, MrtError::SurfacesHidden { sum, .. } if sum > 1.0 + 1e-3),
+        "{e}"
+    );
     assert!(e.to_string().contains("use the Monte Carlo method"));
     let mcm = MrtEngine::new(&s, mc(40_000, 2, DirectionSet::Fibonacci, 8)).unwrap();
     let r = mcm.at(&Point3::new(5.0, 1.0, 1.2), 0).unwrap();
-    assert!((r.view_factor_sum - 1.0).abs() < 1e-3, "{}", r.view_factor_sum);
+    assert!(
+        (r.view_factor_sum - 1.0).abs() < 1e-3,
+        "{}",
+        r.view_factor_sum
+    );
     // The wall facing away at x = 3 (y 2..4) is wholly hidden from there.
     let hidden = mcm.patches().iter().position(|p| p.id == "wall-3").unwrap();
     assert_eq!(r.view_factors[hidden], 0.0);
@@ -138,29 +197,47 @@ fn non_convex_room_exact_checks_visibility_and_monte_carlo_sums_to_one() {
 
 #[test]
 fn random_sampling_errors_match_the_binomial_formula() {
-    let s = scene(&box_room(4.0, 3.0, 2.5, [20.0, 22.0, 21.0, 18.0, 21.0, 21.0]));
+    let s = scene(&box_room(
+        4.0,
+        3.0,
+        2.5,
+        [20.0, 22.0, 21.0, 18.0, 21.0, 21.0],
+    ));
     let n = 32_000;
     let e = MrtEngine::new(&s, mc(n, 5, DirectionSet::Random, 32)).unwrap();
     let mut ratio = 0.0;
     let mut count = 0.0;
     for k in 0..20 {
-        let r = e.at(&Point3::new(1.0 + 0.1 * k as f64, 1.2, 1.1), k).unwrap();
+        let r = e
+            .at(&Point3::new(1.0 + 0.1 * k as f64, 1.2, 1.1), k)
+            .unwrap();
         for (f, se) in r.view_factors.iter().zip(&r.view_factor_std_errors) {
             ratio += se / (f * (1.0 - f) / n as f64).sqrt();
             count += 1.0;
         }
     }
     let mean = ratio / count;
-    assert!((mean - 1.0).abs() < 0.1, "replicate SE / binomial SE = {mean}");
+    assert!(
+        (mean - 1.0).abs() < 0.1,
+        "replicate SE / binomial SE = {mean}"
+    );
 }
 
 #[test]
 fn seeded_results_are_reproducible_and_streams_differ() {
-    let s = scene(&box_room(4.0, 3.0, 2.5, [20.0, 22.0, 21.0, 18.0, 21.0, 21.0]));
+    let s = scene(&box_room(
+        4.0,
+        3.0,
+        2.5,
+        [20.0, 22.0, 21.0, 18.0, 21.0, 21.0],
+    ));
     let e = MrtEngine::new(&s, mc(5000, 42, DirectionSet::Fibonacci, 8)).unwrap();
     let p = Point3::new(1.0, 1.0, 1.0);
     assert_eq!(e.at(&p, 3).unwrap(), e.at(&p, 3).unwrap());
-    assert_ne!(e.at(&p, 3).unwrap().view_factors, e.at(&p, 4).unwrap().view_factors);
+    assert_ne!(
+        e.at(&p, 3).unwrap().view_factors,
+        e.at(&p, 4).unwrap().view_factors
+    );
 }
 
 proptest! {

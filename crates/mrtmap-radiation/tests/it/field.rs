@@ -1,5 +1,7 @@
 use mrtmap_geometry::nalgebra::Point3;
-use mrtmap_radiation::{GridSpec, MapFrame, Method, MonteCarlo, MrtEngine, MrtError, MrtField, example_office};
+use mrtmap_radiation::{
+    GridSpec, MapFrame, Method, MonteCarlo, MrtEngine, MrtError, MrtField, example_office,
+};
 
 use crate::common::*;
 
@@ -26,9 +28,30 @@ fn example_office_grid_covers_the_floor_in_xy() {
 #[test]
 fn l_shaped_floor_leaves_out_the_missing_quadrant() {
     let s = scene(&l_room());
-    let e = MrtEngine::new(&s, Method::MonteCarlo(MonteCarlo { rays: 800, ..MonteCarlo::default() })).unwrap();
-    let field = MrtField::compute(&e, MapFrame::of_scene(&s).unwrap(), GridSpec { nx: 12, ny: 8, height_m: 1.1, margin_m: 0.1 }).unwrap();
-    assert!(field.nodes.len() < 96 && field.nodes.len() > 48, "{}", field.nodes.len());
+    let e = MrtEngine::new(
+        &s,
+        Method::MonteCarlo(MonteCarlo {
+            rays: 800,
+            ..MonteCarlo::default()
+        }),
+    )
+    .unwrap();
+    let field = MrtField::compute(
+        &e,
+        MapFrame::of_scene(&s).unwrap(),
+        GridSpec {
+            nx: 12,
+            ny: 8,
+            height_m: 1.1,
+            margin_m: 0.1,
+        },
+    )
+    .unwrap();
+    assert!(
+        field.nodes.len() < 96 && field.nodes.len() > 48,
+        "{}",
+        field.nodes.len()
+    );
     assert!(field.nodes.iter().all(|n| !(n.uv.x > 3.0 && n.uv.y > 2.0)));
     assert!(field.nodes.iter().all(|n| n.result.is_ok()));
 }
@@ -36,11 +59,37 @@ fn l_shaped_floor_leaves_out_the_missing_quadrant() {
 #[test]
 fn nodes_inside_occluders_are_reported_not_computed() {
     let mut f = box_room(4.0, 4.0, 3.0, [20.0; 6]);
-    f.occluders.push(box_occluder("shelf", [0.0, 0.0, 0.0], [1.0, 4.0, 2.0], 21.0));
+    f.occluders.push(box_occluder(
+        "shelf",
+        [0.0, 0.0, 0.0],
+        [1.0, 4.0, 2.0],
+        21.0,
+    ));
     let s = scene(&f);
-    let e = MrtEngine::new(&s, Method::MonteCarlo(MonteCarlo { rays: 800, ..MonteCarlo::default() })).unwrap();
-    let field = MrtField::compute(&e, MapFrame::of_scene(&s).unwrap(), GridSpec { nx: 8, ny: 8, height_m: 1.1, margin_m: 0.1 }).unwrap();
-    let inside = field.nodes.iter().filter(|n| matches!(n.result, Err(MrtError::InsideOccluder { .. }))).count();
+    let e = MrtEngine::new(
+        &s,
+        Method::MonteCarlo(MonteCarlo {
+            rays: 800,
+            ..MonteCarlo::default()
+        }),
+    )
+    .unwrap();
+    let field = MrtField::compute(
+        &e,
+        MapFrame::of_scene(&s).unwrap(),
+        GridSpec {
+            nx: 8,
+            ny: 8,
+            height_m: 1.1,
+            margin_m: 0.1,
+        },
+    )
+    .unwrap();
+    let inside = field
+        .nodes
+        .iter()
+        .filter(|n| matches!(n.result, Err(MrtError::InsideOccluder { .. })))
+        .count();
     assert_eq!(inside, 16, "two columns of 8 lie within x < 1");
     assert_eq!(field.summary().unwrap().skipped, 16);
 }
@@ -60,7 +109,16 @@ fn bad_grids_are_refused() {
     let s = example_office();
     let e = MrtEngine::new(&s, Method::Exact).unwrap();
     let bad = |spec| MrtField::compute(&e, MapFrame::of_scene(&s).unwrap(), spec).is_err();
-    assert!(bad(GridSpec { nx: 0, ..GridSpec::default() }));
-    assert!(bad(GridSpec { margin_m: 3.0, ..GridSpec::default() }));
-    assert!(bad(GridSpec { height_m: f64::NAN, ..GridSpec::default() }));
+    assert!(bad(GridSpec {
+        nx: 0,
+        ..GridSpec::default()
+    }));
+    assert!(bad(GridSpec {
+        margin_m: 3.0,
+        ..GridSpec::default()
+    }));
+    assert!(bad(GridSpec {
+        height_m: f64::NAN,
+        ..GridSpec::default()
+    }));
 }

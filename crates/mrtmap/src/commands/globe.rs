@@ -1,6 +1,8 @@
 //! `mrtmap globe`: globe temperature ↔ MRT.
 
-use mrtmap_physics::{Convection, Globe, GlobeMethod, GlobeReading, Temperature, globe_temperature, mrt_from_globe};
+use mrtmap_physics::{
+    Convection, Globe, GlobeMethod, GlobeReading, Temperature, globe_temperature, mrt_from_globe,
+};
 use serde::Serialize;
 
 use crate::cli::{ConvectionArg, GlobeArgs, GlobeMethodArg};
@@ -32,14 +34,30 @@ pub fn run(a: &GlobeArgs) -> anyhow::Result<()> {
         GlobeMethodArg::IsoClosedForm => GlobeMethod::IsoClosedForm { convection },
         GlobeMethodArg::Mixed => GlobeMethod::MixedConvection,
     };
-    let globe = Globe { diameter_m: a.diameter, emissivity: a.emissivity };
+    let globe = Globe {
+        diameter_m: a.diameter,
+        emissivity: a.emissivity,
+    };
     let air = Temperature::from_celsius(a.ta);
     let (tg, direction) = match (a.tg, a.tr) {
         (Some(tg), _) => (Temperature::from_celsius(tg), "mrt_from_globe"),
-        (None, Some(tr)) => (globe_temperature(&globe, Temperature::from_celsius(tr), air, a.va, method)?, "globe_from_mrt"),
-        (None, None) => anyhow::bail!("give --tg (globe temperature) or --tr (mean radiant temperature)"),
+        (None, Some(tr)) => (
+            globe_temperature(&globe, Temperature::from_celsius(tr), air, a.va, method)?,
+            "globe_from_mrt",
+        ),
+        (None, None) => {
+            anyhow::bail!("give --tg (globe temperature) or --tr (mean radiant temperature)")
+        }
     };
-    let r = mrt_from_globe(&globe, &GlobeReading { globe: tg, air, air_speed_m_s: a.va }, method)?;
+    let r = mrt_from_globe(
+        &globe,
+        &GlobeReading {
+            globe: tg,
+            air,
+            air_speed_m_s: a.va,
+        },
+        method,
+    )?;
     let out = GlobeOut {
         mrt_c: r.mrt.celsius(),
         globe_c: tg.celsius(),
@@ -56,12 +74,24 @@ pub fn run(a: &GlobeArgs) -> anyhow::Result<()> {
         print!("{}", json(&out)?);
     } else if direction == "mrt_from_globe" {
         println!("MRT {:.2} °C", out.mrt_c);
-        println!("  from globe {:.2} °C, air {:.2} °C, air speed {} m/s, globe {} m, ε {}", out.globe_c, a.ta, a.va, a.diameter, a.emissivity);
-        println!("  formula: {} (h = {:.2} W/m²K)", out.formula_description, out.h_w_m2k);
+        println!(
+            "  from globe {:.2} °C, air {:.2} °C, air speed {} m/s, globe {} m, ε {}",
+            out.globe_c, a.ta, a.va, a.diameter, a.emissivity
+        );
+        println!(
+            "  formula: {} (h = {:.2} W/m²K)",
+            out.formula_description, out.h_w_m2k
+        );
     } else {
         println!("globe temperature {:.2} °C", out.globe_c);
-        println!("  at MRT {:.2} °C, air {:.2} °C, air speed {} m/s, globe {} m, ε {}", out.mrt_c, a.ta, a.va, a.diameter, a.emissivity);
-        println!("  formula: {} (h = {:.2} W/m²K), solved numerically", out.formula_description, out.h_w_m2k);
+        println!(
+            "  at MRT {:.2} °C, air {:.2} °C, air speed {} m/s, globe {} m, ε {}",
+            out.mrt_c, a.ta, a.va, a.diameter, a.emissivity
+        );
+        println!(
+            "  formula: {} (h = {:.2} W/m²K), solved numerically",
+            out.formula_description, out.h_w_m2k
+        );
     }
     Ok(())
 }

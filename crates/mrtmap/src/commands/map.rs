@@ -25,7 +25,12 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
     let method = resolve_method(&a.method, &scene)?;
     let engine = MrtEngine::new(&scene, method)?;
     let frame = MapFrame::of_scene(&scene).with_context(|| format!("cannot map {source}"))?;
-    let spec = GridSpec { nx: a.grid.0, ny: a.grid.1, height_m: a.height, margin_m: a.margin_m };
+    let spec = GridSpec {
+        nx: a.grid.0,
+        ny: a.grid.1,
+        height_m: a.height,
+        margin_m: a.margin_m,
+    };
     let t0 = Instant::now();
     let field = MrtField::compute(&engine, frame, spec)?;
     let secs = t0.elapsed().as_secs_f64();
@@ -43,12 +48,20 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
             .at(&p, (a.grid.0 * a.grid.1 + k) as u64)
             .with_context(|| format!("cannot compute the MRT at mark {name}"))?;
         records.push(PointRecord::new(Some(name.clone()), &r, engine.patches()));
-        marks.push(MapMark { name: name.clone(), uv: field.frame.uv(&p) });
+        marks.push(MapMark {
+            name: name.clone(),
+            uv: field.frame.uv(&p),
+        });
     }
 
     let how = describe_method(&method, engine.ray_engine());
     let subtitle = format!("{source}; {}×{} grid, {how}", a.grid.0, a.grid.1);
-    let input = MapInput { field: &field, scene: &scene, marks: &marks, subtitle };
+    let input = MapInput {
+        field: &field,
+        scene: &scene,
+        marks: &marks,
+        subtitle,
+    };
     let (rays, seed) = match method {
         Method::MonteCarlo(mc) => (Some(mc.rays), Some(mc.seed)),
         Method::Exact => (None, None),
@@ -80,17 +93,41 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
         Some(s) => {
             println!(
                 "MRT at {:.2} m over {} nodes: min {:.2} °C at ({:.2}, {:.2}), max {:.2} °C at ({:.2}, {:.2}), mean {:.2} °C; largest standard error {:.3} K",
-                a.height, s.nodes, s.min.mrt_c, s.min.uv[0], s.min.uv[1], s.max.mrt_c, s.max.uv[0], s.max.uv[1], s.mean_c, s.max_std_error_k
+                a.height,
+                s.nodes,
+                s.min.mrt_c,
+                s.min.uv[0],
+                s.min.uv[1],
+                s.max.mrt_c,
+                s.max.uv[0],
+                s.max.uv[1],
+                s.mean_c,
+                s.max_std_error_k
             );
             if s.skipped > 0 {
-                println!("{} nodes skipped (inside occluders or failed): see the note column of mrt_grid.csv", s.skipped);
+                println!(
+                    "{} nodes skipped (inside occluders or failed): see the note column of mrt_grid.csv",
+                    s.skipped
+                );
             }
         }
         None => println!("no grid node could be computed"),
     }
     for m in &summary.marks {
-        println!("  {}: MRT {:.2} °C ± {:.2} K at ({:.2}, {:.2}, {:.2})", m.name.as_deref().unwrap_or("?"), m.mrt_c, m.std_error_k, m.xyz[0], m.xyz[1], m.xyz[2]);
+        println!(
+            "  {}: MRT {:.2} °C ± {:.2} K at ({:.2}, {:.2}, {:.2})",
+            m.name.as_deref().unwrap_or("?"),
+            m.mrt_c,
+            m.std_error_k,
+            m.xyz[0],
+            m.xyz[1],
+            m.xyz[2]
+        );
     }
-    println!("computed in {:.3} s; wrote mrt_grid.csv, mrt_map.png, mrt_map.svg, summary.json in {}", secs, out.display());
+    println!(
+        "computed in {:.3} s; wrote mrt_grid.csv, mrt_map.png, mrt_map.svg, summary.json in {}",
+        secs,
+        out.display()
+    );
     Ok(())
 }

@@ -25,7 +25,14 @@ pub fn run(a: &MrtArgs) -> anyhow::Result<()> {
         points.push(PointRecord::new(None, &r, engine.patches()));
     }
     if a.json {
-        print!("{}", json(&MrtOut { scene: source, method, points })?);
+        print!(
+            "{}",
+            json(&MrtOut {
+                scene: source,
+                method,
+                points
+            })?
+        );
         return Ok(());
     }
     println!("scene: {source}");
@@ -36,14 +43,24 @@ pub fn run(a: &MrtArgs) -> anyhow::Result<()> {
             "point ({:.3}, {:.3}, {:.3}): MRT {:.2} °C ± {:.2} K   (ΣF = {:.4})",
             p.xyz[0], p.xyz[1], p.xyz[2], p.mrt_c, p.std_error_k, p.view_factor_sum
         );
-        println!("  {:<28} {:<18} {:>9} {:>9} {:>8}", "id", "label", "F", "±", "T (°C)");
+        println!(
+            "  {:<28} {:<18} {:>9} {:>9} {:>8}",
+            "id", "label", "F", "±", "T (°C)"
+        );
         for v in &p.view_factors {
-            let label = if v.label.is_empty() { "-" } else { v.label.as_str() };
+            let label = if v.label.is_empty() {
+                "-"
+            } else {
+                v.label.as_str()
+            };
             let id = match &v.host {
                 Some(h) => format!("{} (on {h})", v.id),
                 None => v.id.clone(),
             };
-            println!("  {:<28} {:<18} {:>9.5} {:>9.5} {:>8.2}", id, label, v.view_factor, v.view_factor_std_error, v.temperature_c);
+            println!(
+                "  {:<28} {:<18} {:>9.5} {:>9.5} {:>8.2}",
+                id, label, v.view_factor, v.view_factor_std_error, v.temperature_c
+            );
         }
     }
     Ok(())
