@@ -20,12 +20,21 @@ fn bumpy_sphere(n: usize) -> Vec<Tri> {
         let th = PI * i as f64 / n as f64;
         let ph = 2.0 * PI * (j % n) as f64 / n as f64;
         let r = 3.0 + 0.05 * (7.0 * th).sin() * (5.0 * ph).cos();
-        Point3::new(r * th.sin() * ph.cos(), r * th.sin() * ph.sin(), r * th.cos())
+        Point3::new(
+            r * th.sin() * ph.cos(),
+            r * th.sin() * ph.sin(),
+            r * th.cos(),
+        )
     };
     let mut t = Vec::with_capacity(2 * n * n);
     for i in 0..n {
         for j in 0..n {
-            let (a, b, c, d) = (vert(i, j), vert(i, j + 1), vert(i + 1, j), vert(i + 1, j + 1));
+            let (a, b, c, d) = (
+                vert(i, j),
+                vert(i, j + 1),
+                vert(i + 1, j),
+                vert(i + 1, j + 1),
+            );
             t.push([a, b, c]);
             t.push([b, d, c]);
         }
@@ -41,7 +50,11 @@ fn rays(n: usize, one_origin: bool) -> Vec<(Point3<f64>, Vector3<f64>)> {
             let o = if one_origin {
                 fixed
             } else {
-                Point3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0))
+                Point3::new(
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                )
             };
             (o, uniform_direction(&mut rng))
         })
@@ -49,22 +62,35 @@ fn rays(n: usize, one_origin: bool) -> Vec<(Point3<f64>, Vector3<f64>)> {
 }
 
 fn cast_all(c: &dyn RayCaster, rays: &[(Point3<f64>, Vector3<f64>)]) -> usize {
-    rays.iter().filter(|(o, d)| c.cast(o, d, f64::INFINITY).is_some()).count()
+    rays.iter()
+        .filter(|(o, d)| c.cast(o, d, f64::INFINITY).is_some())
+        .count()
 }
 
 fn bench(c: &mut Criterion) {
     let tris = bumpy_sphere(224);
-    let mut casters: Vec<Box<dyn RayCaster>> = vec![Box::new(BvhRayCaster::new(&tris))];
+    let casters: Vec<Box<dyn RayCaster>> = vec![Box::new(BvhRayCaster::new(&tris))];
     #[cfg(feature = "embree")]
     casters.push(Box::new(mrtmap_geometry::EmbreeRayCaster::new(&tris)));
-    for (name, one) in [("raycast_100k_incoherent", false), ("raycast_100k_from_one_point", true)] {
+    for (name, one) in [
+        ("raycast_100k_incoherent", false),
+        ("raycast_100k_from_one_point", true),
+    ] {
         let rs = rays(100_000, one);
         let mut g = c.benchmark_group(name);
         g.throughput(Throughput::Elements(rs.len() as u64));
         g.sample_size(20);
         for caster in &casters {
-            assert_eq!(cast_all(caster.as_ref(), &rs), rs.len(), "every ray from inside hits");
-            g.bench_with_input(BenchmarkId::from_parameter(caster.engine()), &rs, |b, rs| b.iter(|| cast_all(caster.as_ref(), rs)));
+            assert_eq!(
+                cast_all(caster.as_ref(), &rs),
+                rs.len(),
+                "every ray from inside hits"
+            );
+            g.bench_with_input(
+                BenchmarkId::from_parameter(caster.engine()),
+                &rs,
+                |b, rs| b.iter(|| cast_all(caster.as_ref(), rs)),
+            );
         }
         g.finish();
     }

@@ -18,11 +18,13 @@
 //! assert!((f - 1.0 / 24.0).abs() < 1e-12);
 //! ```
 
+pub mod camera;
 pub mod polygon;
 pub mod ray;
 pub mod sampling;
 mod solid_angle;
 
+pub use camera::{BrownConrady, PinholeCamera};
 pub use nalgebra;
 pub use polygon::{Containment, NotSimple, PlaneFrame};
 #[cfg(feature = "embree")]

@@ -11,24 +11,48 @@ use std::time::Instant;
 
 use mrtmap_geometry::nalgebra::Point3;
 use mrtmap_geometry::sampling::DirectionSet;
-use mrtmap_radiation::{GridSpec, MapFrame, Method, MonteCarlo, MrtEngine, MrtField, example_office};
+use mrtmap_radiation::{
+    GridSpec, MapFrame, Method, MonteCarlo, MrtEngine, MrtField, example_office,
+};
 
 fn main() {
     let scene = example_office();
     let exact = MrtEngine::new(&scene, Method::Exact).unwrap();
-    let points: Vec<Point3<f64>> =
-        (0..16).map(|k| Point3::new(0.5 + 1.05 * (k % 4) as f64, 0.45 + 0.9 * (k / 4) as f64, 1.1)).collect();
-    let truth: Vec<f64> = points.iter().map(|p| exact.at(p, 0).unwrap().mrt.kelvin()).collect();
+    let points: Vec<Point3<f64>> = (0..16)
+        .map(|k| {
+            Point3::new(
+                0.5 + 1.05 * (k % 4) as f64,
+                0.45 + 0.9 * (k / 4) as f64,
+                1.1,
+            )
+        })
+        .collect();
+    let truth: Vec<f64> = points
+        .iter()
+        .map(|p| exact.at(p, 0).unwrap().mrt.kelvin())
+        .collect();
     let seeds = 24u64;
     let counts = [500usize, 1_000, 2_000, 4_000, 8_000, 16_000, 32_000, 64_000];
-    println!("{:>8} {:>10} {:>14} {:>14} {:>10}", "rays", "directions", "RMS error (K)", "mean SE (K)", "SE/RMS");
+    println!(
+        "{:>8} {:>10} {:>14} {:>14} {:>10}",
+        "rays", "directions", "RMS error (K)", "mean SE (K)", "SE/RMS"
+    );
     let mut needed = Vec::new();
     for set in [DirectionSet::Random, DirectionSet::Fibonacci] {
         let mut found = None;
         for &rays in &counts {
             let (mut sq, mut se, mut n) = (0.0, 0.0, 0.0);
             for seed in 0..seeds {
-                let mc = MrtEngine::new(&scene, Method::MonteCarlo(MonteCarlo { rays, seed, directions: set, replicates: 8 })).unwrap();
+                let mc = MrtEngine::new(
+                    &scene,
+                    Method::MonteCarlo(MonteCarlo {
+                        rays,
+                        seed,
+                        directions: set,
+                        replicates: 8,
+                    }),
+                )
+                .unwrap();
                 for (k, p) in points.iter().enumerate() {
                     let r = mc.at(p, k as u64).unwrap();
                     sq += (r.mrt.kelvin() - truth[k]).powi(2);
@@ -37,7 +61,11 @@ fn main() {
                 }
             }
             let (rms, mse) = ((sq / n).sqrt(), se / n);
-            println!("{rays:>8} {:>10} {rms:>14.4} {mse:>14.4} {:>10.2}", format!("{set:?}"), mse / rms);
+            println!(
+                "{rays:>8} {:>10} {rms:>14.4} {mse:>14.4} {:>10.2}",
+                format!("{set:?}"),
+                mse / rms
+            );
             if found.is_none() && rms <= 0.05 && mse <= 0.05 {
                 found = Some(rays);
             }
@@ -48,10 +76,22 @@ fn main() {
     println!();
     for (set, rays) in needed {
         let Some(rays) = rays else {
-            println!("{set:?}: no ray count up to {} reached 0.05 K", counts[counts.len() - 1]);
+            println!(
+                "{set:?}: no ray count up to {} reached 0.05 K",
+                counts[counts.len() - 1]
+            );
             continue;
         };
-        let mc = MrtEngine::new(&scene, Method::MonteCarlo(MonteCarlo { rays, seed: 1, directions: set, replicates: 8 })).unwrap();
+        let mc = MrtEngine::new(
+            &scene,
+            Method::MonteCarlo(MonteCarlo {
+                rays,
+                seed: 1,
+                directions: set,
+                replicates: 8,
+            }),
+        )
+        .unwrap();
         let mut times: Vec<f64> = (0..5)
             .map(|_| {
                 let t = Instant::now();

@@ -1,6 +1,7 @@
 //! Geometry tests: analytic solid angles, polygon predicates, direction sets, ray casting.
 #![allow(clippy::unwrap_used)]
 
+mod camera;
 mod polygon;
 mod ray;
 mod sampling;
