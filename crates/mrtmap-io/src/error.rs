@@ -1,0 +1,91 @@
+//! File errors that name the file (and line, or pixel) and say what is wrong.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// A problem with one file.
+#[derive(Debug, thiserror::Error)]
+pub struct FileError {
+    /// The file.
+    pub path: PathBuf,
+    /// 1-based line, where the problem is on one.
+    pub line: Option<usize>,
+    /// What is wrong.
+    pub kind: FileErrorKind,
+}
+
+impl fmt::Display for FileError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.line {
+            Some(l) => write!(f, "{}:{}: {}", self.path.display(), l, self.kind),
+            None => write!(f, "{}: {}", self.path.display(), self.kind),
+        }
+    }
+}
+
+/// What is wrong with a file.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum FileErrorKind {
+    /// The file could not be read or written.
+    #[error("{0}")]
+    Io(#[from] std::io::Error),
+    /// A line or value that does not parse.
+    #[error("{0}")]
+    Syntax(String),
+    /// A timestamp earlier than the one before it.
+    #[error("timestamp {t} goes backwards (the previous line has {previous})")]
+    TimestampBackwards {
+        /// This line's timestamp.
+        t: f64,
+        /// The previous one.
+        previous: f64,
+    },
+    /// A quaternion that is not unit length or not finite.
+    #[error("quaternion (x y z w) = {q:?} is not a unit quaternion (norm {norm})")]
+    BadQuaternion {
+        /// As written.
+        q: [f64; 4],
+        /// Its norm.
+        norm: f64,
+    },
+    /// An image whose size differs from the rig's.
+    #[error("image is {width}×{height} pixels but the rig says {expected_width}×{expected_height}")]
+    ImageSize {
+        /// Actual width.
+        width: u32,
+        /// Actual height.
+        height: u32,
+        /// Rig width.
+        expected_width: u32,
+        /// Rig height.
+        expected_height: u32,
+    },
+    /// An image that cannot be decoded or has the wrong pixel type.
+    #[error("{0}")]
+    Image(String),
+    /// A file listed in another that does not exist.
+    #[error("listed file {0} does not exist")]
+    Missing(String),
+}
+
+impl FileError {
+    /// An error in `path`, at `line` if given.
+    pub fn new(path: &Path, line: Option<usize>, kind: FileErrorKind) -> Self {
+        Self {
+            path: path.to_path_buf(),
+            line,
+            kind,
+        }
+    }
+
+    /// A syntax error at a line.
+    pub fn syntax(path: &Path, line: usize, msg: impl Into<String>) -> Self {
+        Self::new(path, Some(line), FileErrorKind::Syntax(msg.into()))
+    }
+
+    /// A read or write failure.
+    pub fn io(path: &Path, e: std::io::Error) -> Self {
+        Self::new(path, None, FileErrorKind::Io(e))
+    }
+}

@@ -1,0 +1,108 @@
+//! 16-bit single-channel images (depth, radiometric thermal, instance masks) and colour images.
+
+use std::path::Path;
+
+use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+use image::{ExtendedColorType, ImageEncoder, ImageReader};
+
+use crate::error::{FileError, FileErrorKind};
+
+/// A 16-bit single-channel image, row-major.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Image16 {
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    /// Pixels, row-major.
+    pub data: Vec<u16>,
+}
+
+impl Image16 {
+    /// A zero image.
+    pub fn zeros(width: u32, height: u32) -> Self {
+        Self {
+            width,
+            height,
+            data: vec![0; (width * height) as usize],
+        }
+    }
+
+    /// The pixel at (u, v).
+    pub fn get(&self, u: u32, v: u32) -> u16 {
+        self.data[(v * self.width + u) as usize]
+    }
+
+    /// Checks the size against the rig's.
+    pub fn check_size(&self, path: &Path, width: u32, height: u32) -> Result<(), FileError> {
+        if (self.width, self.height) != (width, height) {
+            return Err(FileError::new(
+                path,
+                None,
+                FileErrorKind::ImageSize {
+                    width: self.width,
+                    height: self.height,
+                    expected_width: width,
+                    expected_height: height,
+                },
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Reads a 16-bit single-channel PNG or TIFF. 8-bit or colour images are an error.
+pub fn read_image16(path: &Path) -> Result<Image16, FileError> {
+    let img = ImageReader::open(path)
+        .map_err(|e| FileError::io(path, e))?
+        .with_guessed_format()
+        .map_err(|e| FileError::io(path, e))?
+        .decode()
+        .map_err(|e| {
+            FileError::new(
+                path,
+                None,
+                FileErrorKind::Image(format!("cannot decode the image: {e}")),
+            )
+        })?;
+    match img {
+        image::DynamicImage::ImageLuma16(b) => {
+            let (w, h) = b.dimensions();
+            Ok(Image16 {
+                width: w,
+                height: h,
+                data: b.into_raw(),
+            })
+        }
+        other => Err(FileError::new(
+            path,
+            None,
+            FileErrorKind::Image(format!(
+                "expected a 16-bit single-channel image, found {:?}",
+                other.color()
+            )),
+        )),
+    }
+}
+
+/// Encodes a 16-bit single-channel PNG (fast compression).
+pub fn encode_png16(img: &Image16) -> Vec<u8> {
+    // image 0.25 takes 16-bit samples in native byte order and writes PNG's big-endian itself.
+    let mut bytes = Vec::with_capacity(2 * img.data.len());
+    for v in &img.data {
+        bytes.extend_from_slice(&v.to_ne_bytes());
+    }
+    let mut out = Vec::new();
+    let enc = PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Adaptive);
+    // Encoding into memory with a matching buffer cannot fail.
+    let _ = enc.write_image(&bytes, img.width, img.height, ExtendedColorType::L16);
+    out
+}
+
+/// Encodes an 8-bit RGB PNG (fast compression).
+pub fn encode_png_rgb8(width: u32, height: u32, rgb: &[u8]) -> Vec<u8> {
+    let mut out = Vec::new();
+    let enc = PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Adaptive);
+    let _ = enc.write_image(rgb, width, height, ExtendedColorType::Rgb8);
+    out
+}

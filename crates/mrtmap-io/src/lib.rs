@@ -1,0 +1,37 @@
+//! # mrtmap-io
+//!
+//! Every file format in and out of mrtmap's scan pipeline. Today: the recording layout
+//! (`shared/spec/recording.md`), with
+//!
+//! ```text
+//!  scan/
+//!    rig.toml          cameras and extrinsics          → Rig
+//!    depth.txt …       "timestamp path" stream lists   → Vec<StreamEntry>
+//!    trajectory.txt    TUM poses world_from_depth       → Trajectory (interpolated at frame times)
+//!    depth/ thermal/   16-bit PNG or TIFF               → Image16
+//!    masks.txt, masks/ instance PNG + labels JSON       → Image16 + MaskLabels
+//! ```
+//!
+//! Accepted beyond the spec: `masks.txt` (instance masks, see [`masks`]), `distortion` for the depth
+//! and colour cameras, duplicate timestamps in a trajectory (the first pose is kept). Errors name
+//! the file and line (or the image size); [`write_atomic`] and [`PartialDir`] make outputs appear
+//! only when complete.
+
+mod atomic;
+mod error;
+mod image16;
+pub mod masks;
+mod recording;
+mod rig;
+mod streams;
+mod trajectory;
+
+pub use atomic::{PartialDir, write_atomic};
+pub use error::{FileError, FileErrorKind};
+pub use image16::{Image16, encode_png_rgb8, encode_png16, read_image16};
+pub use recording::Recording;
+pub use rig::{PoseFile, RgbCamera, Rig, ThermalEncoding};
+pub use streams::{StreamEntry, parse_stream_list, stream_list_text};
+pub use trajectory::{
+    InterpolationLimits, QUATERNION_NORM_TOLERANCE, Trajectory, quaternion_xyzw, unit_quaternion,
+};

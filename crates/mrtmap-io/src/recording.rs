@@ -1,0 +1,157 @@
+//! The recording layout (a folder, version 1): `rig.toml`, stream lists, TUM trajectories,
+//! images. See `shared/spec/recording.md`; what this reader accepts beyond it is in the crate docs.
+
+use std::path::{Path, PathBuf};
+
+use crate::error::{FileError, FileErrorKind};
+use crate::image16::{Image16, read_image16};
+use crate::rig::Rig;
+use crate::streams::{StreamEntry, parse_stream_list};
+use crate::trajectory::{InterpolationLimits, Trajectory};
+
+/// An opened recording: rig, stream lists and trajectories, checked; images are read on demand.
+#[derive(Clone, Debug)]
+pub struct Recording {
+    /// The folder.
+    pub dir: PathBuf,
+    /// Cameras and extrinsics.
+    pub rig: Rig,
+    /// Depth frames.
+    pub depth: Vec<StreamEntry>,
+    /// Thermal frames.
+    pub thermal: Vec<StreamEntry>,
+    /// Colour frames (optional stream).
+    pub rgb: Vec<StreamEntry>,
+    /// Instance-mask frames (optional stream, see [`crate::masks`]).
+    pub masks: Vec<StreamEntry>,
+    /// world_from_depth poses.
+    pub trajectory: Trajectory,
+    /// True poses, when the recording has them (simulated scans).
+    pub groundtruth: Option<Trajectory>,
+    /// Things worth knowing that do not stop a scan from being used.
+    pub warnings: Vec<String>,
+}
+
+fn list(dir: &Path, name: &str, required: bool) -> Result<Vec<StreamEntry>, FileError> {
+    let p = dir.join(name);
+    if !p.exists() {
+        return if required {
+            Err(FileError::new(
+                &p,
+                None,
+                FileErrorKind::Missing(format!("{name} (a recording needs it)")),
+            ))
+        } else {
+            Ok(Vec::new())
+        };
+    }
+    let text = std::fs::read_to_string(&p).map_err(|e| FileError::io(&p, e))?;
+    let entries = parse_stream_list(&text, &p)?;
+    for e in &entries {
+        if !dir.join(&e.path).is_file() {
+            return Err(FileError::new(
+                &p,
+                Some(e.line),
+                FileErrorKind::Missing(e.path.display().to_string()),
+            ));
+        }
+    }
+    Ok(entries)
+}
+
+impl Recording {
+    /// Opens and checks a recording folder.
+    pub fn open(dir: &Path) -> Result<Self, FileError> {
+        if !dir.is_dir() {
+            return Err(FileError::new(
+                dir,
+                None,
+                FileErrorKind::Io(std::io::Error::new(
+                    std::io::ErrorKind::NotFound,
+                    "not a recording folder",
+                )),
+            ));
+        }
+        let rig_path = dir.join("rig.toml");
+        if !rig_path.exists() {
+            return Err(FileError::new(
+                &rig_path,
+                None,
+                FileErrorKind::Missing("rig.toml (a recording needs it)".into()),
+            ));
+        }
+        let rig = Rig::read(&rig_path)?;
+        let depth = list(dir, "depth.txt", true)?;
+        let thermal = list(dir, "thermal.txt", true)?;
+        let rgb = list(dir, "rgb.txt", false)?;
+        let masks = list(dir, "masks.txt", false)?;
+        let traj_path = dir.join("trajectory.txt");
+        if !traj_path.exists() {
+            return Err(FileError::new(
+                &traj_path,
+                None,
+                FileErrorKind::Missing("trajectory.txt (a recording needs it)".into()),
+            ));
+        }
+        let trajectory = Trajectory::read(&traj_path)?;
+        let gt_path = dir.join("groundtruth.txt");
+        let groundtruth = if gt_path.exists() {
+            Some(Trajectory::read(&gt_path)?)
+        } else {
+            None
+        };
+        let mut warnings = Vec::new();
+        if depth.is_empty() {
+            warnings.push("depth.txt lists no frames".to_string());
+        }
+        if thermal.is_empty() {
+            warnings.push("thermal.txt lists no frames".to_string());
+        }
+        if trajectory.is_empty() {
+            warnings.push("trajectory.txt has no poses".to_string());
+        }
+        let limits = InterpolationLimits::default();
+        let uncovered = thermal
+            .iter()
+            .filter(|e| trajectory.interpolate(e.t, &limits).is_none())
+            .count();
+        if uncovered > 0 && !trajectory.is_empty() {
+            warnings.push(format!(
+                "{uncovered} of {} thermal frames have no pose within the trajectory",
+                thermal.len()
+            ));
+        }
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            rig,
+            depth,
+            thermal,
+            rgb,
+            masks,
+            trajectory,
+            groundtruth,
+            warnings,
+        })
+    }
+
+    /// Absolute path of a listed frame.
+    pub fn path_of(&self, e: &StreamEntry) -> PathBuf {
+        self.dir.join(&e.path)
+    }
+
+    /// Reads a depth frame (raw units; divide by `rig.depth_scale` for metres), checking its size.
+    pub fn read_depth(&self, e: &StreamEntry) -> Result<Image16, FileError> {
+        let p = self.path_of(e);
+        let img = read_image16(&p)?;
+        img.check_size(&p, self.rig.depth.width, self.rig.depth.height)?;
+        Ok(img)
+    }
+
+    /// Reads a thermal frame (raw; see `rig.thermal_encoding`), checking its size.
+    pub fn read_thermal(&self, e: &StreamEntry) -> Result<Image16, FileError> {
+        let p = self.path_of(e);
+        let img = read_image16(&p)?;
+        img.check_size(&p, self.rig.thermal.width, self.rig.thermal.height)?;
+        Ok(img)
+    }
+}

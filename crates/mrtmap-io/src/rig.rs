@@ -1,0 +1,285 @@
+//! `rig.toml`: the cameras of a recording and how they sit relative to the depth camera.
+
+use std::path::Path;
+
+use mrtmap_geometry::camera::{BrownConrady, PinholeCamera};
+use mrtmap_geometry::nalgebra::{Isometry3, Translation3};
+use serde::{Deserialize, Serialize};
+
+use crate::error::{FileError, FileErrorKind};
+use crate::trajectory::{quaternion_xyzw, unit_quaternion};
+
+/// A rigid transform as written in rig.toml.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PoseFile {
+    /// Translation (m).
+    pub translation: [f64; 3],
+    /// Rotation quaternion (x, y, z, w).
+    pub rotation_xyzw: [f64; 4],
+}
+
+impl PoseFile {
+    /// From an isometry.
+    pub fn from_isometry(p: &Isometry3<f64>) -> Self {
+        let t = p.translation.vector;
+        Self {
+            translation: [t.x, t.y, t.z],
+            rotation_xyzw: quaternion_xyzw(&p.rotation),
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+struct DepthSection {
+    width: u32,
+    height: u32,
+    fx: f64,
+    fy: f64,
+    cx: f64,
+    cy: f64,
+    depth_scale: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    distortion: Option<[f64; 5]>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+struct ThermalSection {
+    width: u32,
+    height: u32,
+    fx: f64,
+    fy: f64,
+    cx: f64,
+    cy: f64,
+    #[serde(default)]
+    distortion: [f64; 5],
+    encoding: String,
+    depth_from_thermal: PoseFile,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+struct RgbSection {
+    width: u32,
+    height: u32,
+    fx: f64,
+    fy: f64,
+    cx: f64,
+    cy: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    distortion: Option<[f64; 5]>,
+    depth_from_rgb: PoseFile,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+struct RigFile {
+    depth: DepthSection,
+    thermal: ThermalSection,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    rgb: Option<RgbSection>,
+}
+
+/// How thermal pixel values encode temperature.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ThermalEncoding {
+    /// 16-bit, value / 100 = kelvin (FLIR Lepton TLinear).
+    Centikelvin,
+}
+
+impl ThermalEncoding {
+    /// The rig.toml name.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Centikelvin => "centikelvin",
+        }
+    }
+
+    /// Kelvin of a raw value.
+    pub fn kelvin(self, raw: u16) -> f64 {
+        match self {
+            Self::Centikelvin => raw as f64 / 100.0,
+        }
+    }
+
+    /// Raw value of a temperature in kelvin (rounded, saturating).
+    pub fn raw(self, kelvin: f64) -> u16 {
+        match self {
+            Self::Centikelvin => (kelvin * 100.0).round().clamp(0.0, u16::MAX as f64) as u16,
+        }
+    }
+}
+
+/// The colour camera of a rig.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RgbCamera {
+    /// Intrinsics.
+    pub camera: PinholeCamera,
+    /// p_in_depth = depth_from_rgb · p_in_rgb.
+    pub depth_from_rgb: Isometry3<f64>,
+}
+
+/// A validated rig.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rig {
+    /// Depth camera intrinsics.
+    pub depth: PinholeCamera,
+    /// Raw depth units per metre (RealSense 1000, TUM 5000).
+    pub depth_scale: f64,
+    /// Thermal camera intrinsics and distortion.
+    pub thermal: PinholeCamera,
+    /// Thermal pixel encoding.
+    pub thermal_encoding: ThermalEncoding,
+    /// p_in_depth = depth_from_thermal · p_in_thermal.
+    pub depth_from_thermal: Isometry3<f64>,
+    /// Optional colour camera.
+    pub rgb: Option<RgbCamera>,
+}
+
+fn camera(
+    section: &str,
+    w: u32,
+    h: u32,
+    k: [f64; 4],
+    d: [f64; 5],
+) -> Result<PinholeCamera, String> {
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(format!(
+            "[{section}] image size {w}×{h} is not between 1 and 16384 pixels"
+        ));
+    }
+    if k.iter().chain(d.iter()).any(|x| !x.is_finite()) {
+        return Err(format!("[{section}] a value is not a finite number"));
+    }
+    if k[0] <= 0.0 || k[1] <= 0.0 {
+        return Err(format!(
+            "[{section}] focal lengths must be positive, got fx {} fy {}",
+            k[0], k[1]
+        ));
+    }
+    let mut c = PinholeCamera::new(w, h, k[0], k[1], k[2], k[3]);
+    c.distortion = BrownConrady::from_array(d);
+    Ok(c)
+}
+
+fn pose(section: &str, p: &PoseFile) -> Result<Isometry3<f64>, String> {
+    if p.translation.iter().any(|x| !x.is_finite()) {
+        return Err(format!("{section}: translation is not finite"));
+    }
+    let q = unit_quaternion(p.rotation_xyzw).map_err(|e| format!("{section}: {e}"))?;
+    Ok(Isometry3::from_parts(
+        Translation3::new(p.translation[0], p.translation[1], p.translation[2]),
+        q,
+    ))
+}
+
+impl Rig {
+    /// Parses rig.toml text.
+    pub fn parse(text: &str, path: &Path) -> Result<Self, FileError> {
+        let f: RigFile = toml::from_str(text).map_err(|e| {
+            let line = e
+                .span()
+                .map(|s| text[..s.start.min(text.len())].lines().count().max(1));
+            FileError::new(path, line, FileErrorKind::Syntax(e.message().to_string()))
+        })?;
+        let bad = |m: String| FileError::new(path, None, FileErrorKind::Syntax(m));
+        let d = &f.depth;
+        let depth = camera(
+            "depth",
+            d.width,
+            d.height,
+            [d.fx, d.fy, d.cx, d.cy],
+            d.distortion.unwrap_or_default(),
+        )
+        .map_err(bad)?;
+        if !(d.depth_scale.is_finite() && d.depth_scale > 0.0) {
+            return Err(bad(format!(
+                "[depth] depth_scale must be positive, got {}",
+                d.depth_scale
+            )));
+        }
+        let t = &f.thermal;
+        let thermal = camera(
+            "thermal",
+            t.width,
+            t.height,
+            [t.fx, t.fy, t.cx, t.cy],
+            t.distortion,
+        )
+        .map_err(bad)?;
+        let thermal_encoding = match t.encoding.as_str() {
+            "centikelvin" => ThermalEncoding::Centikelvin,
+            other => {
+                return Err(bad(format!(
+                    "[thermal] unknown encoding '{other}' (supported: centikelvin)"
+                )));
+            }
+        };
+        let depth_from_thermal =
+            pose("[thermal] depth_from_thermal", &t.depth_from_thermal).map_err(bad)?;
+        let rgb = match &f.rgb {
+            None => None,
+            Some(r) => Some(RgbCamera {
+                camera: camera(
+                    "rgb",
+                    r.width,
+                    r.height,
+                    [r.fx, r.fy, r.cx, r.cy],
+                    r.distortion.unwrap_or_default(),
+                )
+                .map_err(bad)?,
+                depth_from_rgb: pose("[rgb] depth_from_rgb", &r.depth_from_rgb).map_err(bad)?,
+            }),
+        };
+        Ok(Self {
+            depth,
+            depth_scale: d.depth_scale,
+            thermal,
+            thermal_encoding,
+            depth_from_thermal,
+            rgb,
+        })
+    }
+
+    /// Reads rig.toml.
+    pub fn read(path: &Path) -> Result<Self, FileError> {
+        let text = std::fs::read_to_string(path).map_err(|e| FileError::io(path, e))?;
+        Self::parse(&text, path)
+    }
+
+    /// rig.toml text.
+    pub fn to_toml(&self) -> String {
+        let dist = |c: &PinholeCamera| (!c.distortion.is_zero()).then(|| c.distortion.to_array());
+        let f = RigFile {
+            depth: DepthSection {
+                width: self.depth.width,
+                height: self.depth.height,
+                fx: self.depth.fx,
+                fy: self.depth.fy,
+                cx: self.depth.cx,
+                cy: self.depth.cy,
+                depth_scale: self.depth_scale,
+                distortion: dist(&self.depth),
+            },
+            thermal: ThermalSection {
+                width: self.thermal.width,
+                height: self.thermal.height,
+                fx: self.thermal.fx,
+                fy: self.thermal.fy,
+                cx: self.thermal.cx,
+                cy: self.thermal.cy,
+                distortion: self.thermal.distortion.to_array(),
+                encoding: self.thermal_encoding.as_str().to_string(),
+                depth_from_thermal: PoseFile::from_isometry(&self.depth_from_thermal),
+            },
+            rgb: self.rgb.map(|r| RgbSection {
+                width: r.camera.width,
+                height: r.camera.height,
+                fx: r.camera.fx,
+                fy: r.camera.fy,
+                cx: r.camera.cx,
+                cy: r.camera.cy,
+                distortion: dist(&r.camera),
+                depth_from_rgb: PoseFile::from_isometry(&r.depth_from_rgb),
+            }),
+        };
+        toml::to_string(&f).unwrap_or_default()
+    }
+}
