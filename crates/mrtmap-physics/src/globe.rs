@@ -247,9 +247,7 @@ pub fn mrt_from_globe(
     reading: &GlobeReading,
     method: GlobeMethod,
 ) -> Result<GlobeMrt, PhysicsError> {
-    let (h, formula) = globe_convection(globe, reading, method)?;
-    let dt = reading.globe.kelvin() - reading.air.kelvin();
-    let t4 = reading.globe.fourth_power() + h * dt / (globe.emissivity * STEFAN_BOLTZMANN);
+    let (t4, h, formula) = mrt4_from_globe(globe, reading, method)?;
     if t4 <= 0.0 {
         return Err(PhysicsError::OutOfRange {
             name: "Tr⁴ (the reading implies no radiant temperature)",
@@ -263,6 +261,21 @@ pub fn mrt_from_globe(
         formula,
         h_w_m2k: h,
     })
+}
+
+/// Tr⁴ = Tg⁴ + h(Tg − Ta)/(εσ), which may be negative for readings no radiant field can produce.
+fn mrt4_from_globe(
+    globe: &Globe,
+    reading: &GlobeReading,
+    method: GlobeMethod,
+) -> Result<(f64, f64, GlobeFormula), PhysicsError> {
+    let (h, formula) = globe_convection(globe, reading, method)?;
+    let dt = reading.globe.kelvin() - reading.air.kelvin();
+    Ok((
+        reading.globe.fourth_power() + h * dt / (globe.emissivity * STEFAN_BOLTZMANN),
+        h,
+        formula,
+    ))
 }
 
 /// The temperature a globe would read at mean radiant temperature `mrt`, air temperature `air` and
@@ -283,16 +296,19 @@ pub fn globe_temperature(
     // Validate inputs once (at the air temperature, where Tr = Ta).
     globe_convection(globe, &reading(air.kelvin()), method)?;
     let target = mrt.kelvin();
+    let target4 = mrt.fourth_power();
     let (mut lo, mut hi) = if target >= air.kelvin() {
         (air.kelvin(), target)
     } else {
         (target, air.kelvin())
     };
-    // Tr(Tg) increases with Tg and Tg lies between Ta and Tr.
+    // Tr⁴(Tg) increases with Tg and Tg lies between Ta and Tr. Tr⁴ is compared directly: near a
+    // cold Tr with warm, fast air it is negative (no radiant field gives such a reading), which
+    // only means the root lies higher.
     for _ in 0..200 {
         let mid = 0.5 * (lo + hi);
-        let tr = mrt_from_globe(globe, &reading(mid), method)?.mrt.kelvin();
-        if tr < target {
+        let (tr4, _, _) = mrt4_from_globe(globe, &reading(mid), method)?;
+        if tr4 < target4 {
             lo = mid;
         } else {
             hi = mid;
