@@ -29,6 +29,81 @@ pub enum Command {
     Globe(GlobeArgs),
     /// Write the built-in example scene (an office with a cold window) as scene.json.
     ExampleScene(ExampleSceneArgs),
+    /// Simulate a handheld thermal + RGB-D scan of a room, with exact truth.
+    Simulate(SimulateArgs),
+    /// List the preset rooms, or print one as TOML to start your own.
+    Rooms(RoomsArgs),
+}
+
+/// Sensor noise of a simulation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum NoiseArg {
+    /// Exact depth (to 1 mm), exact thermal (to 0.01 K), exact labels.
+    None,
+    /// D435i-like depth noise and invalid pixels, Lepton-like NETD and blur, detector-like labels.
+    Realistic,
+}
+
+/// SLAM drift of a simulation's trajectory.txt.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum DriftArg {
+    /// trajectory.txt equals groundtruth.txt.
+    None,
+    /// Visual SLAM without loop closure: 4 mm/√s in position, 0.03°/√s in heading.
+    Slam,
+    /// Plain odometry: 1 cm/√s, 0.1°/√s.
+    Odometry,
+}
+
+/// `mrtmap simulate`.
+#[derive(Debug, Args)]
+pub struct SimulateArgs {
+    /// A preset room (office, l-shaped, radiant-ceiling; see `mrtmap rooms`) or a room TOML file.
+    #[arg(long, default_value = "office")]
+    pub room: String,
+    /// Output folder for the recording (written as DIR.partial, renamed when complete).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Length of the scan (s); the seed paper's took 343 s.
+    #[arg(long, default_value_t = 343.0)]
+    pub seconds: f64,
+    /// Random seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Sensor noise.
+    #[arg(long, value_enum, default_value_t = NoiseArg::Realistic)]
+    pub noise: NoiseArg,
+    /// SLAM drift in trajectory.txt (groundtruth.txt always has the true poses).
+    #[arg(long, value_enum, default_value_t = DriftArg::None)]
+    pub drift: DriftArg,
+    /// Constant thermal camera offset (K), added to every reading.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub thermal_bias: f64,
+    /// Thermal optical blur, Gaussian σ in pixels (realistic noise only).
+    #[arg(long, default_value_t = 0.5)]
+    pub thermal_blur: f64,
+    /// Depth (and colour) image size, WIDTHxHEIGHT; intrinsics scale with it.
+    #[arg(long, default_value = "640x480", value_parser = parse_grid)]
+    pub depth_size: (usize, usize),
+    /// Depth frame rate (Hz).
+    #[arg(long, default_value_t = 30.0)]
+    pub depth_hz: f64,
+    /// Thermal frame rate (Hz).
+    #[arg(long, default_value_t = 8.7)]
+    pub thermal_hz: f64,
+    /// Colour and instance-mask frame rate (Hz).
+    #[arg(long, default_value_t = 5.0)]
+    pub rgb_hz: f64,
+    /// Monte Carlo rays per truth point (rooms with furniture or not convex).
+    #[arg(long, default_value_t = 100_000)]
+    pub truth_rays: usize,
+}
+
+/// `mrtmap rooms`.
+#[derive(Debug, Args)]
+pub struct RoomsArgs {
+    /// Print this preset as TOML.
+    pub name: Option<String>,
 }
 
 /// Where the scene comes from.
@@ -196,7 +271,7 @@ fn parse_point(s: &str) -> Result<[f64; 3], String> {
     Ok([v[0], v[1], v[2]])
 }
 
-fn parse_grid(s: &str) -> Result<(usize, usize), String> {
+pub(crate) fn parse_grid(s: &str) -> Result<(usize, usize), String> {
     let bad = || format!("expected COLSxROWS such as 20x20, got '{s}'");
     let (a, b) = s.split_once(['x', 'X', '×']).ok_or_else(bad)?;
     let (a, b) = (

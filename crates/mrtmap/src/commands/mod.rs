@@ -4,6 +4,7 @@ mod example_scene;
 mod globe;
 mod map;
 mod mrt;
+mod simulate;
 
 use anyhow::bail;
 use mrtmap_geometry::sampling::DirectionSet;
@@ -18,6 +19,8 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Mrt(a) => mrt::run(&a),
         Command::Globe(a) => globe::run(&a),
         Command::ExampleScene(a) => example_scene::run(&a),
+        Command::Simulate(a) => simulate::run(&a),
+        Command::Rooms(a) => simulate::rooms(&a),
     }
 }
 

@@ -1,0 +1,68 @@
+//! # mrtmap-sim
+//!
+//! Synthetic rooms and a handheld scan simulator with exact truth: the embedded default that the
+//! scan pipeline is tested and demonstrated on.
+//!
+//! ```text
+//!  room.toml ──► Room ──► scene (exact MRT truth) ─────────────────────────► truth.json
+//!                  │
+//!                  └──► Walk ──► depth (30 Hz) / thermal (8.7 Hz) / colour + masks / poses (200 Hz)
+//!                                   └──► recording folder (shared/spec/recording.md)
+//! ```
+//!
+//! The world frame of a recording is the depth camera's frame at the first pose (as with a SLAM
+//! system), so it is neither the room frame nor z-up; `truth.json` gives `world_from_room`.
+
+mod render;
+mod room;
+mod sensors;
+mod simulate;
+mod truth;
+mod walk;
+
+pub use render::{Element, Hit, RoomRenderer, temperature_at};
+pub use room::{
+    FeatureSpec, FurnitureSpec, GRADIENT_STRIP_M, PRESETS, PlacedFeature, PointSpec, Room,
+    RoomError, RoomFile, SurfaceRef, TemperaturesFile, WallFile, preset,
+};
+pub use sensors::{
+    DepthNoise, ThermalNoise, camera_rays, instance_label, instance_of, render_depth,
+    render_rgb_and_mask, render_thermal,
+};
+pub use simulate::{Drift, NoiseLevel, Progress, SimConfig, SimSummary, TIME_ORIGIN_S, simulate};
+pub use truth::{TRUTH_FORMAT, Truth, TruthGrid, TruthNode, TruthPoint, compute_truth};
+pub use walk::{Walk, WalkParams, inset_polygon};
+
+/// Why a simulation failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SimError {
+    /// Bad settings.
+    #[error("{0}")]
+    Config(String),
+    /// The room is invalid.
+    #[error(transparent)]
+    Room(#[from] RoomError),
+    /// A scene rule failed.
+    #[error(transparent)]
+    Scene(#[from] mrtmap_radiation::SceneError),
+    /// The truth could not be computed.
+    #[error("truth: {0}")]
+    Truth(#[from] mrtmap_radiation::MrtError),
+    /// The truth grid could not be laid out.
+    #[error("truth grid: {0}")]
+    Field(#[from] mrtmap_radiation::FieldError),
+    /// Writing failed.
+    #[error("cannot write {}: {source}", path.display())]
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// A file error.
+    #[error(transparent)]
+    File(#[from] mrtmap_io::FileError),
+}
+
+use std::path::PathBuf;

@@ -1,0 +1,706 @@
+//! Room descriptions (TOML) and their conversion to radiant scenes.
+//!
+//! A room is a floor plan (a simple polygon, metres) extruded to a height, with a temperature per
+//! wall, floor and ceiling (walls optionally with a vertical gradient), features on any surface,
+//! furniture boxes, the air temperature and named validation points. Coordinates are the room
+//! frame: z up, the floor at z = 0. Wall `i` runs from `floor_plan[i]` to `floor_plan[i + 1]`.
+
+use mrtmap_geometry::nalgebra::{Isometry3, Point2, Point3, Vector3};
+use mrtmap_geometry::polygon::{self, Containment};
+use mrtmap_radiation::{
+    FeatureFile, OccluderFile, RadiantScene, SCENE_FORMAT, SceneError, SceneFile, SurfaceFile,
+};
+use serde::{Deserialize, Serialize};
+
+/// Largest height of a strip when a wall with a gradient is cut into uniform strips (m).
+pub const GRADIENT_STRIP_M: f64 = 0.05;
+
+/// Surface temperatures.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TemperaturesFile {
+    /// Floor (°C).
+    pub floor_c: f64,
+    /// Ceiling (°C).
+    pub ceiling_c: f64,
+    /// Every wall unless overridden (°C, at mid-height).
+    pub walls_c: f64,
+    /// Vertical gradient of every wall unless overridden (K/m, positive = warmer up).
+    #[serde(default)]
+    pub wall_gradient_k_per_m: f64,
+}
+
+/// A per-wall override.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct WallFile {
+    /// Wall index (edge of the floor plan).
+    pub index: usize,
+    /// Temperature at mid-height (°C).
+    #[serde(default)]
+    pub temperature_c: Option<f64>,
+    /// Vertical gradient (K/m).
+    #[serde(default)]
+    pub gradient_k_per_m: Option<f64>,
+    /// Label (default "wall").
+    #[serde(default)]
+    pub label: Option<String>,
+}
+
+/// A feature: a rectangle or polygon on a surface with its own temperature.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FeatureSpec {
+    /// "floor", "ceiling" or "wall N".
+    pub on: String,
+    /// Semantic label (window, recessed light, painting, radiator, door…).
+    pub label: String,
+    /// Temperature (°C).
+    pub temperature_c: f64,
+    /// On a wall [s, z, width, height] (s along the wall from its start, z above the floor); on the
+    /// floor or ceiling [x, y, width, depth] in plan coordinates.
+    #[serde(default)]
+    pub rect: Option<[f64; 4]>,
+    /// Or a polygon in the same 2D coordinates.
+    #[serde(default)]
+    pub polygon: Option<Vec<[f64; 2]>>,
+}
+
+/// A furniture box (an occluder with a temperature).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FurnitureSpec {
+    /// Label.
+    pub label: String,
+    /// Lower corner (room frame).
+    pub min: [f64; 3],
+    /// Upper corner.
+    pub max: [f64; 3],
+    /// Temperature (°C).
+    pub temperature_c: f64,
+}
+
+/// A named validation point (where a globe thermometer would stand).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PointSpec {
+    /// Name (A, B…).
+    pub name: String,
+    /// Plan position (m).
+    pub xy: [f64; 2],
+    /// Height above the floor (m).
+    #[serde(default = "head_height")]
+    pub height_m: f64,
+}
+
+fn head_height() -> f64 {
+    1.1
+}
+
+/// A room description as written in TOML.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RoomFile {
+    /// Name.
+    pub name: String,
+    /// What it is.
+    #[serde(default)]
+    pub description: String,
+    /// Floor-to-ceiling height (m).
+    pub height_m: f64,
+    /// Air temperature (°C).
+    pub air_temperature_c: f64,
+    /// Floor plan vertices (m), either winding.
+    pub floor_plan: Vec<[f64; 2]>,
+    /// Surface temperatures.
+    pub temperatures: TemperaturesFile,
+    /// Per-wall overrides.
+    #[serde(default)]
+    pub walls: Vec<WallFile>,
+    /// Features.
+    #[serde(default)]
+    pub features: Vec<FeatureSpec>,
+    /// Furniture.
+    #[serde(default)]
+    pub furniture: Vec<FurnitureSpec>,
+    /// Validation points.
+    #[serde(default)]
+    pub points: Vec<PointSpec>,
+}
+
+/// Why a room description is invalid.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RoomError {
+    /// TOML syntax or shape.
+    #[error("{0}")]
+    Toml(String),
+    /// A rule broken.
+    #[error("{0}")]
+    Invalid(String),
+    /// The scene built from it is invalid.
+    #[error("the room makes an invalid scene: {0}")]
+    Scene(#[from] SceneError),
+}
+
+/// Which surface of the room.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SurfaceRef {
+    /// The floor.
+    Floor,
+    /// The ceiling.
+    Ceiling,
+    /// Wall `i`.
+    Wall(usize),
+}
+
+/// A feature placed in 3D.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlacedFeature {
+    /// Id ("window-1"…).
+    pub id: String,
+    /// Label.
+    pub label: String,
+    /// Host surface.
+    pub on: SurfaceRef,
+    /// Polygon in the host's 2D coordinates (see [`Room::surface_frame`]).
+    pub polygon_2d: Vec<Point2<f64>>,
+    /// Temperature (°C).
+    pub temperature_c: f64,
+}
+
+/// A validated room.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Room {
+    /// The description it came from.
+    pub file: RoomFile,
+    /// Floor plan, counter-clockwise seen from above.
+    pub plan: Vec<Point2<f64>>,
+    /// Whether the plan is convex.
+    pub convex: bool,
+    /// Wall temperatures at mid-height (°C) and gradients (K/m), by wall index.
+    pub walls: Vec<(f64, f64, String)>,
+    /// Features placed on their surfaces.
+    pub features: Vec<PlacedFeature>,
+}
+
+fn finite(name: &str, v: f64) -> Result<f64, RoomError> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(RoomError::Invalid(format!("{name} is not a finite number")))
+    }
+}
+
+impl Room {
+    /// Parses and validates TOML text.
+    pub fn from_toml(text: &str) -> Result<Self, RoomError> {
+        let file: RoomFile = toml::from_str(text).map_err(|e| {
+            let line = e
+                .span()
+                .map(|s| text[..s.start.min(text.len())].lines().count().max(1));
+            RoomError::Toml(match line {
+                Some(l) => format!("line {l}: {}", e.message()),
+                None => e.message().to_string(),
+            })
+        })?;
+        Self::new(file)
+    }
+
+    /// Validates a room description.
+    pub fn new(file: RoomFile) -> Result<Self, RoomError> {
+        let inv = |m: String| RoomError::Invalid(m);
+        finite("height_m", file.height_m)?;
+        if !(1.5..=20.0).contains(&file.height_m) {
+            return Err(inv(format!(
+                "height_m {} is outside 1.5…20 m",
+                file.height_m
+            )));
+        }
+        finite("air_temperature_c", file.air_temperature_c)?;
+        if file.floor_plan.len() < 3 {
+            return Err(inv("floor_plan needs at least 3 vertices".into()));
+        }
+        let mut plan: Vec<Point2<f64>> = file
+            .floor_plan
+            .iter()
+            .map(|p| Point2::new(p[0], p[1]))
+            .collect();
+        if plan.iter().any(|p| !p.x.is_finite() || !p.y.is_finite()) {
+            return Err(inv("floor_plan has a coordinate that is not finite".into()));
+        }
+        polygon::check_simple(&plan, 1e-6)
+            .map_err(|e| inv(format!("floor_plan is not a simple polygon ({e:?})")))?;
+        let reversed = polygon::signed_area(&plan) < 0.0;
+        if reversed {
+            plan.reverse();
+        }
+        let n = plan.len();
+        let convex = (0..n).all(|i| {
+            let (a, b, c) = (plan[i], plan[(i + 1) % n], plan[(i + 2) % n]);
+            (b - a).perp(&(c - b)) >= -1e-12
+        });
+        // Wall indices follow the file's order; after reversing, file wall i is plan edge n-2-i.
+        let plan_wall = |i: usize| if reversed { (2 * n - 2 - i) % n } else { i };
+        let t = &file.temperatures;
+        for (name, v) in [
+            ("floor_c", t.floor_c),
+            ("ceiling_c", t.ceiling_c),
+            ("walls_c", t.walls_c),
+            ("wall_gradient_k_per_m", t.wall_gradient_k_per_m),
+        ] {
+            finite(name, v)?;
+        }
+        let mut walls: Vec<(f64, f64, String)> =
+            vec![(t.walls_c, t.wall_gradient_k_per_m, "wall".to_string()); n];
+        for w in &file.walls {
+            if w.index >= n {
+                return Err(inv(format!(
+                    "[[walls]] index {} does not exist (the plan has {n} walls, 0…{})",
+                    w.index,
+                    n - 1
+                )));
+            }
+            let e = &mut walls[plan_wall(w.index)];
+            if let Some(v) = w.temperature_c {
+                e.0 = finite("wall temperature_c", v)?;
+            }
+            if let Some(g) = w.gradient_k_per_m {
+                e.1 = finite("wall gradient_k_per_m", g)?;
+            }
+            if let Some(l) = &w.label {
+                e.2 = l.clone();
+            }
+        }
+        let mut counts = std::collections::HashMap::<String, usize>::new();
+        let mut features = Vec::new();
+        for (k, f) in file.features.iter().enumerate() {
+            let on = match f.on.trim() {
+                "floor" => SurfaceRef::Floor,
+                "ceiling" => SurfaceRef::Ceiling,
+                s => {
+                    let idx = s
+                        .strip_prefix("wall")
+                        .and_then(|x| x.trim().parse::<usize>().ok())
+                        .filter(|i| *i < n)
+                        .ok_or_else(|| {
+                            inv(format!(
+                                "feature {} ('{}'): on = '{}' is not floor, ceiling or wall 0…{}",
+                                k + 1,
+                                f.label,
+                                f.on,
+                                n - 1
+                            ))
+                        })?;
+                    SurfaceRef::Wall(plan_wall(idx))
+                }
+            };
+            let poly: Vec<Point2<f64>> = match (&f.rect, &f.polygon) {
+                (Some(r), None) => {
+                    if r.iter().any(|x| !x.is_finite()) || r[2] <= 0.0 || r[3] <= 0.0 {
+                        return Err(inv(format!(
+                            "feature {} ('{}'): rect {:?} needs a positive width and height",
+                            k + 1,
+                            f.label,
+                            r
+                        )));
+                    }
+                    vec![
+                        Point2::new(r[0], r[1]),
+                        Point2::new(r[0] + r[2], r[1]),
+                        Point2::new(r[0] + r[2], r[1] + r[3]),
+                        Point2::new(r[0], r[1] + r[3]),
+                    ]
+                }
+                (None, Some(p)) => p.iter().map(|q| Point2::new(q[0], q[1])).collect(),
+                _ => {
+                    return Err(inv(format!(
+                        "feature {} ('{}'): give either rect or polygon",
+                        k + 1,
+                        f.label
+                    )));
+                }
+            };
+            // Walls with a reversed plan run the other way: mirror s.
+            let poly = match on {
+                SurfaceRef::Wall(i) if reversed => {
+                    let len = (plan[(i + 1) % n] - plan[i]).norm();
+                    poly.iter().map(|q| Point2::new(len - q.x, q.y)).collect()
+                }
+                _ => poly,
+            };
+            finite("feature temperature_c", f.temperature_c)?;
+            let slug: String = f
+                .label
+                .to_lowercase()
+                .split_whitespace()
+                .collect::<Vec<_>>()
+                .join("-");
+            let c = counts.entry(slug.clone()).or_default();
+            *c += 1;
+            features.push(PlacedFeature {
+                id: format!("{slug}-{c}"),
+                label: f.label.clone(),
+                on,
+                polygon_2d: poly,
+                temperature_c: f.temperature_c,
+            });
+        }
+        for (k, b) in file.furniture.iter().enumerate() {
+            if (0..3)
+                .any(|i| !(b.min[i].is_finite() && b.max[i].is_finite() && b.min[i] < b.max[i]))
+            {
+                return Err(inv(format!(
+                    "furniture {} ('{}'): min {:?} must be below max {:?}",
+                    k + 1,
+                    b.label,
+                    b.min,
+                    b.max
+                )));
+            }
+            finite("furniture temperature_c", b.temperature_c)?;
+        }
+        for p in &file.points {
+            let q = Point2::new(p.xy[0], p.xy[1]);
+            if polygon::point_in_polygon(&q, &plan, 1e-3) != Containment::Inside
+                || !(0.0..file.height_m).contains(&p.height_m)
+            {
+                return Err(inv(format!(
+                    "point {} at {:?}, {} m is not inside the room",
+                    p.name, p.xy, p.height_m
+                )));
+            }
+        }
+        let room = Self {
+            file,
+            plan,
+            convex,
+            walls,
+            features,
+        };
+        // Validate the geometry through the scene rules (features inside hosts, no overlaps…).
+        room.scene(&Isometry3::identity(), false)?;
+        Ok(room)
+    }
+
+    /// Number of walls.
+    pub fn wall_count(&self) -> usize {
+        self.plan.len()
+    }
+
+    /// Height.
+    pub fn height(&self) -> f64 {
+        self.file.height_m
+    }
+
+    /// A surface's 2D frame: origin, first axis, second axis (room frame). Walls: s along the wall
+    /// from its start, z up. Floor and ceiling: plan x, y.
+    pub fn surface_frame(&self, s: SurfaceRef) -> (Point3<f64>, Vector3<f64>, Vector3<f64>) {
+        match s {
+            SurfaceRef::Floor => (Point3::origin(), Vector3::x(), Vector3::y()),
+            SurfaceRef::Ceiling => (
+                Point3::new(0.0, 0.0, self.height()),
+                Vector3::x(),
+                Vector3::y(),
+            ),
+            SurfaceRef::Wall(i) => {
+                let (a, b) = (self.plan[i], self.plan[(i + 1) % self.plan.len()]);
+                let d = (b - a).normalize();
+                (
+                    Point3::new(a.x, a.y, 0.0),
+                    Vector3::new(d.x, d.y, 0.0),
+                    Vector3::z(),
+                )
+            }
+        }
+    }
+
+    /// 3D point of 2D coordinates on a surface.
+    pub fn on_surface(&self, s: SurfaceRef, q: &Point2<f64>) -> Point3<f64> {
+        let (o, u, v) = self.surface_frame(s);
+        o + u * q.x + v * q.y
+    }
+
+    /// A surface's polygon in its 2D coordinates.
+    pub fn surface_polygon_2d(&self, s: SurfaceRef) -> Vec<Point2<f64>> {
+        match s {
+            SurfaceRef::Floor | SurfaceRef::Ceiling => self.plan.clone(),
+            SurfaceRef::Wall(i) => {
+                let len = (self.plan[(i + 1) % self.plan.len()] - self.plan[i]).norm();
+                let h = self.height();
+                vec![
+                    Point2::new(0.0, 0.0),
+                    Point2::new(len, 0.0),
+                    Point2::new(len, h),
+                    Point2::new(0.0, h),
+                ]
+            }
+        }
+    }
+
+    /// Inward unit normal of a surface.
+    pub fn inward_normal(&self, s: SurfaceRef) -> Vector3<f64> {
+        match s {
+            SurfaceRef::Floor => Vector3::z(),
+            SurfaceRef::Ceiling => -Vector3::z(),
+            SurfaceRef::Wall(i) => {
+                let (a, b) = (self.plan[i], self.plan[(i + 1) % self.plan.len()]);
+                let d = (b - a).normalize();
+                Vector3::new(-d.y, d.x, 0.0) // left of a counter-clockwise edge
+            }
+        }
+    }
+
+    /// Temperature (°C) of a point on a surface, features excluded (walls include the gradient).
+    pub fn background_temperature_c(&self, s: SurfaceRef, z: f64) -> f64 {
+        match s {
+            SurfaceRef::Floor => self.file.temperatures.floor_c,
+            SurfaceRef::Ceiling => self.file.temperatures.ceiling_c,
+            SurfaceRef::Wall(i) => {
+                let (t, g, _) = &self.walls[i];
+                t + g * (z - self.height() / 2.0)
+            }
+        }
+    }
+
+    /// All surfaces in a fixed order: floor, ceiling, walls 0….
+    pub fn surfaces(&self) -> Vec<SurfaceRef> {
+        let mut v = vec![SurfaceRef::Floor, SurfaceRef::Ceiling];
+        v.extend((0..self.wall_count()).map(SurfaceRef::Wall));
+        v
+    }
+
+    /// Id of a surface in scenes.
+    pub fn surface_id(&self, s: SurfaceRef) -> String {
+        match s {
+            SurfaceRef::Floor => "floor".into(),
+            SurfaceRef::Ceiling => "ceiling".into(),
+            SurfaceRef::Wall(i) => format!("wall-{i}"),
+        }
+    }
+
+    /// The radiant scene of the room in the frame `world_from_room`.
+    ///
+    /// With `strips` false, each surface is whole at its radiant-average temperature (features
+    /// excluded; a gradient wall's temperature is the T⁴ area average of its background), the form a
+    /// scan's segmentation should recover. With `strips` true, walls with a gradient are cut into
+    /// horizontal strips of at most [`GRADIENT_STRIP_M`] with features clipped to them: the model
+    /// the truth MRT is computed from. Furniture becomes box occluders in the room frame and
+    /// triangle meshes otherwise.
+    pub fn scene(
+        &self,
+        world_from_room: &Isometry3<f64>,
+        strips: bool,
+    ) -> Result<RadiantScene, SceneError> {
+        let w = |p: Point3<f64>| {
+            let q = world_from_room * p;
+            [q.x, q.y, q.z]
+        };
+        let h = self.height();
+        let mut surfaces = Vec::new();
+        for s in self.surfaces() {
+            let id = self.surface_id(s);
+            let (kind, label) = match s {
+                SurfaceRef::Floor => ("floor", "floor".to_string()),
+                SurfaceRef::Ceiling => ("ceiling", "ceiling".to_string()),
+                SurfaceRef::Wall(i) => ("wall", self.walls[i].2.clone()),
+            };
+            let poly2 = self.surface_polygon_2d(s);
+            let feats: Vec<&PlacedFeature> = self.features.iter().filter(|f| f.on == s).collect();
+            let gradient = matches!(s, SurfaceRef::Wall(i) if self.walls[i].1 != 0.0);
+            let bands: Vec<(f64, f64)> = if strips && gradient {
+                let k = (h / GRADIENT_STRIP_M).ceil() as usize;
+                (0..k)
+                    .map(|j| (h * j as f64 / k as f64, h * (j + 1) as f64 / k as f64))
+                    .collect()
+            } else {
+                vec![(f64::NEG_INFINITY, f64::INFINITY)]
+            };
+            for (bi, &(z0, z1)) in bands.iter().enumerate() {
+                let band_poly = if bands.len() == 1 {
+                    poly2.clone()
+                } else {
+                    clip_band(&poly2, z0, z1)
+                };
+                let temperature_c = if bands.len() == 1 {
+                    self.surface_radiant_temperature_c(s)
+                } else {
+                    self.background_temperature_c(s, (z0 + z1) / 2.0)
+                };
+                let mut features = Vec::new();
+                for f in &feats {
+                    let fp = if bands.len() == 1 {
+                        f.polygon_2d.clone()
+                    } else {
+                        clip_band(&f.polygon_2d, z0, z1)
+                    };
+                    if fp.len() < 3 || polygon::signed_area(&fp).abs() < 1e-9 {
+                        continue;
+                    }
+                    features.push(FeatureFile {
+                        id: if bands.len() == 1 {
+                            f.id.clone()
+                        } else {
+                            format!("{}#{bi}", f.id)
+                        },
+                        label: f.label.clone(),
+                        polygon: fp.iter().map(|q| w(self.on_surface(s, q))).collect(),
+                        temperature_c: f.temperature_c,
+                        emissivity: 1.0,
+                        temperature_std_k: None,
+                    });
+                }
+                surfaces.push(SurfaceFile {
+                    id: if bands.len() == 1 {
+                        id.clone()
+                    } else {
+                        format!("{id}#{bi}")
+                    },
+                    kind: kind.into(),
+                    label: label.clone(),
+                    polygon: band_poly.iter().map(|q| w(self.on_surface(s, q))).collect(),
+                    temperature_c,
+                    emissivity: 1.0,
+                    temperature_std_k: None,
+                    observed_fraction: None,
+                    features,
+                });
+            }
+        }
+        let axis_aligned = world_from_room.rotation.angle() < 1e-12;
+        let occluders = self
+            .file
+            .furniture
+            .iter()
+            .enumerate()
+            .map(|(k, b)| {
+                let corners: Vec<Point3<f64>> = (0..8)
+                    .map(|c| {
+                        Point3::new(
+                            if c & 1 == 0 { b.min[0] } else { b.max[0] },
+                            if c & 2 == 0 { b.min[1] } else { b.max[1] },
+                            if c & 4 == 0 { b.min[2] } else { b.max[2] },
+                        )
+                    })
+                    .collect();
+                let slug: String = b
+                    .label
+                    .to_lowercase()
+                    .split_whitespace()
+                    .collect::<Vec<_>>()
+                    .join("-");
+                let (box_, vertices, triangles) = if axis_aligned {
+                    let (lo, hi) = (w(corners[0]), w(corners[7]));
+                    (
+                        Some(mrtmap_radiation::BoxFile { min: lo, max: hi }),
+                        None,
+                        None,
+                    )
+                } else {
+                    const QUADS: [[usize; 4]; 6] = [
+                        [0, 2, 6, 4],
+                        [1, 5, 7, 3],
+                        [0, 4, 5, 1],
+                        [2, 3, 7, 6],
+                        [0, 1, 3, 2],
+                        [4, 6, 7, 5],
+                    ];
+                    let tris = QUADS
+                        .iter()
+                        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+                        .collect();
+                    (
+                        None,
+                        Some(corners.iter().map(|c| w(*c)).collect()),
+                        Some(tris),
+                    )
+                };
+                OccluderFile {
+                    id: format!("{slug}-{}", k + 1),
+                    label: b.label.clone(),
+                    temperature_c: b.temperature_c,
+                    emissivity: 1.0,
+                    box_,
+                    vertices,
+                    triangles,
+                }
+            })
+            .collect();
+        let up = world_from_room * Vector3::z();
+        RadiantScene::new(&SceneFile {
+            format: SCENE_FORMAT.into(),
+            up: Some([up.x, up.y, up.z]),
+            surfaces,
+            occluders,
+        })
+    }
+
+    /// Radiant (T⁴ area-average) temperature of a surface's background (features excluded), °C.
+    pub fn surface_radiant_temperature_c(&self, s: SurfaceRef) -> f64 {
+        let gradient = matches!(s, SurfaceRef::Wall(i) if self.walls[i].1 != 0.0);
+        if !gradient {
+            return self.background_temperature_c(s, 0.0);
+        }
+        // Integrate T⁴ over the background area in thin bands.
+        let h = self.height();
+        let poly = self.surface_polygon_2d(s);
+        let feats: Vec<&PlacedFeature> = self.features.iter().filter(|f| f.on == s).collect();
+        let k = 2000;
+        let (mut a, mut a4) = (0.0, 0.0);
+        for j in 0..k {
+            let (z0, z1) = (h * j as f64 / k as f64, h * (j + 1) as f64 / k as f64);
+            let area = polygon::signed_area(&clip_band(&poly, z0, z1)).abs()
+                - feats
+                    .iter()
+                    .map(|f| polygon::signed_area(&clip_band(&f.polygon_2d, z0, z1)).abs())
+                    .sum::<f64>();
+            let t =
+                self.background_temperature_c(s, (z0 + z1) / 2.0) + mrtmap_physics::ZERO_CELSIUS_K;
+            a += area;
+            a4 += area * t.powi(4);
+        }
+        (a4 / a).powf(0.25) - mrtmap_physics::ZERO_CELSIUS_K
+    }
+}
+
+/// Clips a 2D polygon to the band y ∈ [y0, y1] (Sutherland–Hodgman against two half-planes).
+fn clip_band(poly: &[Point2<f64>], y0: f64, y1: f64) -> Vec<Point2<f64>> {
+    let clip = |pts: &[Point2<f64>], keep: &dyn Fn(&Point2<f64>) -> f64| -> Vec<Point2<f64>> {
+        let mut out = Vec::new();
+        let n = pts.len();
+        for i in 0..n {
+            let (a, b) = (pts[i], pts[(i + 1) % n]);
+            let (da, db) = (keep(&a), keep(&b));
+            if da >= 0.0 {
+                out.push(a);
+            }
+            if (da >= 0.0) != (db >= 0.0) {
+                let t = da / (da - db);
+                out.push(a + (b - a) * t);
+            }
+        }
+        out
+    };
+    let lower = clip(poly, &|p| p.y - y0);
+    if lower.is_empty() {
+        return lower;
+    }
+    let mut both = clip(&lower, &|p| y1 - p.y);
+    both.dedup_by(|a, b| (*a - *b).norm() < 1e-12);
+    if both.len() > 1 && (both[0] - both[both.len() - 1]).norm() < 1e-12 {
+        both.pop();
+    }
+    both
+}
+
+/// The documented presets: (name, TOML text).
+pub const PRESETS: [(&str, &str); 3] = [
+    ("office", include_str!("../rooms/office.toml")),
+    ("l-shaped", include_str!("../rooms/l-shaped.toml")),
+    (
+        "radiant-ceiling",
+        include_str!("../rooms/radiant-ceiling.toml"),
+    ),
+];
+
+/// A preset room by name.
+pub fn preset(name: &str) -> Option<Result<Room, RoomError>> {
+    PRESETS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, t)| Room::from_toml(t))
+}

@@ -1,0 +1,448 @@
+//! The scan simulator: a walk through a room, sensors on their own clocks, a recording written in
+//! the layout of `shared/spec/recording.md`, and its truth.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use mrtmap_geometry::camera::{BrownConrady, PinholeCamera};
+use mrtmap_geometry::nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion, Vector3};
+use mrtmap_io::masks::{labels_path, mask_labels_json};
+use mrtmap_io::{
+    PartialDir, RgbCamera, Rig, ThermalEncoding, Trajectory, encode_png_rgb8, encode_png16,
+    stream_list_text,
+};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, Normal};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::SimError;
+use crate::render::RoomRenderer;
+use crate::room::Room;
+use crate::sensors::{
+    DepthNoise, ThermalNoise, camera_rays, render_depth, render_rgb_and_mask, render_thermal,
+};
+use crate::truth::compute_truth;
+use crate::walk::{Walk, WalkParams};
+
+/// How noisy the sensors are.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NoiseLevel {
+    /// Exact depth (to the millimetre), exact thermal (to the centikelvin), exact labels.
+    None,
+    /// D435i-like depth noise and invalid pixels, Lepton-like NETD and blur, grazing emissivity,
+    /// detector-like label mistakes.
+    Realistic,
+}
+
+/// Pose drift of the SLAM estimate (trajectory.txt) against the truth (groundtruth.txt): random
+/// walks in position and in heading about up.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Drift {
+    /// Position random walk (m/√s).
+    pub position_m_per_sqrt_s: f64,
+    /// Heading random walk (degrees/√s).
+    pub heading_deg_per_sqrt_s: f64,
+}
+
+impl Drift {
+    /// No drift: trajectory.txt equals groundtruth.txt.
+    pub const NONE: Drift = Drift {
+        position_m_per_sqrt_s: 0.0,
+        heading_deg_per_sqrt_s: 0.0,
+    };
+    /// Visual SLAM without loop closure (≈ 7 cm and 0.6° after 343 s, 1 σ).
+    pub const SLAM: Drift = Drift {
+        position_m_per_sqrt_s: 0.004,
+        heading_deg_per_sqrt_s: 0.03,
+    };
+    /// Plain odometry (≈ 19 cm and 1.9° after 343 s).
+    pub const ODOMETRY: Drift = Drift {
+        position_m_per_sqrt_s: 0.01,
+        heading_deg_per_sqrt_s: 0.1,
+    };
+}
+
+/// Simulation settings.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SimConfig {
+    /// Length of the scan (s); the seed paper's took 343 s.
+    pub seconds: f64,
+    /// Seed of everything random.
+    pub seed: u64,
+    /// Noise level.
+    pub noise: NoiseLevel,
+    /// Depth camera (the colour camera is the same: depth aligned to colour).
+    pub depth_camera: PinholeCamera,
+    /// Depth raw units per metre.
+    pub depth_scale: f64,
+    /// Depth and colour frame rates (Hz).
+    pub depth_hz: f64,
+    /// Thermal camera.
+    pub thermal_camera: PinholeCamera,
+    /// Thermal frame rate (Hz).
+    pub thermal_hz: f64,
+    /// Colour and mask frame rate (Hz).
+    pub rgb_hz: f64,
+    /// Pose rate (Hz).
+    pub pose_hz: f64,
+    /// p_in_depth = depth_from_thermal · p_in_thermal.
+    pub depth_from_thermal: Isometry3<f64>,
+    /// Thermal imperfections used with `NoiseLevel::Realistic` (bias also applies to `None`).
+    pub thermal_noise: ThermalNoise,
+    /// Depth imperfections used with `NoiseLevel::Realistic`.
+    pub depth_noise: DepthNoise,
+    /// SLAM drift of trajectory.txt.
+    pub drift: Drift,
+    /// The walk.
+    pub walk: WalkParams,
+    /// Monte Carlo rays per truth point (rooms with furniture or not convex).
+    pub truth_rays: usize,
+}
+
+impl Default for SimConfig {
+    fn default() -> Self {
+        let mut thermal = PinholeCamera::from_hfov(160, 120, 57f64.to_radians());
+        thermal.distortion = BrownConrady::from_array([-0.12, 0.06, 0.0005, -0.0008, 0.0]);
+        // The Lepton sits 3.5 cm right of and 2.5 cm above the depth camera, tilted by about a degree.
+        let rot = UnitQuaternion::from_euler_angles(
+            0.4f64.to_radians(),
+            -1.1f64.to_radians(),
+            0.3f64.to_radians(),
+        );
+        Self {
+            seconds: 343.0,
+            seed: 1,
+            noise: NoiseLevel::Realistic,
+            depth_camera: PinholeCamera::new(640, 480, 385.0, 385.0, 319.5, 239.5),
+            depth_scale: 1000.0,
+            depth_hz: 30.0,
+            thermal_camera: thermal,
+            thermal_hz: 8.7,
+            rgb_hz: 5.0,
+            pose_hz: 200.0,
+            depth_from_thermal: Isometry3::from_parts(Translation3::new(0.035, -0.025, 0.004), rot),
+            thermal_noise: ThermalNoise::REALISTIC,
+            depth_noise: DepthNoise::default(),
+            drift: Drift::NONE,
+            walk: WalkParams::default(),
+            truth_rays: 100_000,
+        }
+    }
+}
+
+/// What a simulation wrote.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SimSummary {
+    /// The recording folder.
+    pub out: PathBuf,
+    /// Depth frames.
+    pub depth_frames: usize,
+    /// Thermal frames.
+    pub thermal_frames: usize,
+    /// Colour (and mask) frames.
+    pub rgb_frames: usize,
+    /// Poses.
+    pub poses: usize,
+    /// Bytes written.
+    pub bytes: u64,
+    /// The truth method ("exact" or "montecarlo").
+    pub truth_method: String,
+}
+
+/// Progress: frames done out of the total.
+pub type Progress<'a> = &'a (dyn Fn(u64, u64) + Sync);
+
+fn stamps(seconds: f64, hz: f64, jitter_s: f64, rng: &mut ChaCha8Rng) -> Vec<f64> {
+    let phase = rng.random_range(0.0..1.0 / hz);
+    let mut out = Vec::new();
+    let mut k = 0;
+    loop {
+        let t = phase + k as f64 / hz + rng.random_range(-jitter_s..=jitter_s);
+        if t > seconds - 1e-3 {
+            break;
+        }
+        if t > 1e-3 {
+            out.push(t);
+        }
+        k += 1;
+    }
+    out
+}
+
+/// Recording timestamps start here (a Unix time, like real recordings).
+pub const TIME_ORIGIN_S: f64 = 1_700_000_000.0;
+
+fn write(path: &Path, bytes: &[u8], total: &AtomicU64) -> Result<(), SimError> {
+    std::fs::write(path, bytes).map_err(|e| SimError::Write {
+        path: path.to_path_buf(),
+        source: e,
+    })?;
+    total.fetch_add(bytes.len() as u64, Ordering::Relaxed);
+    Ok(())
+}
+
+/// Simulates a scan of `room` into the folder `out` (written as `out.partial` and renamed when
+/// complete).
+pub fn simulate(
+    room: &Room,
+    cfg: &SimConfig,
+    out: &Path,
+    progress: Progress<'_>,
+) -> Result<SimSummary, SimError> {
+    if !(cfg.seconds > 0.5 && cfg.seconds <= 7200.0) {
+        return Err(SimError::Config(format!(
+            "seconds = {} is outside 0.5…7200",
+            cfg.seconds
+        )));
+    }
+    for (name, hz) in [
+        ("depth", cfg.depth_hz),
+        ("thermal", cfg.thermal_hz),
+        ("rgb", cfg.rgb_hz),
+        ("pose", cfg.pose_hz),
+    ] {
+        if !(hz > 0.0 && hz <= 1000.0) {
+            return Err(SimError::Config(format!(
+                "{name} rate {hz} Hz is outside 0…1000"
+            )));
+        }
+    }
+    let dir = PartialDir::create(out)?;
+    let root = dir.path().to_path_buf();
+    for sub in ["depth", "thermal", "rgb", "masks"] {
+        std::fs::create_dir_all(root.join(sub)).map_err(|e| SimError::Write {
+            path: root.join(sub),
+            source: e,
+        })?;
+    }
+    let walk = Walk::new(room, cfg.walk, cfg.seed);
+    let renderer = RoomRenderer::new(room);
+    let world_from_room = walk.room_from_depth(0.0).inverse();
+    let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
+    let bytes = AtomicU64::new(0);
+
+    // Poses: truth, and the SLAM estimate with drift.
+    let n_poses = (cfg.seconds * cfg.pose_hz).floor() as usize + 1;
+    let pose_t: Vec<f64> = (0..n_poses).map(|k| k as f64 / cfg.pose_hz).collect();
+    let truth_poses: Vec<Isometry3<f64>> = pose_t
+        .iter()
+        .map(|&t| world_from_room * walk.room_from_depth(t))
+        .collect();
+    let up = Unit::new_normalize(world_from_room * Vector3::z());
+    let std = Normal::new(0.0, 1.0).unwrap_or_else(|_| unreachable!("unit normal"));
+    let dt = 1.0 / cfg.pose_hz;
+    let (mut p, mut th) = (Vector3::zeros(), 0.0f64);
+    let slam_poses: Vec<Isometry3<f64>> = truth_poses
+        .iter()
+        .enumerate()
+        .map(|(k, tp)| {
+            if k > 0 {
+                p += Vector3::new(
+                    std.sample(&mut rng),
+                    std.sample(&mut rng),
+                    std.sample(&mut rng),
+                ) * cfg.drift.position_m_per_sqrt_s
+                    * dt.sqrt();
+                th += std.sample(&mut rng)
+                    * cfg.drift.heading_deg_per_sqrt_s.to_radians()
+                    * dt.sqrt();
+            }
+            Isometry3::from_parts(
+                Translation3::from(p),
+                UnitQuaternion::from_axis_angle(&up, th),
+            ) * tp
+        })
+        .collect();
+    let stamp = |t: f64| TIME_ORIGIN_S + t;
+    let header = format!(
+        "mrtmap simulate: room {}, seed {}, noise {:?}",
+        room.file.name, cfg.seed, cfg.noise
+    );
+    let gt = Trajectory {
+        stamps: pose_t.iter().map(|&t| stamp(t)).collect(),
+        poses: truth_poses,
+    };
+    let slam = Trajectory {
+        stamps: gt.stamps.clone(),
+        poses: slam_poses,
+    };
+    write(
+        &root.join("groundtruth.txt"),
+        gt.to_tum(&format!(
+            "{header}\ntrue poses: timestamp tx ty tz qx qy qz qw (world_from_depth)"
+        ))
+        .as_bytes(),
+        &bytes,
+    )?;
+    write(
+        &root.join("trajectory.txt"),
+        slam.to_tum(&format!("{header}\nSLAM poses (drift {:?})", cfg.drift))
+            .as_bytes(),
+        &bytes,
+    )?;
+
+    let depth_t = stamps(cfg.seconds, cfg.depth_hz, 0.0003, &mut rng);
+    let thermal_t = stamps(cfg.seconds, cfg.thermal_hz, 0.002, &mut rng);
+    let rgb_t = stamps(cfg.seconds, cfg.rgb_hz, 0.0003, &mut rng);
+    let total = (depth_t.len() + thermal_t.len() + rgb_t.len()) as u64;
+    let done = AtomicU64::new(0);
+    let tick = || progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+
+    let realistic = cfg.noise == NoiseLevel::Realistic;
+    let rig = Rig {
+        depth: cfg.depth_camera,
+        depth_scale: cfg.depth_scale,
+        thermal: cfg.thermal_camera,
+        thermal_encoding: ThermalEncoding::Centikelvin,
+        depth_from_thermal: cfg.depth_from_thermal,
+        rgb: Some(RgbCamera {
+            camera: cfg.depth_camera,
+            depth_from_rgb: Isometry3::identity(),
+        }),
+    };
+    write(&root.join("rig.toml"), rig.to_toml().as_bytes(), &bytes)?;
+    // Per-frame noise comes from a fast generator seeded from (seed, stream, frame), so frames can
+    // be rendered in any order and on any number of threads with the same result.
+    let frame_rng = |stream: u64, k: usize| {
+        let mut r = ChaCha8Rng::seed_from_u64(cfg.seed);
+        r.set_stream((stream << 40) | k as u64);
+        rand_xoshiro::Xoshiro256PlusPlus::from_rng(&mut r)
+    };
+
+    // Depth.
+    let depth_rays = camera_rays(&cfg.depth_camera, 1);
+    let depth_noise = realistic.then_some(&cfg.depth_noise);
+    depth_t.par_iter().enumerate().try_for_each(|(k, &t)| {
+        let img = render_depth(
+            &renderer,
+            &cfg.depth_camera,
+            &depth_rays,
+            &walk.room_from_depth(t),
+            cfg.depth_scale,
+            depth_noise,
+            &mut frame_rng(1, k),
+        );
+        write(
+            &root.join(format!("depth/{k:06}.png")),
+            &encode_png16(&img),
+            &bytes,
+        )?;
+        tick();
+        Ok::<(), SimError>(())
+    })?;
+    // Thermal.
+    let tnoise = if realistic {
+        cfg.thermal_noise
+    } else {
+        ThermalNoise {
+            bias_k: cfg.thermal_noise.bias_k,
+            ..ThermalNoise::NONE
+        }
+    };
+    let thermal_rays = camera_rays(&cfg.thermal_camera, tnoise.supersample);
+    thermal_t.par_iter().enumerate().try_for_each(|(k, &t)| {
+        let pose = walk.room_from_depth(t) * cfg.depth_from_thermal;
+        let img = render_thermal(
+            room,
+            &renderer,
+            &cfg.thermal_camera,
+            &thermal_rays,
+            &pose,
+            ThermalEncoding::Centikelvin,
+            &tnoise,
+            &mut frame_rng(2, k),
+        );
+        write(
+            &root.join(format!("thermal/{k:06}.png")),
+            &encode_png16(&img),
+            &bytes,
+        )?;
+        tick();
+        Ok::<(), SimError>(())
+    })?;
+    // Colour and masks.
+    rgb_t.par_iter().enumerate().try_for_each(|(k, &t)| {
+        let (rgb, mask, labels) = render_rgb_and_mask(
+            room,
+            &renderer,
+            &cfg.depth_camera,
+            &depth_rays,
+            &walk.room_from_depth(t),
+            realistic,
+            &mut frame_rng(3, k),
+        );
+        write(
+            &root.join(format!("rgb/{k:06}.png")),
+            &encode_png_rgb8(cfg.depth_camera.width, cfg.depth_camera.height, &rgb),
+            &bytes,
+        )?;
+        let mp = root.join(format!("masks/{k:06}.png"));
+        write(&mp, &encode_png16(&mask), &bytes)?;
+        write(
+            &labels_path(&mp),
+            mask_labels_json(&labels).as_bytes(),
+            &bytes,
+        )?;
+        tick();
+        Ok::<(), SimError>(())
+    })?;
+    let list = |ts: &[f64], dir: &str| -> Vec<(f64, String)> {
+        ts.iter()
+            .enumerate()
+            .map(|(k, &t)| (stamp(t), format!("{dir}/{k:06}.png")))
+            .collect()
+    };
+    write(
+        &root.join("depth.txt"),
+        stream_list_text(
+            &format!("{header}\ndepth frames: timestamp path"),
+            &list(&depth_t, "depth"),
+        )
+        .as_bytes(),
+        &bytes,
+    )?;
+    write(
+        &root.join("thermal.txt"),
+        stream_list_text(
+            &format!("{header}\nthermal frames: timestamp path"),
+            &list(&thermal_t, "thermal"),
+        )
+        .as_bytes(),
+        &bytes,
+    )?;
+    write(
+        &root.join("rgb.txt"),
+        stream_list_text(
+            &format!("{header}\ncolour frames: timestamp path"),
+            &list(&rgb_t, "rgb"),
+        )
+        .as_bytes(),
+        &bytes,
+    )?;
+    write(&root.join("masks.txt"), stream_list_text(&format!("{header}\ninstance masks (16-bit ids, labels in the .json beside each): timestamp path"), &list(&rgb_t, "masks")).as_bytes(), &bytes)?;
+    write(
+        &root.join("room.toml"),
+        toml::to_string(&room.file).unwrap_or_default().as_bytes(),
+        &bytes,
+    )?;
+
+    let truth = compute_truth(room, &world_from_room, cfg.truth_rays, cfg.seed)?;
+    write(
+        &root.join("truth.json"),
+        (serde_json::to_string_pretty(&truth).unwrap_or_default() + "\n").as_bytes(),
+        &bytes,
+    )?;
+    let out = dir.finish()?;
+    Ok(SimSummary {
+        out,
+        depth_frames: depth_t.len(),
+        thermal_frames: thermal_t.len(),
+        rgb_frames: rgb_t.len(),
+        poses: n_poses,
+        bytes: bytes.load(Ordering::Relaxed),
+        truth_method: truth.method,
+    })
+}

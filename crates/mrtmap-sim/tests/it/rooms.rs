@@ -1,0 +1,137 @@
+use mrtmap_geometry::nalgebra::{Isometry3, Point3};
+use mrtmap_radiation::{Method, MrtEngine};
+use mrtmap_sim::{PRESETS, Room, SurfaceRef, compute_truth, preset};
+
+#[test]
+fn presets_are_valid_and_differ() {
+    let rooms: Vec<Room> = PRESETS
+        .iter()
+        .map(|(_, t)| Room::from_toml(t).unwrap())
+        .collect();
+    assert_eq!(rooms.len(), 3);
+    assert!(rooms[0].convex && !rooms[1].convex && rooms[2].convex);
+    for r in &rooms {
+        assert_eq!(r.file.points.len(), 4, "{}", r.file.name);
+        assert!(r.scene(&Isometry3::identity(), false).is_ok());
+    }
+    let office = &rooms[0];
+    assert!(
+        office
+            .features
+            .iter()
+            .filter(|f| f.label == "recessed light")
+            .count()
+            == 4
+    );
+    assert!(
+        office
+            .features
+            .iter()
+            .any(|f| f.label == "window" && f.on == SurfaceRef::Wall(1))
+    );
+    assert!(rooms[1].features.iter().any(|f| f.label == "radiator"));
+}
+
+#[test]
+fn room_errors_are_clear() {
+    let office = PRESETS[0].1;
+    let e = Room::from_toml(&office.replace("index = 1", "index = 7"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("[[walls]] index 7 does not exist"), "{e}");
+    let e = Room::from_toml(
+        &office.replace("rect = [0.9, 0.9, 1.8, 1.3]", "rect = [3.0, 0.9, 1.8, 1.3]"),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("feature 'window-1' is not inside the polygon of its host surface 'wall-1'"),
+        "{e}"
+    );
+    let e = Room::from_toml(&office.replace("on = \"wall 3\"", "on = \"wall 9\""))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("'wall 9' is not floor, ceiling or wall 0…3"),
+        "{e}"
+    );
+    let e = Room::from_toml("name = 1").unwrap_err().to_string();
+    assert!(e.starts_with("line 1:"), "{e}");
+}
+
+/// A clockwise floor plan describes the same room: same walls by index, same features, same MRT.
+#[test]
+fn clockwise_plans_are_the_same_room() {
+    let ccw = preset("l-shaped").unwrap().unwrap();
+    let mut file = ccw.file.clone();
+    let n = file.floor_plan.len();
+    file.floor_plan = (0..n)
+        .map(|i| file.floor_plan[(n - i) % n])
+        .collect::<Vec<_>>();
+    // Reversing the list turns wall i (p_i → p_i+1) into wall n−1−i of the new list, run backwards.
+    for w in &mut file.walls {
+        w.index = (n - 1 - w.index) % n;
+    }
+    for f in &mut file.features {
+        if let Some(i) =
+            f.on.strip_prefix("wall ")
+                .and_then(|x| x.parse::<usize>().ok())
+        {
+            let a = ccw.file.floor_plan[i];
+            let b = ccw.file.floor_plan[(i + 1) % n];
+            let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+            f.on = format!("wall {}", (n - 1 - i) % n);
+            if let Some(r) = f.rect.as_mut() {
+                r[0] = len - r[0] - r[2];
+            }
+        }
+    }
+    let cw = Room::new(file).unwrap();
+    let p = Point3::new(2.0, 1.0, 1.1);
+    let m = |r: &Room| {
+        let s = r.scene(&Isometry3::identity(), false).unwrap();
+        let mut s2 = s.clone();
+        s2.occluders.clear();
+        MrtEngine::new(&s2, Method::MonteCarlo(Default::default()))
+            .unwrap()
+            .at(&p, 0)
+            .unwrap()
+            .mrt
+            .celsius()
+    };
+    assert!((m(&ccw) - m(&cw)).abs() < 1e-9, "{} vs {}", m(&ccw), m(&cw));
+}
+
+/// Gradient walls: the strip model's radiant average equals the whole-surface temperature, and
+/// the exact truth of a convex room without furniture agrees with Monte Carlo on the strips.
+#[test]
+fn gradient_truth_is_consistent() {
+    let mut f = preset("radiant-ceiling").unwrap().unwrap().file;
+    f.furniture.clear();
+    let room = Room::new(f).unwrap();
+    let t = room.surface_radiant_temperature_c(SurfaceRef::Wall(0));
+    // Wall 0 of that room: 19.5 °C at mid-height, 0.8 K/m over 3 m: the T⁴ mean is a hair above.
+    assert!(t > 19.5 && t < 19.52, "{t}");
+    let truth = compute_truth(&room, &Isometry3::identity(), 50_000, 3).unwrap();
+    assert_eq!(truth.method, "exact");
+    let fine = room.scene(&Isometry3::identity(), true).unwrap();
+    let mc = MrtEngine::new(
+        &fine,
+        Method::MonteCarlo(mrtmap_radiation::MonteCarlo {
+            rays: 200_000,
+            ..Default::default()
+        }),
+    )
+    .unwrap();
+    for p in &truth.points {
+        let r = mc.at(&Point3::from(p.xyz_room), 0).unwrap();
+        assert!(
+            (r.mrt.celsius() - p.mrt_c).abs() < 4.0 * r.std_error_k + 1e-4,
+            "{}: {} vs {}",
+            p.name,
+            r.mrt.celsius(),
+            p.mrt_c
+        );
+    }
+    assert_eq!(truth.grid.nodes.len(), 400);
+}
