@@ -19,12 +19,15 @@
 //! ```
 
 pub mod camera;
+pub mod cloud;
+pub mod icp;
 pub mod polygon;
 pub mod ray;
 pub mod sampling;
 mod solid_angle;
 
 pub use camera::{BrownConrady, PinholeCamera};
+pub use icp::{IcpParams, IcpTarget, Registration, icp_point_to_plane};
 pub use nalgebra;
 pub use polygon::{Containment, NotSimple, PlaneFrame};
 #[cfg(feature = "embree")]

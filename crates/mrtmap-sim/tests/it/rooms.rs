@@ -135,3 +135,44 @@ fn gradient_truth_is_consistent() {
     }
     assert_eq!(truth.grid.nodes.len(), 400);
 }
+
+/// The default 343 s walk sees every wall, the floor, the ceiling and every feature of each preset
+/// (sampled once per second with a sparse pixel grid of the depth camera).
+#[test]
+fn the_walk_sees_every_surface_and_feature() {
+    use mrtmap_geometry::nalgebra::Point2;
+    use mrtmap_sim::{Element, RoomRenderer, SimConfig, Walk};
+    for (name, _) in PRESETS {
+        let room = preset(name).unwrap().unwrap();
+        let cfg = SimConfig::default();
+        let walk = Walk::new(&room, cfg.walk, 1);
+        let r = RoomRenderer::new(&room);
+        let mut surfaces = vec![0usize; room.surfaces().len()];
+        let mut features = vec![0usize; room.features.len()];
+        for t in 0..343 {
+            let pose = walk.room_from_depth(t as f64);
+            let view = r.view(&pose);
+            for v in (0..480).step_by(40) {
+                for u in (0..640).step_by(40) {
+                    let d = cfg.depth_camera.unproject(&Point2::new(u as f64, v as f64));
+                    if let Some(h) = view.cast(&d) {
+                        if let Element::Surface { surface, feature } = h.element {
+                            surfaces[surface] += 1;
+                            if let Some(f) = feature {
+                                features[f] += 1;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            surfaces.iter().all(|&c| c > 20),
+            "{name}: rays per surface {surfaces:?}"
+        );
+        assert!(
+            features.iter().all(|&c| c > 3),
+            "{name}: rays per feature {features:?}"
+        );
+    }
+}

@@ -1,0 +1,55 @@
+//! Point-cloud basics: voxel downsampling and normals from neighbours.
+
+use std::collections::HashMap;
+
+use nalgebra::{Matrix3, Point3, Vector3};
+
+/// The integer voxel of a point.
+pub fn voxel_key(p: &Point3<f64>, voxel_m: f64) -> [i32; 3] {
+    [
+        (p.x / voxel_m).floor() as i32,
+        (p.y / voxel_m).floor() as i32,
+        (p.z / voxel_m).floor() as i32,
+    ]
+}
+
+/// Downsamples to one point per voxel: the mean of the points in it (as Open3D's
+/// `voxel_down_sample`), in order of first occurrence.
+pub fn voxel_downsample(points: &[Point3<f64>], voxel_m: f64) -> Vec<Point3<f64>> {
+    let mut index: HashMap<[i32; 3], usize> = HashMap::with_capacity(points.len() / 4);
+    let mut sums: Vec<(Vector3<f64>, u32)> = Vec::new();
+    for p in points {
+        let k = voxel_key(p, voxel_m);
+        let i = *index.entry(k).or_insert_with(|| {
+            sums.push((Vector3::zeros(), 0));
+            sums.len() - 1
+        });
+        sums[i].0 += p.coords;
+        sums[i].1 += 1;
+    }
+    sums.into_iter()
+        .map(|(s, n)| Point3::from(s / n as f64))
+        .collect()
+}
+
+/// Unit normal of a set of points by PCA (the eigenvector of the smallest eigenvalue of their
+/// covariance), or `None` for fewer than 3 points or no plane. The sign is arbitrary.
+pub fn pca_normal(points: &[Point3<f64>]) -> Option<Vector3<f64>> {
+    if points.len() < 3 {
+        return None;
+    }
+    let c = points.iter().fold(Vector3::zeros(), |a, p| a + p.coords) / points.len() as f64;
+    let mut cov = Matrix3::zeros();
+    for p in points {
+        let d = p.coords - c;
+        cov += d * d.transpose();
+    }
+    let eig = nalgebra::SymmetricEigen::new(cov);
+    let (k, _) = eig
+        .eigenvalues
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1.total_cmp(b.1))?;
+    let n = eig.eigenvectors.column(k).into_owned();
+    (n.norm() > 0.5).then(|| n.normalize())
+}

@@ -1,0 +1,195 @@
+//! Point-to-plane ICP against a target cloud with normals, nearest neighbours by k-d tree.
+//!
+//! Each iteration pairs every source point with its nearest target point within
+//! `max_correspondence_m`, then solves the linearised point-to-plane problem
+//! min Σ wᵢ (nᵢ · (R sᵢ + t − qᵢ))² (Huber weights) for a small rotation and translation. Directions
+//! the data do not constrain (a single wall leaves translation along it free) are detected from the
+//! eigenvalues of the normal equations and left unchanged instead of drifting
+//! (degeneracy-aware ICP, Zhang & Singh 2016).
+
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use nalgebra::{Isometry3, Matrix6, Point3, Translation3, UnitQuaternion, Vector3, Vector6};
+use serde::{Deserialize, Serialize};
+
+/// Convergence and robustness settings.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct IcpParams {
+    /// Largest distance of a correspondence (m).
+    pub max_correspondence_m: f64,
+    /// Iteration limit.
+    pub max_iterations: usize,
+    /// Stop when an update moves less than this (m)…
+    pub converged_translation_m: f64,
+    /// …and turns less than this (rad).
+    pub converged_rotation_rad: f64,
+    /// Huber threshold on point-to-plane residuals (m).
+    pub huber_m: f64,
+    /// Eigenvalues of the normal equations below this fraction of the largest count as
+    /// unconstrained directions.
+    pub degenerate_ratio: f64,
+}
+
+impl Default for IcpParams {
+    fn default() -> Self {
+        Self {
+            max_correspondence_m: 0.05,
+            max_iterations: 30,
+            converged_translation_m: 1e-5,
+            converged_rotation_rad: 1e-5,
+            huber_m: 0.01,
+            degenerate_ratio: 1e-3,
+        }
+    }
+}
+
+/// An ICP result with its quality (Open3D's `RegistrationResult` plus degeneracy).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Registration {
+    /// target_from_source: maps source points onto the target.
+    pub target_from_source: Isometry3<f64>,
+    /// Fraction of source points with a correspondence within the distance limit.
+    pub fitness: f64,
+    /// RMS point-to-point distance of those correspondences (m).
+    pub inlier_rmse_m: f64,
+    /// RMS point-to-plane residual of those correspondences (m).
+    pub inlier_plane_rmse_m: f64,
+    /// Iterations run.
+    pub iterations: usize,
+    /// Whether the updates fell below the convergence thresholds.
+    pub converged: bool,
+    /// How many of the 6 degrees of freedom the data leave unconstrained (0 = well posed).
+    pub degenerate_dofs: usize,
+}
+
+/// A target cloud: points, unit normals and a k-d tree over the points.
+pub struct IcpTarget {
+    tree: ImmutableKdTree<f64, 3>,
+    points: Vec<Point3<f64>>,
+    normals: Vec<Vector3<f64>>,
+}
+
+impl IcpTarget {
+    /// Builds the target (points and normals of equal length, normals of unit length).
+    pub fn new(points: Vec<Point3<f64>>, normals: Vec<Vector3<f64>>) -> Self {
+        let raw: Vec<[f64; 3]> = points.iter().map(|p| [p.x, p.y, p.z]).collect();
+        let tree = ImmutableKdTree::new_from_slice(&raw).unwrap_or_default();
+        Self {
+            tree,
+            points,
+            normals,
+        }
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    /// Whether it is empty.
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+
+    /// The nearest target point to `p` within `max_m`: (index, distance).
+    pub fn nearest(&self, p: &Point3<f64>, max_m: f64) -> Option<(usize, f64)> {
+        if self.points.is_empty() {
+            return None;
+        }
+        let r = self
+            .tree
+            .query(&[p.x, p.y, p.z])
+            .nearest_one::<SquaredEuclidean<f64>>()
+            .execute();
+        (r.distance <= max_m * max_m).then_some((r.item as usize, r.distance.sqrt()))
+    }
+}
+
+fn exp_se3(x: &Vector6<f64>) -> Isometry3<f64> {
+    let rot = UnitQuaternion::from_scaled_axis(Vector3::new(x[0], x[1], x[2]));
+    Isometry3::from_parts(Translation3::new(x[3], x[4], x[5]), rot)
+}
+
+/// Registers `source` onto `target` starting from `init` (target_from_source).
+pub fn icp_point_to_plane(
+    source: &[Point3<f64>],
+    target: &IcpTarget,
+    init: &Isometry3<f64>,
+    params: &IcpParams,
+) -> Registration {
+    let mut t = *init;
+    let mut result = Registration {
+        target_from_source: t,
+        fitness: 0.0,
+        inlier_rmse_m: f64::INFINITY,
+        inlier_plane_rmse_m: f64::INFINITY,
+        iterations: 0,
+        converged: false,
+        degenerate_dofs: 6,
+    };
+    if source.is_empty() || target.is_empty() {
+        return result;
+    }
+    for it in 0..params.max_iterations {
+        let mut h = Matrix6::<f64>::zeros();
+        let mut g = Vector6::<f64>::zeros();
+        let (mut n_in, mut sq, mut sq_plane) = (0usize, 0.0, 0.0);
+        for s in source {
+            let p = t * s;
+            let Some((k, d)) = target.nearest(&p, params.max_correspondence_m) else {
+                continue;
+            };
+            let n = target.normals[k];
+            let r = n.dot(&(p - target.points[k]));
+            let w = if r.abs() <= params.huber_m {
+                1.0
+            } else {
+                params.huber_m / r.abs()
+            };
+            let j = Vector6::new(
+                p.y * n.z - p.z * n.y,
+                p.z * n.x - p.x * n.z,
+                p.x * n.y - p.y * n.x,
+                n.x,
+                n.y,
+                n.z,
+            );
+            h += j * j.transpose() * w;
+            g += j * (w * r);
+            n_in += 1;
+            sq += d * d;
+            sq_plane += r * r;
+        }
+        result.iterations = it + 1;
+        result.fitness = n_in as f64 / source.len() as f64;
+        if n_in < 6 {
+            result.degenerate_dofs = 6;
+            break;
+        }
+        result.inlier_rmse_m = (sq / n_in as f64).sqrt();
+        result.inlier_plane_rmse_m = (sq_plane / n_in as f64).sqrt();
+        // Solve in the well-constrained eigen-directions only.
+        let eig = nalgebra::SymmetricEigen::new(h);
+        let lmax = eig.eigenvalues.iter().cloned().fold(0.0, f64::max);
+        let mut x = Vector6::zeros();
+        let mut degenerate = 0;
+        for k in 0..6 {
+            let l = eig.eigenvalues[k];
+            let v = eig.eigenvectors.column(k);
+            if l > params.degenerate_ratio * lmax && l > 0.0 {
+                x -= v * (v.dot(&g) / l);
+            } else {
+                degenerate += 1;
+            }
+        }
+        result.degenerate_dofs = degenerate;
+        t = exp_se3(&x) * t;
+        if x.fixed_rows::<3>(3).norm() < params.converged_translation_m
+            && x.fixed_rows::<3>(0).norm() < params.converged_rotation_rad
+        {
+            result.converged = true;
+            break;
+        }
+    }
+    result.target_from_source = t;
+    result
+}
