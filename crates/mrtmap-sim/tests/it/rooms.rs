@@ -155,12 +155,12 @@ fn the_walk_sees_every_surface_and_feature() {
             for v in (0..480).step_by(40) {
                 for u in (0..640).step_by(40) {
                     let d = cfg.depth_camera.unproject(&Point2::new(u as f64, v as f64));
-                    if let Some(h) = view.cast(&d) {
-                        if let Element::Surface { surface, feature } = h.element {
-                            surfaces[surface] += 1;
-                            if let Some(f) = feature {
-                                features[f] += 1;
-                            }
+                    if let Some(h) = view.cast(&d)
+                        && let Element::Surface { surface, feature } = h.element
+                    {
+                        surfaces[surface] += 1;
+                        if let Some(f) = feature {
+                            features[f] += 1;
                         }
                     }
                 }
