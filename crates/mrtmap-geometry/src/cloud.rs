@@ -1,6 +1,6 @@
 //! Point-cloud basics: voxel downsampling and normals from neighbours.
 
-use std::collections::HashMap;
+use rustc_hash::FxHashMap;
 
 use nalgebra::{Matrix3, Point3, Vector3};
 
@@ -16,7 +16,7 @@ pub fn voxel_key(p: &Point3<f64>, voxel_m: f64) -> [i32; 3] {
 /// Downsamples to one point per voxel: the mean of the points in it (as Open3D's
 /// `voxel_down_sample`), in order of first occurrence.
 pub fn voxel_downsample(points: &[Point3<f64>], voxel_m: f64) -> Vec<Point3<f64>> {
-    let mut index: HashMap<[i32; 3], usize> = HashMap::with_capacity(points.len() / 4);
+    let mut index: FxHashMap<[i32; 3], usize> = FxHashMap::default();
     let mut sums: Vec<(Vector3<f64>, u32)> = Vec::new();
     for p in points {
         let k = voxel_key(p, voxel_m);

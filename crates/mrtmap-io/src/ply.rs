@@ -170,6 +170,7 @@ impl PropertyAccess for Vertex {
 }
 
 /// A cloud read from PLY, with any extra per-vertex fields (as integers) by name.
+#[derive(Clone, Debug)]
 pub struct ReadCloud {
     /// The cloud.
     pub cloud: ThermalCloud,

@@ -13,6 +13,7 @@
 //! The world frame of a recording is the depth camera's frame at the first pose (as with a SLAM
 //! system), so it is neither the room frame nor z-up; `truth.json` gives `world_from_room`.
 
+mod evaluate;
 mod render;
 mod room;
 mod sensors;
@@ -20,6 +21,7 @@ mod simulate;
 mod truth;
 mod walk;
 
+pub use evaluate::{CloudScore, score_cloud, truth_at};
 pub use render::{Element, Hit, RoomRenderer, temperature_at};
 pub use room::{
     FeatureSpec, FurnitureSpec, GRADIENT_STRIP_M, PRESETS, PlacedFeature, PointSpec, Room,

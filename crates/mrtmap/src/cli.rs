@@ -33,6 +33,39 @@ pub enum Command {
     Simulate(SimulateArgs),
     /// List the preset rooms, or print one as TOML to start your own.
     Rooms(RoomsArgs),
+    /// Fuse a recording into a 3D thermal point cloud (cloud.ply, fusion.json).
+    Fuse(FuseArgs),
+}
+
+/// On or off.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum OnOff {
+    /// On.
+    On,
+    /// Off.
+    Off,
+}
+
+/// `mrtmap fuse`.
+#[derive(Debug, Args)]
+pub struct FuseArgs {
+    /// The recording folder (shared/spec/recording.md).
+    pub recording: PathBuf,
+    /// Output folder for cloud.ply, fusion.json and the refined trajectory.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Voxel size (m).
+    #[arg(long = "voxel-m", default_value_t = 0.03)]
+    pub voxel_m: f64,
+    /// Refine poses by point-to-plane ICP against the map built so far.
+    #[arg(long, value_enum, default_value_t = OnOff::On)]
+    pub icp: OnOff,
+    /// Largest time between a thermal frame and the depth frame it takes (ms).
+    #[arg(long = "sync-tolerance-ms", default_value_t = 20.0)]
+    pub sync_tolerance_ms: f64,
+    /// Use every N-th depth pixel in each direction.
+    #[arg(long, default_value_t = 2)]
+    pub depth_stride: u32,
 }
 
 /// Sensor noise of a simulation.

@@ -1,6 +1,7 @@
 //! One module per subcommand, and the settings they share.
 
 mod example_scene;
+mod fuse;
 mod globe;
 mod map;
 mod mrt;
@@ -21,6 +22,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::ExampleScene(a) => example_scene::run(&a),
         Command::Simulate(a) => simulate::run(&a),
         Command::Rooms(a) => simulate::rooms(&a),
+        Command::Fuse(a) => fuse::run(&a),
     }
 }
 

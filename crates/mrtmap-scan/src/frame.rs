@@ -1,0 +1,164 @@
+//! One thermal frame made ready for fusion: its depth frame back-projected (camera frame, at a
+//! pixel stride, with normals from a wider baseline), and its thermal image in kelvin.
+
+use mrtmap_geometry::camera::PinholeCamera;
+use mrtmap_geometry::nalgebra::{Point2, Point3, Vector3};
+use mrtmap_io::{Image16, ThermalEncoding};
+
+/// Back-projection settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DepthSampling {
+    /// Use every `stride`-th pixel in each direction.
+    pub stride: u32,
+    /// Normals from neighbours this many pixels away (robust to depth noise).
+    pub normal_radius_px: u32,
+    /// Valid range (m).
+    pub min_m: f64,
+    /// Valid range (m).
+    pub max_m: f64,
+}
+
+impl Default for DepthSampling {
+    fn default() -> Self {
+        Self {
+            stride: 2,
+            normal_radius_px: 6,
+            min_m: 0.3,
+            max_m: 5.0,
+        }
+    }
+}
+
+/// Unit ray directions (z = 1) of every pixel, precomputed once per camera.
+pub struct RayTable {
+    width: u32,
+    rays: Vec<Vector3<f64>>,
+}
+
+impl RayTable {
+    /// The table of a camera.
+    pub fn new(cam: &PinholeCamera) -> Self {
+        let mut rays = Vec::with_capacity((cam.width * cam.height) as usize);
+        for v in 0..cam.height {
+            for u in 0..cam.width {
+                rays.push(cam.unproject(&Point2::new(u as f64, v as f64)));
+            }
+        }
+        Self {
+            width: cam.width,
+            rays,
+        }
+    }
+
+    fn ray(&self, u: u32, v: u32) -> &Vector3<f64> {
+        &self.rays[(v * self.width + u) as usize]
+    }
+}
+
+/// Depth points of a frame in the depth camera's frame, with unit normals facing the camera.
+#[derive(Clone, Debug, Default)]
+pub struct DepthPoints {
+    /// Points (m).
+    pub points: Vec<Point3<f64>>,
+    /// Normals.
+    pub normals: Vec<Vector3<f64>>,
+}
+
+/// Back-projects a depth image. Points without four consistent neighbours (edges, holes) are left
+/// out, so every point has a normal.
+pub fn depth_points(img: &Image16, rays: &RayTable, scale: f64, s: &DepthSampling) -> DepthPoints {
+    let (w, h) = (img.width, img.height);
+    let r = s.normal_radius_px.max(1);
+    let z_at = |u: u32, v: u32| {
+        let z = img.data[(v * w + u) as usize] as f64 / scale;
+        (z >= s.min_m && z <= s.max_m).then_some(z)
+    };
+    let mut out = DepthPoints::default();
+    let stride = s.stride.max(1);
+    let mut v = r;
+    while v + r < h {
+        let mut u = r;
+        while u + r < w {
+            if let Some(z) = z_at(u, v) {
+                let nb = [
+                    z_at(u - r, v),
+                    z_at(u + r, v),
+                    z_at(u, v - r),
+                    z_at(u, v + r),
+                ];
+                if let [Some(zl), Some(zr), Some(zu), Some(zd)] = nb {
+                    // Neighbours across a depth jump would give a wrong normal.
+                    let jump = 0.25 * z;
+                    if (zl - z).abs() < jump
+                        && (zr - z).abs() < jump
+                        && (zu - z).abs() < jump
+                        && (zd - z).abs() < jump
+                    {
+                        let p = Point3::from(rays.ray(u, v) * z);
+                        let dx = rays.ray(u + r, v) * zr - rays.ray(u - r, v) * zl;
+                        let dy = rays.ray(u, v + r) * zd - rays.ray(u, v - r) * zu;
+                        let mut n = dy.cross(&dx);
+                        if n.dot(&p.coords) > 0.0 {
+                            n = -n;
+                        }
+                        if let Some(n) = n.try_normalize(1e-12) {
+                            out.points.push(p);
+                            out.normals.push(n);
+                        }
+                    }
+                }
+            }
+            u += stride;
+        }
+        v += stride;
+    }
+    out
+}
+
+/// A thermal image in kelvin (f32), row-major.
+#[derive(Clone, Debug, Default)]
+pub struct ThermalImage {
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    /// Kelvin.
+    pub kelvin: Vec<f32>,
+}
+
+impl ThermalImage {
+    /// Decodes raw pixels.
+    pub fn from_raw(img: &Image16, enc: ThermalEncoding) -> Self {
+        Self {
+            width: img.width,
+            height: img.height,
+            kelvin: img.data.iter().map(|&r| enc.kelvin(r) as f32).collect(),
+        }
+    }
+
+    /// Bilinear sample at pixel position (u, v) (centres at integers) and the local contrast
+    /// (max − min of the four pixels used), or `None` outside the image.
+    pub fn sample(&self, u: f64, v: f64) -> Option<(f64, f64)> {
+        let (w, h) = (self.width as i64, self.height as i64);
+        if u < -0.5 || v < -0.5 || u > w as f64 - 0.5 || v > h as f64 - 0.5 {
+            return None;
+        }
+        let u = u.clamp(0.0, (w - 1) as f64);
+        let v = v.clamp(0.0, (h - 1) as f64);
+        let (u0, v0) = (
+            (u.floor() as i64).min(w - 2).max(0),
+            (v.floor() as i64).min(h - 2).max(0),
+        );
+        let (fu, fv) = (u - u0 as f64, v - v0 as f64);
+        let at = |x: i64, y: i64| self.kelvin[(y * w + x) as usize] as f64;
+        let (a, b, c, d) = (
+            at(u0, v0),
+            at(u0 + 1, v0),
+            at(u0, v0 + 1),
+            at(u0 + 1, v0 + 1),
+        );
+        let t = (1.0 - fv) * ((1.0 - fu) * a + fu * b) + fv * ((1.0 - fu) * c + fu * d);
+        let contrast = a.max(b).max(c).max(d) - a.min(b).min(c).min(d);
+        Some((t, contrast))
+    }
+}

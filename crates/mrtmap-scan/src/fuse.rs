@@ -1,0 +1,412 @@
+//! From a recording to a fused thermal point cloud (stage 3 of the seed method).
+//!
+//! ```text
+//!  thermal frame ─ nearest depth frame (≤ 20 ms) ─ poses at both times
+//!      │ depth → points + normals (camera)        [parallel, chunks of frames]
+//!      │ ICP refinement against the map so far     [sequential: the map grows]
+//!      │ points → world → thermal camera, z-buffer, bilinear samples, weights   [parallel]
+//!      └ voxels (T⁴ radiant averages)              [merged in frame order]
+//! ```
+//!
+//! Results do not depend on the number of threads: parallel work is per frame, merged in order.
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use mrtmap_geometry::icp::{IcpParams, IcpTarget, icp_point_to_plane};
+use mrtmap_geometry::nalgebra::{Isometry3, Point3, Vector3};
+use mrtmap_io::{InterpolationLimits, Recording, ThermalCloud};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::frame::{DepthPoints, DepthSampling, RayTable, ThermalImage, depth_points};
+use crate::observe::{ObservationCounts, ObservationParams, observe};
+use crate::sync::{SkipReason, pair_frames};
+use crate::voxels::{FrameVoxels, VoxelMap};
+
+/// ICP refinement settings and the checks a refinement must pass.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct IcpSettings {
+    /// Whether to refine poses by ICP.
+    pub enabled: bool,
+    /// Source points per frame.
+    pub source_points: usize,
+    /// ICP parameters.
+    pub params: IcpParams,
+    /// The map needs this many surface voxels before ICP starts.
+    pub min_map_voxels: usize,
+    /// Rebuild the map's k-d tree every this many frames.
+    pub rebuild_every: usize,
+    /// The target keeps one voxel in `target_every`³.
+    pub target_every: i32,
+    /// Gain of the carried drift correction: each accepted refinement moves it this fraction of the
+    /// way (per-frame depth errors average out, slow drift is followed).
+    pub correction_gain: f64,
+    /// Reject refinements with a lower fitness.
+    pub min_fitness: f64,
+    /// Reject refinements with a larger point-to-plane RMSE (m).
+    pub max_rmse_m: f64,
+    /// Reject refinements that move a frame farther (m)…
+    pub max_step_m: f64,
+    /// …or turn it more (degrees).
+    pub max_step_deg: f64,
+}
+
+impl Default for IcpSettings {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            source_points: 1500,
+            params: IcpParams {
+                max_iterations: 15,
+                ..IcpParams::default()
+            },
+            min_map_voxels: 3000,
+            rebuild_every: 10,
+            target_every: 2,
+            correction_gain: 0.1,
+            min_fitness: 0.5,
+            max_rmse_m: 0.02,
+            max_step_m: 0.05,
+            max_step_deg: 2.0,
+        }
+    }
+}
+
+/// Fusion settings.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FuseParams {
+    /// Voxel size (m).
+    pub voxel_m: f64,
+    /// Largest time between a thermal frame and its depth frame (s).
+    pub sync_tolerance_s: f64,
+    /// Depth pixel stride, normal baseline and range.
+    #[serde(skip)]
+    pub depth: DepthSampling,
+    /// Observation model.
+    pub observation: ObservationParams,
+    /// ICP.
+    pub icp: IcpSettings,
+    /// Frames prepared in parallel at a time.
+    pub chunk: usize,
+}
+
+impl Default for FuseParams {
+    fn default() -> Self {
+        Self {
+            voxel_m: 0.03,
+            sync_tolerance_s: 0.020,
+            depth: DepthSampling::default(),
+            observation: ObservationParams::default(),
+            icp: IcpSettings::default(),
+            chunk: 8,
+        }
+    }
+}
+
+/// ICP statistics of a run.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct IcpReport {
+    /// Whether ICP was on.
+    pub enabled: bool,
+    /// Frames ICP ran on.
+    pub attempted: usize,
+    /// Refinements accepted.
+    pub accepted: usize,
+    /// Refinements rejected, by reason.
+    pub rejected: BTreeMap<String, usize>,
+    /// Mean fitness of accepted refinements.
+    pub mean_fitness: f64,
+    /// Mean point-to-point inlier RMSE of accepted refinements (m).
+    pub mean_inlier_rmse_m: f64,
+    /// Frames where some directions were unconstrained (left unchanged).
+    pub degenerate_frames: usize,
+    /// The final correction applied to the trajectory: translation (m) and rotation (degrees).
+    pub final_correction_m: f64,
+    /// Rotation of the final correction (degrees).
+    pub final_correction_deg: f64,
+}
+
+/// Time spent per phase (s), summed over threads for the parallel phases.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Timing {
+    /// Reading and decoding images, back-projecting depth (CPU seconds).
+    pub read_cpu: f64,
+    /// ICP (wall).
+    pub icp: f64,
+    /// Projection into thermal and sampling (CPU seconds).
+    pub observe_cpu: f64,
+    /// Merging into the voxel map and rebuilding the ICP tree (wall).
+    pub merge: f64,
+    /// Building the output cloud (wall).
+    pub output: f64,
+    /// Whole run (wall).
+    pub total: f64,
+}
+
+/// What `fuse` did: `fusion.json`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct FusionReport {
+    /// Thermal frames listed.
+    pub thermal_frames: usize,
+    /// Depth frames listed.
+    pub depth_frames: usize,
+    /// Thermal frames fused.
+    pub used_frames: usize,
+    /// Frames skipped, by reason.
+    pub skipped: BTreeMap<String, usize>,
+    /// The first few problems, with file names.
+    pub problems: Vec<String>,
+    /// What happened to the depth points.
+    pub observations: ObservationCounts,
+    /// Voxels with a temperature.
+    pub voxels: usize,
+    /// ICP.
+    pub icp: IcpReport,
+    /// Timing.
+    pub timing_s: Timing,
+    /// Thermal frames per second of wall time.
+    pub frames_per_second: f64,
+    /// The parameters used.
+    pub parameters: FuseParams,
+}
+
+/// The result of fusion.
+pub struct Fused {
+    /// The cloud.
+    pub cloud: ThermalCloud,
+    /// The report.
+    pub report: FusionReport,
+    /// The refined world_from_depth pose of each used thermal frame's depth frame, by thermal time.
+    pub poses: Vec<(f64, Isometry3<f64>)>,
+}
+
+/// A prepared frame.
+struct Prepared {
+    thermal_t: f64,
+    depth_t: f64,
+    points: DepthPoints,
+    thermal: ThermalImage,
+}
+
+fn rotation_deg(p: &Isometry3<f64>) -> f64 {
+    p.rotation.angle().to_degrees()
+}
+
+/// Fuses a recording. `progress(done, total)` is called after each frame.
+pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) + Sync)) -> Fused {
+    let t_start = Instant::now();
+    let limits = InterpolationLimits::default();
+    let pairs = pair_frames(rec, params.sync_tolerance_s, &limits);
+    let mut report = FusionReport {
+        thermal_frames: rec.thermal.len(),
+        depth_frames: rec.depth.len(),
+        parameters: *params,
+        ..Default::default()
+    };
+    report.icp.enabled = params.icp.enabled;
+    let skip = |r: SkipReason, report: &mut FusionReport| {
+        *report.skipped.entry(r.describe().to_string()).or_default() += 1
+    };
+    let usable: Vec<(usize, usize)> = pairs
+        .iter()
+        .filter_map(|p| match p.depth {
+            Ok(d) => Some((p.thermal, d)),
+            Err(r) => {
+                skip(r, &mut report);
+                None
+            }
+        })
+        .collect();
+    let total = rec.thermal.len() as u64;
+    let mut done = (rec.thermal.len() - usable.len()) as u64;
+    let rays = RayTable::new(&rec.rig.depth);
+    let mut map = VoxelMap::new(params.voxel_m);
+    let mut target: Option<IcpTarget> = None;
+    let mut since_rebuild = 0usize;
+    let mut correction = Isometry3::identity();
+    let (mut fit_sum, mut rmse_sum) = (0.0, 0.0);
+    let mut poses = Vec::new();
+    let mut timing = Timing::default();
+
+    for chunk in usable.chunks(params.chunk.max(1)) {
+        // Read and back-project in parallel.
+        let t0 = Instant::now();
+        let prepared: Vec<Result<Prepared, String>> = chunk
+            .par_iter()
+            .map(|&(ti, di)| {
+                let th = &rec.thermal[ti];
+                let de = &rec.depth[di];
+                let depth = rec.read_depth(de).map_err(|e| e.to_string())?;
+                let thermal = rec.read_thermal(th).map_err(|e| e.to_string())?;
+                Ok(Prepared {
+                    thermal_t: th.t,
+                    depth_t: de.t,
+                    points: depth_points(&depth, &rays, rec.rig.depth_scale, &params.depth),
+                    thermal: ThermalImage::from_raw(&thermal, rec.rig.thermal_encoding),
+                })
+            })
+            .collect();
+        timing.read_cpu += t0.elapsed().as_secs_f64() * rayon::current_num_threads() as f64;
+
+        // ICP: every frame of the chunk is refined in parallel from the correction at the chunk's
+        // start; the carried correction is then updated in frame order.
+        let t1 = Instant::now();
+        let mut ready: Vec<(Prepared, Isometry3<f64>, Isometry3<f64>)> =
+            Vec::with_capacity(chunk.len());
+        for pr in prepared {
+            let pr = match pr {
+                Ok(p) => p,
+                Err(msg) => {
+                    skip(SkipReason::UnreadableImage, &mut report);
+                    if report.problems.len() < 10 {
+                        report.problems.push(msg);
+                    }
+                    done += 1;
+                    continue;
+                }
+            };
+            if pr.points.points.len() < 100 {
+                skip(SkipReason::TooFewDepthPoints, &mut report);
+                done += 1;
+                continue;
+            }
+            let (Some(wd), Some(wt)) = (
+                rec.trajectory.interpolate(pr.depth_t, &limits),
+                rec.trajectory.interpolate(pr.thermal_t, &limits),
+            ) else {
+                skip(SkipReason::NoPose, &mut report);
+                done += 1;
+                continue;
+            };
+            ready.push((pr, wd, wt));
+        }
+        let start = correction;
+        let refinements: Vec<Option<Result<(Isometry3<f64>, f64, f64, usize), &'static str>>> =
+            ready
+                .par_iter()
+                .map(|(pr, wd, _)| {
+                    let tgt = target.as_ref().filter(|_| params.icp.enabled)?;
+                    let init = start * wd;
+                    let step = (pr.points.points.len() / params.icp.source_points.max(1)).max(1);
+                    let src: Vec<Point3<f64>> = pr
+                        .points
+                        .points
+                        .iter()
+                        .step_by(step)
+                        .map(|p| init * p)
+                        .collect();
+                    let reg =
+                        icp_point_to_plane(&src, tgt, &Isometry3::identity(), &params.icp.params);
+                    let d = reg.target_from_source;
+                    Some(if reg.fitness < params.icp.min_fitness {
+                        Err("fitness below the limit")
+                    } else if reg.inlier_plane_rmse_m > params.icp.max_rmse_m {
+                        Err("residual above the limit")
+                    } else if d.translation.vector.norm() > params.icp.max_step_m
+                        || rotation_deg(&d) > params.icp.max_step_deg
+                    {
+                        Err("step larger than the limit")
+                    } else {
+                        Ok((d, reg.fitness, reg.inlier_rmse_m, reg.degenerate_dofs))
+                    })
+                })
+                .collect();
+        let mut work: Vec<(Prepared, Isometry3<f64>, Isometry3<f64>)> =
+            Vec::with_capacity(ready.len());
+        for ((pr, wd, wt), refinement) in ready.into_iter().zip(refinements) {
+            let mut frame_correction = start;
+            match refinement {
+                None => {}
+                Some(Err(why)) => {
+                    report.icp.attempted += 1;
+                    *report.icp.rejected.entry(why.to_string()).or_default() += 1;
+                }
+                Some(Ok((d, fitness, rmse, degenerate))) => {
+                    report.icp.attempted += 1;
+                    report.icp.accepted += 1;
+                    fit_sum += fitness;
+                    rmse_sum += rmse;
+                    report.icp.degenerate_frames += (degenerate > 0) as usize;
+                    frame_correction = d * start;
+                    correction =
+                        correction.lerp_slerp(&frame_correction, params.icp.correction_gain);
+                }
+            }
+            let world_from_depth = frame_correction * wd;
+            let world_from_thermal = frame_correction * wt * rec.rig.depth_from_thermal;
+            poses.push((pr.thermal_t, world_from_depth));
+            work.push((pr, world_from_depth, world_from_thermal));
+        }
+        timing.icp += t1.elapsed().as_secs_f64();
+
+        // Observe in parallel.
+        let t2 = Instant::now();
+        let results: Vec<(FrameVoxels, ObservationCounts)> = work
+            .par_iter()
+            .map(|(pr, wd, wt)| {
+                let pts: Vec<Point3<f64>> = pr.points.points.iter().map(|p| wd * p).collect();
+                let nrm: Vec<Vector3<f64>> =
+                    pr.points.normals.iter().map(|n| wd.rotation * n).collect();
+                let (obs, counts) = observe(
+                    &pts,
+                    &nrm,
+                    wt,
+                    &rec.rig.thermal,
+                    &pr.thermal,
+                    &params.observation,
+                );
+                let mut fv = FrameVoxels::default();
+                for (p, n) in pts.iter().zip(&nrm) {
+                    fv.add_point(params.voxel_m, p, n);
+                }
+                for o in &obs {
+                    fv.add_temperature(params.voxel_m, &o.p, o.t_k, o.w);
+                }
+                (fv, counts)
+            })
+            .collect();
+        timing.observe_cpu += t2.elapsed().as_secs_f64() * rayon::current_num_threads() as f64;
+
+        // Merge in frame order.
+        let t3 = Instant::now();
+        for (fv, counts) in results {
+            if counts.kept == 0 {
+                skip(SkipReason::NothingVisible, &mut report);
+            } else {
+                report.used_frames += 1;
+            }
+            report.observations.add(&counts);
+            map.merge(fv);
+            since_rebuild += 1;
+            done += 1;
+            progress(done, total);
+        }
+        if params.icp.enabled && (target.is_none() || since_rebuild >= params.icp.rebuild_every) {
+            let (p, n) = map.surface(3, params.icp.target_every);
+            if p.len() >= params.icp.min_map_voxels {
+                target = Some(IcpTarget::new(p, n));
+                since_rebuild = 0;
+            }
+        }
+        timing.merge += t3.elapsed().as_secs_f64();
+    }
+    let t4 = Instant::now();
+    let cloud = map.to_cloud();
+    timing.output = t4.elapsed().as_secs_f64();
+    timing.total = t_start.elapsed().as_secs_f64();
+    report.voxels = cloud.len();
+    if report.icp.accepted > 0 {
+        report.icp.mean_fitness = fit_sum / report.icp.accepted as f64;
+        report.icp.mean_inlier_rmse_m = rmse_sum / report.icp.accepted as f64;
+    }
+    report.icp.final_correction_m = correction.translation.vector.norm();
+    report.icp.final_correction_deg = rotation_deg(&correction);
+    report.frames_per_second = report.thermal_frames as f64 / timing.total.max(1e-9);
+    report.timing_s = timing;
+    Fused {
+        cloud,
+        report,
+        poses,
+    }
+}

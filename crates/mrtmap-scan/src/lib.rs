@@ -1,0 +1,19 @@
+//! # mrtmap-scan
+//!
+//! The scan pipeline: from a recording (frames on their own clocks, poses) to a fused thermal
+//! point cloud, then (segmentation, later) to a radiant scene.
+//!
+//! ```text
+//!  Recording ──► pair_frames ──► depth_points ──► ICP ──► observe (z-buffer, weights) ──► VoxelMap ──► ThermalCloud
+//! ```
+//!
+//! See [`fuse`] for the pipeline and [`observe`](mod@observe) for the observation weights.
+
+pub mod frame;
+mod fuse;
+pub mod observe;
+mod sync;
+pub mod voxels;
+
+pub use fuse::{FuseParams, Fused, FusionReport, IcpReport, IcpSettings, Timing, fuse};
+pub use sync::{Pairing, SkipReason, pair_frames};

@@ -1,0 +1,81 @@
+//! Matching streams by timestamp: each thermal frame takes the nearest depth frame within a
+//! tolerance; poses are interpolated at each frame's own time.
+
+use mrtmap_io::{InterpolationLimits, Recording};
+use serde::{Deserialize, Serialize};
+
+/// Why a thermal frame was not used.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SkipReason {
+    /// No depth frame within the sync tolerance.
+    NoDepthWithinTolerance,
+    /// No pose at the thermal or the depth frame's time.
+    NoPose,
+    /// An image could not be read.
+    UnreadableImage,
+    /// Too few valid depth points.
+    TooFewDepthPoints,
+    /// Nothing of the depth frame is visible in the thermal camera.
+    NothingVisible,
+}
+
+impl SkipReason {
+    /// A phrase for people.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::NoDepthWithinTolerance => "no depth frame within the sync tolerance",
+            Self::NoPose => "no pose at the frame time",
+            Self::UnreadableImage => "an image could not be read",
+            Self::TooFewDepthPoints => "too few valid depth points",
+            Self::NothingVisible => "no depth point visible in the thermal image",
+        }
+    }
+}
+
+/// A thermal frame with its depth frame, or why it has none.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pairing {
+    /// Index into `recording.thermal`.
+    pub thermal: usize,
+    /// Index into `recording.depth`, or why not.
+    pub depth: Result<usize, SkipReason>,
+}
+
+/// Pairs every thermal frame with the nearest depth frame within `tolerance_s` that has poses at
+/// both times.
+pub fn pair_frames(
+    rec: &Recording,
+    tolerance_s: f64,
+    limits: &InterpolationLimits,
+) -> Vec<Pairing> {
+    let depth_t: Vec<f64> = rec.depth.iter().map(|e| e.t).collect();
+    rec.thermal
+        .iter()
+        .enumerate()
+        .map(|(i, th)| {
+            let k = depth_t.partition_point(|&t| t < th.t);
+            let best = [k.checked_sub(1), (k < depth_t.len()).then_some(k)]
+                .into_iter()
+                .flatten()
+                .min_by(|&a, &b| {
+                    (depth_t[a] - th.t)
+                        .abs()
+                        .total_cmp(&(depth_t[b] - th.t).abs())
+                });
+            let depth = match best {
+                Some(d) if (depth_t[d] - th.t).abs() <= tolerance_s => {
+                    if rec.trajectory.interpolate(th.t, limits).is_some()
+                        && rec.trajectory.interpolate(depth_t[d], limits).is_some()
+                    {
+                        Ok(d)
+                    } else {
+                        Err(SkipReason::NoPose)
+                    }
+                }
+                _ => Err(SkipReason::NoDepthWithinTolerance),
+            };
+            Pairing { thermal: i, depth }
+        })
+        .collect()
+}

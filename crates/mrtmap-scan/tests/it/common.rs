@@ -1,0 +1,58 @@
+use std::path::Path;
+
+use mrtmap_geometry::nalgebra::{Isometry3, Translation3};
+use mrtmap_io::Recording;
+use mrtmap_scan::{FuseParams, Fused, fuse};
+use mrtmap_sim::{
+    CloudScore, Drift, NoiseLevel, Room, SimConfig, Truth, preset, score_cloud, simulate,
+};
+
+/// Simulates a short scan at 320×240 depth.
+pub fn scan(room: &str, noise: NoiseLevel, drift: Drift, seconds: f64, out: &Path) -> Room {
+    scan_scaled(room, noise, drift, seconds, 0.5, out)
+}
+
+/// Simulates a scan with the depth camera scaled by `depth_scale` (1 = 640×480).
+pub fn scan_scaled(
+    room: &str,
+    noise: NoiseLevel,
+    drift: Drift,
+    seconds: f64,
+    depth_scale: f64,
+    out: &Path,
+) -> Room {
+    let mut cfg = SimConfig {
+        seconds,
+        noise,
+        drift,
+        truth_rays: 1_000,
+        ..SimConfig::default()
+    };
+    cfg.depth_camera = cfg.depth_camera.scaled(depth_scale);
+    let room = preset(room).unwrap().unwrap();
+    simulate(&room, &cfg, out, &|_, _| {}).unwrap();
+    room
+}
+
+/// Default fusion at depth stride 1 (the small test frames).
+pub fn params(icp: bool) -> FuseParams {
+    let mut p = FuseParams::default();
+    p.depth.stride = 1;
+    p.icp.enabled = icp;
+    p
+}
+
+pub fn fuse_dir(dir: &Path, p: &FuseParams) -> Fused {
+    fuse(&Recording::open(dir).unwrap(), p, &|_, _| {})
+}
+
+pub fn score(room: &Room, dir: &Path, fused: &Fused) -> CloudScore {
+    let truth: Truth =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
+    let t = truth.world_from_room;
+    let wfr = Isometry3::from_parts(
+        Translation3::new(t.translation[0], t.translation[1], t.translation[2]),
+        mrtmap_io::unit_quaternion(t.rotation_xyzw).unwrap(),
+    );
+    score_cloud(room, &wfr, &fused.cloud, 0.03)
+}

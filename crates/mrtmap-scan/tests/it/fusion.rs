@@ -1,0 +1,99 @@
+use mrtmap_sim::{Drift, NoiseLevel};
+
+use crate::common::*;
+
+/// Noise-free: per-voxel |T − true surface temperature| median under 0.05 K and 95th percentile
+/// under 0.3 K away from temperature borders.
+#[test]
+fn noise_free_fusion_recovers_surface_temperatures() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("scan");
+    let room = scan("office", NoiseLevel::None, Drift::NONE, 4.0, &rec);
+    let fused = fuse_dir(&rec, &params(true));
+    let s = score(&room, &rec, &fused);
+    println!("noise-free: {s:?}");
+    assert!(s.voxels > 10_000, "{}", s.voxels);
+    assert!(s.abs_error_median_k < 0.05, "{s:?}");
+    assert!(s.abs_error_p95_k < 0.3, "{s:?}");
+    assert!(s.near_border_fraction < 0.2, "{s:?}");
+    assert!(s.distance_median_m < 0.005, "{s:?}");
+    let r = &fused.report;
+    assert_eq!(r.used_frames, r.thermal_frames, "{:?}", r.skipped);
+    assert!(
+        r.observations.occluded > 0 && r.observations.edge > 0,
+        "{:?}",
+        r.observations
+    );
+}
+
+/// Realistic noise: the same figures stay well inside the targets.
+#[test]
+fn realistic_fusion_stays_accurate() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("scan");
+    let room = scan("l-shaped", NoiseLevel::Realistic, Drift::NONE, 4.0, &rec);
+    let fused = fuse_dir(&rec, &params(true));
+    let s = score(&room, &rec, &fused);
+    println!("realistic: {s:?}");
+    assert!(s.abs_error_median_k < 0.05, "{s:?}");
+    assert!(s.abs_error_p95_k < 0.3, "{s:?}");
+    assert!(s.bias_k.abs() < 0.02, "{s:?}");
+}
+
+/// With pose drift, ICP against the map at least halves the cloud's distance to the true surfaces
+/// (median and 95th percentile; noise-free sensors, so drift is what is measured). A minute of
+/// scanning: three and a half loops of the office, so later loops meet what earlier ones mapped.
+#[test]
+fn icp_cuts_drift_at_least_in_half() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("scan");
+    let room = scan_scaled(
+        "office",
+        NoiseLevel::None,
+        Drift::ODOMETRY,
+        60.0,
+        0.25,
+        &rec,
+    );
+    let on = score(&room, &rec, &fuse_dir(&rec, &params(true)));
+    let off = score(&room, &rec, &fuse_dir(&rec, &params(false)));
+    println!(
+        "drift: ICP on median {:.1} mm p95 {:.1} mm; off median {:.1} mm p95 {:.1} mm",
+        on.distance_median_m * 1e3,
+        on.distance_p95_m * 1e3,
+        off.distance_median_m * 1e3,
+        off.distance_p95_m * 1e3
+    );
+    assert!(off.distance_p95_m > 0.01, "the scan must drift: {off:?}");
+    assert!(
+        on.distance_median_m <= 0.5 * off.distance_median_m,
+        "{on:?} vs {off:?}"
+    );
+    assert!(
+        on.distance_p95_m <= 0.5 * off.distance_p95_m,
+        "{on:?} vs {off:?}"
+    );
+}
+
+/// A corrupt frame is skipped, counted and named; the rest is fused.
+#[test]
+fn corrupt_frames_are_skipped_and_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("scan");
+    scan("office", NoiseLevel::None, Drift::NONE, 2.0, &rec);
+    std::fs::write(rec.join("thermal/000003.png"), b"\x89PNG broken").unwrap();
+    let fused = fuse_dir(&rec, &params(false));
+    let r = &fused.report;
+    assert_eq!(
+        r.skipped.get("an image could not be read"),
+        Some(&1),
+        "{:?}",
+        r.skipped
+    );
+    assert!(
+        r.problems[0].contains("thermal/000003.png"),
+        "{:?}",
+        r.problems
+    );
+    assert_eq!(r.used_frames, r.thermal_frames - 1);
+}

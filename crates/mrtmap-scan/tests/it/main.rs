@@ -1,0 +1,6 @@
+//! Fusion tests on small simulated scans, against the simulator's exact truth.
+#![allow(clippy::unwrap_used)]
+
+mod common;
+mod fusion;
+mod parts;
