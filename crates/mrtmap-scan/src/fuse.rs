@@ -181,6 +181,14 @@ pub struct Fused {
     pub poses: Vec<(f64, Isometry3<f64>)>,
 }
 
+/// An accepted ICP refinement: the correction and its quality.
+struct Refinement {
+    delta: Isometry3<f64>,
+    fitness: f64,
+    rmse_m: f64,
+    degenerate_dofs: usize,
+}
+
 /// A prepared frame.
 struct Prepared {
     thermal_t: f64,
@@ -206,7 +214,7 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
     };
     report.icp.enabled = params.icp.enabled;
     let skip = |r: SkipReason, report: &mut FusionReport| {
-        *report.skipped.entry(r.describe().to_string()).or_default() += 1
+        *report.skipped.entry(r.describe().to_string()).or_default() += 1;
     };
     let usable: Vec<(usize, usize)> = pairs
         .iter()
@@ -282,36 +290,39 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
             ready.push((pr, wd, wt));
         }
         let start = correction;
-        let refinements: Vec<Option<Result<(Isometry3<f64>, f64, f64, usize), &'static str>>> =
-            ready
-                .par_iter()
-                .map(|(pr, wd, _)| {
-                    let tgt = target.as_ref().filter(|_| params.icp.enabled)?;
-                    let init = start * wd;
-                    let step = (pr.points.points.len() / params.icp.source_points.max(1)).max(1);
-                    let src: Vec<Point3<f64>> = pr
-                        .points
-                        .points
-                        .iter()
-                        .step_by(step)
-                        .map(|p| init * p)
-                        .collect();
-                    let reg =
-                        icp_point_to_plane(&src, tgt, &Isometry3::identity(), &params.icp.params);
-                    let d = reg.target_from_source;
-                    Some(if reg.fitness < params.icp.min_fitness {
-                        Err("fitness below the limit")
-                    } else if reg.inlier_plane_rmse_m > params.icp.max_rmse_m {
-                        Err("residual above the limit")
-                    } else if d.translation.vector.norm() > params.icp.max_step_m
-                        || rotation_deg(&d) > params.icp.max_step_deg
-                    {
-                        Err("step larger than the limit")
-                    } else {
-                        Ok((d, reg.fitness, reg.inlier_rmse_m, reg.degenerate_dofs))
+        let refinements: Vec<Option<Result<Refinement, &'static str>>> = ready
+            .par_iter()
+            .map(|(pr, wd, _)| {
+                let tgt = target.as_ref().filter(|_| params.icp.enabled)?;
+                let init = start * wd;
+                let step = (pr.points.points.len() / params.icp.source_points.max(1)).max(1);
+                let src: Vec<Point3<f64>> = pr
+                    .points
+                    .points
+                    .iter()
+                    .step_by(step)
+                    .map(|p| init * p)
+                    .collect();
+                let reg = icp_point_to_plane(&src, tgt, &Isometry3::identity(), &params.icp.params);
+                let d = reg.target_from_source;
+                Some(if reg.fitness < params.icp.min_fitness {
+                    Err("fitness below the limit")
+                } else if reg.inlier_plane_rmse_m > params.icp.max_rmse_m {
+                    Err("residual above the limit")
+                } else if d.translation.vector.norm() > params.icp.max_step_m
+                    || rotation_deg(&d) > params.icp.max_step_deg
+                {
+                    Err("step larger than the limit")
+                } else {
+                    Ok(Refinement {
+                        delta: d,
+                        fitness: reg.fitness,
+                        rmse_m: reg.inlier_rmse_m,
+                        degenerate_dofs: reg.degenerate_dofs,
                     })
                 })
-                .collect();
+            })
+            .collect();
         let mut work: Vec<(Prepared, Isometry3<f64>, Isometry3<f64>)> =
             Vec::with_capacity(ready.len());
         for ((pr, wd, wt), refinement) in ready.into_iter().zip(refinements) {
@@ -322,13 +333,13 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
                     report.icp.attempted += 1;
                     *report.icp.rejected.entry(why.to_string()).or_default() += 1;
                 }
-                Some(Ok((d, fitness, rmse, degenerate))) => {
+                Some(Ok(r)) => {
                     report.icp.attempted += 1;
                     report.icp.accepted += 1;
-                    fit_sum += fitness;
-                    rmse_sum += rmse;
-                    report.icp.degenerate_frames += (degenerate > 0) as usize;
-                    frame_correction = d * start;
+                    fit_sum += r.fitness;
+                    rmse_sum += r.rmse_m;
+                    report.icp.degenerate_frames += (r.degenerate_dofs > 0) as usize;
+                    frame_correction = r.delta * start;
                     correction =
                         correction.lerp_slerp(&frame_correction, params.icp.correction_gain);
                 }
