@@ -14,12 +14,23 @@ pub fn voxel_key(p: &Point3<f64>, voxel_m: f64) -> [i32; 3] {
 }
 
 /// Downsamples to one point per voxel: the mean of the points in it (as Open3D's
-/// `voxel_down_sample`), in order of first occurrence.
+/// `voxel_down_sample`), in order of first occurrence. Voxels are aligned to the world origin; see
+/// [`voxel_downsample_from`] for another grid origin.
 pub fn voxel_downsample(points: &[Point3<f64>], voxel_m: f64) -> Vec<Point3<f64>> {
+    voxel_downsample_from(points, voxel_m, &Point3::origin())
+}
+
+/// [`voxel_downsample`] with voxels aligned to `origin` (Open3D aligns them to the cloud's minimum
+/// bound minus half a voxel).
+pub fn voxel_downsample_from(
+    points: &[Point3<f64>],
+    voxel_m: f64,
+    origin: &Point3<f64>,
+) -> Vec<Point3<f64>> {
     let mut index: FxHashMap<[i32; 3], usize> = FxHashMap::default();
     let mut sums: Vec<(Vector3<f64>, u32)> = Vec::new();
     for p in points {
-        let k = voxel_key(p, voxel_m);
+        let k = voxel_key(&Point3::from(p - origin), voxel_m);
         let i = *index.entry(k).or_insert_with(|| {
             sums.push((Vector3::zeros(), 0));
             sums.len() - 1

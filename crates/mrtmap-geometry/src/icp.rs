@@ -9,6 +9,7 @@
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use nalgebra::{Isometry3, Matrix6, Point3, Translation3, UnitQuaternion, Vector3, Vector6};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Convergence and robustness settings.
@@ -104,6 +105,26 @@ impl IcpTarget {
     }
 }
 
+#[derive(Default)]
+struct Accum {
+    h: Matrix6<f64>,
+    g: Vector6<f64>,
+    n: usize,
+    sq: f64,
+    sq_plane: f64,
+}
+
+impl Accum {
+    fn add(mut self, o: &Accum) -> Accum {
+        self.h += o.h;
+        self.g += o.g;
+        self.n += o.n;
+        self.sq += o.sq;
+        self.sq_plane += o.sq_plane;
+        self
+    }
+}
+
 fn exp_se3(x: &Vector6<f64>) -> Isometry3<f64> {
     let rot = UnitQuaternion::from_scaled_axis(Vector3::new(x[0], x[1], x[2]));
     Isometry3::from_parts(Translation3::new(x[3], x[4], x[5]), rot)
@@ -130,35 +151,45 @@ pub fn icp_point_to_plane(
         return result;
     }
     for it in 0..params.max_iterations {
-        let mut h = Matrix6::<f64>::zeros();
-        let mut g = Vector6::<f64>::zeros();
-        let (mut n_in, mut sq, mut sq_plane) = (0usize, 0.0, 0.0);
-        for s in source {
-            let p = t * s;
-            let Some((k, d)) = target.nearest(&p, params.max_correspondence_m) else {
-                continue;
-            };
-            let n = target.normals[k];
-            let r = n.dot(&(p - target.points[k]));
-            let w = if r.abs() <= params.huber_m {
-                1.0
-            } else {
-                params.huber_m / r.abs()
-            };
-            let j = Vector6::new(
-                p.y * n.z - p.z * n.y,
-                p.z * n.x - p.x * n.z,
-                p.x * n.y - p.y * n.x,
-                n.x,
-                n.y,
-                n.z,
-            );
-            h += j * j.transpose() * w;
-            g += j * (w * r);
-            n_in += 1;
-            sq += d * d;
-            sq_plane += r * r;
-        }
+        // Normal equations over all correspondences (in parallel for large sources; the sum is
+        // taken in a fixed chunk order, so results do not depend on the thread count).
+        let acc = |chunk: &[Point3<f64>]| {
+            let mut a = Accum::default();
+            for s in chunk {
+                let p = t * s;
+                let Some((k, d)) = target.nearest(&p, params.max_correspondence_m) else {
+                    continue;
+                };
+                let n = target.normals[k];
+                let r = n.dot(&(p - target.points[k]));
+                let w = if r.abs() <= params.huber_m {
+                    1.0
+                } else {
+                    params.huber_m / r.abs()
+                };
+                let j = Vector6::new(
+                    p.y * n.z - p.z * n.y,
+                    p.z * n.x - p.x * n.z,
+                    p.x * n.y - p.y * n.x,
+                    n.x,
+                    n.y,
+                    n.z,
+                );
+                a.h += j * j.transpose() * w;
+                a.g += j * (w * r);
+                a.n += 1;
+                a.sq += d * d;
+                a.sq_plane += r * r;
+            }
+            a
+        };
+        let parts: Vec<Accum> = if source.len() >= 4096 {
+            source.par_chunks(1024).map(acc).collect()
+        } else {
+            vec![acc(source)]
+        };
+        let total = parts.into_iter().fold(Accum::default(), |a, b| a.add(&b));
+        let (h, g, n_in, sq, sq_plane) = (total.h, total.g, total.n, total.sq, total.sq_plane);
         result.iterations = it + 1;
         result.fitness = n_in as f64 / source.len() as f64;
         if n_in < 6 {

@@ -2,7 +2,7 @@
 //!
 //! `cloud.ply` is binary little-endian with, per vertex: `x y z` (float, m), `nx ny nz` (float),
 //! `temperature_c` (float, °C: the radiant T⁴ average), `temperature_std` (float, K),
-//! `observations` (uint), `red green blue` (uchar, an iron colour map of the temperature), and any
+//! `observations` (int: Open3D's tensor reader skips uint), `red green blue` (uchar, an iron colour map of the temperature), and any
 //! extra integer fields (segments.ply adds `surface_id`, `feature_id`). CloudCompare shows the
 //! non-standard properties as scalar fields; Open3D's tensor API
 //! (`open3d.t.io.read_point_cloud`) keeps them as attributes.
@@ -97,7 +97,7 @@ pub fn cloud_ply_bytes(cloud: &ThermalCloud, comment: &str, extra: &[(&str, &[i3
     ] {
         header.push_str(&format!("property float {p}\n"));
     }
-    header.push_str("property uint observations\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n");
+    header.push_str("property int observations\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n");
     for (name, _) in extra {
         header.push_str(&format!("property int {name}\n"));
     }
@@ -110,7 +110,7 @@ pub fn cloud_ply_bytes(cloud: &ThermalCloud, comment: &str, extra: &[(&str, &[i3
         let t = cloud.temperature_k[i];
         out.extend_from_slice(&((t as f64 - 273.15) as f32).to_le_bytes());
         out.extend_from_slice(&cloud.temperature_std_k[i].to_le_bytes());
-        out.extend_from_slice(&cloud.observations[i].to_le_bytes());
+        out.extend_from_slice(&(cloud.observations[i].min(i32::MAX as u32) as i32).to_le_bytes());
         out.extend_from_slice(&iron((t - lo) / span));
         for (_, vals) in extra {
             out.extend_from_slice(&vals[i].to_le_bytes());

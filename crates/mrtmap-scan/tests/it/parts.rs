@@ -155,7 +155,7 @@ fn ply_round_trip_keeps_every_field() {
         "float nx",
         "float temperature_c",
         "float temperature_std",
-        "uint observations",
+        "int observations",
         "uchar red",
         "int surface_id",
     ] {
