@@ -21,14 +21,17 @@
 pub mod camera;
 pub mod cloud;
 pub mod icp;
+pub mod plane;
 pub mod polygon;
 pub mod ray;
 pub mod sampling;
+pub mod shape2d;
 mod solid_angle;
 
 pub use camera::{BrownConrady, PinholeCamera};
 pub use icp::{IcpParams, IcpTarget, Registration, icp_point_to_plane};
 pub use nalgebra;
+pub use plane::{Plane, RansacParams, intersect_three, ransac_plane};
 pub use polygon::{Containment, NotSimple, PlaneFrame};
 #[cfg(feature = "embree")]
 pub use ray::EmbreeRayCaster;

@@ -147,6 +147,8 @@ pub struct Timing {
 /// What `fuse` did: `fusion.json`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct FusionReport {
+    /// The recording fused.
+    pub recording: String,
     /// Thermal frames listed.
     pub thermal_frames: usize,
     /// Depth frames listed.
@@ -207,6 +209,7 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
     let limits = InterpolationLimits::default();
     let pairs = pair_frames(rec, params.sync_tolerance_s, &limits);
     let mut report = FusionReport {
+        recording: rec.dir.display().to_string(),
         thermal_frames: rec.thermal.len(),
         depth_frames: rec.depth.len(),
         parameters: *params,

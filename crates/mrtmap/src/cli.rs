@@ -35,6 +35,28 @@ pub enum Command {
     Rooms(RoomsArgs),
     /// Fuse a recording into a 3D thermal point cloud (cloud.ply, fusion.json).
     Fuse(FuseArgs),
+    /// Segment a fused cloud into the room's surfaces and thermal features: scene.json.
+    Segment(SegmentArgs),
+}
+
+/// `mrtmap segment`.
+#[derive(Debug, Args)]
+pub struct SegmentArgs {
+    /// The output folder of `mrtmap fuse` (cloud.ply, poses.txt).
+    pub fused: PathBuf,
+    /// A recording with instance masks (masks.txt; see docs/simulator.md for the format) to label
+    /// the features by a majority vote over frames. Without it, features get rule labels.
+    #[arg(long, value_name = "DIR")]
+    pub masks: Option<PathBuf>,
+    /// Output folder for scene.json, segments.ply and segment.json.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// A texel belongs to a feature when it differs from its surface's background by more (K).
+    #[arg(long, default_value_t = 0.8)]
+    pub feature_threshold_k: f64,
+    /// Smallest feature (m²).
+    #[arg(long = "feature-min-area-m2", default_value_t = 0.04)]
+    pub feature_min_area_m2: f64,
 }
 
 /// On or off.

@@ -5,6 +5,7 @@ mod fuse;
 mod globe;
 mod map;
 mod mrt;
+mod segment;
 mod simulate;
 
 use anyhow::bail;
@@ -23,6 +24,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Simulate(a) => simulate::run(&a),
         Command::Rooms(a) => simulate::rooms(&a),
         Command::Fuse(a) => fuse::run(&a),
+        Command::Segment(a) => segment::run(&a),
     }
 }
 

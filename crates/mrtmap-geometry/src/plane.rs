@@ -1,0 +1,172 @@
+//! Planes: least-squares fits and RANSAC with normal agreement, and plane intersections.
+
+use nalgebra::{Matrix3, Point3, Unit, Vector3};
+use rand::Rng;
+use serde::{Deserialize, Serialize};
+
+/// A plane n·p = d with a unit normal.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Plane {
+    /// Unit normal.
+    pub normal: Unit<Vector3<f64>>,
+    /// Offset along the normal.
+    pub d: f64,
+}
+
+impl Plane {
+    /// The plane through `p` with normal `n`.
+    pub fn from_point_normal(p: &Point3<f64>, n: Unit<Vector3<f64>>) -> Self {
+        Self {
+            d: n.dot(&p.coords),
+            normal: n,
+        }
+    }
+
+    /// Signed distance of a point.
+    pub fn distance(&self, p: &Point3<f64>) -> f64 {
+        self.normal.dot(&p.coords) - self.d
+    }
+
+    /// The same plane with the opposite normal.
+    pub fn flipped(&self) -> Self {
+        Self {
+            normal: -self.normal,
+            d: -self.d,
+        }
+    }
+
+    /// Projection of a point onto the plane.
+    pub fn project(&self, p: &Point3<f64>) -> Point3<f64> {
+        p - self.normal.as_ref() * self.distance(p)
+    }
+
+    /// Least-squares plane of points (PCA), or `None` for fewer than 3 or collinear points.
+    pub fn fit(points: &[Point3<f64>]) -> Option<Self> {
+        if points.len() < 3 {
+            return None;
+        }
+        let c = points.iter().fold(Vector3::zeros(), |a, p| a + p.coords) / points.len() as f64;
+        let mut cov = Matrix3::zeros();
+        for p in points {
+            let d = p.coords - c;
+            cov += d * d.transpose();
+        }
+        let eig = nalgebra::SymmetricEigen::new(cov);
+        let mut idx = [0usize, 1, 2];
+        idx.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
+        if eig.eigenvalues[idx[1]] <= 1e-12 {
+            return None;
+        }
+        let n = Unit::try_new(eig.eigenvectors.column(idx[0]).into_owned(), 1e-9)?;
+        Some(Self::from_point_normal(&Point3::from(c), n))
+    }
+}
+
+/// The point where three planes meet, or `None` when they do not meet in one point.
+pub fn intersect_three(a: &Plane, b: &Plane, c: &Plane) -> Option<Point3<f64>> {
+    let m = Matrix3::from_rows(&[
+        a.normal.transpose(),
+        b.normal.transpose(),
+        c.normal.transpose(),
+    ]);
+    let det = m.determinant();
+    if det.abs() < 1e-9 {
+        return None;
+    }
+    m.try_inverse()
+        .map(|inv| Point3::from(inv * Vector3::new(a.d, b.d, c.d)))
+}
+
+/// RANSAC settings.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RansacParams {
+    /// Largest point-to-plane distance of an inlier (m).
+    pub distance_m: f64,
+    /// Largest angle between a point's normal and the plane's (degrees).
+    pub normal_deg: f64,
+    /// Hypotheses drawn.
+    pub iterations: usize,
+    /// Hypotheses are scored on at most this many points.
+    pub sample: usize,
+}
+
+impl Default for RansacParams {
+    fn default() -> Self {
+        Self {
+            distance_m: 0.05,
+            normal_deg: 30.0,
+            iterations: 400,
+            sample: 20_000,
+        }
+    }
+}
+
+/// The best plane among `candidates` (indices into `points`): RANSAC over three-point hypotheses
+/// scored on a subsample (inliers within `distance_m` whose normal agrees within `normal_deg`),
+/// then refitted by least squares to all its inliers. Returns the plane and its inliers.
+pub fn ransac_plane<R: Rng>(
+    points: &[Point3<f64>],
+    normals: &[Vector3<f64>],
+    candidates: &[usize],
+    params: &RansacParams,
+    rng: &mut R,
+) -> Option<(Plane, Vec<usize>)> {
+    if candidates.len() < 3 {
+        return None;
+    }
+    let cos = params.normal_deg.to_radians().cos();
+    let step = (candidates.len() / params.sample.max(1)).max(1);
+    let sample: Vec<usize> = candidates.iter().step_by(step).copied().collect();
+    let is_inlier = |pl: &Plane, i: usize, tol: f64| {
+        pl.distance(&points[i]).abs() <= tol && pl.normal.dot(&normals[i]).abs() >= cos
+    };
+    let mut best: Option<(Plane, usize)> = None;
+    for _ in 0..params.iterations {
+        let (a, b, c) = (
+            candidates[rng.random_range(0..candidates.len())],
+            candidates[rng.random_range(0..candidates.len())],
+            candidates[rng.random_range(0..candidates.len())],
+        );
+        let n = (points[b] - points[a]).cross(&(points[c] - points[a]));
+        let Some(n) = Unit::try_new(n, 1e-9) else {
+            continue;
+        };
+        let pl = Plane::from_point_normal(&points[a], n);
+        if [a, b, c]
+            .iter()
+            .any(|&i| pl.normal.dot(&normals[i]).abs() < cos)
+        {
+            continue;
+        }
+        let score = sample
+            .iter()
+            .filter(|&&i| is_inlier(&pl, i, params.distance_m))
+            .count();
+        if best.is_none_or(|b| score > b.1) {
+            best = Some((pl, score));
+        }
+    }
+    let (mut pl, _) = best?;
+    // Refine twice: fit to inliers, recollect.
+    for _ in 0..2 {
+        let inliers: Vec<usize> = candidates
+            .iter()
+            .copied()
+            .filter(|&i| is_inlier(&pl, i, params.distance_m))
+            .collect();
+        let pts: Vec<Point3<f64>> = inliers.iter().map(|&i| points[i]).collect();
+        if let Some(f) = Plane::fit(&pts) {
+            pl = if f.normal.dot(&pl.normal) < 0.0 {
+                f.flipped()
+            } else {
+                f
+            };
+        }
+    }
+    let inliers = candidates
+        .iter()
+        .copied()
+        .filter(|&i| is_inlier(&pl, i, params.distance_m))
+        .collect();
+    Some((pl, inliers))
+}

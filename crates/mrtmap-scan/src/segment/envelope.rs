@@ -1,0 +1,401 @@
+//! The room's envelope from a thermal cloud: up, planes, their classes, and the loop of walls
+//! whose consecutive intersections are the room's corners (the seed paper's Algorithm 1, "retrieve
+//! surface plane and corners").
+
+use mrtmap_geometry::PlaneFrame;
+use mrtmap_geometry::nalgebra::{Isometry3, Point2, Point3, Unit, Vector2, Vector3};
+use mrtmap_geometry::plane::{Plane, RansacParams, intersect_three, ransac_plane};
+use mrtmap_geometry::polygon::signed_area;
+use mrtmap_geometry::shape2d::line_intersection;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+use super::{SegmentError, SegmentParams};
+
+/// What a plane is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlaneClass {
+    /// The floor.
+    Floor,
+    /// The ceiling.
+    Ceiling,
+    /// A wall of the envelope.
+    Wall,
+    /// Horizontal, not floor or ceiling (a table top…).
+    OtherHorizontal,
+    /// Vertical but not a wall (too short, or not on the outline).
+    OtherVertical,
+    /// Neither horizontal nor vertical.
+    Slanted,
+}
+
+/// A plane found in the cloud.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct FoundPlane {
+    /// The plane (normal into the room for envelope planes).
+    pub plane: Plane,
+    /// Its inliers (indices into the cloud).
+    #[serde(skip)]
+    pub inliers: Vec<usize>,
+    /// Number of inliers.
+    pub points: usize,
+    /// Class.
+    pub class: PlaneClass,
+}
+
+/// The envelope: up, floor, ceiling and the walls in order around the room, with corners.
+#[derive(Clone, Debug)]
+pub struct Envelope {
+    /// Up (unit).
+    pub up: Unit<Vector3<f64>>,
+    /// Index of the floor in `planes`.
+    pub floor: usize,
+    /// Index of the ceiling.
+    pub ceiling: usize,
+    /// Walls in order around the room (counter-clockwise seen from above).
+    pub walls: Vec<usize>,
+    /// Corners at the floor: corner k is where wall k−1 meets wall k.
+    pub floor_corners: Vec<Point3<f64>>,
+    /// Corners at the ceiling.
+    pub ceiling_corners: Vec<Point3<f64>>,
+    /// All planes found.
+    pub planes: Vec<FoundPlane>,
+    /// The horizontal frame (origin on the floor, normal up).
+    pub frame: PlaneFrame,
+}
+
+/// Up from the camera poses: the mean of the cameras' "up" (−y in OpenCV's convention) over the
+/// walk. Tilt sweeps cancel over a walk that looks all around.
+pub fn up_from_poses(world_from_camera: &[Isometry3<f64>]) -> Option<Unit<Vector3<f64>>> {
+    let s = world_from_camera
+        .iter()
+        .fold(Vector3::zeros(), |a, p| a - p.rotation * Vector3::y());
+    Unit::try_new(s, 1e-9)
+}
+
+fn percentile(v: &mut [f64], q: f64) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[((v.len() - 1) as f64 * q).round() as usize]
+}
+
+/// Finds planes by repeated RANSAC, merging near-coplanar ones.
+pub fn find_planes(
+    points: &[Point3<f64>],
+    normals: &[Vector3<f64>],
+    p: &SegmentParams,
+) -> Vec<FoundPlane> {
+    let mut rng = ChaCha8Rng::seed_from_u64(p.seed);
+    let mut remaining: Vec<usize> = (0..points.len()).collect();
+    let min_points = p.min_plane_points.max(points.len() / 400);
+    let mut found: Vec<(Plane, Vec<usize>)> = Vec::new();
+    let ransac = RansacParams {
+        distance_m: p.plane_distance_m,
+        normal_deg: p.plane_normal_deg,
+        ..RansacParams::default()
+    };
+    for _ in 0..p.max_planes {
+        let Some((pl, inl)) = ransac_plane(points, normals, &remaining, &ransac, &mut rng) else {
+            break;
+        };
+        if inl.len() < min_points {
+            break;
+        }
+        let mut taken = vec![false; points.len()];
+        for &i in &inl {
+            taken[i] = true;
+        }
+        remaining.retain(|&i| !taken[i]);
+        found.push((pl, inl));
+    }
+    // Merge planes that are the same surface split in two.
+    let mut merged: Vec<(Plane, Vec<usize>)> = Vec::new();
+    for (pl, inl) in found {
+        let same = merged.iter_mut().find(|(m, _)| {
+            m.normal.dot(&pl.normal).abs() > p.merge_deg.to_radians().cos() && {
+                let c = inl
+                    .iter()
+                    .fold(Vector3::zeros(), |a, &i| a + points[i].coords)
+                    / inl.len() as f64;
+                m.distance(&Point3::from(c)).abs() < p.merge_distance_m
+            }
+        });
+        match same {
+            Some((m, mi)) => {
+                mi.extend(inl);
+                let pts: Vec<Point3<f64>> = mi.iter().map(|&i| points[i]).collect();
+                if let Some(f) = Plane::fit(&pts) {
+                    *m = if f.normal.dot(&m.normal) < 0.0 {
+                        f.flipped()
+                    } else {
+                        f
+                    };
+                }
+            }
+            None => merged.push((pl, inl)),
+        }
+    }
+    merged
+        .into_iter()
+        .map(|(plane, inliers)| FoundPlane {
+            plane,
+            points: inliers.len(),
+            inliers,
+            class: PlaneClass::Slanted,
+        })
+        .collect()
+}
+
+/// Classifies planes against an up estimate, picks floor and ceiling, refines up from the floor,
+/// links the walls into a loop and computes the corners.
+pub fn envelope(
+    points: &[Point3<f64>],
+    mut planes: Vec<FoundPlane>,
+    up0: Unit<Vector3<f64>>,
+    p: &SegmentParams,
+) -> Result<Envelope, SegmentError> {
+    let cos_h = p.horizontal_deg.to_radians().cos();
+    let sin_v = p.vertical_deg.to_radians().sin();
+    let height = |pt: &Point3<f64>, up: &Vector3<f64>| up.dot(&pt.coords);
+    // Floor and ceiling: the lowest and highest large horizontal planes.
+    let horizontal: Vec<usize> = (0..planes.len())
+        .filter(|&k| planes[k].plane.normal.dot(&up0).abs() > cos_h)
+        .collect();
+    let largest = horizontal
+        .iter()
+        .map(|&k| planes[k].points)
+        .max()
+        .ok_or(SegmentError::NoFloor)?;
+    let big: Vec<usize> = horizontal
+        .iter()
+        .copied()
+        .filter(|&k| planes[k].points * 5 >= largest)
+        .collect();
+    let heights: Vec<f64> = planes
+        .iter()
+        .map(|f| {
+            height(
+                &Point3::from(
+                    f.inliers
+                        .iter()
+                        .fold(Vector3::zeros(), |a, &i| a + points[i].coords)
+                        / f.points.max(1) as f64,
+                ),
+                &up0,
+            )
+        })
+        .collect();
+    let plane_height = |k: usize| heights[k];
+    let floor = *big
+        .iter()
+        .min_by(|&&a, &&b| plane_height(a).total_cmp(&plane_height(b)))
+        .ok_or(SegmentError::NoFloor)?;
+    let ceiling = *big
+        .iter()
+        .max_by(|&&a, &&b| plane_height(a).total_cmp(&plane_height(b)))
+        .ok_or(SegmentError::NoCeiling)?;
+    if floor == ceiling || plane_height(ceiling) - plane_height(floor) < 1.5 {
+        return Err(SegmentError::NoCeiling);
+    }
+    // Up from the floor's normal, oriented like the cameras' up.
+    let mut fp = planes[floor].plane;
+    if fp.normal.dot(&up0) < 0.0 {
+        fp = fp.flipped();
+    }
+    planes[floor].plane = fp;
+    let up = fp.normal;
+    let mut cp = planes[ceiling].plane;
+    if cp.normal.dot(&up) > 0.0 {
+        cp = cp.flipped();
+    }
+    planes[ceiling].plane = cp;
+    let (h_floor, h_ceiling) = (plane_height(floor), plane_height(ceiling));
+    for &k in &horizontal {
+        if k != floor && k != ceiling {
+            planes[k].class = PlaneClass::OtherHorizontal;
+        }
+    }
+    planes[floor].class = PlaneClass::Floor;
+    planes[ceiling].class = PlaneClass::Ceiling;
+    // The room's interior: the mean of points between floor and ceiling.
+    let inside: Vec<&Point3<f64>> = points
+        .iter()
+        .filter(|q| {
+            let h = height(q, &up);
+            h > h_floor + 0.2 && h < h_ceiling - 0.2
+        })
+        .collect();
+    let centre = Point3::from(
+        inside.iter().fold(Vector3::zeros(), |a, q| a + q.coords) / inside.len().max(1) as f64,
+    );
+    // Walls: vertical planes spanning enough of the room's height.
+    let mut walls = Vec::new();
+    #[allow(clippy::needless_range_loop)] // planes[k] is read and rewritten in the body
+    for k in 0..planes.len() {
+        if planes[k].class != PlaneClass::Slanted || planes[k].plane.normal.dot(&up).abs() > sin_v {
+            continue; // horizontal (classified above) or slanted
+        }
+        let mut hs: Vec<f64> = planes[k]
+            .inliers
+            .iter()
+            .map(|&i| height(&points[i], &up))
+            .collect();
+        let span = percentile(&mut hs, 0.95) - percentile(&mut hs, 0.05);
+        if span >= p.wall_min_height_fraction * (h_ceiling - h_floor) {
+            // Make vertical exactly (project the normal) and point it into the room.
+            let n = Unit::new_normalize(
+                planes[k].plane.normal.as_ref() - up.as_ref() * planes[k].plane.normal.dot(&up),
+            );
+            let c = planes[k]
+                .inliers
+                .iter()
+                .fold(Vector3::zeros(), |a, &i| a + points[i].coords)
+                / planes[k].points as f64;
+            let mut pl = Plane::from_point_normal(&Point3::from(c), n);
+            if pl.distance(&centre) < 0.0 {
+                pl = pl.flipped();
+            }
+            planes[k].plane = pl;
+            planes[k].class = PlaneClass::Wall;
+            walls.push(k);
+        } else {
+            planes[k].class = PlaneClass::OtherVertical;
+        }
+    }
+    // The horizontal frame and the walls' lines and extents in it.
+    let origin = fp.project(&centre);
+    let frame = PlaneFrame::new(origin, up, &Vector3::x());
+    struct Line {
+        k: usize,
+        p: Point2<f64>,
+        d: Vector2<f64>,
+        ends: [Point2<f64>; 2],
+    }
+    let lines: Vec<Line> = walls
+        .iter()
+        .map(|&k| {
+            let pl = &planes[k].plane;
+            let n2 = Vector2::new(frame.u.dot(&pl.normal), frame.v.dot(&pl.normal)).normalize();
+            let d = Vector2::new(-n2.y, n2.x);
+            let on = frame.to_2d(&pl.project(&origin));
+            let mut s: Vec<f64> = planes[k]
+                .inliers
+                .iter()
+                .map(|&i| (frame.to_2d(&points[i]) - on).dot(&d))
+                .collect();
+            let (a, b) = (percentile(&mut s, 0.02), percentile(&mut s, 0.98));
+            Line {
+                k,
+                p: on,
+                d,
+                ends: [on + d * a, on + d * b],
+            }
+        })
+        .collect();
+    // Link wall ends: the corner of two walls is their lines' intersection; pair ends greedily by
+    // how far the corner lies from both ends.
+    let mut pairs: Vec<(f64, usize, usize, usize, usize, Point2<f64>)> = Vec::new();
+    for a in 0..lines.len() {
+        for b in (a + 1)..lines.len() {
+            let (la, lb) = (&lines[a], &lines[b]);
+            if la.d.dot(&lb.d).abs() > p.corner_min_angle_deg.to_radians().cos() {
+                continue;
+            }
+            let Some(c) = line_intersection(&la.p, &la.d, &lb.p, &lb.d) else {
+                continue;
+            };
+            for ea in 0..2 {
+                for eb in 0..2 {
+                    let cost = (c - la.ends[ea]).norm() + (c - lb.ends[eb]).norm();
+                    if cost < p.corner_max_gap_m {
+                        pairs.push((cost, a, ea, b, eb, c));
+                    }
+                }
+            }
+        }
+    }
+    pairs.sort_by(|x, y| x.0.total_cmp(&y.0));
+    // For each wall's two ends: the wall it meets there and the corner.
+    type End = Option<(usize, Point2<f64>)>;
+    let mut link: Vec<[End; 2]> = vec![[None, None]; lines.len()];
+    for (_, a, ea, b, eb, c) in pairs {
+        if link[a][ea].is_none() && link[b][eb].is_none() && link[a][1 - ea].map(|l| l.0) != Some(b)
+        {
+            link[a][ea] = Some((b, c));
+            link[b][eb] = Some((a, c));
+        }
+    }
+    // Walk the loop from the longest wall.
+    let start = (0..lines.len())
+        .max_by(|&a, &b| {
+            (lines[a].ends[1] - lines[a].ends[0])
+                .norm()
+                .total_cmp(&(lines[b].ends[1] - lines[b].ends[0]).norm())
+        })
+        .ok_or(SegmentError::NoWalls)?;
+    let mut order = vec![start];
+    let mut corners2 = Vec::new();
+    let (mut cur, mut out_end) = (start, 1usize);
+    loop {
+        let Some((next, c)) = link[cur][out_end] else {
+            return Err(SegmentError::OpenOutline { walls: order.len() });
+        };
+        corners2.push(c);
+        if next == start {
+            break;
+        }
+        if order.contains(&next) || order.len() > lines.len() {
+            return Err(SegmentError::OpenOutline { walls: order.len() });
+        }
+        let in_end = if link[next][0].map(|l| l.0) == Some(cur) {
+            0
+        } else {
+            1
+        };
+        order.push(next);
+        cur = next;
+        out_end = 1 - in_end;
+    }
+    if order.len() < 3 {
+        return Err(SegmentError::OpenOutline { walls: order.len() });
+    }
+    // corners2[k] joins order[k] and order[k+1]; rotate so corner k joins wall k−1 and wall k.
+    corners2.rotate_right(1);
+    let mut wall_order: Vec<usize> = order.iter().map(|&i| lines[i].k).collect();
+    if signed_area(&corners2) < 0.0 {
+        // Counter-clockwise seen from above: reverse, keeping corner k between walls k−1 and k
+        // (the new corner k is the old corner n−k).
+        wall_order.reverse();
+        corners2.reverse();
+        corners2.rotate_right(1);
+    }
+    for k in walls.iter().filter(|k| !wall_order.contains(k)) {
+        planes[*k].class = PlaneClass::OtherVertical;
+    }
+    let n = wall_order.len();
+    let corner3 = |k: usize, cap: &Plane| {
+        let (a, b) = (
+            &planes[wall_order[(k + n - 1) % n]].plane,
+            &planes[wall_order[k]].plane,
+        );
+        intersect_three(a, b, cap)
+    };
+    let floor_corners: Option<Vec<Point3<f64>>> =
+        (0..n).map(|k| corner3(k, &planes[floor].plane)).collect();
+    let ceiling_corners: Option<Vec<Point3<f64>>> =
+        (0..n).map(|k| corner3(k, &planes[ceiling].plane)).collect();
+    let (Some(floor_corners), Some(ceiling_corners)) = (floor_corners, ceiling_corners) else {
+        return Err(SegmentError::OpenOutline { walls: n });
+    };
+    Ok(Envelope {
+        up,
+        floor,
+        ceiling,
+        walls: wall_order,
+        floor_corners,
+        ceiling_corners,
+        planes,
+        frame,
+    })
+}

@@ -1,0 +1,439 @@
+//! Thermal features on one envelope surface.
+//!
+//! The surface's fused points are rasterised into square texels (radiant T⁴ averages). Its
+//! background is a robust fit (constant on floor and ceiling, linear in height on walls, which
+//! may be stratified) through iteratively trimmed least squares; texels farther than the
+//! threshold from it form warm and cold masks. Each connected region's outline is then redrawn at
+//! half its own core contrast (hysteresis: a border texel joins when the feature covers more than
+//! about half of it, so the outline is not biased outwards by the detection threshold), and regions
+//! of at least the minimum area become features: a rectangle (the minimum-area rectangle of the region's texels) when the
+//! region fills at least 75 % of it, otherwise the region's simplified convex outline, clipped to
+//! the host. The host's temperature is the radiant average of its background texels only.
+
+use mrtmap_geometry::PlaneFrame;
+use mrtmap_geometry::nalgebra::{Point2, Point3};
+use mrtmap_geometry::polygon::{
+    point_in_polygon_fast, polygon_inside, polygons_overlap, signed_area,
+};
+use mrtmap_geometry::shape2d::{convex_hull, min_area_rectangle, simplify_closed};
+use mrtmap_physics::{RadiantAverage, Temperature};
+use serde::{Deserialize, Serialize};
+
+use super::SegmentParams;
+
+/// A feature found on a surface.
+#[derive(Clone, Debug)]
+pub struct FoundFeature {
+    /// Outline in the surface's 2D frame.
+    pub polygon_2d: Vec<Point2<f64>>,
+    /// Radiant temperature (K).
+    pub temperature_k: f64,
+    /// Standard error of that temperature (K).
+    pub temperature_std_k: f64,
+    /// Mean difference from the background (K): positive warm, negative cold.
+    pub contrast_k: f64,
+    /// Area (m²).
+    pub area_m2: f64,
+    /// Cloud points on it.
+    pub points: Vec<usize>,
+}
+
+/// What a surface's texels say.
+#[derive(Clone, Debug)]
+pub struct SurfaceAnalysis {
+    /// Radiant temperature of the background (K), if any texel was observed.
+    pub temperature_k: Option<f64>,
+    /// Its standard uncertainty (K): sampling and the unobserved share (see the module docs).
+    pub temperature_std_k: f64,
+    /// Fraction of the surface's texels observed.
+    pub observed_fraction: f64,
+    /// Features.
+    pub features: Vec<FoundFeature>,
+    /// Features dropped (overlapping, or not fitting in the host), with why.
+    pub dropped: Vec<String>,
+}
+
+/// Background model coefficients: T = a + b·v.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Background {
+    /// Constant (K).
+    pub a: f64,
+    /// Slope along the frame's v axis (K/m).
+    pub b: f64,
+}
+
+struct Grid {
+    lo: Point2<f64>,
+    t: f64,
+    inside: Vec<bool>,
+    temp: Vec<RadiantAverage>,
+    points: Vec<Vec<usize>>,
+}
+
+impl Grid {
+    fn centre(&self, i: usize, j: usize) -> Point2<f64> {
+        Point2::new(
+            self.lo.x + (i as f64 + 0.5) * self.t,
+            self.lo.y + (j as f64 + 0.5) * self.t,
+        )
+    }
+}
+
+fn robust_background(samples: &[(f64, f64)], linear: bool) -> Background {
+    // samples: (v, T). Start from the median; trim at 3 robust σ (at least 0.3 K), refit, thrice.
+    let mut ts: Vec<f64> = samples.iter().map(|s| s.1).collect();
+    ts.sort_by(f64::total_cmp);
+    let mut bg = Background {
+        a: ts[ts.len() / 2],
+        b: 0.0,
+    };
+    for _ in 0..4 {
+        let mut res: Vec<f64> = samples
+            .iter()
+            .map(|(v, t)| (t - bg.a - bg.b * v).abs())
+            .collect();
+        res.sort_by(f64::total_cmp);
+        let cut = (3.0 * 1.4826 * res[res.len() / 2]).max(0.3);
+        let keep: Vec<&(f64, f64)> = samples
+            .iter()
+            .filter(|(v, t)| (t - bg.a - bg.b * v).abs() <= cut)
+            .collect();
+        if keep.len() < 3 {
+            break;
+        }
+        let n = keep.len() as f64;
+        let (sv, st) = (
+            keep.iter().map(|s| s.0).sum::<f64>(),
+            keep.iter().map(|s| s.1).sum::<f64>(),
+        );
+        if linear {
+            let svv = keep.iter().map(|s| s.0 * s.0).sum::<f64>();
+            let svt = keep.iter().map(|s| s.0 * s.1).sum::<f64>();
+            let den = n * svv - sv * sv;
+            if den.abs() > 1e-9 {
+                let b = (n * svt - sv * st) / den;
+                bg = Background {
+                    a: (st - b * sv) / n,
+                    b,
+                };
+                continue;
+            }
+        }
+        bg = Background { a: st / n, b: 0.0 };
+    }
+    bg
+}
+
+/// Clips polygon `p` to the convex polygon `clip` (both counter-clockwise).
+fn clip_convex(p: &[Point2<f64>], clip: &[Point2<f64>]) -> Vec<Point2<f64>> {
+    let mut out = p.to_vec();
+    for i in 0..clip.len() {
+        let (a, b) = (clip[i], clip[(i + 1) % clip.len()]);
+        let side = |q: &Point2<f64>| (b - a).perp(&(q - a));
+        let input = std::mem::take(&mut out);
+        for k in 0..input.len() {
+            let (c, d) = (input[k], input[(k + 1) % input.len()]);
+            let (sc, sd) = (side(&c), side(&d));
+            if sc >= 0.0 {
+                out.push(c);
+            }
+            if (sc >= 0.0) != (sd >= 0.0) {
+                out.push(c + (d - c) * (sc / (sc - sd)));
+            }
+        }
+        if out.is_empty() {
+            break;
+        }
+    }
+    out
+}
+
+fn ccw(mut p: Vec<Point2<f64>>) -> Vec<Point2<f64>> {
+    if signed_area(&p) < 0.0 {
+        p.reverse();
+    }
+    p
+}
+
+/// Analyses one surface: `frame` and `host` (its polygon in the frame), the cloud's points on it
+/// (`idx` into `pos`/`temp_k`), whether the background may vary linearly along v (walls).
+pub fn analyse_surface(
+    frame: &PlaneFrame,
+    host: &[Point2<f64>],
+    idx: &[usize],
+    pos: &[Point3<f64>],
+    temp_k: &[f64],
+    linear: bool,
+    p: &SegmentParams,
+) -> SurfaceAnalysis {
+    let t = p.texel_m;
+    let (mut lo, mut hi) = (
+        Point2::new(f64::INFINITY, f64::INFINITY),
+        Point2::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+    );
+    for q in host {
+        lo = Point2::new(lo.x.min(q.x), lo.y.min(q.y));
+        hi = Point2::new(hi.x.max(q.x), hi.y.max(q.y));
+    }
+    let nx = ((hi.x - lo.x) / t).ceil().max(1.0) as usize;
+    let ny = ((hi.y - lo.y) / t).ceil().max(1.0) as usize;
+    let mut g = Grid {
+        lo,
+        t,
+        inside: vec![false; nx * ny],
+        temp: vec![RadiantAverage::new(); nx * ny],
+        points: vec![Vec::new(); nx * ny],
+    };
+    for j in 0..ny {
+        for i in 0..nx {
+            g.inside[j * nx + i] = point_in_polygon_fast(&g.centre(i, j), host);
+        }
+    }
+    for &k in idx {
+        let q = frame.to_2d(&pos[k]);
+        let (i, j) = (((q.x - lo.x) / t).floor(), ((q.y - lo.y) / t).floor());
+        if i >= 0.0 && j >= 0.0 && (i as usize) < nx && (j as usize) < ny {
+            let c = j as usize * nx + i as usize;
+            g.temp[c].add(Temperature::from_kelvin(temp_k[k]), 1.0);
+            g.points[c].push(k);
+        }
+    }
+    let cells: Vec<usize> = (0..nx * ny)
+        .filter(|&c| g.inside[c] && g.temp[c].count() > 0)
+        .collect();
+    let n_inside = g.inside.iter().filter(|x| **x).count();
+    let observed_fraction = cells.len() as f64 / n_inside.max(1) as f64;
+    let mut out = SurfaceAnalysis {
+        temperature_k: None,
+        temperature_std_k: 0.0,
+        observed_fraction,
+        features: Vec::new(),
+        dropped: Vec::new(),
+    };
+    if cells.len() < 3 {
+        return out;
+    }
+    let tk = |c: usize| g.temp[c].mean().map_or(f64::NAN, |x| x.kelvin());
+    let samples: Vec<(f64, f64)> = cells
+        .iter()
+        .map(|&c| (g.centre(c % nx, c / nx).y, tk(c)))
+        .collect();
+    let bg = robust_background(&samples, linear);
+    let resid = |c: usize| tk(c) - bg.a - bg.b * g.centre(c % nx, c / nx).y;
+    // Warm and cold masks, with one-texel holes (unobserved or noisy) closed.
+    let mut in_feature = vec![false; nx * ny];
+    for sign in [1.0f64, -1.0] {
+        let raw: Vec<bool> = (0..nx * ny)
+            .map(|c| {
+                g.inside[c] && g.temp[c].count() > 0 && sign * resid(c) > p.feature_threshold_k
+            })
+            .collect();
+        let mut mask = raw.clone();
+        for j in 0..ny {
+            for i in 0..nx {
+                let c = j * nx + i;
+                if !mask[c] && g.inside[c] {
+                    let nb = [
+                        (i > 0, c.wrapping_sub(1)),
+                        (i + 1 < nx, c + 1),
+                        (j > 0, c.wrapping_sub(nx)),
+                        (j + 1 < ny, c + nx),
+                    ];
+                    if nb.iter().filter(|&&(ok, d)| ok && raw[d]).count() >= 3 {
+                        mask[c] = true;
+                    }
+                }
+            }
+        }
+        // Connected components (4-connectivity).
+        let mut label = vec![usize::MAX; nx * ny];
+        for seed in 0..nx * ny {
+            if !mask[seed] || label[seed] != usize::MAX {
+                continue;
+            }
+            let mut comp = vec![seed];
+            label[seed] = seed;
+            let mut k = 0;
+            while k < comp.len() {
+                let c = comp[k];
+                k += 1;
+                let (i, j) = (c % nx, c / nx);
+                for (ok, d) in [
+                    (i > 0, c.wrapping_sub(1)),
+                    (i + 1 < nx, c + 1),
+                    (j > 0, c.wrapping_sub(nx)),
+                    (j + 1 < ny, c + nx),
+                ] {
+                    if ok && mask[d] && label[d] == usize::MAX {
+                        label[d] = seed;
+                        comp.push(d);
+                    }
+                }
+            }
+            // Hysteresis: grow or shrink the region to the texels beyond half its core contrast.
+            let mut core: Vec<f64> = comp
+                .iter()
+                .filter(|&&c| g.temp[c].count() > 0)
+                .map(|&c| sign * resid(c))
+                .collect();
+            if core.is_empty() {
+                continue;
+            }
+            core.sort_by(f64::total_cmp);
+            let half = 0.5 * core[core.len() / 2];
+            let mut member = vec![false; nx * ny];
+            let mut comp2 = Vec::new();
+            let mut queue: Vec<usize> = comp
+                .iter()
+                .copied()
+                .filter(|&c| g.temp[c].count() > 0 && sign * resid(c) > half)
+                .collect();
+            for &c in &queue {
+                member[c] = true;
+            }
+            while let Some(c) = queue.pop() {
+                comp2.push(c);
+                let (i, j) = (c % nx, c / nx);
+                for (ok, d) in [
+                    (i > 0, c.wrapping_sub(1)),
+                    (i + 1 < nx, c + 1),
+                    (j > 0, c.wrapping_sub(nx)),
+                    (j + 1 < ny, c + nx),
+                ] {
+                    if ok
+                        && !member[d]
+                        && g.inside[d]
+                        && g.temp[d].count() > 0
+                        && sign * resid(d) > half
+                    {
+                        member[d] = true;
+                        queue.push(d);
+                    }
+                }
+            }
+            let comp = comp2;
+            let area = comp.len() as f64 * t * t;
+            if area < p.feature_min_area_m2 {
+                continue;
+            }
+            let corners: Vec<Point2<f64>> = comp
+                .iter()
+                .flat_map(|&c| {
+                    let o = Point2::new(lo.x + (c % nx) as f64 * t, lo.y + (c / nx) as f64 * t);
+                    [
+                        o,
+                        o + mrtmap_geometry::nalgebra::Vector2::new(t, 0.0),
+                        o + mrtmap_geometry::nalgebra::Vector2::new(t, t),
+                        o + mrtmap_geometry::nalgebra::Vector2::new(0.0, t),
+                    ]
+                })
+                .collect();
+            let Some((rect, rect_area)) = min_area_rectangle(&corners) else {
+                continue;
+            };
+            let mut poly = if area / rect_area >= 0.75 {
+                rect.to_vec()
+            } else {
+                simplify_closed(&convex_hull(&corners), 0.5 * t)
+            };
+            poly = ccw(poly);
+            if !polygon_inside(&poly, host, 1e-3) {
+                poly = ccw(clip_convex(&poly, &ccw(convex_hull(host))));
+                poly.dedup_by(|a, b| (*a - *b).norm() < 1e-6);
+            }
+            if poly.len() < 3 || !polygon_inside(&poly, host, 1e-3) {
+                out.dropped.push(format!(
+                    "a {:.2} m² region does not fit inside its surface",
+                    area
+                ));
+                continue;
+            }
+            if out
+                .features
+                .iter()
+                .any(|f| polygons_overlap(&f.polygon_2d, &poly, 1e-3))
+            {
+                out.dropped
+                    .push(format!("a {:.2} m² region overlaps another feature", area));
+                continue;
+            }
+            // Temperature from interior texels (all four neighbours in the feature): border texels
+            // mix in the background. Fall back to all texels for small features.
+            let mut in_comp = vec![false; nx * ny];
+            for &c in &comp {
+                in_comp[c] = true;
+            }
+            let interior: Vec<usize> = comp
+                .iter()
+                .copied()
+                .filter(|&c| {
+                    let (i, j) = (c % nx, c / nx);
+                    i > 0
+                        && j > 0
+                        && i + 1 < nx
+                        && j + 1 < ny
+                        && in_comp[c - 1]
+                        && in_comp[c + 1]
+                        && in_comp[c - nx]
+                        && in_comp[c + nx]
+                })
+                .collect();
+            let use_cells = if interior.iter().filter(|&&c| g.temp[c].count() > 0).count() >= 4 {
+                &interior
+            } else {
+                &comp
+            };
+            let mut avg = RadiantAverage::new();
+            let mut contrast = 0.0;
+            for &c in use_cells {
+                if g.temp[c].count() > 0 {
+                    avg.add(Temperature::from_kelvin(tk(c)), 1.0);
+                    contrast += resid(c);
+                }
+            }
+            let n_obs = avg.count().max(1) as f64;
+            for &c in &comp {
+                in_feature[c] = true;
+            }
+            out.features.push(FoundFeature {
+                temperature_k: avg.mean().map_or(bg.a, |x| x.kelvin()),
+                temperature_std_k: avg.std_dev_k().unwrap_or(0.0) / n_obs.sqrt(),
+                contrast_k: contrast / n_obs,
+                area_m2: signed_area(&poly).abs(),
+                points: comp
+                    .iter()
+                    .flat_map(|&c| g.points[c].iter().copied())
+                    .collect(),
+                polygon_2d: poly,
+            });
+        }
+    }
+    // The host: its background texels only (the features' are subtracted, Algorithm 1), one texel
+    // clear of every feature (border texels mix both).
+    let near_feature = |c: usize| {
+        let (i, j) = (c % nx, c / nx);
+        (j.saturating_sub(1)..=(j + 1).min(ny - 1)).any(|jj| {
+            (i.saturating_sub(1)..=(i + 1).min(nx - 1)).any(|ii| in_feature[jj * nx + ii])
+        })
+    };
+    let mut host_avg = RadiantAverage::new();
+    for &c in &cells {
+        let centre = g.centre(c % nx, c / nx);
+        if !near_feature(c)
+            && !out
+                .features
+                .iter()
+                .any(|f| point_in_polygon_fast(&centre, &f.polygon_2d))
+        {
+            host_avg.add(Temperature::from_kelvin(tk(c)), 1.0);
+        }
+    }
+    if let Some(m) = host_avg.mean() {
+        let sigma = host_avg.std_dev_k().unwrap_or(0.0);
+        let n = host_avg.count().max(1) as f64;
+        out.temperature_k = Some(m.kelvin());
+        out.temperature_std_k =
+            ((sigma * sigma) / n + ((1.0 - observed_fraction) * sigma).powi(2)).sqrt();
+    }
+    out
+}

@@ -1,0 +1,197 @@
+//! Semantic labels for thermal features: a majority vote of detector labels over frames (the seed
+//! paper's rule), or, without masks, simple documented rules.
+//!
+//! # Votes
+//! For each mask frame, the feature's cloud points are projected into the colour camera at the
+//! frame's pose; a point counts when the depth frame nearest in time confirms it is visible (its
+//! depth within 5 cm + 3 % of the image's). If at least 10 points are visible and one instance
+//! covers at least half of them, that instance's label gets the frame's vote. The label with the
+//! most votes wins; its share of the votes is reported, and a tie or a share under 0.6 is flagged.
+//!
+//! # Rules (no masks, or no votes)
+//! | where | sign | label |
+//! |---|---|---|
+//! | ceiling | warmer, under 1.5 m² | recessed light |
+//! | ceiling | warmer, 1.5 m² or more | radiant panel |
+//! | wall | colder by more than 2 K | window |
+//! | wall | warmer by more than 8 K | radiator |
+//! | anything else | | unlabelled |
+
+use std::collections::BTreeMap;
+
+use mrtmap_geometry::nalgebra::{Isometry3, Point2, Point3};
+use mrtmap_io::masks::{labels_path, read_mask_labels};
+use mrtmap_io::{Recording, read_image16};
+use mrtmap_radiation::SurfaceKind;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Share of the votes under which a majority is flagged as weak.
+pub const WEAK_MAJORITY: f64 = 0.6;
+
+/// The votes a feature got.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Votes {
+    /// Votes per label.
+    pub votes: BTreeMap<String, usize>,
+    /// The winning label's share of the votes.
+    pub share: f64,
+    /// Whether the top two labels tie.
+    pub tie: bool,
+    /// Whether the share is under [`WEAK_MAJORITY`].
+    pub weak: bool,
+}
+
+impl Votes {
+    fn from_counts(votes: &BTreeMap<String, usize>) -> Option<(String, Votes)> {
+        let total: usize = votes.values().sum();
+        let mut ranked: Vec<(&String, &usize)> = votes.iter().collect();
+        ranked.sort_by(|a, b| b.1.cmp(a.1).then(a.0.cmp(b.0)));
+        let (top, n) = ranked.first().map(|(l, n)| ((*l).clone(), **n))?;
+        let tie = ranked.get(1).is_some_and(|x| *x.1 == n);
+        let share = n as f64 / total.max(1) as f64;
+        Some((
+            top,
+            Votes {
+                share,
+                tie,
+                weak: share < WEAK_MAJORITY,
+                votes: votes.clone(),
+            },
+        ))
+    }
+}
+
+/// The rule label of a feature.
+pub fn rule_label(host: SurfaceKind, contrast_k: f64, area_m2: f64) -> &'static str {
+    match host {
+        SurfaceKind::Ceiling if contrast_k > 0.0 => {
+            if area_m2 < 1.5 {
+                "recessed light"
+            } else {
+                "radiant panel"
+            }
+        }
+        SurfaceKind::Wall if contrast_k < -2.0 => "window",
+        SurfaceKind::Wall if contrast_k > 8.0 => "radiator",
+        _ => "unlabelled",
+    }
+}
+
+/// What the masks gave.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MaskSummary {
+    /// Mask frames listed.
+    pub frames: usize,
+    /// Frames that could be used (pose, depth and images found).
+    pub frames_used: usize,
+    /// Votes cast.
+    pub votes: usize,
+    /// Problems (first few).
+    pub problems: Vec<String>,
+}
+
+/// Votes for every feature (given as its cloud points) from the recording's masks, with
+/// `world_from_depth` giving the (refined) pose at any time.
+pub fn vote(
+    rec: &Recording,
+    world_from_depth: &(dyn Fn(f64) -> Option<Isometry3<f64>> + Sync),
+    features: &[Vec<Point3<f64>>],
+) -> (Vec<Option<(String, Votes)>>, MaskSummary) {
+    let (cam, depth_from_cam) = match rec.rig.rgb {
+        Some(r) => (r.camera, r.depth_from_rgb),
+        None => (rec.rig.depth, Isometry3::identity()),
+    };
+    let mut summary = MaskSummary {
+        frames: rec.masks.len(),
+        ..Default::default()
+    };
+    let per_frame: Vec<Result<Vec<Option<String>>, String>> = rec
+        .masks
+        .par_iter()
+        .map(|m| {
+            let wd = world_from_depth(m.t)
+                .ok_or_else(|| format!("{}: no pose at {:.3} s", m.path.display(), m.t))?;
+            let k = rec.depth.partition_point(|d| d.t < m.t);
+            let near = [k.checked_sub(1), (k < rec.depth.len()).then_some(k)]
+                .into_iter()
+                .flatten()
+                .min_by(|&a, &b| {
+                    (rec.depth[a].t - m.t)
+                        .abs()
+                        .total_cmp(&(rec.depth[b].t - m.t).abs())
+                })
+                .filter(|&d| (rec.depth[d].t - m.t).abs() <= 0.05)
+                .ok_or_else(|| format!("{}: no depth frame within 50 ms", m.path.display()))?;
+            let depth = rec
+                .read_depth(&rec.depth[near])
+                .map_err(|e| e.to_string())?;
+            let wd_depth = world_from_depth(rec.depth[near].t).unwrap_or(wd);
+            let png = rec.path_of(m);
+            let mask = read_image16(&png).map_err(|e| e.to_string())?;
+            mask.check_size(&png, cam.width, cam.height)
+                .map_err(|e| e.to_string())?;
+            let labels = read_mask_labels(&labels_path(&png)).map_err(|e| e.to_string())?;
+            let cam_from_world = (wd * depth_from_cam).inverse();
+            let depth_from_world = wd_depth.inverse();
+            Ok(features
+                .iter()
+                .map(|pts| {
+                    let mut counts: BTreeMap<u16, usize> = BTreeMap::new();
+                    let mut visible = 0usize;
+                    for p in pts {
+                        let q = depth_from_world * p;
+                        let Some(px) = rec
+                            .rig
+                            .depth
+                            .project(&q)
+                            .filter(|px| rec.rig.depth.contains(px))
+                        else {
+                            continue;
+                        };
+                        let raw = depth.get(px.x.round() as u32, px.y.round() as u32);
+                        let z = raw as f64 / rec.rig.depth_scale;
+                        if raw == 0 || (z - q.z).abs() > 0.05 + 0.03 * q.z {
+                            continue;
+                        }
+                        let Some(pc) = cam
+                            .project(&(cam_from_world * p))
+                            .filter(|pc: &Point2<f64>| cam.contains(pc))
+                        else {
+                            continue;
+                        };
+                        visible += 1;
+                        let id = mask.get(pc.x.round() as u32, pc.y.round() as u32);
+                        if id > 0 {
+                            *counts.entry(id).or_default() += 1;
+                        }
+                    }
+                    let (id, n) = counts.iter().max_by_key(|(_, n)| **n)?;
+                    (visible >= 10 && 2 * n >= visible)
+                        .then(|| labels.get(id).map(|l| l.label.clone()))
+                        .flatten()
+                })
+                .collect())
+        })
+        .collect();
+    let mut tallies: Vec<BTreeMap<String, usize>> = vec![BTreeMap::new(); features.len()];
+    for r in per_frame {
+        match r {
+            Ok(votes) => {
+                summary.frames_used += 1;
+                for (f, v) in votes.into_iter().enumerate() {
+                    if let Some(label) = v {
+                        *tallies[f].entry(label).or_default() += 1;
+                        summary.votes += 1;
+                    }
+                }
+            }
+            Err(e) => {
+                if summary.problems.len() < 10 {
+                    summary.problems.push(e);
+                }
+            }
+        }
+    }
+    (tallies.iter().map(Votes::from_counts).collect(), summary)
+}

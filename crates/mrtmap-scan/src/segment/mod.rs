@@ -1,0 +1,502 @@
+//! Segmentation: from the fused thermal cloud to a radiant scene (stage 4 of the seed method).
+//!
+//! ```text
+//!  cloud ─► up (cameras, then floor) ─► planes (RANSAC) ─► floor, ceiling, wall loop, corners
+//!        ─► points per surface ─► texels ─► background + thermal features ─► labels ─► scene.json
+//! ```
+
+mod envelope;
+mod features;
+pub mod labels;
+
+use std::collections::BTreeMap;
+
+use mrtmap_geometry::PlaneFrame;
+use mrtmap_geometry::nalgebra::{Isometry3, Point3, Unit, Vector3};
+use mrtmap_geometry::polygon::{Containment, point_in_polygon};
+use mrtmap_io::{Recording, ThermalCloud};
+use mrtmap_physics::ZERO_CELSIUS_K;
+use mrtmap_radiation::{
+    FeatureFile, RadiantScene, SCENE_FORMAT, SceneError, SceneFile, SurfaceFile, SurfaceKind,
+};
+use serde::{Deserialize, Serialize};
+
+pub use envelope::{Envelope, FoundPlane, PlaneClass, up_from_poses};
+pub use labels::{MaskSummary, Votes, WEAK_MAJORITY, rule_label};
+
+/// Segmentation settings (all documented in docs/segmentation.md).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SegmentParams {
+    /// RANSAC inlier distance (m): the fused surfaces are as thick as the depth noise.
+    pub plane_distance_m: f64,
+    /// RANSAC normal agreement (degrees).
+    pub plane_normal_deg: f64,
+    /// Smallest plane (points; at least 0.25 % of the cloud).
+    pub min_plane_points: usize,
+    /// Planes sought at most.
+    pub max_planes: usize,
+    /// Planes closer than this in angle (degrees)…
+    pub merge_deg: f64,
+    /// …and offset (m) are one surface.
+    pub merge_distance_m: f64,
+    /// Horizontal: normal within this of up (degrees).
+    pub horizontal_deg: f64,
+    /// Vertical: normal within this of horizontal (degrees).
+    pub vertical_deg: f64,
+    /// A wall spans at least this fraction of the floor-to-ceiling height.
+    pub wall_min_height_fraction: f64,
+    /// Walls meet at corners of at least this angle (degrees).
+    pub corner_min_angle_deg: f64,
+    /// A corner may lie at most this far (sum over both walls, m) beyond the walls' seen ends.
+    pub corner_max_gap_m: f64,
+    /// Points within this distance of a surface belong to it (m).
+    pub surface_band_m: f64,
+    /// Texel size for the thermal analysis (m).
+    pub texel_m: f64,
+    /// A texel belongs to a feature when it differs from the background by more than this (K).
+    pub feature_threshold_k: f64,
+    /// Smallest feature (m²).
+    pub feature_min_area_m2: f64,
+    /// Seed of RANSAC.
+    pub seed: u64,
+}
+
+impl Default for SegmentParams {
+    fn default() -> Self {
+        Self {
+            plane_distance_m: 0.06,
+            plane_normal_deg: 35.0,
+            min_plane_points: 300,
+            max_planes: 24,
+            merge_deg: 5.0,
+            merge_distance_m: 0.08,
+            horizontal_deg: 15.0,
+            vertical_deg: 15.0,
+            wall_min_height_fraction: 0.5,
+            corner_min_angle_deg: 20.0,
+            corner_max_gap_m: 3.0,
+            surface_band_m: 0.10,
+            texel_m: 0.03,
+            feature_threshold_k: 0.8,
+            feature_min_area_m2: 0.04,
+            seed: 1,
+        }
+    }
+}
+
+/// Why segmentation failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SegmentError {
+    /// No camera poses to estimate up from.
+    #[error("no camera poses to estimate up from (poses.txt of the fusion is empty)")]
+    NoPoses,
+    /// No horizontal plane below the rest.
+    #[error("no floor found: no large horizontal plane (is the floor in the scan?)")]
+    NoFloor,
+    /// No ceiling.
+    #[error(
+        "no ceiling found: no large horizontal plane at least 1.5 m above the floor (is the ceiling in the scan?)"
+    )]
+    NoCeiling,
+    /// No walls.
+    #[error("no walls found: no vertical plane spans half the room's height")]
+    NoWalls,
+    /// The walls do not close into a loop.
+    #[error(
+        "the walls do not close into an outline of the room ({walls} linked): parts of the room may be unscanned"
+    )]
+    OpenOutline {
+        /// Walls linked before the loop broke.
+        walls: usize,
+    },
+    /// The scene built breaks a scene rule.
+    #[error("the scene built from the cloud is invalid: {0}")]
+    Scene(#[from] SceneError),
+}
+
+/// One surface of the result.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SurfaceSummary {
+    /// Id in scene.json.
+    pub id: String,
+    /// Kind.
+    pub kind: SurfaceKind,
+    /// Radiant temperature of its background (°C).
+    pub temperature_c: Option<f64>,
+    /// Standard uncertainty (K).
+    pub temperature_std_k: f64,
+    /// Observed fraction.
+    pub observed_fraction: f64,
+    /// Area (m²).
+    pub area_m2: f64,
+    /// Cloud points on it.
+    pub points: usize,
+}
+
+/// One feature of the result.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FeatureSummary {
+    /// Id in scene.json.
+    pub id: String,
+    /// Host surface id.
+    pub host: String,
+    /// Label.
+    pub label: String,
+    /// "masks", or "rule".
+    pub label_source: String,
+    /// The votes, with masks.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub votes: Option<Votes>,
+    /// Radiant temperature (°C).
+    pub temperature_c: f64,
+    /// Difference from the host's background (K).
+    pub contrast_k: f64,
+    /// Area (m²).
+    pub area_m2: f64,
+}
+
+/// `segment.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SegmentReport {
+    /// Up in the world frame.
+    pub up: [f64; 3],
+    /// Planes found: class, normal, offset, points.
+    pub planes: Vec<(PlaneClass, [f64; 3], f64, usize)>,
+    /// Room corners at the floor, in order (counter-clockwise from above).
+    pub floor_corners: Vec<[f64; 3]>,
+    /// Floor-to-ceiling height (m).
+    pub height_m: f64,
+    /// Surfaces.
+    pub surfaces: Vec<SurfaceSummary>,
+    /// Features.
+    pub features: Vec<FeatureSummary>,
+    /// Fraction of cloud points on no envelope surface (furniture, clutter, noise).
+    pub unassigned_fraction: f64,
+    /// Features dropped, and why.
+    pub dropped: Vec<String>,
+    /// Masks, when given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub masks: Option<MaskSummary>,
+    /// Things to check.
+    pub warnings: Vec<String>,
+}
+
+/// The result of segmentation.
+pub struct Segmentation {
+    /// The scene (world frame of the recording).
+    pub scene: RadiantScene,
+    /// Surface index of each cloud point (−1 for none).
+    pub surface_id: Vec<i32>,
+    /// Feature index of each cloud point (−1 for none), counting features over all surfaces.
+    pub feature_id: Vec<i32>,
+    /// The report.
+    pub report: SegmentReport,
+}
+
+/// Masks for labels: a recording with `masks.txt`, and the refined pose at any time.
+pub struct MaskInput<'a> {
+    /// The recording.
+    pub recording: &'a Recording,
+    /// world_from_depth at a time.
+    pub world_from_depth: &'a (dyn Fn(f64) -> Option<Isometry3<f64>> + Sync),
+}
+
+fn arr(p: &Point3<f64>) -> [f64; 3] {
+    [p.x, p.y, p.z]
+}
+
+struct SurfaceGeom {
+    id: String,
+    kind: SurfaceKind,
+    polygon: Vec<Point3<f64>>,
+    frame: PlaneFrame,
+}
+
+/// Segments a thermal cloud into a radiant scene.
+pub fn segment(
+    cloud: &ThermalCloud,
+    camera_poses: &[Isometry3<f64>],
+    masks: Option<&MaskInput<'_>>,
+    p: &SegmentParams,
+) -> Result<Segmentation, SegmentError> {
+    let pos: Vec<Point3<f64>> = cloud
+        .positions
+        .iter()
+        .map(|q| Point3::new(q[0] as f64, q[1] as f64, q[2] as f64))
+        .collect();
+    let nrm: Vec<Vector3<f64>> = cloud
+        .normals
+        .iter()
+        .map(|n| Vector3::new(n[0] as f64, n[1] as f64, n[2] as f64))
+        .collect();
+    let temp: Vec<f64> = cloud.temperature_k.iter().map(|t| *t as f64).collect();
+    let up0 = up_from_poses(camera_poses).ok_or(SegmentError::NoPoses)?;
+    let planes = envelope::find_planes(&pos, &nrm, p);
+    let env = envelope::envelope(&pos, planes, up0, p)?;
+    let up = env.up;
+    let n = env.walls.len();
+    let height_m = env.planes[env.floor]
+        .plane
+        .distance(&env.ceiling_corners[0])
+        .abs();
+
+    // Surface geometry: floor, ceiling, walls in loop order. Floor and ceiling texels run along the
+    // longest wall, so features aligned with the room align with the texel grid.
+    let mut geoms = Vec::with_capacity(n + 2);
+    let longest = (0..n)
+        .map(|k| env.floor_corners[(k + 1) % n] - env.floor_corners[k])
+        .max_by(|a, b| a.norm().total_cmp(&b.norm()))
+        .unwrap_or_else(Vector3::x);
+    let centroid = |ps: &[Point3<f64>]| {
+        Point3::from(ps.iter().fold(Vector3::zeros(), |a, q| a + q.coords) / ps.len() as f64)
+    };
+    geoms.push(SurfaceGeom {
+        id: "floor".into(),
+        kind: SurfaceKind::Floor,
+        frame: PlaneFrame::new(centroid(&env.floor_corners), up, &longest),
+        polygon: env.floor_corners.clone(),
+    });
+    geoms.push(SurfaceGeom {
+        id: "ceiling".into(),
+        kind: SurfaceKind::Ceiling,
+        frame: PlaneFrame::new(centroid(&env.ceiling_corners), -up, &longest),
+        polygon: env.ceiling_corners.clone(),
+    });
+    for k in 0..n {
+        let poly = vec![
+            env.floor_corners[k],
+            env.floor_corners[(k + 1) % n],
+            env.ceiling_corners[(k + 1) % n],
+            env.ceiling_corners[k],
+        ];
+        let wall = &env.planes[env.walls[k]].plane;
+        let along = env.floor_corners[(k + 1) % n] - env.floor_corners[k];
+        let mut frame = PlaneFrame::new(centroid(&poly), wall.normal, &along);
+        if frame.v.dot(&up) < 0.0 {
+            // Keep v pointing up so the background's slope reads as a vertical gradient.
+            frame = PlaneFrame {
+                u: -frame.u,
+                v: -frame.v,
+                ..frame
+            };
+        }
+        geoms.push(SurfaceGeom {
+            id: format!("wall-{}", k + 1),
+            kind: SurfaceKind::Wall,
+            polygon: poly,
+            frame,
+        });
+    }
+    let polys2: Vec<Vec<_>> = geoms
+        .iter()
+        .map(|g| g.polygon.iter().map(|q| g.frame.to_2d(q)).collect())
+        .collect();
+
+    // Points to surfaces: the nearest surface plane within the band whose outline (grown by the
+    // band) contains the point's projection.
+    let mut surface_id = vec![-1i32; pos.len()];
+    let mut members: Vec<Vec<usize>> = vec![Vec::new(); geoms.len()];
+    for (i, q) in pos.iter().enumerate() {
+        let mut best: Option<(f64, usize)> = None;
+        for (s, g) in geoms.iter().enumerate() {
+            let d = g.frame.signed_distance(q).abs();
+            if d <= p.surface_band_m
+                && best.is_none_or(|b| d < b.0)
+                && point_in_polygon(&g.frame.to_2d(q), &polys2[s], p.surface_band_m)
+                    != Containment::Outside
+            {
+                best = Some((d, s));
+            }
+        }
+        if let Some((_, s)) = best {
+            surface_id[i] = s as i32;
+            members[s].push(i);
+        }
+    }
+    let unassigned = surface_id.iter().filter(|s| **s < 0).count();
+
+    // Thermal analysis per surface.
+    let analyses: Vec<features::SurfaceAnalysis> = geoms
+        .iter()
+        .enumerate()
+        .map(|(s, g)| {
+            features::analyse_surface(
+                &g.frame,
+                &polys2[s],
+                &members[s],
+                &pos,
+                &temp,
+                g.kind == SurfaceKind::Wall,
+                p,
+            )
+        })
+        .collect();
+    let mut all_features: Vec<(usize, &features::FoundFeature)> = Vec::new();
+    for (s, a) in analyses.iter().enumerate() {
+        for f in &a.features {
+            all_features.push((s, f));
+        }
+    }
+    // Labels.
+    let (voted, mask_summary) = match masks {
+        Some(m) => {
+            let pts: Vec<Vec<Point3<f64>>> = all_features
+                .iter()
+                .map(|(_, f)| f.points.iter().map(|&i| pos[i]).collect())
+                .collect();
+            let (v, s) = labels::vote(m.recording, m.world_from_depth, &pts);
+            (v, Some(s))
+        }
+        None => (vec![None; all_features.len()], None),
+    };
+    let mut feature_id = vec![-1i32; pos.len()];
+    let mut counts: BTreeMap<String, usize> = BTreeMap::new();
+    let mut feature_summaries = Vec::new();
+    let mut scene_features: Vec<Vec<FeatureFile>> = vec![Vec::new(); geoms.len()];
+    let mut warnings = Vec::new();
+    for (k, ((s, f), vote)) in all_features.iter().zip(voted).enumerate() {
+        let (label, source, votes) = match vote {
+            Some((l, v)) => (l, "masks", Some(v)),
+            None => (
+                rule_label(geoms[*s].kind, f.contrast_k, f.area_m2).to_string(),
+                "rule",
+                None,
+            ),
+        };
+        let slug: String = label
+            .to_lowercase()
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join("-");
+        let c = counts.entry(slug.clone()).or_default();
+        *c += 1;
+        let id = format!("{slug}-{c}");
+        if let Some(v) = &votes
+            && (v.tie || v.weak)
+        {
+            warnings.push(format!(
+                "feature {id}: label '{label}' won only {:.0} % of {} votes{}",
+                v.share * 100.0,
+                v.votes.values().sum::<usize>(),
+                if v.tie { " (a tie)" } else { "" }
+            ));
+        }
+        for &i in &f.points {
+            feature_id[i] = k as i32;
+        }
+        scene_features[*s].push(FeatureFile {
+            id: id.clone(),
+            label: label.clone(),
+            polygon: f
+                .polygon_2d
+                .iter()
+                .map(|q| arr(&geoms[*s].frame.to_3d(q)))
+                .collect(),
+            temperature_c: f.temperature_k - ZERO_CELSIUS_K,
+            emissivity: 1.0,
+            temperature_std_k: Some(f.temperature_std_k),
+        });
+        feature_summaries.push(FeatureSummary {
+            id,
+            host: geoms[*s].id.clone(),
+            label,
+            label_source: source.into(),
+            votes,
+            temperature_c: f.temperature_k - ZERO_CELSIUS_K,
+            contrast_k: f.contrast_k,
+            area_m2: f.area_m2,
+        });
+    }
+    // Surfaces never observed get the mean of the observed ones, and say so.
+    let observed: Vec<f64> = analyses.iter().filter_map(|a| a.temperature_k).collect();
+    let fallback = observed.iter().sum::<f64>() / observed.len().max(1) as f64;
+    let mut surfaces = Vec::new();
+    let mut summaries = Vec::new();
+    for (s, g) in geoms.iter().enumerate() {
+        let a = &analyses[s];
+        let t = match a.temperature_k {
+            Some(t) => t,
+            None => {
+                warnings.push(format!(
+                    "surface {} was not observed: it takes the mean of the others",
+                    g.id
+                ));
+                fallback
+            }
+        };
+        if a.observed_fraction < 0.5 {
+            warnings.push(format!(
+                "surface {} is only {:.0} % observed",
+                g.id,
+                a.observed_fraction * 100.0
+            ));
+        }
+        surfaces.push(SurfaceFile {
+            id: g.id.clone(),
+            kind: g.kind.as_str().into(),
+            label: match g.kind {
+                SurfaceKind::Wall => "wall".into(),
+                k => k.as_str().into(),
+            },
+            polygon: g.polygon.iter().map(arr).collect(),
+            temperature_c: t - ZERO_CELSIUS_K,
+            emissivity: 1.0,
+            temperature_std_k: Some(a.temperature_std_k),
+            observed_fraction: Some(a.observed_fraction),
+            features: std::mem::take(&mut scene_features[s]),
+        });
+        summaries.push(SurfaceSummary {
+            id: g.id.clone(),
+            kind: g.kind,
+            temperature_c: a.temperature_k.map(|t| t - ZERO_CELSIUS_K),
+            temperature_std_k: a.temperature_std_k,
+            observed_fraction: a.observed_fraction,
+            area_m2: mrtmap_geometry::polygon::area_3d(&g.polygon),
+            points: members[s].len(),
+        });
+    }
+    let scene = RadiantScene::new(&SceneFile {
+        format: SCENE_FORMAT.into(),
+        up: Some([up.x, up.y, up.z]),
+        surfaces,
+        occluders: Vec::new(),
+    })?;
+    let report = SegmentReport {
+        up: [up.x, up.y, up.z],
+        planes: env
+            .planes
+            .iter()
+            .map(|f| {
+                (
+                    f.class,
+                    [f.plane.normal.x, f.plane.normal.y, f.plane.normal.z],
+                    f.plane.d,
+                    f.points,
+                )
+            })
+            .collect(),
+        floor_corners: env.floor_corners.iter().map(arr).collect(),
+        height_m,
+        surfaces: summaries,
+        features: feature_summaries,
+        unassigned_fraction: unassigned as f64 / pos.len().max(1) as f64,
+        dropped: analyses
+            .iter()
+            .flat_map(|a| a.dropped.iter().cloned())
+            .collect(),
+        masks: mask_summary,
+        warnings,
+    };
+    Ok(Segmentation {
+        scene,
+        surface_id,
+        feature_id,
+        report,
+    })
+}
+
+/// A unit vector from an array.
+pub fn unit(v: [f64; 3]) -> Option<Unit<Vector3<f64>>> {
+    Unit::try_new(Vector3::from(v), 1e-9)
+}
