@@ -136,6 +136,9 @@ pub enum Method {
     Exact,
     /// Monte Carlo ray tracing.
     MonteCarlo(MonteCarlo),
+    /// Exact where it is valid, Monte Carlo elsewhere: scenes with occluders, and points from
+    /// which one surface hides another (non-convex rooms).
+    Auto(MonteCarlo),
 }
 
 impl Method {
@@ -144,6 +147,7 @@ impl Method {
         match self {
             Method::Exact => "exact",
             Method::MonteCarlo(_) => "montecarlo",
+            Method::Auto(_) => "auto",
         }
     }
 }
@@ -279,7 +283,7 @@ impl<'a> MrtEngine<'a> {
                 }
                 None
             }
-            Method::MonteCarlo(mc) => {
+            Method::MonteCarlo(mc) | Method::Auto(mc) => {
                 if mc.replicates < 2 || mc.rays < 2 * mc.replicates {
                     let r = mc.replicates.max(2);
                     return Err(MrtError::TooFewRays {
@@ -344,17 +348,25 @@ impl<'a> MrtEngine<'a> {
                 id: o.id.clone(),
             });
         }
-        let (f, se, rays, replicate_f) = match self.method {
-            Method::Exact => {
-                let f = self.exact_view_factors(p);
-                let sum: f64 = f.iter().sum();
-                if sum > 1.0 + EXACT_OVERLAP_TOLERANCE {
-                    return Err(MrtError::SurfacesHidden { point: arr(p), sum });
-                }
-                let n = f.len();
-                (f, vec![0.0; n], 0, Vec::new())
+        let exact = |me: &Self| -> Result<_, MrtError> {
+            let f = me.exact_view_factors(p);
+            let sum: f64 = f.iter().sum();
+            if sum > 1.0 + EXACT_OVERLAP_TOLERANCE {
+                return Err(MrtError::SurfacesHidden { point: arr(p), sum });
             }
+            let n = f.len();
+            Ok((f, vec![0.0; n], 0, Vec::new()))
+        };
+        let (f, se, rays, replicate_f) = match self.method {
+            Method::Exact => exact(self)?,
             Method::MonteCarlo(mc) => self.monte_carlo(p, &mc, stream),
+            Method::Auto(mc) if !self.scene.occluders.is_empty() => {
+                self.monte_carlo(p, &mc, stream)
+            }
+            Method::Auto(mc) => match exact(self) {
+                Ok(r) => r,
+                Err(_) => self.monte_carlo(p, &mc, stream),
+            },
         };
         let mrt_of = |f: &[f64]| {
             let src: Vec<RadiantSource> = self

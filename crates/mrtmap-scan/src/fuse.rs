@@ -65,10 +65,10 @@ impl Default for IcpSettings {
             rebuild_every: 10,
             target_every: 2,
             correction_gain: 0.1,
-            min_fitness: 0.5,
+            min_fitness: 0.7,
             max_rmse_m: 0.02,
-            max_step_m: 0.05,
-            max_step_deg: 2.0,
+            max_step_m: 0.03,
+            max_step_deg: 1.0,
         }
     }
 }

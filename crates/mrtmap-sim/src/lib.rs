@@ -14,6 +14,7 @@
 //! system), so it is neither the room frame nor z-up; `truth.json` gives `world_from_room`.
 
 mod evaluate;
+mod evaluate_scene;
 mod render;
 mod room;
 mod sensors;
@@ -22,6 +23,7 @@ mod truth;
 mod walk;
 
 pub use evaluate::{CloudScore, score_cloud, truth_at};
+pub use evaluate_scene::{FeatureScore, PointScore, SceneScore, SurfaceScore, score_scene};
 pub use render::{Element, Hit, RoomRenderer, temperature_at};
 pub use room::{
     FeatureSpec, FurnitureSpec, GRADIENT_STRIP_M, PRESETS, PlacedFeature, PointSpec, Room,

@@ -173,7 +173,8 @@ pub struct SceneArgs {
 /// How view factors are computed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum MethodArg {
-    /// Exact when the scene has no occluders, else Monte Carlo.
+    /// Exact solid angles where valid; Monte Carlo with occluders or where surfaces hide each
+    /// other (non-convex rooms).
     Auto,
     /// Exact solid angles (Van Oosterom–Strackee), features subtracted from their host.
     Exact,

@@ -241,8 +241,67 @@ pub fn envelope(
             .iter()
             .map(|&i| height(&points[i], &up))
             .collect();
-        let span = percentile(&mut hs, 0.95) - percentile(&mut hs, 0.05);
-        if span >= p.wall_min_height_fraction * (h_ceiling - h_floor) {
+        let (bottom, top) = (percentile(&mut hs, 0.05), percentile(&mut hs, 0.98));
+        // The wall's main run: 10 cm bins along it, the contiguous run (gaps up to 30 cm) holding
+        // the most inliers. Inliers elsewhere on the infinite plane belong to other surfaces and
+        // are dropped; coverage is the occupied share of the run. A plane through the points of
+        // two corners (an artefact of mixed normals) covers little of its run.
+        let along = {
+            let n = planes[k].plane.normal;
+            let d = up.cross(&n);
+            let s: Vec<f64> = planes[k]
+                .inliers
+                .iter()
+                .map(|&i| d.dot(&points[i].coords))
+                .collect();
+            let lo = s.iter().cloned().fold(f64::INFINITY, f64::min);
+            let hi = s.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+            let bins = (((hi - lo) / 0.1).ceil() as usize).clamp(1, 100_000);
+            let bin = |v: f64| (((v - lo) / 0.1) as usize).min(bins - 1);
+            let mut count = vec![0usize; bins];
+            for v in &s {
+                count[bin(*v)] += 1;
+            }
+            let (mut best, mut cur_start, mut gap, mut cur_n) =
+                ((0usize, 0usize, 0usize), None::<usize>, 0usize, 0usize);
+            let mut last_occupied = 0usize;
+            for (b, &c) in count.iter().enumerate() {
+                if c >= 3 {
+                    if cur_start.is_none() {
+                        cur_start = Some(b);
+                        cur_n = 0;
+                    }
+                    cur_n += c;
+                    gap = 0;
+                    last_occupied = b;
+                    if cur_n > best.2 {
+                        best = (cur_start.unwrap_or(b), b, cur_n);
+                    }
+                } else if cur_start.is_some() {
+                    gap += 1;
+                    if gap > 3 {
+                        cur_start = None;
+                    }
+                }
+            }
+            let _ = last_occupied;
+            let (b0, b1, _) = best;
+            planes[k].inliers = planes[k]
+                .inliers
+                .iter()
+                .zip(&s)
+                .filter(|(_, v)| (b0..=b1).contains(&bin(**v)))
+                .map(|(i, _)| *i)
+                .collect();
+            planes[k].points = planes[k].inliers.len();
+            count[b0..=b1].iter().filter(|&&c| c >= 3).count() as f64 / (b1 - b0 + 1) as f64
+        };
+        // A wall spans much of the room's height and reaches the ceiling (furniture does not), and
+        // is seen along most of its length.
+        if top - bottom >= p.wall_min_height_fraction * (h_ceiling - h_floor)
+            && top >= h_ceiling - p.wall_ceiling_gap_m
+            && along >= 0.5
+        {
             // Make vertical exactly (project the normal) and point it into the room.
             let n = Unit::new_normalize(
                 planes[k].plane.normal.as_ref() - up.as_ref() * planes[k].plane.normal.dot(&up),
@@ -261,6 +320,63 @@ pub fn envelope(
             walls.push(k);
         } else {
             planes[k].class = PlaneClass::OtherVertical;
+        }
+    }
+    // One wall found twice (a doubled slab in a noisy cloud): merge walls whose horizontal
+    // directions agree within `merge_deg`, whose lines lie within `merge_distance_m` of each other
+    // and whose extents overlap; refit the merged wall.
+    let mut merged_any = true;
+    while merged_any {
+        merged_any = false;
+        'pairs: for a in 0..walls.len() {
+            for b in (a + 1)..walls.len() {
+                let (pa, pb) = (planes[walls[a]].plane, planes[walls[b]].plane);
+                if pa.normal.dot(&pb.normal) < p.merge_deg.to_radians().cos() {
+                    continue;
+                }
+                let d = up.cross(&pa.normal);
+                let cb = planes[walls[b]]
+                    .inliers
+                    .iter()
+                    .fold(Vector3::zeros(), |s, &i| s + points[i].coords)
+                    / planes[walls[b]].points as f64;
+                if pa.distance(&Point3::from(cb)).abs() > p.merge_distance_m {
+                    continue;
+                }
+                let span = |k: usize| {
+                    let mut s: Vec<f64> = planes[k]
+                        .inliers
+                        .iter()
+                        .map(|&i| d.dot(&points[i].coords))
+                        .collect();
+                    (percentile(&mut s, 0.05), percentile(&mut s, 0.95))
+                };
+                let ((a0, a1), (b0, b1)) = (span(walls[a]), span(walls[b]));
+                if a1.min(b1) - a0.max(b0) <= 0.0 {
+                    continue;
+                }
+                let (ka, kb) = (walls[a], walls[b]);
+                let moved = std::mem::take(&mut planes[kb].inliers);
+                planes[ka].inliers.extend(moved);
+                planes[ka].points = planes[ka].inliers.len();
+                planes[kb].points = 0;
+                planes[kb].class = PlaneClass::OtherVertical;
+                let pts: Vec<Point3<f64>> = planes[ka].inliers.iter().map(|&i| points[i]).collect();
+                if let Some(f) = Plane::fit(&pts) {
+                    let n =
+                        Unit::new_normalize(f.normal.as_ref() - up.as_ref() * f.normal.dot(&up));
+                    let c =
+                        pts.iter().fold(Vector3::zeros(), |s, q| s + q.coords) / pts.len() as f64;
+                    let mut pl = Plane::from_point_normal(&Point3::from(c), n);
+                    if pl.distance(&centre) < 0.0 {
+                        pl = pl.flipped();
+                    }
+                    planes[ka].plane = pl;
+                }
+                walls.remove(b);
+                merged_any = true;
+                break 'pairs;
+            }
         }
     }
     // The horizontal frame and the walls' lines and extents in it.
@@ -316,6 +432,21 @@ pub fn envelope(
         }
     }
     pairs.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let found = lines
+        .iter()
+        .map(|l| {
+            let d = l.ends[1] - l.ends[0];
+            format!(
+                "{:.0}° {:.2} m long at ({:.2}, {:.2}), {} points",
+                d.y.atan2(d.x).to_degrees(),
+                d.norm(),
+                l.ends[0].x,
+                l.ends[0].y,
+                planes[l.k].points
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("; ");
     // For each wall's two ends: the wall it meets there and the corner.
     type End = Option<(usize, Point2<f64>)>;
     let mut link: Vec<[End; 2]> = vec![[None, None]; lines.len()];
@@ -339,14 +470,20 @@ pub fn envelope(
     let (mut cur, mut out_end) = (start, 1usize);
     loop {
         let Some((next, c)) = link[cur][out_end] else {
-            return Err(SegmentError::OpenOutline { walls: order.len() });
+            return Err(SegmentError::OpenOutline {
+                walls: order.len(),
+                found: found.clone(),
+            });
         };
         corners2.push(c);
         if next == start {
             break;
         }
         if order.contains(&next) || order.len() > lines.len() {
-            return Err(SegmentError::OpenOutline { walls: order.len() });
+            return Err(SegmentError::OpenOutline {
+                walls: order.len(),
+                found: found.clone(),
+            });
         }
         let in_end = if link[next][0].map(|l| l.0) == Some(cur) {
             0
@@ -358,7 +495,10 @@ pub fn envelope(
         out_end = 1 - in_end;
     }
     if order.len() < 3 {
-        return Err(SegmentError::OpenOutline { walls: order.len() });
+        return Err(SegmentError::OpenOutline {
+            walls: order.len(),
+            found: found.clone(),
+        });
     }
     // corners2[k] joins order[k] and order[k+1]; rotate so corner k joins wall k−1 and wall k.
     corners2.rotate_right(1);
@@ -386,7 +526,7 @@ pub fn envelope(
     let ceiling_corners: Option<Vec<Point3<f64>>> =
         (0..n).map(|k| corner3(k, &planes[ceiling].plane)).collect();
     let (Some(floor_corners), Some(ceiling_corners)) = (floor_corners, ceiling_corners) else {
-        return Err(SegmentError::OpenOutline { walls: n });
+        return Err(SegmentError::OpenOutline { walls: n, found });
     };
     Ok(Envelope {
         up,

@@ -17,6 +17,8 @@ use mrtmap_geometry::polygon::{
 };
 use mrtmap_geometry::shape2d::{convex_hull, min_area_rectangle, simplify_closed};
 use mrtmap_physics::{RadiantAverage, Temperature};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use super::SegmentParams;
@@ -51,6 +53,8 @@ pub struct SurfaceAnalysis {
     pub features: Vec<FoundFeature>,
     /// Features dropped (overlapping, or not fitting in the host), with why.
     pub dropped: Vec<String>,
+    /// The background model.
+    pub background: Background,
 }
 
 /// Background model coefficients: T = a + b·v.
@@ -79,49 +83,84 @@ impl Grid {
     }
 }
 
+/// Texels within this of the background model count as background when fitting it (K).
+const BACKGROUND_TOLERANCE_K: f64 = 0.3;
+
+/// Least squares T = a + b·v over `samples` (constant when `linear` is false or v does not vary).
+fn least_squares(samples: &[&(f64, f64)], linear: bool) -> Option<Background> {
+    let n = samples.len() as f64;
+    if samples.is_empty() {
+        return None;
+    }
+    let (sv, st) = (
+        samples.iter().map(|s| s.0).sum::<f64>(),
+        samples.iter().map(|s| s.1).sum::<f64>(),
+    );
+    if linear {
+        let svv = samples.iter().map(|s| s.0 * s.0).sum::<f64>();
+        let svt = samples.iter().map(|s| s.0 * s.1).sum::<f64>();
+        let den = n * svv - sv * sv;
+        if den.abs() > 1e-9 * n * n {
+            let b = (n * svt - sv * st) / den;
+            return Some(Background {
+                a: (st - b * sv) / n,
+                b,
+            });
+        }
+    }
+    Some(Background { a: st / n, b: 0.0 })
+}
+
+/// The background of a surface: the model (constant, or linear in v) that the most texels lie
+/// within [`BACKGROUND_TOLERANCE_K`] of, found by consensus over candidate models through one or
+/// two texels, then refitted by least squares to those texels. Unlike trimming around a median,
+/// this holds when features cover a large part of the surface and the background has a gradient,
+/// as long as the background is the largest part.
 fn robust_background(samples: &[(f64, f64)], linear: bool) -> Background {
-    // samples: (v, T). Start from the median; trim at 3 robust σ (at least 0.3 K), refit, thrice.
-    let mut ts: Vec<f64> = samples.iter().map(|s| s.1).collect();
-    ts.sort_by(f64::total_cmp);
-    let mut bg = Background {
-        a: ts[ts.len() / 2],
+    let tol = BACKGROUND_TOLERANCE_K;
+    let count = |bg: &Background| {
+        samples
+            .iter()
+            .filter(|(v, t)| (t - bg.a - bg.b * v).abs() <= tol)
+            .count()
+    };
+    let mut rng = ChaCha8Rng::seed_from_u64(0x6267);
+    let mut best = Background {
+        a: samples[samples.len() / 2].1,
         b: 0.0,
     };
-    for _ in 0..4 {
-        let mut res: Vec<f64> = samples
-            .iter()
-            .map(|(v, t)| (t - bg.a - bg.b * v).abs())
-            .collect();
-        res.sort_by(f64::total_cmp);
-        let cut = (3.0 * 1.4826 * res[res.len() / 2]).max(0.3);
-        let keep: Vec<&(f64, f64)> = samples
-            .iter()
-            .filter(|(v, t)| (t - bg.a - bg.b * v).abs() <= cut)
-            .collect();
-        if keep.len() < 3 {
-            break;
-        }
-        let n = keep.len() as f64;
-        let (sv, st) = (
-            keep.iter().map(|s| s.0).sum::<f64>(),
-            keep.iter().map(|s| s.1).sum::<f64>(),
-        );
-        if linear {
-            let svv = keep.iter().map(|s| s.0 * s.0).sum::<f64>();
-            let svt = keep.iter().map(|s| s.0 * s.1).sum::<f64>();
-            let den = n * svv - sv * sv;
-            if den.abs() > 1e-9 {
-                let b = (n * svt - sv * st) / den;
-                bg = Background {
-                    a: (st - b * sv) / n,
-                    b,
-                };
+    let mut best_n = count(&best);
+    for _ in 0..300 {
+        let x = samples[rng.random_range(0..samples.len())];
+        let cand = if linear {
+            let y = samples[rng.random_range(0..samples.len())];
+            if (x.0 - y.0).abs() < 0.3 {
                 continue;
             }
+            let b = (y.1 - x.1) / (y.0 - x.0);
+            Background {
+                a: x.1 - b * x.0,
+                b,
+            }
+        } else {
+            Background { a: x.1, b: 0.0 }
+        };
+        let n = count(&cand);
+        if n > best_n {
+            (best, best_n) = (cand, n);
         }
-        bg = Background { a: st / n, b: 0.0 };
     }
-    bg
+    for _ in 0..3 {
+        let inliers: Vec<&(f64, f64)> = samples
+            .iter()
+            .filter(|(v, t)| (t - best.a - best.b * v).abs() <= tol)
+            .collect();
+        match least_squares(&inliers, linear) {
+            Some(b) => best = b,
+            None => break,
+        }
+    }
+    best
 }
 
 /// Clips polygon `p` to the convex polygon `clip` (both counter-clockwise).
@@ -209,6 +248,7 @@ pub fn analyse_surface(
         observed_fraction,
         features: Vec::new(),
         dropped: Vec::new(),
+        background: Background::default(),
     };
     if cells.len() < 3 {
         return out;
@@ -219,6 +259,7 @@ pub fn analyse_surface(
         .map(|&c| (g.centre(c % nx, c / nx).y, tk(c)))
         .collect();
     let bg = robust_background(&samples, linear);
+    out.background = bg;
     let resid = |c: usize| tk(c) - bg.a - bg.b * g.centre(c % nx, c / nx).y;
     // Warm and cold masks, with one-texel holes (unobserved or noisy) closed.
     let mut in_feature = vec![false; nx * ny];
@@ -436,4 +477,27 @@ pub fn analyse_surface(
             ((sigma * sigma) / n + ((1.0 - observed_fraction) * sigma).powi(2)).sqrt();
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A stratified wall (18 °C at mid-height, 0.8 K/m) with a 14 °C window over a quarter of it.
+    #[test]
+    fn background_ignores_a_large_cold_window() {
+        let mut s = Vec::new();
+        for j in 0..100 {
+            for i in 0..133 {
+                let (u, v) = (i as f64 * 0.03, -1.5 + j as f64 * 0.03);
+                let window = (1.0..3.0).contains(&u) && (-0.5..0.9).contains(&v);
+                s.push((v, if window { 287.15 } else { 291.15 + 0.8 * v }));
+            }
+        }
+        let bg = robust_background(&s, true);
+        assert!(
+            (bg.a - 291.15).abs() < 0.01 && (bg.b - 0.8).abs() < 0.01,
+            "{bg:?}"
+        );
+    }
 }

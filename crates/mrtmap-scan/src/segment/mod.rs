@@ -43,8 +43,10 @@ pub struct SegmentParams {
     pub horizontal_deg: f64,
     /// Vertical: normal within this of horizontal (degrees).
     pub vertical_deg: f64,
-    /// A wall spans at least this fraction of the floor-to-ceiling height.
+    /// A wall spans at least this fraction of the floor-to-ceiling height…
     pub wall_min_height_fraction: f64,
+    /// …and reaches within this of the ceiling (m); furniture does not.
+    pub wall_ceiling_gap_m: f64,
     /// Walls meet at corners of at least this angle (degrees).
     pub corner_min_angle_deg: f64,
     /// A corner may lie at most this far (sum over both walls, m) beyond the walls' seen ends.
@@ -64,15 +66,16 @@ pub struct SegmentParams {
 impl Default for SegmentParams {
     fn default() -> Self {
         Self {
-            plane_distance_m: 0.06,
+            plane_distance_m: 0.12,
             plane_normal_deg: 35.0,
             min_plane_points: 300,
-            max_planes: 24,
+            max_planes: 40,
             merge_deg: 5.0,
-            merge_distance_m: 0.08,
+            merge_distance_m: 0.25,
             horizontal_deg: 15.0,
             vertical_deg: 15.0,
             wall_min_height_fraction: 0.5,
+            wall_ceiling_gap_m: 0.4,
             corner_min_angle_deg: 20.0,
             corner_max_gap_m: 3.0,
             surface_band_m: 0.10,
@@ -104,11 +107,13 @@ pub enum SegmentError {
     NoWalls,
     /// The walls do not close into a loop.
     #[error(
-        "the walls do not close into an outline of the room ({walls} linked): parts of the room may be unscanned"
+        "the walls do not close into an outline of the room ({walls} linked; wall planes found: {found}): parts of the room may be unscanned"
     )]
     OpenOutline {
         /// Walls linked before the loop broke.
         walls: usize,
+        /// The wall planes found (direction on the floor, extent, points).
+        found: String,
     },
     /// The scene built breaks a scene rule.
     #[error("the scene built from the cloud is invalid: {0}")]
@@ -132,6 +137,10 @@ pub struct SurfaceSummary {
     pub area_m2: f64,
     /// Cloud points on it.
     pub points: usize,
+    /// Background model: level at the surface's centre (°C) and vertical gradient (K/m, walls).
+    pub background_c: f64,
+    /// Vertical gradient of the background (K/m).
+    pub gradient_k_per_m: f64,
 }
 
 /// One feature of the result.
@@ -254,13 +263,21 @@ pub fn segment(
     geoms.push(SurfaceGeom {
         id: "floor".into(),
         kind: SurfaceKind::Floor,
-        frame: PlaneFrame::new(centroid(&env.floor_corners), up, &longest),
+        frame: PlaneFrame::new(
+            centroid(&env.floor_corners),
+            env.planes[env.floor].plane.normal,
+            &longest,
+        ),
         polygon: env.floor_corners.clone(),
     });
     geoms.push(SurfaceGeom {
         id: "ceiling".into(),
         kind: SurfaceKind::Ceiling,
-        frame: PlaneFrame::new(centroid(&env.ceiling_corners), -up, &longest),
+        frame: PlaneFrame::new(
+            centroid(&env.ceiling_corners),
+            env.planes[env.ceiling].plane.normal,
+            &longest,
+        ),
         polygon: env.ceiling_corners.clone(),
     });
     for k in 0..n {
@@ -293,16 +310,19 @@ pub fn segment(
         .map(|g| g.polygon.iter().map(|q| g.frame.to_2d(q)).collect())
         .collect();
 
-    // Points to surfaces: the nearest surface plane within the band whose outline (grown by the
-    // band) contains the point's projection.
+    // Points to surfaces: the nearest surface plane within the band, with an agreeing normal, whose
+    // outline (grown by the band) contains the point's projection.
     let mut surface_id = vec![-1i32; pos.len()];
     let mut members: Vec<Vec<usize>> = vec![Vec::new(); geoms.len()];
+    let cos_agree = p.plane_normal_deg.to_radians().cos();
     for (i, q) in pos.iter().enumerate() {
         let mut best: Option<(f64, usize)> = None;
         for (s, g) in geoms.iter().enumerate() {
             let d = g.frame.signed_distance(q).abs();
+            // Normals must agree: the side of a box standing on the floor is not floor.
             if d <= p.surface_band_m
                 && best.is_none_or(|b| d < b.0)
+                && nrm[i].dot(&g.frame.normal).abs() >= cos_agree
                 && point_in_polygon(&g.frame.to_2d(q), &polys2[s], p.surface_band_m)
                     != Containment::Outside
             {
@@ -454,6 +474,8 @@ pub fn segment(
             observed_fraction: a.observed_fraction,
             area_m2: mrtmap_geometry::polygon::area_3d(&g.polygon),
             points: members[s].len(),
+            background_c: a.background.a - ZERO_CELSIUS_K,
+            gradient_k_per_m: a.background.b,
         });
     }
     let scene = RadiantScene::new(&SceneFile {

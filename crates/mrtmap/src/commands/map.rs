@@ -63,7 +63,7 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
         subtitle,
     };
     let (rays, seed) = match method {
-        Method::MonteCarlo(mc) => (Some(mc.rays), Some(mc.seed)),
+        Method::MonteCarlo(mc) | Method::Auto(mc) => (Some(mc.rays), Some(mc.seed)),
         Method::Exact => (None, None),
     };
     let summary = Summary {

@@ -53,7 +53,7 @@ pub(crate) fn resolve_method(args: &MethodArgs, scene: &RadiantScene) -> anyhow:
     Ok(match args.method {
         MethodArg::Exact => Method::Exact,
         MethodArg::Montecarlo => Method::MonteCarlo(mc()),
-        MethodArg::Auto if scene.occluders.is_empty() => Method::Exact,
+        MethodArg::Auto if scene.occluders.is_empty() => Method::Auto(mc()),
         MethodArg::Auto => Method::MonteCarlo(mc()),
     })
 }
@@ -62,6 +62,10 @@ pub(crate) fn resolve_method(args: &MethodArgs, scene: &RadiantScene) -> anyhow:
 pub(crate) fn describe_method(method: &Method, engine: Option<&str>) -> String {
     match method {
         Method::Exact => "exact view factors (solid angles)".to_string(),
+        Method::Auto(mc) => format!(
+            "exact view factors (solid angles), Monte Carlo ({} rays) where surfaces hide each other",
+            mc.rays
+        ),
         Method::MonteCarlo(mc) => format!(
             "Monte Carlo view factors ({} rays per point, {:?} directions in {} replicates, seed {}{})",
             mc.rays,

@@ -1,0 +1,232 @@
+//! Scoring a segmented scene against the truth of the simulated recording it came from: planes,
+//! corners, features (IoU), temperatures, and the MRT at the validation points.
+
+use mrtmap_geometry::PlaneFrame;
+use mrtmap_geometry::nalgebra::{Point2, Point3};
+use mrtmap_geometry::polygon::signed_area;
+use mrtmap_radiation::{Method, MonteCarlo, MrtEngine, RadiantScene, SurfaceKind};
+use serde::{Deserialize, Serialize};
+
+use crate::truth::Truth;
+
+/// A surface compared with its truth.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SurfaceScore {
+    /// Truth id.
+    pub truth_id: String,
+    /// Matched id.
+    pub id: Option<String>,
+    /// Angle between the planes (degrees).
+    pub angle_deg: f64,
+    /// Distance of the true polygon's centroid from the found plane (m).
+    pub offset_m: f64,
+    /// Found − true temperature (K).
+    pub temperature_error_k: f64,
+}
+
+/// A true feature compared with the best-overlapping found feature on its host.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FeatureScore {
+    /// Truth id.
+    pub truth_id: String,
+    /// True label.
+    pub truth_label: String,
+    /// Matched id and label.
+    pub found: Option<(String, String)>,
+    /// Intersection over union in the host's plane.
+    pub iou: f64,
+    /// Found − true temperature (K).
+    pub temperature_error_k: Option<f64>,
+}
+
+/// MRT at a validation point.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PointScore {
+    /// Name.
+    pub name: String,
+    /// Truth (°C).
+    pub truth_c: f64,
+    /// From the found scene (°C).
+    pub found_c: f64,
+    /// Difference (K).
+    pub error_k: f64,
+}
+
+/// Everything compared.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SceneScore {
+    /// Surfaces.
+    pub surfaces: Vec<SurfaceScore>,
+    /// Largest corner error (m), true floor and ceiling corners to the nearest found ones.
+    pub corner_max_error_m: f64,
+    /// Features.
+    pub features: Vec<FeatureScore>,
+    /// Found features matching no true feature.
+    pub spurious_features: Vec<String>,
+    /// MRT at the validation points.
+    pub points: Vec<PointScore>,
+}
+
+/// Area of the intersection of two convex polygons (counter-clockwise).
+fn convex_intersection_area(a: &[Point2<f64>], b: &[Point2<f64>]) -> f64 {
+    let mut out = a.to_vec();
+    for i in 0..b.len() {
+        let (p, q) = (b[i], b[(i + 1) % b.len()]);
+        let side = |x: &Point2<f64>| (q - p).perp(&(x - p));
+        let input = std::mem::take(&mut out);
+        for k in 0..input.len() {
+            let (c, d) = (input[k], input[(k + 1) % input.len()]);
+            let (sc, sd) = (side(&c), side(&d));
+            if sc >= 0.0 {
+                out.push(c);
+            }
+            if (sc >= 0.0) != (sd >= 0.0) {
+                out.push(c + (d - c) * (sc / (sc - sd)));
+            }
+        }
+        if out.len() < 3 {
+            return 0.0;
+        }
+    }
+    signed_area(&out).abs()
+}
+
+fn ccw(mut p: Vec<Point2<f64>>) -> Vec<Point2<f64>> {
+    if signed_area(&p) < 0.0 {
+        p.reverse();
+    }
+    p
+}
+
+/// Scores `found` against `truth` (both in the recording's world frame).
+pub fn score_scene(found: &RadiantScene, truth: &Truth) -> Result<SceneScore, crate::SimError> {
+    let t_scene = RadiantScene::new(&truth.scene)?;
+    let mut surfaces = Vec::new();
+    let mut features = Vec::new();
+    let mut matched_found = std::collections::HashSet::new();
+    for ts in &t_scene.surfaces {
+        // The found surface of the same kind whose plane is nearest the true centroid.
+        let c = Point3::from(
+            ts.polygon
+                .iter()
+                .fold(mrtmap_geometry::nalgebra::Vector3::zeros(), |a, p| {
+                    a + p.coords
+                })
+                / ts.polygon.len() as f64,
+        );
+        let best = found
+            .surfaces
+            .iter()
+            .filter(|s| s.kind == ts.kind && s.frame.normal.dot(&ts.frame.normal).abs() > 0.9)
+            .min_by(|a, b| {
+                a.frame
+                    .signed_distance(&c)
+                    .abs()
+                    .total_cmp(&b.frame.signed_distance(&c).abs())
+            });
+        let Some(fs) = best else {
+            surfaces.push(SurfaceScore {
+                truth_id: ts.id.clone(),
+                id: None,
+                angle_deg: f64::NAN,
+                offset_m: f64::NAN,
+                temperature_error_k: f64::NAN,
+            });
+            continue;
+        };
+        surfaces.push(SurfaceScore {
+            truth_id: ts.id.clone(),
+            id: Some(fs.id.clone()),
+            angle_deg: fs
+                .frame
+                .normal
+                .dot(&ts.frame.normal)
+                .abs()
+                .min(1.0)
+                .acos()
+                .to_degrees(),
+            offset_m: fs.frame.signed_distance(&c).abs(),
+            temperature_error_k: fs.temperature.kelvin() - ts.temperature.kelvin(),
+        });
+        // Features of this host: IoU in the true host's plane.
+        let frame: &PlaneFrame = &ts.frame;
+        for tf in &ts.features {
+            let tpoly = ccw(tf.polygon.iter().map(|p| frame.to_2d(p)).collect());
+            let t_area = signed_area(&tpoly).abs();
+            let best = fs
+                .features
+                .iter()
+                .map(|ff| {
+                    let fpoly = ccw(ff.polygon.iter().map(|p| frame.to_2d(p)).collect());
+                    let inter = convex_intersection_area(&fpoly, &tpoly);
+                    (inter / (t_area + signed_area(&fpoly).abs() - inter), ff)
+                })
+                .max_by(|a, b| a.0.total_cmp(&b.0))
+                .filter(|(iou, _)| *iou > 0.0);
+            if let Some((_, ff)) = best {
+                matched_found.insert(ff.id.clone());
+            }
+            features.push(FeatureScore {
+                truth_id: tf.id.clone(),
+                truth_label: tf.label.clone(),
+                found: best.map(|(_, ff)| (ff.id.clone(), ff.label.clone())),
+                iou: best.map_or(0.0, |b| b.0),
+                temperature_error_k: best
+                    .map(|(_, ff)| ff.temperature.kelvin() - tf.temperature.kelvin()),
+            });
+        }
+    }
+    let corners = |s: &RadiantScene, k: SurfaceKind| -> Vec<Point3<f64>> {
+        s.surfaces
+            .iter()
+            .filter(|x| x.kind == k)
+            .flat_map(|x| x.polygon.clone())
+            .collect()
+    };
+    let mut corner_max = 0.0f64;
+    for k in [SurfaceKind::Floor, SurfaceKind::Ceiling] {
+        let fc = corners(found, k);
+        for tc in corners(&t_scene, k) {
+            let d = fc
+                .iter()
+                .map(|f| (f - tc).norm())
+                .fold(f64::INFINITY, f64::min);
+            corner_max = corner_max.max(d);
+        }
+    }
+    let spurious = found
+        .surfaces
+        .iter()
+        .flat_map(|s| s.features.iter())
+        .filter(|f| !matched_found.contains(&f.id))
+        .map(|f| f.id.clone())
+        .collect();
+    let engine = MrtEngine::new(
+        found,
+        Method::Auto(MonteCarlo {
+            rays: 200_000,
+            ..MonteCarlo::default()
+        }),
+    )?;
+    let points = truth
+        .points
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let r = engine.at(&Point3::from(p.xyz_world), k as u64)?;
+            Ok(PointScore {
+                name: p.name.clone(),
+                truth_c: p.mrt_c,
+                found_c: r.mrt.celsius(),
+                error_k: r.mrt.celsius() - p.mrt_c,
+            })
+        })
+        .collect::<Result<Vec<_>, mrtmap_radiation::MrtError>>()?;
+    Ok(SceneScore {
+        surfaces,
+        corner_max_error_m: corner_max,
+        features,
+        spurious_features: spurious,
+        points,
+    })
+}
