@@ -7,6 +7,7 @@
 
 mod envelope;
 mod features;
+mod furniture;
 pub mod labels;
 
 use std::collections::BTreeMap;
@@ -17,7 +18,8 @@ use mrtmap_geometry::polygon::{Containment, point_in_polygon};
 use mrtmap_io::{Recording, ThermalCloud};
 use mrtmap_physics::ZERO_CELSIUS_K;
 use mrtmap_radiation::{
-    FeatureFile, RadiantScene, SCENE_FORMAT, SceneError, SceneFile, SurfaceFile, SurfaceKind,
+    FeatureFile, OccluderFile, RadiantScene, SCENE_FORMAT, SceneError, SceneFile, SurfaceFile,
+    SurfaceKind,
 };
 use serde::{Deserialize, Serialize};
 
@@ -59,6 +61,10 @@ pub struct SegmentParams {
     pub feature_threshold_k: f64,
     /// Smallest feature (m²).
     pub feature_min_area_m2: f64,
+    /// Furniture: points this close to a wall are the wall's (m).
+    pub furniture_wall_clearance_m: f64,
+    /// Furniture: the smallest group of points.
+    pub furniture_min_points: usize,
     /// Seed of RANSAC.
     pub seed: u64,
 }
@@ -82,6 +88,8 @@ impl Default for SegmentParams {
             texel_m: 0.03,
             feature_threshold_k: 0.8,
             feature_min_area_m2: 0.04,
+            furniture_wall_clearance_m: 0.15,
+            furniture_min_points: 200,
             seed: 1,
         }
     }
@@ -165,6 +173,26 @@ pub struct FeatureSummary {
     pub area_m2: f64,
 }
 
+/// A piece of furniture of the result.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FurnitureSummary {
+    /// Id in scene.json.
+    pub id: String,
+    /// Label.
+    pub label: String,
+    /// "masks" or "none".
+    pub label_source: String,
+    /// The votes, with masks.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub votes: Option<Votes>,
+    /// Size along, across and up (m).
+    pub size_m: [f64; 3],
+    /// Radiant temperature (°C).
+    pub temperature_c: f64,
+    /// Cloud points.
+    pub points: usize,
+}
+
 /// `segment.json`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SegmentReport {
@@ -180,6 +208,8 @@ pub struct SegmentReport {
     pub surfaces: Vec<SurfaceSummary>,
     /// Features.
     pub features: Vec<FeatureSummary>,
+    /// Furniture found (occluders in the scene).
+    pub furniture: Vec<FurnitureSummary>,
     /// Fraction of cloud points on no envelope surface (furniture, clutter, noise).
     pub unassigned_fraction: f64,
     /// Features dropped, and why.
@@ -358,18 +388,49 @@ pub fn segment(
             all_features.push((s, f));
         }
     }
-    // Labels.
+    // Furniture: what stands off the envelope.
+    let floor_height = up.dot(&env.floor_corners[0].coords);
+    let floor_2d: Vec<mrtmap_geometry::nalgebra::Point2<f64>> = {
+        let u = (longest - up.as_ref() * longest.dot(&up)).normalize();
+        let v = up.cross(&u);
+        env.floor_corners
+            .iter()
+            .map(|q| mrtmap_geometry::nalgebra::Point2::new(u.dot(&q.coords), v.dot(&q.coords)))
+            .collect()
+    };
+    let wall_planes: Vec<mrtmap_geometry::Plane> =
+        env.walls.iter().map(|&k| env.planes[k].plane).collect();
+    let furniture = furniture::find_furniture(
+        &pos,
+        &temp,
+        &surface_id,
+        &up,
+        &longest,
+        floor_height,
+        height_m,
+        &floor_2d,
+        &wall_planes,
+        p,
+    );
+    // Labels: one pass over the masks for features and furniture.
     let (voted, mask_summary) = match masks {
         Some(m) => {
             let pts: Vec<Vec<Point3<f64>>> = all_features
                 .iter()
                 .map(|(_, f)| f.points.iter().map(|&i| pos[i]).collect())
+                .chain(
+                    furniture
+                        .iter()
+                        .map(|f| f.points.iter().map(|&i| pos[i]).collect()),
+                )
                 .collect();
             let (v, s) = labels::vote(m.recording, m.world_from_depth, &pts);
             (v, Some(s))
         }
-        None => (vec![None; all_features.len()], None),
+        None => (vec![None; all_features.len() + furniture.len()], None),
     };
+    let mut voted = voted;
+    let furniture_votes = voted.split_off(all_features.len());
     let mut feature_id = vec![-1i32; pos.len()];
     let mut counts: BTreeMap<String, usize> = BTreeMap::new();
     let mut feature_summaries = Vec::new();
@@ -478,11 +539,50 @@ pub fn segment(
             gradient_k_per_m: a.background.b,
         });
     }
+    let mut furniture_summaries = Vec::new();
+    let mut occluders = Vec::new();
+    for (f, vote) in furniture.iter().zip(furniture_votes) {
+        let (label, source, votes) = match vote {
+            Some((l, v)) => (l, "masks", Some(v)),
+            None => ("furniture".to_string(), "none", None),
+        };
+        let slug: String = label
+            .to_lowercase()
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join("-");
+        let c = counts.entry(slug.clone()).or_default();
+        *c += 1;
+        let id = format!("{slug}-{c}");
+        occluders.push(OccluderFile {
+            id: id.clone(),
+            label: label.clone(),
+            temperature_c: f.temperature_k - ZERO_CELSIUS_K,
+            emissivity: 1.0,
+            box_: None,
+            vertices: Some(f.corners.iter().map(arr).collect()),
+            triangles: Some(
+                furniture::BOX_TRIANGLES
+                    .iter()
+                    .map(|t| [t[0], t[1], t[2]])
+                    .collect(),
+            ),
+        });
+        furniture_summaries.push(FurnitureSummary {
+            id,
+            label,
+            label_source: source.into(),
+            votes,
+            size_m: f.size_m,
+            temperature_c: f.temperature_k - ZERO_CELSIUS_K,
+            points: f.points.len(),
+        });
+    }
     let scene = RadiantScene::new(&SceneFile {
         format: SCENE_FORMAT.into(),
         up: Some([up.x, up.y, up.z]),
         surfaces,
-        occluders: Vec::new(),
+        occluders,
     })?;
     let report = SegmentReport {
         up: [up.x, up.y, up.z],
@@ -502,6 +602,7 @@ pub fn segment(
         height_m,
         surfaces: summaries,
         features: feature_summaries,
+        furniture: furniture_summaries,
         unassigned_fraction: unassigned as f64 / pos.len().max(1) as f64,
         dropped: analyses
             .iter()

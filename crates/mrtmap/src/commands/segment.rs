@@ -132,6 +132,23 @@ pub fn run(a: &SegmentArgs) -> anyhow::Result<()> {
             f.id, f.host, f.temperature_c, f.contrast_k, f.area_m2, f.label_source
         );
     }
+    for f in &r.furniture {
+        let votes = f
+            .votes
+            .as_ref()
+            .map(|v| {
+                format!(
+                    ", {:.0} % of {} votes",
+                    v.share * 100.0,
+                    v.votes.values().sum::<usize>()
+                )
+            })
+            .unwrap_or_default();
+        println!(
+            "  {:<18} furniture {:.2} × {:.2} × {:.2} m, {:6.2} °C, label by {}{votes}",
+            f.id, f.size_m[0], f.size_m[1], f.size_m[2], f.temperature_c, f.label_source
+        );
+    }
     for w in &r.warnings {
         println!("  warning: {w}");
     }
