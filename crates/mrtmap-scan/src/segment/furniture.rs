@@ -1,13 +1,15 @@
 //! Furniture as occluders: what the cloud holds off the envelope (desks, cabinets, sofas) blocks
 //! part of the room from view and radiates at its own temperature, so it belongs in the scene.
 //!
-//! Points on no envelope surface, inside the room and at least `furniture_wall_clearance_m` from
-//! the walls (closer, they are the noisy remainder of a wall), are grouped by connectivity on a
+//! Points on no envelope surface, inside the room and clear of the walls (by each wall's band and
+//! 5 cm, at least `furniture_wall_clearance_m`: closer, they are the noisy remainder of a wall), are
+//! grouped by connectivity on a
 //! 5 cm grid. A group of at least `furniture_min_points` points, 0.02 m³ and 15 cm across both
 //! horizontal axes becomes a box in the
 //! room's axes (along the longest wall, across it, up), spanning the 1st–99th percentiles of its
 //! points, extended to the floor when it ends within 15 cm of it (furniture stands on the floor),
-//! at the radiant average of its points.
+//! at the radiant average of its points. Groups reaching within 15 cm of the ceiling are wall
+//! remainders too.
 
 use std::collections::{HashMap, VecDeque};
 
@@ -62,7 +64,7 @@ pub fn find_furniture(
     floor_height: f64,
     room_height: f64,
     floor_2d: &[Point2<f64>],
-    wall_planes: &[mrtmap_geometry::Plane],
+    wall_planes: &[(mrtmap_geometry::Plane, f64)],
     p: &SegmentParams,
 ) -> Vec<FoundFurniture> {
     let u = (along - up.as_ref() * along.dot(up)).normalize();
@@ -84,7 +86,7 @@ pub fn find_furniture(
         }
         if wall_planes
             .iter()
-            .any(|w| w.distance(q).abs() < p.furniture_wall_clearance_m)
+            .any(|(w, clearance)| w.distance(q).abs() < clearance.max(p.furniture_wall_clearance_m))
         {
             continue;
         }
@@ -134,6 +136,11 @@ pub fn find_furniture(
         let (mut h0, h1) = (percentile(&mut h, 0.01), percentile(&mut h, 0.99));
         if h0 < 0.15 {
             h0 = 0.0;
+        }
+        // Reaching the ceiling, it is the noisy remainder of a wall; lower than 20 cm, the remainder
+        // of the floor (or a rug, which is floor): not furniture.
+        if h1 > room_height - 0.15 || h1 < 0.2 {
+            continue;
         }
         let size = [a1 - a0, b1 - b0, h1 - h0];
         // Thinner than 15 cm across, it is the noisy remainder of a wall or a picture, not furniture.

@@ -195,3 +195,40 @@ pub fn vote(
     }
     (tallies.iter().map(Votes::from_counts).collect(), summary)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn majority_share_ties_and_weak_majorities() {
+        let v = |pairs: &[(&str, usize)]| {
+            pairs
+                .iter()
+                .map(|(l, n)| (l.to_string(), *n))
+                .collect::<BTreeMap<_, _>>()
+        };
+        let (l, r) = Votes::from_counts(&v(&[("window", 8), ("mirror", 2)])).unwrap();
+        assert_eq!(l, "window");
+        assert!((r.share - 0.8).abs() < 1e-12 && !r.tie && !r.weak);
+        let (_, r) = Votes::from_counts(&v(&[("lamp", 3), ("recessed light", 3)])).unwrap();
+        assert!(r.tie && r.weak);
+        let (l, r) = Votes::from_counts(&v(&[("a", 5), ("b", 3), ("c", 2)])).unwrap();
+        assert_eq!(l, "a");
+        assert!(r.weak && !r.tie, "5 of 10 is a weak majority");
+        assert!(Votes::from_counts(&BTreeMap::new()).is_none());
+    }
+
+    #[test]
+    fn rules_label_without_masks() {
+        assert_eq!(
+            rule_label(SurfaceKind::Ceiling, 7.0, 0.36),
+            "recessed light"
+        );
+        assert_eq!(rule_label(SurfaceKind::Ceiling, 14.0, 4.3), "radiant panel");
+        assert_eq!(rule_label(SurfaceKind::Wall, -7.0, 2.3), "window");
+        assert_eq!(rule_label(SurfaceKind::Wall, 25.0, 1.0), "radiator");
+        assert_eq!(rule_label(SurfaceKind::Wall, 1.2, 0.6), "unlabelled");
+        assert_eq!(rule_label(SurfaceKind::Floor, 3.0, 1.0), "unlabelled");
+    }
+}

@@ -53,7 +53,8 @@ pub struct SegmentParams {
     pub corner_min_angle_deg: f64,
     /// A corner may lie at most this far (sum over both walls, m) beyond the walls' seen ends.
     pub corner_max_gap_m: f64,
-    /// Points within this distance of a surface belong to it (m).
+    /// Points within this distance of a surface belong to it (m); more where the surface's fused
+    /// points are spread wider (three robust standard deviations, up to 0.35 m).
     pub surface_band_m: f64,
     /// Texel size for the thermal analysis (m).
     pub texel_m: f64,
@@ -345,16 +346,42 @@ pub fn segment(
     let mut surface_id = vec![-1i32; pos.len()];
     let mut members: Vec<Vec<usize>> = vec![Vec::new(); geoms.len()];
     let cos_agree = p.plane_normal_deg.to_radians().cos();
+    // Each surface's band: three robust standard deviations of the distances of the points near
+    // it (the fused surface is as thick as the depth noise), at least `surface_band_m`.
+    let bands: Vec<f64> = geoms
+        .iter()
+        .enumerate()
+        .map(|(s, g)| {
+            let mut d: Vec<f64> = pos
+                .iter()
+                .zip(&nrm)
+                .filter(|(q, n)| {
+                    n.dot(&g.frame.normal).abs() >= cos_agree
+                        && g.frame.signed_distance(q).abs() < 0.4
+                        && point_in_polygon(&g.frame.to_2d(q), &polys2[s], 0.0)
+                            == Containment::Inside
+                })
+                .map(|(q, _)| g.frame.signed_distance(q))
+                .collect();
+            if d.len() < 100 {
+                return p.surface_band_m;
+            }
+            d.sort_by(f64::total_cmp);
+            let med = d[d.len() / 2];
+            let mut dev: Vec<f64> = d.iter().map(|x| (x - med).abs()).collect();
+            dev.sort_by(f64::total_cmp);
+            (3.0 * 1.4826 * dev[dev.len() / 2]).clamp(p.surface_band_m, 0.35)
+        })
+        .collect();
     for (i, q) in pos.iter().enumerate() {
         let mut best: Option<(f64, usize)> = None;
         for (s, g) in geoms.iter().enumerate() {
             let d = g.frame.signed_distance(q).abs();
             // Normals must agree: the side of a box standing on the floor is not floor.
-            if d <= p.surface_band_m
+            if d <= bands[s]
                 && best.is_none_or(|b| d < b.0)
                 && nrm[i].dot(&g.frame.normal).abs() >= cos_agree
-                && point_in_polygon(&g.frame.to_2d(q), &polys2[s], p.surface_band_m)
-                    != Containment::Outside
+                && point_in_polygon(&g.frame.to_2d(q), &polys2[s], bands[s]) != Containment::Outside
             {
                 best = Some((d, s));
             }
@@ -398,8 +425,13 @@ pub fn segment(
             .map(|q| mrtmap_geometry::nalgebra::Point2::new(u.dot(&q.coords), v.dot(&q.coords)))
             .collect()
     };
-    let wall_planes: Vec<mrtmap_geometry::Plane> =
-        env.walls.iter().map(|&k| env.planes[k].plane).collect();
+    // Walls with the clearance furniture must keep from them: their band and 5 cm.
+    let wall_planes: Vec<(mrtmap_geometry::Plane, f64)> = env
+        .walls
+        .iter()
+        .enumerate()
+        .map(|(w, &k)| (env.planes[k].plane, bands[w + 2] + 0.05))
+        .collect();
     let furniture = furniture::find_furniture(
         &pos,
         &temp,
@@ -622,4 +654,41 @@ pub fn segment(
 /// A unit vector from an array.
 pub fn unit(v: [f64; 3]) -> Option<Unit<Vector3<f64>>> {
     Unit::try_new(Vector3::from(v), 1e-9)
+}
+
+/// The refined pose at any time: the recording's trajectory corrected by fusion's ICP correction
+/// (`fused` = the refined world_from_depth of the fused frames), interpolated between the fused
+/// frames. For placing mask frames, which run on their own clock.
+pub fn refined_poses(
+    rec: &Recording,
+    fused: &mrtmap_io::Trajectory,
+) -> impl Fn(f64) -> Option<Isometry3<f64>> + Sync + use<> {
+    use mrtmap_io::InterpolationLimits;
+    let wide = InterpolationLimits {
+        max_gap_secs: 5.0,
+        max_extrapolation_secs: 5.0,
+    };
+    let corrections = mrtmap_io::Trajectory {
+        stamps: fused.stamps.clone(),
+        poses: fused
+            .stamps
+            .iter()
+            .zip(&fused.poses)
+            .map(|(t, p)| {
+                rec.trajectory
+                    .interpolate(*t, &InterpolationLimits::default())
+                    .map_or(Isometry3::identity(), |s| p * s.inverse())
+            })
+            .collect(),
+    };
+    let traj = rec.trajectory.clone();
+    move |t| {
+        let s = traj.interpolate(t, &InterpolationLimits::default())?;
+        Some(
+            corrections
+                .interpolate(t, &wide)
+                .unwrap_or(Isometry3::identity())
+                * s,
+        )
+    }
 }

@@ -4,3 +4,4 @@
 mod common;
 mod fusion;
 mod parts;
+mod segment;

@@ -1,49 +1,11 @@
 //! `mrtmap segment`: thermal cloud → radiant scene.
 
 use anyhow::{Context, bail};
-use mrtmap_geometry::nalgebra::Isometry3;
-use mrtmap_io::{
-    InterpolationLimits, Recording, Trajectory, read_cloud_ply, write_atomic, write_cloud_ply,
-};
-use mrtmap_scan::segment::{MaskInput, SegmentParams, segment};
+use mrtmap_io::{Recording, Trajectory, read_cloud_ply, write_atomic, write_cloud_ply};
+use mrtmap_scan::segment::{MaskInput, SegmentParams, refined_poses, segment};
 
 use crate::cli::SegmentArgs;
 use crate::output::json;
-
-/// The refined pose at any time: the recording's trajectory corrected by the fusion's ICP
-/// correction, interpolated between the fused frames.
-pub(crate) fn refined_poses(
-    rec: &Recording,
-    fused: &Trajectory,
-) -> impl Fn(f64) -> Option<Isometry3<f64>> + Sync {
-    let lim = InterpolationLimits {
-        max_gap_secs: 5.0,
-        max_extrapolation_secs: 5.0,
-    };
-    let corrections = Trajectory {
-        stamps: fused.stamps.clone(),
-        poses: fused
-            .stamps
-            .iter()
-            .zip(&fused.poses)
-            .map(|(t, p)| {
-                rec.trajectory
-                    .interpolate(*t, &InterpolationLimits::default())
-                    .map_or(Isometry3::identity(), |s| p * s.inverse())
-            })
-            .collect(),
-    };
-    let traj = rec.trajectory.clone();
-    move |t| {
-        let s = traj.interpolate(t, &InterpolationLimits::default())?;
-        Some(
-            corrections
-                .interpolate(t, &lim)
-                .unwrap_or(Isometry3::identity())
-                * s,
-        )
-    }
-}
 
 pub fn run(a: &SegmentArgs) -> anyhow::Result<()> {
     let cloud_path = a.fused.join("cloud.ply");

@@ -1,0 +1,140 @@
+use mrtmap_geometry::nalgebra::Isometry3;
+use mrtmap_io::{Recording, Trajectory};
+use mrtmap_scan::segment::{MaskInput, SegmentParams, refined_poses, segment};
+use mrtmap_sim::{Drift, NoiseLevel, SceneScore, Truth, score_scene};
+
+use crate::common::*;
+
+/// Simulates, fuses and segments (with masks) a scan; scores the scene against the truth.
+fn run(
+    room: &str,
+    noise: NoiseLevel,
+    seconds: f64,
+) -> (SceneScore, mrtmap_scan::segment::SegmentReport) {
+    let dir = tempfile::tempdir().unwrap();
+    let rec_dir = dir.path().join("scan");
+    scan_scaled(room, noise, Drift::NONE, seconds, 0.5, &rec_dir);
+    let rec = Recording::open(&rec_dir).unwrap();
+    let mut p = params(true);
+    p.depth.stride = 1;
+    let fused = mrtmap_scan::fuse(&rec, &p, &|_, _| {});
+    let poses = Trajectory {
+        stamps: fused.poses.iter().map(|x| x.0).collect(),
+        poses: fused.poses.iter().map(|x| x.1).collect(),
+    };
+    let pose_fn = refined_poses(&rec, &poses);
+    let masks = MaskInput {
+        recording: &rec,
+        world_from_depth: &pose_fn,
+    };
+    let cams: Vec<Isometry3<f64>> = poses.poses.clone();
+    let seg = segment(&fused.cloud, &cams, Some(&masks), &SegmentParams::default()).unwrap();
+    let truth: Truth =
+        serde_json::from_str(&std::fs::read_to_string(rec_dir.join("truth.json")).unwrap())
+            .unwrap();
+    (score_scene(&seg.scene, &truth).unwrap(), seg.report)
+}
+
+fn check_noise_free(room: &str, s: &SceneScore) {
+    for x in &s.surfaces {
+        assert!(x.id.is_some(), "{room}: surface {} not found", x.truth_id);
+        assert!(
+            x.angle_deg < 1.0 && x.offset_m < 0.02,
+            "{room}: plane {} off by {:.3}° {:.1} mm",
+            x.truth_id,
+            x.angle_deg,
+            x.offset_m * 1e3
+        );
+        assert!(
+            x.temperature_error_k.abs() < 0.1,
+            "{room}: surface {} ΔT {:.3} K",
+            x.truth_id,
+            x.temperature_error_k
+        );
+    }
+    assert!(
+        s.corner_max_error_m < 0.03,
+        "{room}: corners off by {:.1} mm",
+        s.corner_max_error_m * 1e3
+    );
+    for p in &s.points {
+        assert!(
+            p.error_k.abs() < 0.2,
+            "{room}: MRT at {} off by {:.3} K",
+            p.name,
+            p.error_k
+        );
+    }
+}
+
+/// Noise-free office: planes within 2 cm and 1°, corners within 3 cm, every feature found with
+/// IoU ≥ 0.8, the right label by mask votes and its temperature within 0.1 K; MRT at A–D within 0.2 K;
+/// the desk found as furniture.
+#[test]
+fn noise_free_office_scene_matches_the_truth() {
+    let (s, report) = run("office", NoiseLevel::None, 20.0);
+    check_noise_free("office", &s);
+    for f in &s.features {
+        let (_, label) = f
+            .found
+            .clone()
+            .unwrap_or_else(|| panic!("feature {} not found", f.truth_id));
+        assert!(f.iou >= 0.8, "{}: IoU {:.3}", f.truth_id, f.iou);
+        assert_eq!(label, f.truth_label, "{}", f.truth_id);
+        assert!(
+            f.temperature_error_k.unwrap().abs() < 0.1,
+            "{}: {:?}",
+            f.truth_id,
+            f.temperature_error_k
+        );
+    }
+    assert!(s.spurious_features.is_empty(), "{:?}", s.spurious_features);
+    assert!(
+        report
+            .features
+            .iter()
+            .all(|f| f.label_source == "masks" && f.votes.as_ref().is_some_and(|v| v.share > 0.9))
+    );
+    assert!(
+        report.furniture.iter().any(|f| f.label == "desk"),
+        "{:?}",
+        report.furniture
+    );
+    println!("office: {s:?}");
+}
+
+/// Noise-free L-shaped room: the re-entrant corner is found, the outline closes with six walls.
+#[test]
+fn noise_free_l_shaped_room_closes_its_outline() {
+    let (s, report) = run("l-shaped", NoiseLevel::None, 30.0);
+    assert_eq!(
+        report
+            .surfaces
+            .iter()
+            .filter(|x| x.kind == mrtmap_radiation::SurfaceKind::Wall)
+            .count(),
+        6
+    );
+    check_noise_free("l-shaped", &s);
+    // Window and radiator under it are told apart; the painting (0.4 K warmer than its wall) is
+    // below the default 0.8 K threshold.
+    for label in ["window", "radiator", "recessed light"] {
+        let f = s.features.iter().find(|f| f.truth_label == label).unwrap();
+        assert!(f.iou >= 0.8, "{label}: {f:?}");
+    }
+}
+
+/// Realistic noise: the office's MRT at A–D stays within 0.2 K.
+#[test]
+fn realistic_office_mrt_within_tolerance() {
+    let (s, _) = run("office", NoiseLevel::Realistic, 20.0);
+    for p in &s.points {
+        assert!(
+            p.error_k.abs() < 0.2,
+            "MRT at {} off by {:.3} K",
+            p.name,
+            p.error_k
+        );
+    }
+    println!("realistic office points: {:?}", s.points);
+}
