@@ -52,7 +52,7 @@ pub struct SegmentArgs {
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
     /// A texel belongs to a feature when it differs from its surface's background by more (K).
-    #[arg(long, default_value_t = 0.8)]
+    #[arg(long, default_value_t = 0.3)]
     pub feature_threshold_k: f64,
     /// Smallest feature (m²).
     #[arg(long = "feature-min-area-m2", default_value_t = 0.04)]

@@ -87,7 +87,7 @@ impl Default for SegmentParams {
             corner_max_gap_m: 3.0,
             surface_band_m: 0.10,
             texel_m: 0.03,
-            feature_threshold_k: 0.8,
+            feature_threshold_k: 0.3,
             feature_min_area_m2: 0.04,
             furniture_wall_clearance_m: 0.15,
             furniture_min_points: 200,
