@@ -176,7 +176,7 @@ impl Rig {
         let f: RigFile = toml::from_str(text).map_err(|e| {
             let line = e
                 .span()
-                .map(|s| text[..s.start.min(text.len())].lines().count().max(1));
+                .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
             FileError::new(path, line, FileErrorKind::Syntax(e.message().to_string()))
         })?;
         let bad = |m: String| FileError::new(path, None, FileErrorKind::Syntax(m));

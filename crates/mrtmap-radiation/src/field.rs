@@ -238,7 +238,9 @@ impl MrtField {
         }
         let u = linspace(lo.x + m, hi.x - m, spec.nx);
         let v = linspace(lo.y + m, hi.y - m, spec.ny);
-        let tol = (m - 1e-6).max(0.0);
+        // Nodes keep at least half the margin from the outline: a scanned floor is not an exact
+        // rectangle, and the outermost nodes of its bounding box may lie a few mm beyond the margin.
+        let tol = 0.5 * m;
         let mut places = Vec::new();
         for (j, &vv) in v.iter().enumerate() {
             for (i, &uu) in u.iter().enumerate() {

@@ -10,11 +10,18 @@
 //!
 //! Nothing here writes files or prints: functions return bytes and text for the caller to write.
 
+mod html;
 mod map;
 mod tables;
+mod validate;
 
+pub use html::{ComparisonRow, KeyValues, ReportData, ReportMap, esc, render_html};
 pub use map::{MapInput, MapMark, contour_step, render_png, render_svg};
 pub use tables::{MapAxes, MapSummary, grid_csv};
+pub use validate::{
+    GlobeRow, ISO_DESIRED_K, ISO_REQUIRED_K, ValidationRow, parse_globe_csv, validate,
+    validation_csv,
+};
 
 /// Errors of report rendering.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -23,4 +30,7 @@ pub enum ReportError {
     /// Drawing or encoding failed.
     #[error("drawing the map failed: {0}")]
     Draw(String),
+    /// An input file is wrong (the message names the file and line).
+    #[error("{0}")]
+    Input(String),
 }

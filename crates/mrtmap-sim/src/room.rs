@@ -192,7 +192,7 @@ impl Room {
         let file: RoomFile = toml::from_str(text).map_err(|e| {
             let line = e
                 .span()
-                .map(|s| text[..s.start.min(text.len())].lines().count().max(1));
+                .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
             RoomError::Toml(match line {
                 Some(l) => format!("line {l}: {}", e.message()),
                 None => e.message().to_string(),

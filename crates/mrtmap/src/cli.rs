@@ -37,6 +37,101 @@ pub enum Command {
     Fuse(FuseArgs),
     /// Segment a fused cloud into the room's surfaces and thermal features: scene.json.
     Segment(SegmentArgs),
+    /// The whole pipeline on a recording: fuse, segment, MRT maps and points, report.html.
+    Run(RunArgs),
+    /// Simulate the office scan, run the pipeline and compare with the truth (the seed paper's table).
+    Demo(DemoArgs),
+    /// Compare a map with black-globe readings (ISO 7726 and mixed convection).
+    Validate(ValidateArgs),
+}
+
+/// `mrtmap run`.
+#[derive(Debug, Args)]
+#[command(after_long_help = crate::project::PROJECT_EXAMPLE)]
+pub struct RunArgs {
+    /// The recording folder (shared/spec/recording.md).
+    pub recording: PathBuf,
+    /// Output folder: fuse/, segment/, map-H.HHm/ per height, report.html, run.json.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// A project file (TOML) with what is set once per scan; every key is listed below. Flags
+    /// override it.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// Rerun every stage even when its inputs have not changed.
+    #[arg(long)]
+    pub force: bool,
+    /// Grid nodes as COLSxROWS ([map] grid).
+    #[arg(long, value_parser = parse_grid)]
+    pub grid: Option<(usize, usize)>,
+    /// Map height above the floor (m), repeatable ([map] heights_m).
+    #[arg(long = "height")]
+    pub heights: Vec<f64>,
+    /// Margin from the walls (m) ([map] margin_m).
+    #[arg(long = "margin-m")]
+    pub margin_m: Option<f64>,
+    /// A named point NAME=X,Y,Z in the scan's frame, repeatable ([[points]]).
+    #[arg(long = "mark", value_name = "NAME=X,Y,Z", value_parser = parse_mark)]
+    pub marks: Vec<(String, Vec<f64>)>,
+    /// Voxel size (m) ([fuse] voxel_m).
+    #[arg(long = "voxel-m")]
+    pub voxel_m: Option<f64>,
+    /// ICP refinement ([fuse] icp).
+    #[arg(long, value_enum)]
+    pub icp: Option<OnOff>,
+    /// Do not use the recording's instance masks ([segment] masks = false).
+    #[arg(long)]
+    pub no_masks: bool,
+    /// Air temperature for the report (°C) ([air] temperature_c).
+    #[arg(long, allow_negative_numbers = true)]
+    pub air_c: Option<f64>,
+}
+
+/// `mrtmap demo`.
+#[derive(Debug, Args)]
+pub struct DemoArgs {
+    /// Output folder (the recording goes in DIR/recording, the run in DIR/run).
+    #[arg(long, value_name = "DIR", default_value = "mrtmap-demo")]
+    pub out: PathBuf,
+    /// Length of the simulated scan (s).
+    #[arg(long, default_value_t = 60.0)]
+    pub seconds: f64,
+    /// Simulate the seed paper's full 343 s scan (overrides --seconds).
+    #[arg(long)]
+    pub full: bool,
+    /// The preset room.
+    #[arg(long, default_value = "office")]
+    pub room: String,
+    /// Sensor noise.
+    #[arg(long, value_enum, default_value_t = NoiseArg::Realistic)]
+    pub noise: NoiseArg,
+    /// Air speed at the simulated globes (m/s).
+    #[arg(long, default_value_t = 0.1)]
+    pub air_speed: f64,
+    /// Depth image size of the simulated scan, WIDTHxHEIGHT (smaller runs faster).
+    #[arg(long, default_value = "640x480", value_parser = parse_grid)]
+    pub depth_size: (usize, usize),
+    /// Random seed of the simulation.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Rerun every stage.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// `mrtmap validate`.
+#[derive(Debug, Args)]
+pub struct ValidateArgs {
+    /// A folder with scene.json (or a `mrtmap run` output, with segment/scene.json).
+    #[arg(long, value_name = "DIR")]
+    pub map: PathBuf,
+    /// Globe readings: CSV with header label,x,y,z,tg_c,ta_c,va_m_s,diameter_m,emissivity (x, y, z in
+    /// the scan's frame, the frame of scene.json).
+    #[arg(long, value_name = "FILE")]
+    pub globe: PathBuf,
+    /// Where to write validation.csv and validation.json (default: the map folder).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
 }
 
 /// `mrtmap segment`.

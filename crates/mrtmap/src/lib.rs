@@ -6,7 +6,10 @@
 
 mod cli;
 mod commands;
+mod maps;
 mod output;
+mod pipeline;
+mod project;
 
 use std::process::ExitCode;
 

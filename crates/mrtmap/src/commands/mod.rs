@@ -1,12 +1,15 @@
 //! One module per subcommand, and the settings they share.
 
+mod demo;
 mod example_scene;
 mod fuse;
 mod globe;
 mod map;
 mod mrt;
+mod run;
 mod segment;
 mod simulate;
+mod validate;
 
 use anyhow::bail;
 use mrtmap_geometry::sampling::DirectionSet;
@@ -25,6 +28,9 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Rooms(a) => simulate::rooms(&a),
         Command::Fuse(a) => fuse::run(&a),
         Command::Segment(a) => segment::run(&a),
+        Command::Run(a) => run::run(&a),
+        Command::Demo(a) => demo::run(&a),
+        Command::Validate(a) => validate::run(&a),
     }
 }
 
@@ -59,7 +65,7 @@ pub(crate) fn resolve_method(args: &MethodArgs, scene: &RadiantScene) -> anyhow:
 }
 
 /// A line describing a method for people.
-pub(crate) fn describe_method(method: &Method, engine: Option<&str>) -> String {
+pub fn describe_method(method: &Method, engine: Option<&str>) -> String {
     match method {
         Method::Exact => "exact view factors (solid angles)".to_string(),
         Method::Auto(mc) => format!(

@@ -1,0 +1,401 @@
+//! The pipeline from the command line: run (stages, reuse, resume), report (numbers match the
+//! CSV; renders in headless Chromium), validate, demo. One small simulated scan is shared.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::OnceLock;
+
+use serde_json::Value;
+
+fn mrtmap(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_mrtmap"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn ok(args: &[&str]) -> String {
+    let o = mrtmap(args);
+    assert!(
+        o.status.success(),
+        "mrtmap {args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8(o.stdout).unwrap()
+}
+
+/// A 20 s noise-free office scan at 160×120 depth (the accuracy under noise is tested in
+/// mrtmap-scan), simulated once for all tests here.
+fn recording() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap().keep();
+        let rec = dir.join("scan");
+        ok(&[
+            "simulate",
+            "--room",
+            "office",
+            "--out",
+            rec.to_str().unwrap(),
+            "--seconds",
+            "20",
+            "--depth-size",
+            "160x120",
+            "--noise",
+            "none",
+            "--truth-rays",
+            "1000",
+        ]);
+        rec
+    })
+}
+
+fn read_json(p: &Path) -> Value {
+    serde_json::from_str(
+        &std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display())),
+    )
+    .unwrap()
+}
+
+fn stages_skipped(out: &Path) -> Vec<(String, bool)> {
+    read_json(&out.join("run.json"))["stages"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| {
+            (
+                s["stage"].as_str().unwrap().to_string(),
+                s["skipped"].as_bool().unwrap(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn run_produces_every_output_and_reuses_unchanged_stages() {
+    let rec = recording();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let o = out.to_str().unwrap();
+    let r = rec.to_str().unwrap();
+    let text = ok(&[
+        "run",
+        r,
+        "--out",
+        o,
+        "--grid",
+        "8x6",
+        "--mark",
+        "P=0.2,0.5,1.0",
+    ]);
+    assert!(text.contains("report:"), "{text}");
+    for f in [
+        "fuse/cloud.ply",
+        "fuse/fusion.json",
+        "fuse/poses.txt",
+        "segment/scene.json",
+        "segment/segments.ply",
+        "segment/segment.json",
+        "map-1.10m/mrt_grid.csv",
+        "map-1.10m/mrt_map.png",
+        "map-1.10m/summary.json",
+        "report.html",
+        "run.json",
+    ] {
+        assert!(out.join(f).exists(), "{f} missing");
+    }
+    assert!(stages_skipped(&out).iter().all(|s| !s.1));
+    // Unchanged: everything reused.
+    ok(&[
+        "run",
+        r,
+        "--out",
+        o,
+        "--grid",
+        "8x6",
+        "--mark",
+        "P=0.2,0.5,1.0",
+    ]);
+    assert!(
+        stages_skipped(&out).iter().all(|s| s.1),
+        "{:?}",
+        stages_skipped(&out)
+    );
+    // A new height: only that map is computed.
+    ok(&[
+        "run",
+        r,
+        "--out",
+        o,
+        "--grid",
+        "8x6",
+        "--mark",
+        "P=0.2,0.5,1.0",
+        "--height",
+        "1.1",
+        "--height",
+        "1.7",
+    ]);
+    let st = stages_skipped(&out);
+    assert_eq!(
+        st,
+        vec![
+            ("fuse".into(), true),
+            ("segment".into(), true),
+            ("map at 1.10 m".into(), true),
+            ("map at 1.70 m".into(), false)
+        ]
+    );
+    // An interrupted run resumes: remove segment's fingerprint, as if it stopped mid-stage.
+    std::fs::remove_file(out.join("segment/stage.json")).unwrap();
+    ok(&[
+        "run",
+        r,
+        "--out",
+        o,
+        "--grid",
+        "8x6",
+        "--mark",
+        "P=0.2,0.5,1.0",
+        "--height",
+        "1.1",
+        "--height",
+        "1.7",
+    ]);
+    let st = stages_skipped(&out);
+    assert!(st[0].1 && !st[1].1, "{st:?}");
+    // --force reruns all.
+    ok(&["run", r, "--out", o, "--grid", "8x6", "--force"]);
+    assert!(stages_skipped(&out).iter().all(|s| !s.1));
+    // A project file with an unknown key is refused with its name and line.
+    let cfg = dir.path().join("p.toml");
+    std::fs::write(&cfg, "[map]\ngrid = [8, 6]\nhieghts_m = [1.1]\n").unwrap();
+    let e = mrtmap(&["run", r, "--out", o, "--config", cfg.to_str().unwrap()]);
+    assert!(!e.status.success());
+    let err = String::from_utf8_lossy(&e.stderr);
+    assert!(
+        err.contains("p.toml:3") && err.contains("hieghts_m"),
+        "{err}"
+    );
+}
+
+/// The report is self-contained, its numbers match the CSV, and it renders in headless Chromium.
+#[test]
+fn report_numbers_match_the_csv_and_it_renders() {
+    let rec = recording();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    ok(&[
+        "run",
+        rec.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--grid",
+        "10x8",
+        "--mark",
+        "P=0.2,0.5,1.0",
+    ]);
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(
+        html.contains("data:image/png;base64,") && !html.contains("src=\"map-"),
+        "images are embedded"
+    );
+    let value = |id: &str| -> f64 {
+        let key = format!("id=\"{id}\">");
+        let i = html
+            .find(&key)
+            .unwrap_or_else(|| panic!("{id} not in the report"))
+            + key.len();
+        html[i..].split('<').next().unwrap().parse().unwrap()
+    };
+    let csv = std::fs::read_to_string(out.join("map-1.10m/mrt_grid.csv")).unwrap();
+    let mrt: Vec<f64> = csv
+        .lines()
+        .skip(1)
+        .filter_map(|l| l.split(',').nth(3)?.parse().ok())
+        .collect();
+    assert!(!mrt.is_empty());
+    let (min, max) = mrt
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(*v), b.max(*v))
+        });
+    let mean = mrt.iter().sum::<f64>() / mrt.len() as f64;
+    assert!((value("map-1.10-min") - min).abs() <= 0.005 + 1e-9);
+    assert!((value("map-1.10-max") - max).abs() <= 0.005 + 1e-9);
+    assert!((value("map-1.10-mean") - mean).abs() <= 0.005 + 1e-9);
+    let summary = read_json(&out.join("map-1.10m/summary.json"));
+    assert!(
+        (value("point-P") - summary["marks"][0]["mrt_c"].as_f64().unwrap()).abs() <= 0.005 + 1e-9
+    );
+    // Headless Chromium (CI installs Debian's chromium and sets MRTMAP_REQUIRE_CHROMIUM).
+    let chromium = ["chromium", "chromium-browser", "google-chrome"]
+        .into_iter()
+        .find(|c| {
+            Command::new(c)
+                .arg("--version")
+                .output()
+                .is_ok_and(|o| o.status.success())
+        });
+    let Some(chromium) = chromium else {
+        assert!(
+            std::env::var_os("MRTMAP_REQUIRE_CHROMIUM").is_none(),
+            "MRTMAP_REQUIRE_CHROMIUM is set but no chromium was found"
+        );
+        eprintln!("chromium not installed: the rendering check was not run");
+        return;
+    };
+    let profile = dir.path().join("chromium-profile");
+    let common = [
+        "--headless",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--disable-quic",
+        "--no-first-run",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+    ];
+    let url = format!("file://{}", out.join("report.html").display());
+    let dom = Command::new(chromium)
+        .args(common)
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .args(["--dump-dom", &url])
+        .output()
+        .unwrap();
+    let dom = String::from_utf8_lossy(&dom.stdout);
+    assert!(
+        dom.contains("Mean radiant temperature at 1.10 m") && dom.contains("id=\"map-1.10-min\""),
+        "Chromium did not render the report: {}",
+        &dom[..dom.len().min(300)]
+    );
+    let shot = dir.path().join("report.png");
+    let s = Command::new(chromium)
+        .args(common)
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .args([
+            "--window-size=1200,1600",
+            &format!("--screenshot={}", shot.display()),
+            &url,
+        ])
+        .output()
+        .unwrap();
+    assert!(s.status.success());
+    assert!(
+        std::fs::metadata(&shot).unwrap().len() > 20_000,
+        "a blank screenshot"
+    );
+}
+
+#[test]
+fn validate_compares_globes_with_the_map() {
+    let rec = recording();
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    ok(&[
+        "run",
+        rec.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--grid",
+        "6x5",
+    ]);
+    // A globe reading consistent with the map at a point: the map's MRT turned into what a
+    // standard globe would read there, via the inverse of the ISO formula.
+    let scene = out.join("segment/scene.json");
+    let p = "0.2,0.5,1.0";
+    let m: Value = serde_json::from_str(&ok(&[
+        "mrt",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--at",
+        p,
+        "--rays",
+        "200000",
+        "--json",
+    ]))
+    .unwrap();
+    let ours = m["points"][0]["mrt_c"].as_f64().unwrap();
+    let g: Value = serde_json::from_str(&ok(&[
+        "globe",
+        "--tr",
+        &ours.to_string(),
+        "--ta",
+        "21",
+        "--va",
+        "0.1",
+        "--json",
+    ]))
+    .unwrap();
+    let tg = g["globe_c"].as_f64().unwrap();
+    let csv = dir.path().join("globe.csv");
+    std::fs::write(&csv, format!("label,x,y,z,tg_c,ta_c,va_m_s,diameter_m,emissivity\nG1,0.2,0.5,1.0,{tg},21,0.1,0.15,0.95\nG2,0.2,0.5,1.0,{},21,0.1,0.3,0.95\n", tg + 3.0)).unwrap();
+    let text = ok(&[
+        "validate",
+        "--map",
+        out.to_str().unwrap(),
+        "--globe",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(
+        text.contains("G1") && text.contains("meets desired"),
+        "{text}"
+    );
+    let v = read_json(&out.join("validation.json"));
+    assert!(
+        v[0]["diff_iso_k"].as_f64().unwrap().abs() < 0.05,
+        "{}",
+        v[0]
+    );
+    assert_eq!(v[0]["meets_desired"], true);
+    assert!(
+        v[1]["mrt_mixed_c"]["Err"].is_string(),
+        "a 0.3 m globe is outside mixed convection's range: {}",
+        v[1]
+    );
+    assert_eq!(v[1]["meets_desired"], false);
+    let vcsv = std::fs::read_to_string(out.join("validation.csv")).unwrap();
+    assert_eq!(vcsv.lines().count(), 3);
+    std::fs::write(&csv, "label,x,y,z,tg_c,ta_c,va_m_s,diameter_m,emissivity\nG1,0.2,0.5,1.0,warm,21,0.1,0.15,0.95\n").unwrap();
+    let e = mrtmap(&[
+        "validate",
+        "--map",
+        out.to_str().unwrap(),
+        "--globe",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(
+        String::from_utf8_lossy(&e.stderr).contains("globe.csv:2: tg_c 'warm' is not a number")
+    );
+}
+
+#[test]
+fn demo_prints_the_papers_table_and_grid_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("demo");
+    let text = ok(&[
+        "demo",
+        "--out",
+        out.to_str().unwrap(),
+        "--seconds",
+        "20",
+        "--depth-size",
+        "160x120",
+        "--noise",
+        "none",
+    ]);
+    assert!(
+        text.contains("black globe (ISO)") && text.contains("over the 20×20 grid"),
+        "{text}"
+    );
+    let d = read_json(&out.join("demo.json"));
+    let points = d["points"].as_array().unwrap();
+    assert_eq!(points.len(), 4);
+    for p in points {
+        assert!(p["diff_k"].as_f64().unwrap().abs() < 0.5, "{p}");
+    }
+    assert!(d["grid"]["nodes"].as_u64().unwrap() > 300);
+    assert!(out.join("run/report.html").exists());
+    let html = std::fs::read_to_string(out.join("run/report.html")).unwrap();
+    assert!(html.contains("Against the truth") && html.contains("id=\"grid-rmse\""));
+}
