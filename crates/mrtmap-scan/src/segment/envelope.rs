@@ -379,6 +379,36 @@ pub fn envelope(
             }
         }
     }
+    // A shadow of a wall: a weaker vertical plane, tilted a few degrees from a wall, whose points
+    // mostly lie within the wall's slab (RANSAC's leftovers of a thick fused wall plus whatever
+    // stands against it; long scans gather enough of them). It is not a wall of its own: drop
+    // walls within `SHADOW_DEG` of a wall with `SHADOW_RATIO` times their points when most of
+    // their points lie within two inlier distances of that wall's plane.
+    const SHADOW_DEG: f64 = 15.0;
+    const SHADOW_RATIO: usize = 4;
+    let shadows: Vec<usize> = walls
+        .iter()
+        .copied()
+        .filter(|&w| {
+            walls.iter().any(|&v| {
+                let (pv, pw) = (&planes[v].plane, &planes[w].plane);
+                v != w
+                    && planes[v].points >= SHADOW_RATIO * planes[w].points
+                    && pv.normal.dot(&pw.normal) >= SHADOW_DEG.to_radians().cos()
+                    && planes[w]
+                        .inliers
+                        .iter()
+                        .filter(|&&i| pv.distance(&points[i]).abs() < 2.0 * p.plane_distance_m)
+                        .count()
+                        * 2
+                        > planes[w].points
+            })
+        })
+        .collect();
+    for &w in &shadows {
+        planes[w].class = PlaneClass::OtherVertical;
+    }
+    walls.retain(|w| !shadows.contains(w));
     // The horizontal frame and the walls' lines and extents in it.
     let origin = fp.project(&centre);
     let frame = PlaneFrame::new(origin, up, &Vector3::x());
@@ -538,4 +568,103 @@ pub fn envelope(
         planes,
         frame,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Points on a rectangle spanned from `o` along `a` and `b` (5 cm grid).
+    fn sheet(o: [f64; 3], a: [f64; 3], b: [f64; 3], pts: &mut Vec<Point3<f64>>) -> Vec<usize> {
+        let (o, a, b) = (Vector3::from(o), Vector3::from(a), Vector3::from(b));
+        let (na, nb) = ((a.norm() / 0.05) as usize, (b.norm() / 0.05) as usize);
+        let start = pts.len();
+        for i in 0..=na {
+            for j in 0..=nb {
+                pts.push(Point3::from(
+                    o + a * (i as f64 / na as f64) + b * (j as f64 / nb as f64),
+                ));
+            }
+        }
+        (start..pts.len()).collect()
+    }
+
+    fn found(points: &[Point3<f64>], inliers: Vec<usize>) -> FoundPlane {
+        let pts: Vec<Point3<f64>> = inliers.iter().map(|&i| points[i]).collect();
+        FoundPlane {
+            plane: Plane::fit(&pts).expect("a plane"),
+            points: inliers.len(),
+            inliers,
+            class: PlaneClass::Slanted,
+        }
+    }
+
+    /// A 4 × 3 × 2.7 m box room and its planes (the wall at y = 0 seen only between x = 0.6 and
+    /// 3.4 m), plus `extra` planes' points.
+    fn box_room(extra: &[Vec<Point3<f64>>]) -> (Vec<Point3<f64>>, Vec<FoundPlane>) {
+        let (w, d, h) = (4.0, 3.0, 2.7);
+        let mut pts = Vec::new();
+        let sheets = [
+            sheet([0.0, 0.0, 0.0], [w, 0.0, 0.0], [0.0, d, 0.0], &mut pts),
+            sheet([0.0, 0.0, h], [w, 0.0, 0.0], [0.0, d, 0.0], &mut pts),
+            sheet(
+                [0.6, 0.0, 0.0],
+                [w - 1.2, 0.0, 0.0],
+                [0.0, 0.0, h],
+                &mut pts,
+            ),
+            sheet([w, 0.0, 0.0], [0.0, d, 0.0], [0.0, 0.0, h], &mut pts),
+            sheet([0.0, d, 0.0], [w, 0.0, 0.0], [0.0, 0.0, h], &mut pts),
+            sheet([0.0, 0.0, 0.0], [0.0, d, 0.0], [0.0, 0.0, h], &mut pts),
+        ];
+        let mut planes: Vec<FoundPlane> = sheets.into_iter().map(|s| found(&pts, s)).collect();
+        for e in extra {
+            let start = pts.len();
+            pts.extend_from_slice(e);
+            planes.push(found(&pts, (start..pts.len()).collect()));
+        }
+        (pts, planes)
+    }
+
+    /// A weak plane tilted 6° from the wall at y = 0, along the wall's whole length and mostly
+    /// within its slab: the long full-office scan's failure. With the wall's ends hidden (by
+    /// furniture, say), the shadow's ends lie nearer the corners than the wall's.
+    fn shadow_of_front_wall() -> Vec<Point3<f64>> {
+        let tilt = 6f64.to_radians().tan();
+        let mut v = Vec::new();
+        for i in 0..=40 {
+            for j in 0..=13 {
+                let x = i as f64 * 0.1;
+                v.push(Point3::new(x, -0.1 + x * tilt, j as f64 * 0.2));
+            }
+        }
+        v
+    }
+
+    #[test]
+    fn a_box_room_closes_with_four_walls() {
+        let (pts, planes) = box_room(&[]);
+        let env = envelope(&pts, planes, Vector3::z_axis(), &SegmentParams::default())
+            .expect("an envelope");
+        assert_eq!(env.walls.len(), 4);
+        for c in &env.floor_corners {
+            let near = [[0.0, 0.0], [4.0, 0.0], [4.0, 3.0], [0.0, 3.0]]
+                .iter()
+                .map(|q| (c.x - q[0]).hypot(c.y - q[1]))
+                .fold(f64::INFINITY, f64::min);
+            assert!(near < 1e-6 && c.z.abs() < 1e-6, "corner {c:?}");
+        }
+    }
+
+    /// A wall's shadow plane is dropped instead of breaking the loop of walls.
+    #[test]
+    fn a_shadow_of_a_wall_is_not_a_wall() {
+        let (pts, planes) = box_room(&[shadow_of_front_wall()]);
+        let shadow = planes.len() - 1;
+        let env = envelope(&pts, planes, Vector3::z_axis(), &SegmentParams::default())
+            .expect("an envelope");
+        assert_eq!(env.walls.len(), 4);
+        assert!(!env.walls.contains(&shadow));
+        assert_eq!(env.planes[shadow].class, PlaneClass::OtherVertical);
+    }
 }
