@@ -87,8 +87,9 @@ pub fn parse_globe_csv(text: &str, file: &str) -> Result<Vec<GlobeRow>, ReportEr
 /// The map's MRT (°C) and its standard error (K) at a scan-frame point, or why not.
 pub type MrtAt<'a> = dyn Fn(&[f64; 3]) -> Result<(f64, f64), String> + 'a;
 
-/// A validation row.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// A validation row. In JSON every value is a number or null, a missing one with a `…_note`
+/// saying why (`mrt_mixed_note`: "globe diameter … outside …").
+#[derive(Clone, Debug, PartialEq)]
 pub struct ValidationRow {
     /// The reading.
     pub globe: GlobeRow,
@@ -108,6 +109,48 @@ pub struct ValidationRow {
     pub meets_required: Option<bool>,
     /// Whether it meets the desired accuracy (±0.2 K).
     pub meets_desired: Option<bool>,
+}
+
+/// The flat JSON form of a [`ValidationRow`].
+#[derive(Serialize)]
+struct ValidationJson<'a> {
+    globe: &'a GlobeRow,
+    mrt_iso_c: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    mrt_iso_note: Option<&'a str>,
+    iso_formula: &'a str,
+    mrt_mixed_c: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    mrt_mixed_note: Option<&'a str>,
+    ours_c: Option<f64>,
+    ours_std_error_k: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    ours_note: Option<&'a str>,
+    diff_iso_k: Option<f64>,
+    diff_mixed_k: Option<f64>,
+    meets_required: Option<bool>,
+    meets_desired: Option<bool>,
+}
+
+impl Serialize for ValidationRow {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        ValidationJson {
+            globe: &self.globe,
+            mrt_iso_c: self.mrt_iso_c.as_ref().ok().copied(),
+            mrt_iso_note: self.mrt_iso_c.as_ref().err().map(String::as_str),
+            iso_formula: &self.iso_formula,
+            mrt_mixed_c: self.mrt_mixed_c.as_ref().ok().copied(),
+            mrt_mixed_note: self.mrt_mixed_c.as_ref().err().map(String::as_str),
+            ours_c: self.ours_c.as_ref().ok().map(|x| x.0),
+            ours_std_error_k: self.ours_c.as_ref().ok().map(|x| x.1),
+            ours_note: self.ours_c.as_ref().err().map(String::as_str),
+            diff_iso_k: self.diff_iso_k,
+            diff_mixed_k: self.diff_mixed_k,
+            meets_required: self.meets_required,
+            meets_desired: self.meets_desired,
+        }
+        .serialize(s)
+    }
 }
 
 /// Validates `rows` against `ours` (MRT in °C and its standard error at a scan-frame point).
