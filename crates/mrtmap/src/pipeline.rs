@@ -414,6 +414,13 @@ pub fn report_data(
                     .and_then(|m| m.0.map.field.as_ref())
                     .map_or("—".into(), |f| format!("{:.3} K", f.max_std_error_k)),
             ),
+            (
+                "what ± covers".into(),
+                "view-factor sampling and the fused surface temperatures' random error; not the \
+                 thermal camera's absolute accuracy (a common offset passes one to one into MRT), \
+                 emissivity, or the room's geometry: check against a black globe (mrtmap validate)"
+                    .into(),
+            ),
         ],
         warnings: o.warnings.clone(),
         timing: o
