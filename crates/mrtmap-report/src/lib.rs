@@ -19,8 +19,8 @@ pub use html::{ComparisonRow, KeyValues, ReportData, ReportMap, esc, render_html
 pub use map::{MapInput, MapMark, contour_step, render_png, render_svg};
 pub use tables::{MapAxes, MapSummary, grid_csv};
 pub use validate::{
-    GlobeRow, ISO_DESIRED_K, ISO_REQUIRED_K, ValidationRow, parse_globe_csv, validate,
-    validation_csv,
+    GLOBE_COLUMNS, GlobeRow, ISO_DESIRED_K, ISO_REQUIRED_K, ValidationRow, parse_globe_csv,
+    validate, validation_csv,
 };
 
 /// Errors of report rendering.

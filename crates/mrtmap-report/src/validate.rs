@@ -35,53 +35,111 @@ pub struct GlobeRow {
     pub emissivity: f64,
 }
 
-/// Parses globe.csv text.
+/// The columns of globe.csv, in the order of a file without a header.
+pub const GLOBE_COLUMNS: [&str; 9] = [
+    "label",
+    "x",
+    "y",
+    "z",
+    "tg_c",
+    "ta_c",
+    "va_m_s",
+    "diameter_m",
+    "emissivity",
+];
+
+/// Parses globe.csv text (RFC 4180: quoted fields may hold commas). With a header (a first row
+/// naming any of the columns; `location` may stand for `label`), columns are found by name in any order and other
+/// columns (time, notes…) are ignored; without one, the nine columns come in [`GLOBE_COLUMNS`]
+/// order. Errors name `file` and the line.
 pub fn parse_globe_csv(text: &str, file: &str) -> Result<Vec<GlobeRow>, ReportError> {
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .comment(Some(b'#'))
+        .trim(csv::Trim::All)
+        .flexible(true)
+        .from_reader(text.as_bytes());
     let mut rows = Vec::new();
-    let mut header_seen = false;
-    for (i, line) in text.lines().enumerate() {
-        let l = line.trim();
-        if l.is_empty() || l.starts_with('#') {
+    let mut columns: Option<[usize; 9]> = None;
+    for record in reader.records() {
+        let record = record.map_err(|e| {
+            let line = e.position().map_or(0, |p| p.line());
+            ReportError::Input(format!("{file}:{line}: {e}"))
+        })?;
+        let line = record.position().map_or(0, |p| p.line());
+        let bad = |m: String| ReportError::Input(format!("{file}:{line}: {m}"));
+        if record.iter().all(str::is_empty) {
             continue;
         }
-        let cols: Vec<&str> = l.split(',').map(|c| c.trim()).collect();
-        if !header_seen {
-            header_seen = true;
-            if cols
-                .first()
-                .is_some_and(|c| c.eq_ignore_ascii_case("label"))
-            {
+        let Some(cols) = columns else {
+            let named = |h: &str| {
+                h.eq_ignore_ascii_case("location")
+                    || GLOBE_COLUMNS.iter().any(|c| h.eq_ignore_ascii_case(c))
+            };
+            if record.iter().any(named) {
+                let mut idx = [0usize; 9];
+                for (k, name) in GLOBE_COLUMNS.iter().enumerate() {
+                    idx[k] = record
+                        .iter()
+                        .position(|h| {
+                            h.eq_ignore_ascii_case(name)
+                                || (k == 0 && h.eq_ignore_ascii_case("location"))
+                        })
+                        .ok_or_else(|| {
+                            bad(format!(
+                                "the header has no column '{name}' (needs {})",
+                                GLOBE_COLUMNS.join(",")
+                            ))
+                        })?;
+                }
+                columns = Some(idx);
                 continue;
             }
-        }
-        let bad = |m: String| ReportError::Input(format!("{file}:{}: {m}", i + 1));
-        if cols.len() != 9 {
-            return Err(bad(format!(
-                "expected 9 columns (label,x,y,z,tg_c,ta_c,va_m_s,diameter_m,emissivity), found {}",
-                cols.len()
-            )));
-        }
-        let num = |k: usize, name: &str| -> Result<f64, ReportError> {
-            cols[k]
-                .parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| bad(format!("{name} '{}' is not a number", cols[k])))
+            columns = Some([0, 1, 2, 3, 4, 5, 6, 7, 8]);
+            if record.len() != 9 {
+                return Err(bad(format!(
+                    "expected 9 columns ({}) or a header naming them, found {}",
+                    GLOBE_COLUMNS.join(","),
+                    record.len()
+                )));
+            }
+            rows.push(globe_row(&record, &[0, 1, 2, 3, 4, 5, 6, 7, 8], &bad)?);
+            continue;
         };
-        rows.push(GlobeRow {
-            label: cols[0].to_string(),
-            xyz: [num(1, "x")?, num(2, "y")?, num(3, "z")?],
-            tg_c: num(4, "tg_c")?,
-            ta_c: num(5, "ta_c")?,
-            va_m_s: num(6, "va_m_s")?,
-            diameter_m: num(7, "diameter_m")?,
-            emissivity: num(8, "emissivity")?,
-        });
+        rows.push(globe_row(&record, &cols, &bad)?);
     }
     if rows.is_empty() {
         return Err(ReportError::Input(format!("{file}: no readings")));
     }
     Ok(rows)
+}
+
+/// One reading from a record whose column k holds [`GLOBE_COLUMNS`]`[k]` at `cols[k]`.
+fn globe_row(
+    record: &csv::StringRecord,
+    cols: &[usize; 9],
+    bad: &dyn Fn(String) -> ReportError,
+) -> Result<GlobeRow, ReportError> {
+    let field = |k: usize| record.get(cols[k]).unwrap_or("");
+    let num = |k: usize| -> Result<f64, ReportError> {
+        let v = field(k);
+        if v.is_empty() {
+            return Err(bad(format!("{} is missing", GLOBE_COLUMNS[k])));
+        }
+        v.parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| bad(format!("{} '{v}' is not a number", GLOBE_COLUMNS[k])))
+    };
+    Ok(GlobeRow {
+        label: field(0).to_string(),
+        xyz: [num(1)?, num(2)?, num(3)?],
+        tg_c: num(4)?,
+        ta_c: num(5)?,
+        va_m_s: num(6)?,
+        diameter_m: num(7)?,
+        emissivity: num(8)?,
+    })
 }
 
 /// The map's MRT (°C) and its standard error (K) at a scan-frame point, or why not.
@@ -199,34 +257,56 @@ pub fn validate(rows: &[GlobeRow], ours: &MrtAt<'_>) -> Vec<ValidationRow> {
         .collect()
 }
 
-/// validation.csv.
+/// validation.csv (labels quoted where they need it).
 pub fn validation_csv(rows: &[ValidationRow]) -> String {
-    let mut s = String::from(
-        "label,x,y,z,tg_c,ta_c,va_m_s,diameter_m,emissivity,mrt_iso_c,mrt_mixed_c,ours_c,ours_std_error_k,diff_iso_k,diff_mixed_k,meets_required_2k,meets_desired_0_2k\n",
-    );
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let header = [
+        "label",
+        "x",
+        "y",
+        "z",
+        "tg_c",
+        "ta_c",
+        "va_m_s",
+        "diameter_m",
+        "emissivity",
+        "mrt_iso_c",
+        "mrt_mixed_c",
+        "ours_c",
+        "ours_std_error_k",
+        "diff_iso_k",
+        "diff_mixed_k",
+        "meets_required_2k",
+        "meets_desired_0_2k",
+    ];
+    let f = |x: Option<f64>| x.map(|v| format!("{v:.3}")).unwrap_or_default();
+    let b = |x: Option<bool>| x.map(|v| v.to_string()).unwrap_or_default();
+    let mut records = vec![header.map(String::from).to_vec()];
     for r in rows {
         let g = &r.globe;
-        let f = |x: Option<f64>| x.map(|v| format!("{v:.3}")).unwrap_or_default();
-        s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
-            g.label,
-            g.xyz[0],
-            g.xyz[1],
-            g.xyz[2],
-            g.tg_c,
-            g.ta_c,
-            g.va_m_s,
-            g.diameter_m,
-            g.emissivity,
+        records.push(vec![
+            g.label.clone(),
+            g.xyz[0].to_string(),
+            g.xyz[1].to_string(),
+            g.xyz[2].to_string(),
+            g.tg_c.to_string(),
+            g.ta_c.to_string(),
+            g.va_m_s.to_string(),
+            g.diameter_m.to_string(),
+            g.emissivity.to_string(),
             f(r.mrt_iso_c.as_ref().ok().copied()),
             f(r.mrt_mixed_c.as_ref().ok().copied()),
             f(r.ours_c.as_ref().ok().map(|x| x.0)),
             f(r.ours_c.as_ref().ok().map(|x| x.1)),
             f(r.diff_iso_k),
             f(r.diff_mixed_k),
-            r.meets_required.map(|b| b.to_string()).unwrap_or_default(),
-            r.meets_desired.map(|b| b.to_string()).unwrap_or_default(),
-        ));
+            b(r.meets_required),
+            b(r.meets_desired),
+        ]);
     }
-    s
+    for rec in &records {
+        // Writing to a Vec cannot fail.
+        let _ = w.write_record(rec);
+    }
+    String::from_utf8(w.into_inner().unwrap_or_default()).unwrap_or_default()
 }

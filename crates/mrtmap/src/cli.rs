@@ -125,8 +125,9 @@ pub struct ValidateArgs {
     /// A folder with scene.json (or a `mrtmap run` output, with segment/scene.json).
     #[arg(long, value_name = "DIR")]
     pub map: PathBuf,
-    /// Globe readings: CSV with header label,x,y,z,tg_c,ta_c,va_m_s,diameter_m,emissivity (x, y, z in
-    /// the scan's frame, the frame of scene.json).
+    /// Globe readings: CSV with the columns label,x,y,z,tg_c,ta_c,va_m_s,diameter_m,emissivity (°C,
+    /// m/s, m; x, y, z in the scan's frame, the frame of scene.json). With a header the columns may
+    /// come in any order and others (time, notes) are ignored; `#` starts a comment line.
     #[arg(long, value_name = "FILE")]
     pub globe: PathBuf,
     /// Where to write validation.csv and validation.json (default: the map folder).
