@@ -1,0 +1,701 @@
+//! Intrinsic (Zhang) and stereo calibration.
+//!
+//! One camera: homographies → focal lengths with the principal point at the centre → board poses
+//! → Levenberg–Marquardt over the intrinsics, the distortion model's coefficients and every pose,
+//! first without distortion, then with it; views whose RMS error is far above the others' are
+//! rejected and the fit repeated.
+//!
+//! Two cameras: each is first calibrated alone. The thermal corners' numbering is then tied to the
+//! colour image's (a plain checkerboard is numbered from what each camera sees: a quarter turn
+//! apart, or shifted on a partly visible board): the quarter turn that makes the two cameras look
+//! the same way, the shift that puts the thermal camera where the pairs showing the whole board
+//! in both images put it. Last, the intrinsics of both cameras, the extrinsic and every board pose
+//! are refined together, and pairs whose error stands out are rejected and reported.
+
+use mrtmap_geometry::camera::{BrownConrady, PinholeCamera};
+use mrtmap_geometry::nalgebra::{
+    Isometry3, Matrix3, Point2, Point3, Quaternion, Translation3, UnitQuaternion, Vector3,
+};
+use serde::{Deserialize, Serialize};
+
+use crate::CalibError;
+use crate::board::Board;
+use crate::detect::{Corner, Detection};
+use crate::lm::{Problem, solve};
+use crate::zhang::{fit_homography, init_focal, pose_from_homography};
+
+/// Which distortion coefficients are estimated (the others stay zero).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum DistortionModel {
+    /// No distortion.
+    None,
+    /// k1, k2.
+    Radial,
+    /// k1, k2, p1, p2 (OpenCV's model with k3 fixed, its advice for ordinary lenses).
+    #[default]
+    RadialTangential,
+    /// k1, k2, p1, p2, k3 (OpenCV's default).
+    Full,
+}
+
+impl DistortionModel {
+    fn free(self) -> [bool; 9] {
+        let (r, t, k3) = match self {
+            Self::None => (false, false, false),
+            Self::Radial => (true, false, false),
+            Self::RadialTangential => (true, true, false),
+            Self::Full => (true, true, true),
+        };
+        [true, true, true, true, r, r, t, t, k3]
+    }
+}
+
+/// Camera from the 9 intrinsic parameters (fx fy cx cy k1 k2 p1 p2 k3).
+pub fn camera_from(width: u32, height: u32, g: &[f64]) -> PinholeCamera {
+    let mut c = PinholeCamera::new(width, height, g[0], g[1], g[2], g[3]);
+    c.distortion = BrownConrady::from_array([g[4], g[5], g[6], g[7], g[8]]);
+    c
+}
+
+fn intrinsics(c: &PinholeCamera) -> [f64; 9] {
+    let d = c.distortion.to_array();
+    [c.fx, c.fy, c.cx, c.cy, d[0], d[1], d[2], d[3], d[4]]
+}
+
+/// Isometry from (axis-angle, translation).
+pub fn iso(p: &[f64]) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::new(p[3], p[4], p[5]),
+        UnitQuaternion::from_scaled_axis(Vector3::new(p[0], p[1], p[2])),
+    )
+}
+
+/// (axis-angle, translation) of an isometry.
+pub fn vec6(i: &Isometry3<f64>) -> [f64; 6] {
+    let w = i.rotation.scaled_axis();
+    let t = i.translation.vector;
+    [w.x, w.y, w.z, t.x, t.y, t.z]
+}
+
+/// A pixel far off for a point behind the camera, so residual counts never change.
+const BEHIND: f64 = 1e3;
+
+fn push_residuals(
+    cam: &PinholeCamera,
+    pose: &Isometry3<f64>,
+    board: &Board,
+    corners: &[Corner],
+    out: &mut Vec<f64>,
+) {
+    for c in corners {
+        let p = pose * board.point(c.i, c.j);
+        match cam.project(&p) {
+            Some(px) => {
+                out.push(px.x - c.x);
+                out.push(px.y - c.y);
+            }
+            None => {
+                out.push(BEHIND);
+                out.push(BEHIND);
+            }
+        }
+    }
+}
+
+/// Reprojection errors of one view: RMS and mean of the per-corner distances (px).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ViewError {
+    /// Root mean square distance.
+    pub rms_px: f64,
+    /// Mean distance (the "mean reprojection error").
+    pub mean_px: f64,
+    /// Corners.
+    pub corners: usize,
+}
+
+fn view_error(
+    cam: &PinholeCamera,
+    pose: &Isometry3<f64>,
+    board: &Board,
+    c: &[Corner],
+) -> ViewError {
+    let mut r = Vec::new();
+    push_residuals(cam, pose, board, c, &mut r);
+    let d: Vec<f64> = r.chunks(2).map(|e| e[0].hypot(e[1])).collect();
+    let n = d.len().max(1) as f64;
+    ViewError {
+        rms_px: (d.iter().map(|x| x * x).sum::<f64>() / n).sqrt(),
+        mean_px: d.iter().sum::<f64>() / n,
+        corners: d.len(),
+    }
+}
+
+/// Pooled error over views (weighted by corners).
+fn pooled(v: &[ViewError]) -> ViewError {
+    let n: usize = v.iter().map(|e| e.corners).sum();
+    let nf = n.max(1) as f64;
+    ViewError {
+        rms_px: (v
+            .iter()
+            .map(|e| e.rms_px * e.rms_px * e.corners as f64)
+            .sum::<f64>()
+            / nf)
+            .sqrt(),
+        mean_px: v.iter().map(|e| e.mean_px * e.corners as f64).sum::<f64>() / nf,
+        corners: n,
+    }
+}
+
+/// One camera's calibration.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct MonoResult {
+    /// Intrinsics and distortion.
+    pub camera: PinholeCamera,
+    /// Standard deviations of fx fy cx cy k1 k2 p1 p2 k3 (0 for fixed ones).
+    pub std: Option<[f64; 9]>,
+    /// Per input view: the board pose (camera_from_board) when the view was used.
+    #[serde(skip)]
+    pub poses: Vec<Option<Isometry3<f64>>>,
+    /// Per input view: its error when used.
+    pub view_errors: Vec<Option<ViewError>>,
+    /// Views rejected as outliers (indices into the input).
+    pub rejected: Vec<usize>,
+    /// Pooled error over the used views.
+    pub error: ViewError,
+}
+
+struct Mono<'a> {
+    board: &'a Board,
+    size: (u32, u32),
+    views: Vec<&'a [Corner]>,
+}
+
+impl Problem for Mono<'_> {
+    fn views(&self) -> usize {
+        self.views.len()
+    }
+    fn residuals(&self, v: usize, g: &[f64], p: &[f64; 6], out: &mut Vec<f64>) {
+        let cam = camera_from(self.size.0, self.size.1, g);
+        push_residuals(&cam, &iso(p), self.board, self.views[v], out);
+    }
+}
+
+/// Rejects views whose RMS exceeds max(3 × median, `floor_px`): returns the flags of kept views.
+fn keep_flags(rms: &[Option<f64>], floor_px: f64) -> Vec<bool> {
+    let mut v: Vec<f64> = rms.iter().flatten().copied().collect();
+    if v.is_empty() {
+        return rms.iter().map(|_| false).collect();
+    }
+    v.sort_by(f64::total_cmp);
+    let limit = (3.0 * v[v.len() / 2]).max(floor_px);
+    rms.iter().map(|r| r.is_some_and(|x| x <= limit)).collect()
+}
+
+/// Calibrates one camera from its detections (`None` where the board was not found).
+pub fn calibrate_mono(
+    board: &Board,
+    width: u32,
+    height: u32,
+    dets: &[Option<Detection>],
+    model: DistortionModel,
+) -> Result<MonoResult, CalibError> {
+    let usable: Vec<usize> = (0..dets.len())
+        .filter(|&k| dets[k].as_ref().is_some_and(|d| d.corners.len() >= 6))
+        .collect();
+    if usable.len() < 3 {
+        return Err(CalibError::NotEnough(format!(
+            "the board was found in {} image(s) of {width}×{height}; at least 3 views at different angles are needed",
+            usable.len()
+        )));
+    }
+    let (cx, cy) = ((width as f64 - 1.0) / 2.0, (height as f64 - 1.0) / 2.0);
+    let mut homs = Vec::new();
+    for &k in &usable {
+        let d = dets[k]
+            .as_ref()
+            .map(|d| d.corners.as_slice())
+            .unwrap_or(&[]);
+        let src: Vec<Point2<f64>> = d
+            .iter()
+            .map(|c| {
+                let p = board.point(c.i, c.j);
+                Point2::new(p.x, p.y)
+            })
+            .collect();
+        let dst: Vec<Point2<f64>> = d.iter().map(|c| Point2::new(c.x, c.y)).collect();
+        homs.push(fit_homography(&src, &dst));
+    }
+    let good: Vec<Matrix3<f64>> = homs.iter().flatten().copied().collect();
+    let (fx, fy) = init_focal(&good, cx, cy).unwrap_or((width as f64, width as f64));
+    let k = Matrix3::new(fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0);
+    let mut views: Vec<&[Corner]> = Vec::new();
+    let mut index = Vec::new();
+    let mut poses = Vec::new();
+    for (h, &vi) in homs.iter().zip(&usable) {
+        if let Some(p) = h.as_ref().and_then(|h| pose_from_homography(h, &k)) {
+            views.push(
+                dets[vi]
+                    .as_ref()
+                    .map(|d| d.corners.as_slice())
+                    .unwrap_or(&[]),
+            );
+            index.push(vi);
+            poses.push(vec6(&p));
+        }
+    }
+    let prob = Mono {
+        board,
+        size: (width, height),
+        views,
+    };
+    let g0 = vec![fx, fy, cx, cy, 0.0, 0.0, 0.0, 0.0, 0.0];
+    let mut active = vec![true; index.len()];
+    let s0 = solve(&prob, g0, poses, &DistortionModel::None.free(), &active, 50);
+    let mut s = solve(&prob, s0.global, s0.views, &model.free(), &active, 100);
+    let mut rejected = Vec::new();
+    for _ in 0..2 {
+        let cam = camera_from(width, height, &s.global);
+        let rms: Vec<Option<f64>> = (0..index.len())
+            .map(|v| {
+                active[v].then(|| view_error(&cam, &iso(&s.views[v]), board, prob.views[v]).rms_px)
+            })
+            .collect();
+        let keep = keep_flags(&rms, 0.5);
+        let newly: Vec<usize> = (0..index.len())
+            .filter(|&v| active[v] && !keep[v])
+            .collect();
+        if newly.is_empty() || active.iter().filter(|a| **a).count() - newly.len() < 3 {
+            break;
+        }
+        for v in newly {
+            active[v] = false;
+            rejected.push(index[v]);
+        }
+        s = solve(&prob, s.global, s.views, &model.free(), &active, 100);
+    }
+    let cam = camera_from(width, height, &s.global);
+    let mut pose_out = vec![None; dets.len()];
+    let mut errs = vec![None; dets.len()];
+    for v in 0..index.len() {
+        if active[v] {
+            let p = iso(&s.views[v]);
+            pose_out[index[v]] = Some(p);
+            errs[index[v]] = Some(view_error(&cam, &p, board, prob.views[v]));
+        }
+    }
+    let error = pooled(&errs.iter().flatten().copied().collect::<Vec<_>>());
+    rejected.sort_unstable();
+    Ok(MonoResult {
+        camera: cam,
+        std: s.global_std.map(|v| {
+            let mut a = [0.0; 9];
+            a.copy_from_slice(&v[..9]);
+            a
+        }),
+        poses: pose_out,
+        view_errors: errs,
+        rejected,
+        error,
+    })
+}
+
+/// What became of one pair.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "status", content = "reason")]
+pub enum PairStatus {
+    /// Used in the stereo fit.
+    Used,
+    /// Not used, and why.
+    Rejected(String),
+}
+
+/// One pair in the stereo result.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PairResult {
+    /// Status.
+    #[serde(flatten)]
+    pub status: PairStatus,
+    /// Colour corners found.
+    pub rgb_corners: usize,
+    /// Thermal corners found.
+    pub thermal_corners: usize,
+    /// Colour error in the joint fit.
+    pub rgb_error: Option<ViewError>,
+    /// Thermal error in the joint fit.
+    pub thermal_error: Option<ViewError>,
+}
+
+/// The result of a stereo calibration.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct StereoResult {
+    /// Colour camera.
+    pub rgb: PinholeCamera,
+    /// Thermal camera.
+    pub thermal: PinholeCamera,
+    /// p_in_rgb = rgb_from_thermal · p_in_thermal.
+    pub rgb_from_thermal: Isometry3<f64>,
+    /// Standard deviations: colour intrinsics (9), thermal intrinsics (9), extrinsic (axis-angle
+    /// rad ×3, translation m ×3, of thermal_from_rgb).
+    pub std: Option<Vec<f64>>,
+    /// Per input pair.
+    pub pairs: Vec<PairResult>,
+    /// Pooled colour error over used pairs.
+    pub rgb_error: ViewError,
+    /// Pooled thermal error over used pairs.
+    pub thermal_error: ViewError,
+    /// Single-camera results (all colour images, all thermal images).
+    pub rgb_alone: MonoResult,
+    /// See `rgb_alone`.
+    pub thermal_alone: MonoResult,
+    /// The thermal corners' labels after tying them to the colour image's numbering (per pair).
+    #[serde(skip)]
+    pub thermal_labels: Vec<Option<Vec<Corner>>>,
+}
+
+/// Relabels corners by k quarter turns then a shift that brings the smallest labels to (0, 0);
+/// returns the new corners and the board-frame isometry S with X_new = S · X_old.
+fn relabel(corners: &[Corner], k: u32, board: &Board) -> (Vec<Corner>, Isometry3<f64>) {
+    let rot = |i: i32, j: i32| match k % 4 {
+        0 => (i, j),
+        1 => (-j, i),
+        2 => (-i, -j),
+        _ => (j, -i),
+    };
+    let turned: Vec<(i32, i32)> = corners.iter().map(|c| rot(c.i, c.j)).collect();
+    let mi = turned.iter().map(|t| t.0).min().unwrap_or(0);
+    let mj = turned.iter().map(|t| t.1).min().unwrap_or(0);
+    let out = corners
+        .iter()
+        .zip(&turned)
+        .map(|(c, t)| Corner {
+            i: t.0 - mi,
+            j: t.1 - mj,
+            ..*c
+        })
+        .collect();
+    let s = Isometry3::from_parts(
+        Translation3::new(
+            -mi as f64 * board.square_m,
+            -mj as f64 * board.square_m,
+            0.0,
+        ),
+        UnitQuaternion::from_axis_angle(&Vector3::z_axis(), k as f64 * std::f64::consts::FRAC_PI_2),
+    );
+    (out, s)
+}
+
+fn shift(corners: &[Corner], di: i32, dj: i32) -> Vec<Corner> {
+    corners
+        .iter()
+        .map(|c| Corner {
+            i: c.i + di,
+            j: c.j + dj,
+            ..*c
+        })
+        .collect()
+}
+
+fn board_shift(board: &Board, di: i32, dj: i32) -> Isometry3<f64> {
+    Isometry3::translation(di as f64 * board.square_m, dj as f64 * board.square_m, 0.0)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    if v.is_empty() { 0.0 } else { v[v.len() / 2] }
+}
+
+fn mean_rotation(q: &[UnitQuaternion<f64>]) -> UnitQuaternion<f64> {
+    let Some(q0) = q.first() else {
+        return UnitQuaternion::identity();
+    };
+    let mut acc = Quaternion::new(0.0, 0.0, 0.0, 0.0);
+    for x in q {
+        let s = if x.coords.dot(&q0.coords) < 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
+        acc += x.into_inner() * s;
+    }
+    UnitQuaternion::from_quaternion(acc)
+}
+
+struct Stereo<'a> {
+    board: &'a Board,
+    rgb_size: (u32, u32),
+    th_size: (u32, u32),
+    rgb: Vec<&'a [Corner]>,
+    th: Vec<Vec<Corner>>,
+}
+
+impl Problem for Stereo<'_> {
+    fn views(&self) -> usize {
+        self.rgb.len()
+    }
+    fn residuals(&self, v: usize, g: &[f64], p: &[f64; 6], out: &mut Vec<f64>) {
+        let cr = camera_from(self.rgb_size.0, self.rgb_size.1, &g[0..9]);
+        let ct = camera_from(self.th_size.0, self.th_size.1, &g[9..18]);
+        let pose = iso(p);
+        let e = iso(&g[18..24]);
+        push_residuals(&cr, &pose, self.board, self.rgb[v], out);
+        push_residuals(&ct, &(e * pose), self.board, &self.th[v], out);
+    }
+}
+
+/// A pair of detections (`None` where the board was not found) with image sizes.
+pub struct PairInput<'a> {
+    /// Colour detection.
+    pub rgb: Option<&'a Detection>,
+    /// Thermal detection.
+    pub thermal: Option<&'a Detection>,
+}
+
+/// Calibrates both cameras and the extrinsic between them.
+pub fn calibrate_stereo(
+    board: &Board,
+    rgb_size: (u32, u32),
+    thermal_size: (u32, u32),
+    pairs: &[PairInput<'_>],
+    model_rgb: DistortionModel,
+    model_thermal: DistortionModel,
+) -> Result<StereoResult, CalibError> {
+    let rgb_dets: Vec<Option<Detection>> = pairs.iter().map(|p| p.rgb.cloned()).collect();
+    let th_dets: Vec<Option<Detection>> = pairs.iter().map(|p| p.thermal.cloned()).collect();
+    let rgb_alone = calibrate_mono(board, rgb_size.0, rgb_size.1, &rgb_dets, model_rgb)
+        .map_err(|e| CalibError::NotEnough(format!("colour camera: {e}")))?;
+    let thermal_alone = calibrate_mono(
+        board,
+        thermal_size.0,
+        thermal_size.1,
+        &th_dets,
+        model_thermal,
+    )
+    .map_err(|e| CalibError::NotEnough(format!("thermal camera: {e}")))?;
+    let n = pairs.len();
+    let mut status: Vec<PairStatus> = (0..n)
+        .map(|k| {
+            PairStatus::Rejected(match (&rgb_dets[k], &th_dets[k]) {
+                (None, None) => "no board found in either image".into(),
+                (None, _) => "no board found in the colour image".into(),
+                (_, None) => "no board found in the thermal image".into(),
+                _ => "rejected as an outlier by the single-camera fit".into(),
+            })
+        })
+        .collect();
+    // Tie thermal labels to the colour labels: the quarter turn first.
+    struct Cand {
+        k: usize,
+        th: Vec<Corner>,
+        tc: Isometry3<f64>,
+        tt: Isometry3<f64>,
+    }
+    let mut cands = Vec::new();
+    for (k, dt) in th_dets.iter().enumerate() {
+        let (Some(tc), Some(tt), Some(dt)) =
+            (rgb_alone.poses[k], thermal_alone.poses[k], dt.as_ref())
+        else {
+            continue;
+        };
+        let best = (0..4)
+            .map(|q| {
+                let (c, s) = relabel(&dt.corners, q, board);
+                let tt2 = tt * s.inverse();
+                let e = tt2 * tc.inverse();
+                (e.rotation.angle(), c, tt2)
+            })
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        if let Some((_, c, tt2)) = best {
+            cands.push(Cand {
+                k,
+                th: c,
+                tc,
+                tt: tt2,
+            });
+        }
+    }
+    let full = |d: &Option<Detection>| {
+        d.as_ref().is_some_and(|d| {
+            let (w, h) = d.extent();
+            d.corners.len() == board.corners()
+                && ((w, h) == (board.cols as i32, board.rows as i32)
+                    || (w, h) == (board.rows as i32, board.cols as i32))
+        })
+    };
+    let complete: Vec<&Cand> = cands
+        .iter()
+        .filter(|c| full(&rgb_dets[c.k]) && full(&th_dets[c.k]))
+        .collect();
+    if complete.is_empty() {
+        return Err(CalibError::NotEnough(format!(
+            "no pair shows all {}×{} inner corners in both images, which is needed to tie the thermal corners' numbering to the colour image's",
+            board.cols, board.rows
+        )));
+    }
+    let t0 = {
+        let ts: Vec<Vector3<f64>> = complete
+            .iter()
+            .map(|c| (c.tt * c.tc.inverse()).translation.vector)
+            .collect();
+        Vector3::new(
+            median(ts.iter().map(|t| t.x).collect()),
+            median(ts.iter().map(|t| t.y).collect()),
+            median(ts.iter().map(|t| t.z).collect()),
+        )
+    };
+    let mut used = Vec::new();
+    let mut th_labels: Vec<Option<Vec<Corner>>> = vec![None; n];
+    let (c, r) = (board.cols as i32, board.rows as i32);
+    let reach = c.max(r);
+    for cand in &cands {
+        let mut best: Option<(f64, i32, i32)> = None;
+        for di in -reach..=reach {
+            for dj in -reach..=reach {
+                let tt = cand.tt * board_shift(board, di, dj).inverse();
+                let d = ((tt * cand.tc.inverse()).translation.vector - t0).norm();
+                if best.is_none_or(|b| d < b.0) {
+                    best = Some((d, di, dj));
+                }
+            }
+        }
+        let Some((d, di, dj)) = best else { continue };
+        if d > 0.4 * board.square_m {
+            status[cand.k] = PairStatus::Rejected(format!(
+                "the thermal corners cannot be matched to the colour corners (the best numbering puts the thermal camera {:.0} mm from where the other pairs do)",
+                d * 1e3
+            ));
+            continue;
+        }
+        let th = shift(&cand.th, di, dj);
+        let tt = cand.tt * board_shift(board, di, dj).inverse();
+        used.push((cand.k, cand.tc, tt * cand.tc.inverse()));
+        th_labels[cand.k] = Some(th);
+    }
+    let e0 = Isometry3::from_parts(
+        Translation3::from(t0),
+        mean_rotation(&used.iter().map(|u| u.2.rotation).collect::<Vec<_>>()),
+    );
+    let idx: Vec<usize> = used.iter().map(|u| u.0).collect();
+    let prob = Stereo {
+        board,
+        rgb_size,
+        th_size: thermal_size,
+        rgb: idx
+            .iter()
+            .map(|&k| {
+                rgb_dets[k]
+                    .as_ref()
+                    .map(|d| d.corners.as_slice())
+                    .unwrap_or(&[])
+            })
+            .collect(),
+        th: idx
+            .iter()
+            .map(|&k| th_labels[k].clone().unwrap_or_default())
+            .collect(),
+    };
+    let mut g: Vec<f64> = intrinsics(&rgb_alone.camera).to_vec();
+    g.extend(intrinsics(&thermal_alone.camera));
+    g.extend(vec6(&e0));
+    let mut free: Vec<bool> = model_rgb.free().to_vec();
+    free.extend(model_thermal.free());
+    free.extend([true; 6]);
+    let views: Vec<[f64; 6]> = used.iter().map(|u| vec6(&u.1)).collect();
+    let mut active = vec![true; idx.len()];
+    let mut s = solve(&prob, g, views, &free, &active, 100);
+    let errors = |s: &crate::lm::Solved, v: usize| {
+        let cr = camera_from(rgb_size.0, rgb_size.1, &s.global[0..9]);
+        let ct = camera_from(thermal_size.0, thermal_size.1, &s.global[9..18]);
+        let pose = iso(&s.views[v]);
+        let e = iso(&s.global[18..24]);
+        (
+            view_error(&cr, &pose, board, prob.rgb[v]),
+            view_error(&ct, &(e * pose), board, &prob.th[v]),
+        )
+    };
+    for _ in 0..2 {
+        let errs: Vec<Option<(ViewError, ViewError)>> = (0..idx.len())
+            .map(|v| active[v].then(|| errors(&s, v)))
+            .collect();
+        let kr = keep_flags(
+            &errs
+                .iter()
+                .map(|e| e.map(|x| x.0.rms_px))
+                .collect::<Vec<_>>(),
+            0.5,
+        );
+        let kt = keep_flags(
+            &errs
+                .iter()
+                .map(|e| e.map(|x| x.1.rms_px))
+                .collect::<Vec<_>>(),
+            0.5,
+        );
+        let newly: Vec<usize> = (0..idx.len())
+            .filter(|&v| active[v] && !(kr[v] && kt[v]))
+            .collect();
+        if newly.is_empty() || active.iter().filter(|a| **a).count() - newly.len() < 3 {
+            break;
+        }
+        for v in newly {
+            active[v] = false;
+            let (er, et) = errs[v].unwrap_or_default();
+            status[idx[v]] = PairStatus::Rejected(format!(
+                "outlier: RMS error {:.2} px colour, {:.2} px thermal, far above the other pairs'",
+                er.rms_px, et.rms_px
+            ));
+        }
+        s = solve(&prob, s.global, s.views, &free, &active, 100);
+    }
+    let mut results: Vec<PairResult> = (0..n)
+        .map(|k| PairResult {
+            status: status[k].clone(),
+            rgb_corners: rgb_dets[k].as_ref().map_or(0, |d| d.corners.len()),
+            thermal_corners: th_dets[k].as_ref().map_or(0, |d| d.corners.len()),
+            rgb_error: None,
+            thermal_error: None,
+        })
+        .collect();
+    let (mut er_all, mut et_all) = (Vec::new(), Vec::new());
+    for v in 0..idx.len() {
+        let (er, et) = errors(&s, v);
+        let r = &mut results[idx[v]];
+        r.rgb_error = Some(er);
+        r.thermal_error = Some(et);
+        if active[v] {
+            r.status = PairStatus::Used;
+            er_all.push(er);
+            et_all.push(et);
+        }
+    }
+    let e = iso(&s.global[18..24]);
+    Ok(StereoResult {
+        rgb: camera_from(rgb_size.0, rgb_size.1, &s.global[0..9]),
+        thermal: camera_from(thermal_size.0, thermal_size.1, &s.global[9..18]),
+        rgb_from_thermal: e.inverse(),
+        std: s.global_std,
+        pairs: results,
+        rgb_error: pooled(&er_all),
+        thermal_error: pooled(&et_all),
+        rgb_alone,
+        thermal_alone,
+        thermal_labels: th_labels,
+    })
+}
+
+/// The board point seen at a colour pixel, through the board plane of a pose (camera_from_board).
+pub fn board_plane_point(
+    cam: &PinholeCamera,
+    pose: &Isometry3<f64>,
+    px: &Point2<f64>,
+) -> Option<Point3<f64>> {
+    let ray = cam.unproject(px);
+    let inv = pose.inverse();
+    let o = inv * Point3::origin();
+    let d = inv * ray;
+    if d.z.abs() < 1e-12 {
+        return None;
+    }
+    let s = -o.z / d.z;
+    (s > 0.0).then(|| pose * (o + d * s))
+}
