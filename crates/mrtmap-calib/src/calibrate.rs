@@ -451,15 +451,27 @@ pub struct PairInput<'a> {
     pub thermal: Option<&'a Detection>,
 }
 
+/// Settings of a stereo calibration.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StereoOptions {
+    /// Colour camera distortion model.
+    pub model_rgb: DistortionModel,
+    /// Thermal camera distortion model.
+    pub model_thermal: DistortionModel,
+    /// Use only the corners found in both images of a pair in the joint fit (as OpenCV's
+    /// `stereoCalibrate` requires); by default every corner of either image counts.
+    pub common_corners: bool,
+}
+
 /// Calibrates both cameras and the extrinsic between them.
 pub fn calibrate_stereo(
     board: &Board,
     rgb_size: (u32, u32),
     thermal_size: (u32, u32),
     pairs: &[PairInput<'_>],
-    model_rgb: DistortionModel,
-    model_thermal: DistortionModel,
+    opts: &StereoOptions,
 ) -> Result<StereoResult, CalibError> {
+    let (model_rgb, model_thermal) = (opts.model_rgb, opts.model_thermal);
     let rgb_dets: Vec<Option<Detection>> = pairs.iter().map(|p| p.rgb.cloned()).collect();
     let th_dets: Vec<Option<Detection>> = pairs.iter().map(|p| p.thermal.cloned()).collect();
     let rgb_alone = calibrate_mono(board, rgb_size.0, rgb_size.1, &rgb_dets, model_rgb)

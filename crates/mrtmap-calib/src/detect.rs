@@ -3,9 +3,9 @@
 //! The ChESS corner detector and grid labelling of `calib-targets` find the corners; small images
 //! (a 160×120 thermal camera) are first upsampled so that a square spans enough pixels for the
 //! detector's ring. Saddle points do not care which squares are bright, so thermal images with
-//! inverted contrast need no special case. Each corner is then refined on the original image by
-//! the gradient-orthogonality method (as OpenCV's `cornerSubPix`), and corners that disagree with
-//! a homography fitted to the rest are dropped.
+//! inverted contrast need no special case. On images that were not upsampled each corner is
+//! refined by the gradient-orthogonality method (as OpenCV's `cornerSubPix`); corners that
+//! disagree with a homography fitted to the rest are dropped.
 
 use calib_targets::chessboard::ChessboardParams;
 use calib_targets::detect::{default_chess_config, detect_chessboard_all};
@@ -59,8 +59,12 @@ impl Detection {
 /// Detector settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DetectOptions {
-    /// Refine corners by gradient orthogonality on the original image.
+    /// Refine corners by gradient orthogonality on images large enough not to need upsampling
+    /// (on upsampled low-resolution images, the ChESS detector's own sub-pixel positions measured
+    /// better: 0.20 px MRE against 0.32–0.50 px on the real thermal board images).
     pub subpixel: bool,
+    /// Half-width of the refinement window as a fraction of the square's side.
+    pub window: f64,
     /// Fewest corners for a usable view.
     pub min_corners: usize,
 }
@@ -69,6 +73,7 @@ impl Default for DetectOptions {
     fn default() -> Self {
         Self {
             subpixel: true,
+            window: 0.35,
             min_corners: 12,
         }
     }
@@ -106,8 +111,8 @@ pub fn detect(img: &Gray, max_grid: (u32, u32), opts: &DetectOptions) -> Option<
         .map(|c| c as f64 / s)
         .unwrap_or_else(|| median_neighbour_distance(&corners));
     corners = clip_to_board(corners, max_grid);
-    if opts.subpixel {
-        let half = (0.35 * cell_px).clamp(1.5, 6.0);
+    if opts.subpixel && scale == 1 {
+        let half = (opts.window * cell_px).clamp(1.5, 6.0);
         for c in &mut corners {
             if let Some(p) = refine_corner(img, Point2::new(c.x, c.y), half) {
                 c.x = p.x;

@@ -19,6 +19,7 @@ pub mod gray;
 pub mod lm;
 pub mod pairs;
 pub mod report;
+pub mod rig;
 pub mod synth;
 pub mod zhang;
 
@@ -26,8 +27,8 @@ use std::path::{Path, PathBuf};
 
 pub use board::{Board, GridSize};
 pub use calibrate::{
-    DistortionModel, MonoResult, PairResult, PairStatus, StereoResult, ViewError, calibrate_mono,
-    calibrate_stereo,
+    DistortionModel, MonoResult, PairInput, PairResult, PairStatus, StereoOptions, StereoResult,
+    ViewError, calibrate_mono, calibrate_stereo,
 };
 pub use detect::{Corner, DetectOptions, Detection, detect};
 pub use gray::Gray;

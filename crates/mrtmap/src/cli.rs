@@ -43,6 +43,94 @@ pub enum Command {
     Demo(DemoArgs),
     /// Compare a map with black-globe readings (ISO 7726 and mixed convection).
     Validate(ValidateArgs),
+    /// Calibrate the rig from checkerboard image pairs: thermal and colour intrinsics, and the
+    /// thermal camera's pose (rig.toml).
+    Calibrate(CalibrateArgs),
+    /// Render synthetic checkerboard pairs (colour + 160×120 thermal) with exact truth.
+    SimulateBoard(SimulateBoardArgs),
+}
+
+/// Distortion coefficients to estimate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum DistortionArg {
+    /// None.
+    None,
+    /// k1, k2.
+    Radial,
+    /// k1, k2, p1, p2 (k3 fixed at 0, OpenCV's advice for ordinary lenses).
+    RadialTangential,
+    /// k1, k2, p1, p2, k3 (OpenCV's default model).
+    Full,
+}
+
+/// `mrtmap calibrate`.
+#[derive(Debug, Args)]
+#[command(after_long_help = "Examples:
+  mrtmap simulate-board --out boards
+  mrtmap calibrate --pairs boards --board 8x6 --square-m 0.06 --out rig.toml --report calib-report
+  mrtmap calibrate --images thermal-shots --board 11x9 --square-m 0.0505 --report r
+
+The pairs folder holds rgb/ and thermal/ sub-folders (images paired by file stem, or by the nearest
+timestamp when the stems are numbers), or files tagged like 0001_rgb.png + 0001_thermal.png.
+Thermal images may be 16-bit radiometric (any scale: they are stretched) or 8-bit grey or
+colour-mapped. At least one pair must show all inner corners in both images; other pairs may show
+part of the board.")]
+pub struct CalibrateArgs {
+    /// Folder of colour + thermal image pairs.
+    #[arg(long, value_name = "DIR", conflicts_with = "images")]
+    pub pairs: Option<PathBuf>,
+    /// Folder of one camera's images: its intrinsics only.
+    #[arg(long, value_name = "DIR")]
+    pub images: Option<PathBuf>,
+    /// Inner corners per row and column, COLSxROWS (a board of 9×7 squares has 8x6).
+    #[arg(long, value_name = "COLSxROWS")]
+    pub board: mrtmap_calib::GridSize,
+    /// Side of one square (m).
+    #[arg(long, value_name = "M")]
+    pub square_m: f64,
+    /// rig.toml to write. An existing one keeps its [depth] section and encoding; a new one takes
+    /// the colour camera as the depth camera (a RealSense with depth aligned to colour).
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Report folder: corners drawn on every image, thermal-over-colour overlays, index.html,
+    /// calibration.json.
+    #[arg(long, value_name = "DIR")]
+    pub report: Option<PathBuf>,
+    /// Distortion model of the colour camera (or of the --images camera).
+    #[arg(long, value_enum, default_value = "radial-tangential")]
+    pub distortion: DistortionArg,
+    /// Distortion model of the thermal camera.
+    #[arg(long, value_enum, default_value = "radial-tangential")]
+    pub thermal_distortion: DistortionArg,
+    /// Largest time difference (s) when pairing images by timestamp.
+    #[arg(long, default_value_t = 0.05, value_name = "S")]
+    pub max_dt: f64,
+    /// Fit only the corners found in both images of a pair (as OpenCV's stereoCalibrate).
+    #[arg(long)]
+    pub common_corners: bool,
+}
+
+/// `mrtmap simulate-board`.
+#[derive(Debug, Args)]
+pub struct SimulateBoardArgs {
+    /// Output folder: rgb/, thermal/ (16-bit centikelvin), truth.json.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Number of pairs.
+    #[arg(long, default_value_t = 20)]
+    pub pairs: usize,
+    /// Of those, pairs with the board partly out of view.
+    #[arg(long, default_value_t = 3)]
+    pub partial: usize,
+    /// Random seed.
+    #[arg(long, default_value_t = 7)]
+    pub seed: u64,
+    /// Thermal blur, Gaussian σ in thermal pixels.
+    #[arg(long, default_value_t = 0.7)]
+    pub blur_px: f64,
+    /// Thermal noise (K, standard deviation).
+    #[arg(long, default_value_t = 0.05)]
+    pub noise_k: f64,
 }
 
 /// `mrtmap run`.

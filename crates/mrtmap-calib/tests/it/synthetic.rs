@@ -3,8 +3,7 @@
 
 use mrtmap_calib::synth::{SynthOptions, SynthRig, render_pairs};
 use mrtmap_calib::{
-    DetectOptions, DistortionModel, Gray, PairStatus, calibrate::PairInput, calibrate_stereo,
-    detect,
+    DetectOptions, Gray, PairInput, PairStatus, StereoOptions, calibrate_stereo, detect,
 };
 
 #[test]
@@ -48,8 +47,7 @@ fn stereo_calibration_recovers_the_synthetic_rig() {
         (640, 480),
         (160, 120),
         &inputs,
-        DistortionModel::RadialTangential,
-        DistortionModel::RadialTangential,
+        &StereoOptions::default(),
     )
     .expect("calibration");
     let used = r

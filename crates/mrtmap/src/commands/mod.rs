@@ -1,5 +1,6 @@
 //! One module per subcommand, and the settings they share.
 
+mod calibrate;
 mod demo;
 mod example_scene;
 mod fuse;
@@ -31,6 +32,8 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Run(a) => run::run(&a),
         Command::Demo(a) => demo::run(&a),
         Command::Validate(a) => validate::run(&a),
+        Command::Calibrate(a) => calibrate::run(&a),
+        Command::SimulateBoard(a) => calibrate::simulate_board(&a),
     }
 }
 
