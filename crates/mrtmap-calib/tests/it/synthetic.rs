@@ -102,3 +102,39 @@ fn stereo_calibration_recovers_the_synthetic_rig() {
     assert!(dt < 0.002, "translation off by {:.2} mm", dt * 1e3);
     assert!(dr < 0.2, "rotation off by {dr:.3}°");
 }
+
+/// 8-bit colour-mapped thermal images (iron palette, as many cameras export) give the same corners
+/// as the 16-bit radiometric ones.
+#[test]
+fn colour_mapped_thermal_gives_the_same_corners() {
+    let rig = SynthRig::default();
+    let o = SynthOptions {
+        pairs: 4,
+        partial: 0,
+        ..SynthOptions::default()
+    };
+    let pairs = render_pairs(&rig, &o);
+    let max = (o.board.cols, o.board.rows);
+    let opts = DetectOptions::default();
+    for p in &pairs {
+        let g16 = Gray::from_u16(p.thermal.width, p.thermal.height, &p.thermal.data);
+        let iron = image::RgbImage::from_fn(p.thermal.width, p.thermal.height, |x, y| {
+            image::Rgb(mrtmap_io::iron(
+                g16.data[(y * p.thermal.width + x) as usize],
+            ))
+        });
+        let g8 = Gray::from_dynamic(&image::DynamicImage::ImageRgb8(iron));
+        let a = detect(&g16, max, &opts).expect("16-bit board");
+        let b = detect(&g8, max, &opts).expect("colour-mapped board");
+        assert_eq!(a.corners.len(), 48);
+        assert_eq!(b.corners.len(), 48);
+        for c in &a.corners {
+            let d = b
+                .corners
+                .iter()
+                .map(|e| (e.x - c.x).hypot(e.y - c.y))
+                .fold(f64::INFINITY, f64::min);
+            assert!(d < 0.15, "corner moved {d:.3} px");
+        }
+    }
+}
