@@ -6,7 +6,7 @@
 use image::RgbImage;
 use mrtmap_geometry::camera::{BrownConrady, PinholeCamera};
 use mrtmap_geometry::nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
-use mrtmap_io::{Image16, ThermalEncoding};
+use mrtmap_io::{Image16, ThermalEncoding, gaussian_blur};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
@@ -168,38 +168,6 @@ fn render<F: Fn(Surface) -> f64>(
         .collect()
 }
 
-fn gaussian_blur(img: &mut [f64], w: usize, h: usize, sigma: f64) {
-    if sigma <= 0.0 {
-        return;
-    }
-    let r = (3.0 * sigma).ceil() as i64;
-    let k: Vec<f64> = (-r..=r)
-        .map(|i| (-(i * i) as f64 / (2.0 * sigma * sigma)).exp())
-        .collect();
-    let ks: f64 = k.iter().sum();
-    let mut tmp = vec![0.0; img.len()];
-    for y in 0..h {
-        for x in 0..w {
-            let mut a = 0.0;
-            for (t, kv) in k.iter().enumerate() {
-                let xx = (x as i64 + t as i64 - r).clamp(0, w as i64 - 1) as usize;
-                a += kv * img[y * w + xx];
-            }
-            tmp[y * w + x] = a / ks;
-        }
-    }
-    for y in 0..h {
-        for x in 0..w {
-            let mut a = 0.0;
-            for (t, kv) in k.iter().enumerate() {
-                let yy = (y as i64 + t as i64 - r).clamp(0, h as i64 - 1) as usize;
-                a += kv * tmp[yy * w + x];
-            }
-            img[y * w + x] = a / ks;
-        }
-    }
-}
-
 /// Random board poses (rgb_from_board): 0.65–1.25 m away, tilted up to 35°, rolled up to 25°
 /// (one in four a quarter turn further), the first `partial` pushed partly out of the thermal view
 /// (and maybe the colour view).
@@ -280,20 +248,20 @@ pub fn render_pairs(rig: &SynthRig, o: &SynthOptions) -> Vec<SynthPair> {
         .map(|(k, pose)| {
             let mut rng =
                 ChaCha8Rng::seed_from_u64(o.seed.wrapping_mul(1000).wrapping_add(k as u64));
-            let mut grey = render(&rig.rgb, &rgb_rays, nr, pose, &o.board, |s| match s {
+            let grey = render(&rig.rgb, &rgb_rays, nr, pose, &o.board, |s| match s {
                 Surface::Black => 28.0,
                 Surface::Foil | Surface::Margin => 205.0,
                 Surface::Background => 120.0,
             });
             let (w, h) = (rig.rgb.width as usize, rig.rgb.height as usize);
-            gaussian_blur(&mut grey, w, h, 0.5);
+            let grey = gaussian_blur(&grey, w, h, 0.5);
             let cn = Normal::new(0.0, 1.5).unwrap_or_else(|_| unreachable!());
             let rgb = RgbImage::from_fn(rig.rgb.width, rig.rgb.height, |x, y| {
                 let g = grey[y as usize * w + x as usize] + cn.sample(&mut rng);
                 let c = |f: f64| (g * f).round().clamp(0.0, 255.0) as u8;
                 image::Rgb([c(1.0), c(0.97), c(0.92)])
             });
-            let mut kelvin = render(
+            let kelvin = render(
                 &rig.thermal,
                 &th_rays,
                 nt,
@@ -307,7 +275,7 @@ pub fn render_pairs(rig: &SynthRig, o: &SynthOptions) -> Vec<SynthPair> {
                 },
             );
             let (tw, th) = (rig.thermal.width as usize, rig.thermal.height as usize);
-            gaussian_blur(&mut kelvin, tw, th, o.thermal_blur_px);
+            let kelvin = gaussian_blur(&kelvin, tw, th, o.thermal_blur_px);
             let tn =
                 Normal::new(0.0, o.thermal_noise_k.max(0.0)).unwrap_or_else(|_| unreachable!());
             let thermal = Image16 {

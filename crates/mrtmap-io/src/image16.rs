@@ -106,3 +106,36 @@ pub fn encode_png_rgb8(width: u32, height: u32, rgb: &[u8]) -> Vec<u8> {
     let _ = enc.write_image(rgb, width, height, ExtendedColorType::Rgb8);
     out
 }
+
+/// Separable Gaussian blur of a row-major image with edge clamping (σ in pixels; σ ≤ 0 copies).
+pub fn gaussian_blur(src: &[f64], w: usize, h: usize, sigma: f64) -> Vec<f64> {
+    if sigma <= 0.0 || !sigma.is_finite() {
+        return src.to_vec();
+    }
+    let r = (3.0 * sigma).ceil() as isize;
+    let kernel: Vec<f64> = (-r..=r)
+        .map(|i| (-(i * i) as f64 / (2.0 * sigma * sigma)).exp())
+        .collect();
+    let sum: f64 = kernel.iter().sum();
+    let kernel: Vec<f64> = kernel.iter().map(|k| k / sum).collect();
+    let pass = |src: &[f64], horizontal: bool| -> Vec<f64> {
+        let mut out = vec![0.0; src.len()];
+        for y in 0..h {
+            for x in 0..w {
+                let mut acc = 0.0;
+                for (ki, kv) in kernel.iter().enumerate() {
+                    let o = ki as isize - r;
+                    let (xx, yy) = if horizontal {
+                        ((x as isize + o).clamp(0, w as isize - 1) as usize, y)
+                    } else {
+                        (x, (y as isize + o).clamp(0, h as isize - 1) as usize)
+                    };
+                    acc += kv * src[yy * w + xx];
+                }
+                out[y * w + x] = acc;
+            }
+        }
+        out
+    };
+    pass(&pass(src, true), false)
+}

@@ -29,7 +29,7 @@ mod trajectory;
 
 pub use atomic::{PartialDir, write_atomic};
 pub use error::{FileError, FileErrorKind};
-pub use image16::{Image16, encode_png_rgb8, encode_png16, read_image16};
+pub use image16::{Image16, encode_png_rgb8, encode_png16, gaussian_blur, read_image16};
 pub use ply::{ReadCloud, ThermalCloud, cloud_ply_bytes, iron, read_cloud_ply, write_cloud_ply};
 pub use recording::Recording;
 pub use rig::{PoseFile, RgbCamera, Rig, ThermalEncoding};

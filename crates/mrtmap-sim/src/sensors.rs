@@ -4,7 +4,7 @@
 use mrtmap_geometry::camera::PinholeCamera;
 use mrtmap_geometry::nalgebra::{Isometry3, Point2, Vector3};
 use mrtmap_io::masks::{InstanceInfo, MaskLabels};
-use mrtmap_io::{Image16, ThermalEncoding};
+use mrtmap_io::{Image16, ThermalEncoding, gaussian_blur};
 use mrtmap_physics::ZERO_CELSIUS_K;
 use rand::Rng;
 use rand_distr::{Distribution, Normal};
@@ -276,36 +276,6 @@ pub fn render_thermal<R: Rng>(
         *p = encoding.raw(t + noise.bias_k);
     }
     img
-}
-
-/// Separable Gaussian blur with edge clamping.
-fn gaussian_blur(src: &[f64], w: usize, h: usize, sigma: f64) -> Vec<f64> {
-    let r = (3.0 * sigma).ceil() as isize;
-    let kernel: Vec<f64> = (-r..=r)
-        .map(|i| (-(i * i) as f64 / (2.0 * sigma * sigma)).exp())
-        .collect();
-    let sum: f64 = kernel.iter().sum();
-    let kernel: Vec<f64> = kernel.iter().map(|k| k / sum).collect();
-    let pass = |src: &[f64], horizontal: bool| -> Vec<f64> {
-        let mut out = vec![0.0; src.len()];
-        for y in 0..h {
-            for x in 0..w {
-                let mut acc = 0.0;
-                for (ki, kv) in kernel.iter().enumerate() {
-                    let o = ki as isize - r;
-                    let (xx, yy) = if horizontal {
-                        ((x as isize + o).clamp(0, w as isize - 1) as usize, y)
-                    } else {
-                        (x, (y as isize + o).clamp(0, h as isize - 1) as usize)
-                    };
-                    acc += kv * src[yy * w + xx];
-                }
-                out[y * w + x] = acc;
-            }
-        }
-        out
-    };
-    pass(&pass(src, true), false)
 }
 
 /// Instance id of what a hit sees: features 1…F (room order), furniture F+1…; 0 = surface.

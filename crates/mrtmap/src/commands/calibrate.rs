@@ -34,7 +34,7 @@ struct Seen {
     problem: Option<String>,
 }
 
-fn see(path: &Path, board: &Board, size: &mut Option<(u32, u32)>) -> Seen {
+fn see(path: &Path, board: &Board, size: Option<(u32, u32)>) -> Seen {
     match Gray::read(path) {
         Err(e) => Seen {
             gray: None,
@@ -42,7 +42,7 @@ fn see(path: &Path, board: &Board, size: &mut Option<(u32, u32)>) -> Seen {
             problem: Some(e.to_string()),
         },
         Ok(g) => {
-            if let Some((w, h)) = *size
+            if let Some((w, h)) = size
                 && (g.width, g.height) != (w, h)
             {
                 return Seen {
@@ -76,13 +76,7 @@ fn see_all(paths: &[PathBuf], board: &Board) -> (Vec<Seen>, Option<(u32, u32)>) 
             .into_dimensions()
             .ok()
     });
-    let seen = paths
-        .par_iter()
-        .map(|p| {
-            let mut s = size;
-            see(p, board, &mut s)
-        })
-        .collect();
+    let seen = paths.par_iter().map(|p| see(p, board, size)).collect();
     (seen, size)
 }
 

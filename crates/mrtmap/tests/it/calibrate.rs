@@ -3,28 +3,12 @@
 //! board images (when `shared/data` is present).
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::sync::OnceLock;
 
 use mrtmap_io::Rig;
 use serde_json::Value;
 
-fn mrtmap(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_mrtmap"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn ok(args: &[&str]) -> String {
-    let o = mrtmap(args);
-    assert!(
-        o.status.success(),
-        "mrtmap {args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8(o.stdout).unwrap()
-}
+use crate::{mrtmap, ok};
 
 fn fails(args: &[&str]) -> String {
     let o = mrtmap(args);

@@ -1,14 +1,8 @@
 use std::path::Path;
-use std::process::{Command, Output};
 
 use serde_json::Value;
 
-fn mrtmap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mrtmap"))
-        .args(args)
-        .output()
-        .unwrap()
-}
+use crate::mrtmap;
 
 fn ok_json(args: &[&str]) -> Value {
     let out = mrtmap(args);

@@ -7,22 +7,7 @@ use std::sync::OnceLock;
 
 use serde_json::Value;
 
-fn mrtmap(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_mrtmap"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn ok(args: &[&str]) -> String {
-    let o = mrtmap(args);
-    assert!(
-        o.status.success(),
-        "mrtmap {args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8(o.stdout).unwrap()
-}
+use crate::{mrtmap, ok};
 
 /// A 20 s noise-free office scan at 160×120 depth (the accuracy under noise is tested in
 /// mrtmap-scan), simulated once for all tests here.
