@@ -67,6 +67,14 @@ pub enum FileErrorKind {
     /// A file listed in another that does not exist.
     #[error("listed file {0} does not exist")]
     Missing(String),
+    /// A binary file whose content is cut short or inconsistent at a byte offset.
+    #[error("at byte {offset}: {what}")]
+    Corrupt {
+        /// Byte offset from the start of the file.
+        offset: u64,
+        /// What is wrong there.
+        what: String,
+    },
 }
 
 impl FileError {
@@ -82,6 +90,18 @@ impl FileError {
     /// A syntax error at a line.
     pub fn syntax(path: &Path, line: usize, msg: impl Into<String>) -> Self {
         Self::new(path, Some(line), FileErrorKind::Syntax(msg.into()))
+    }
+
+    /// Corrupt or truncated content at a byte offset.
+    pub fn corrupt(path: &Path, offset: u64, what: impl Into<String>) -> Self {
+        Self::new(
+            path,
+            None,
+            FileErrorKind::Corrupt {
+                offset,
+                what: what.into(),
+            },
+        )
     }
 
     /// A read or write failure.

@@ -18,13 +18,16 @@
 //! only when complete.
 
 mod atomic;
+pub mod bytes;
 mod error;
+pub mod flir;
 mod image16;
 pub mod masks;
 mod ply;
 mod recording;
 mod rig;
 mod streams;
+mod thermal_file;
 mod trajectory;
 
 pub use atomic::{PartialDir, write_atomic};
@@ -34,6 +37,9 @@ pub use ply::{ReadCloud, ThermalCloud, cloud_ply_bytes, iron, read_cloud_ply, wr
 pub use recording::Recording;
 pub use rig::{PoseFile, RgbCamera, Rig, ThermalEncoding};
 pub use streams::{StreamEntry, parse_stream_list, stream_list_text};
+pub use thermal_file::{
+    ThermalFileKind, ThermalImage, ThermalOptions, decode_thermal, read_thermal_file,
+};
 pub use trajectory::{
     InterpolationLimits, QUATERNION_NORM_TOLERANCE, Trajectory, quaternion_xyzw, unit_quaternion,
 };

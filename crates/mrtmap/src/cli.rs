@@ -48,6 +48,62 @@ pub enum Command {
     Calibrate(CalibrateArgs),
     /// Render synthetic checkerboard pairs (colour + 160×120 thermal) with exact truth.
     SimulateBoard(SimulateBoardArgs),
+    /// Read one thermal image (FLIR R-JPEG/FFF, Lepton PNG/TIFF/raw, radiometric TIFF): metadata,
+    /// temperature statistics, CSV/PNG export.
+    Thermal(ThermalArgs),
+}
+
+/// `mrtmap thermal`.
+#[derive(Debug, Args)]
+#[command(after_long_help = "Examples:
+  mrtmap thermal IR_0001.jpg --csv ir.csv --png ir.png
+  mrtmap thermal frame.fff --emissivity 0.92 --reflected 21.5 --distance 2
+  mrtmap thermal lepton.y16 --centikelvin thermal.png
+  mrtmap thermal duo.tiff --scale 0.04
+
+FLIR files are converted with their own Planck constants, emissivity, reflected temperature,
+distance and atmosphere (the options replace the file's values). 16-bit PNG/TIFF/raw values are
+kelvin × scale: 0.01 (Lepton TLinear centikelvin) unless --scale says otherwise or only 0.04
+gives plausible temperatures (it says so). Float TIFFs are °C, or K when their median is above 150.")]
+pub struct ThermalArgs {
+    /// The thermal image.
+    pub file: PathBuf,
+    /// Write the temperatures (°C, one image row per line) as CSV.
+    #[arg(long, value_name = "OUT")]
+    pub csv: Option<PathBuf>,
+    /// Write a colour-mapped PNG (iron palette, min to max).
+    #[arg(long, value_name = "OUT")]
+    pub png: Option<PathBuf>,
+    /// Write a 16-bit centikelvin PNG (the recording layout's thermal encoding).
+    #[arg(long, value_name = "OUT")]
+    pub centikelvin: Option<PathBuf>,
+    /// Print the metadata and statistics as JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// Size of a raw .y16/.bin file, WxH (default: 160x120 or 80x60 from the file length).
+    #[arg(long, value_name = "WxH")]
+    pub size: Option<String>,
+    /// Kelvin per count of 16-bit PNG/TIFF/raw values.
+    #[arg(long)]
+    pub scale: Option<f64>,
+    /// Kelvin added after scaling 16-bit values.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub offset_k: f64,
+    /// FLIR: object emissivity (replaces the file's).
+    #[arg(long)]
+    pub emissivity: Option<f64>,
+    /// FLIR: object distance, m.
+    #[arg(long)]
+    pub distance: Option<f64>,
+    /// FLIR: reflected apparent temperature, °C.
+    #[arg(long, allow_negative_numbers = true)]
+    pub reflected: Option<f64>,
+    /// FLIR: atmospheric temperature, °C.
+    #[arg(long, allow_negative_numbers = true)]
+    pub atmospheric: Option<f64>,
+    /// FLIR: relative humidity, percent.
+    #[arg(long)]
+    pub humidity: Option<f64>,
 }
 
 /// Distortion coefficients to estimate.

@@ -10,6 +10,7 @@ mod mrt;
 mod run;
 mod segment;
 mod simulate;
+mod thermal;
 mod validate;
 
 use anyhow::bail;
@@ -34,6 +35,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Validate(a) => validate::run(&a),
         Command::Calibrate(a) => calibrate::run(&a),
         Command::SimulateBoard(a) => calibrate::simulate_board(&a),
+        Command::Thermal(a) => thermal::run(&a),
     }
 }
 

@@ -1,0 +1,186 @@
+//! `mrtmap thermal`: one thermal image → metadata, statistics, CSV / PNG.
+
+use anyhow::{Context, bail};
+use mrtmap_io::flir::FlirOverrides;
+use mrtmap_io::{ThermalImage, ThermalOptions, encode_png_rgb8, encode_png16, iron};
+use serde::Serialize;
+
+use crate::cli::ThermalArgs;
+use crate::output::{json, write_atomic};
+
+/// Parses "WxH".
+pub(crate) fn parse_size(s: &str) -> anyhow::Result<(u32, u32)> {
+    let (w, h) = s
+        .split_once(['x', 'X', '×'])
+        .with_context(|| format!("size {s:?} is not WxH (for example 160x120)"))?;
+    let w: u32 = w
+        .trim()
+        .parse()
+        .with_context(|| format!("size {s:?}: bad width"))?;
+    let h: u32 = h
+        .trim()
+        .parse()
+        .with_context(|| format!("size {s:?}: bad height"))?;
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        bail!("size {s:?} is outside 1…16384 pixels a side");
+    }
+    Ok((w, h))
+}
+
+pub(crate) fn options(a: &ThermalArgs) -> anyhow::Result<ThermalOptions> {
+    if let Some(e) = a.emissivity
+        && !(e > 0.0 && e <= 1.0)
+    {
+        bail!("--emissivity {e} is outside (0, 1]");
+    }
+    if let Some(h) = a.humidity
+        && !(0.0..=100.0).contains(&h)
+    {
+        bail!("--humidity {h} is outside 0…100 %");
+    }
+    if let Some(d) = a.distance
+        && !(d >= 0.0 && d.is_finite())
+    {
+        bail!("--distance {d} must be a distance in metres, 0 or more");
+    }
+    if let Some(s) = a.scale
+        && !(s > 0.0 && s.is_finite())
+    {
+        bail!("--scale {s} must be a positive number of kelvin per count");
+    }
+    Ok(ThermalOptions {
+        size: a.size.as_deref().map(parse_size).transpose()?,
+        scale_k: a.scale,
+        offset_k: a.offset_k,
+        flir: FlirOverrides {
+            emissivity: a.emissivity,
+            object_distance_m: a.distance,
+            reflected_c: a.reflected,
+            atmospheric_c: a.atmospheric,
+            relative_humidity: a.humidity.map(|h| h / 100.0),
+        },
+    })
+}
+
+#[derive(Serialize)]
+struct Out<'a> {
+    file: String,
+    format: &'static str,
+    width: u32,
+    height: u32,
+    min_c: f64,
+    max_c: f64,
+    mean_c: f64,
+    median_c: f64,
+    centre_c: f64,
+    invalid_pixels: usize,
+    metadata: &'a [(String, String)],
+    notes: &'a [String],
+}
+
+fn csv(img: &ThermalImage) -> String {
+    let mut s = String::with_capacity(img.celsius.len() * 7);
+    for row in img.celsius.chunks(img.width as usize) {
+        let cells: Vec<String> = row
+            .iter()
+            .map(|c| {
+                if c.is_finite() {
+                    format!("{c:.3}")
+                } else {
+                    String::new()
+                }
+            })
+            .collect();
+        s.push_str(&cells.join(","));
+        s.push('\n');
+    }
+    s
+}
+
+fn colour_png(img: &ThermalImage, lo: f64, hi: f64) -> Vec<u8> {
+    let span = (hi - lo).max(1e-9);
+    let rgb: Vec<u8> = img
+        .celsius
+        .iter()
+        .flat_map(|&c| {
+            if c.is_finite() {
+                iron(((c - lo) / span) as f32)
+            } else {
+                [0, 0, 0]
+            }
+        })
+        .collect();
+    encode_png_rgb8(img.width, img.height, &rgb)
+}
+
+pub fn run(a: &ThermalArgs) -> anyhow::Result<()> {
+    let opts = options(a)?;
+    let img = mrtmap_io::read_thermal_file(&a.file, &opts)?;
+    let Some((lo, hi, mean, median)) = img.stats() else {
+        bail!(
+            "{}: no pixel has a temperature (raw values outside the calibration)",
+            a.file.display()
+        );
+    };
+    let centre = img.celsius[(img.height / 2 * img.width + img.width / 2) as usize];
+    let out = Out {
+        file: a.file.display().to_string(),
+        format: img.kind.name(),
+        width: img.width,
+        height: img.height,
+        min_c: lo,
+        max_c: hi,
+        mean_c: mean,
+        median_c: median,
+        centre_c: centre,
+        invalid_pixels: img.celsius.iter().filter(|c| !c.is_finite()).count(),
+        metadata: &img.metadata,
+        notes: &img.notes,
+    };
+    if let Some(p) = &a.csv {
+        write_atomic(p, csv(&img).as_bytes())?;
+    }
+    if let Some(p) = &a.png {
+        write_atomic(p, &colour_png(&img, lo, hi))?;
+    }
+    if let Some(p) = &a.centikelvin {
+        write_atomic(p, &encode_png16(&img.centikelvin()))?;
+    }
+    if a.json {
+        print!("{}", json(&out)?);
+        return Ok(());
+    }
+    println!(
+        "{}: {}, {}×{} pixels",
+        out.file, out.format, out.width, out.height
+    );
+    for n in &img.notes {
+        println!("  {n}");
+    }
+    if !img.metadata.is_empty() {
+        println!("metadata:");
+        let w = img.metadata.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
+        for (k, v) in &img.metadata {
+            println!("  {k:<w$}  {v}");
+        }
+    }
+    println!(
+        "temperature °C: min {lo:.2}  max {hi:.2}  mean {mean:.2}  median {median:.2}  centre {centre:.2}"
+    );
+    if out.invalid_pixels > 0 {
+        println!(
+            "{} pixels have no temperature (raw value outside the calibration)",
+            out.invalid_pixels
+        );
+    }
+    for (flag, p) in [
+        ("csv", &a.csv),
+        ("png", &a.png),
+        ("centikelvin", &a.centikelvin),
+    ] {
+        if let Some(p) = p {
+            println!("wrote {} ({flag})", p.display());
+        }
+    }
+    Ok(())
+}
