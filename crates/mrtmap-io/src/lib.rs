@@ -18,14 +18,21 @@
 //! only when complete.
 
 mod atomic;
+pub mod bag;
 pub mod bytes;
 mod error;
 pub mod flir;
 mod image16;
+pub mod layout_writer;
 pub mod masks;
+pub mod mcap_file;
 mod ply;
 mod recording;
 mod rig;
+pub mod ros_msg;
+pub mod ros_scan;
+pub mod rtabmap;
+pub mod rvl;
 mod streams;
 mod thermal_file;
 mod trajectory;

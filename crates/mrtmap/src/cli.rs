@@ -51,6 +51,108 @@ pub enum Command {
     /// Read one thermal image (FLIR R-JPEG/FFF, Lepton PNG/TIFF/raw, radiometric TIFF): metadata,
     /// temperature statistics, CSV/PNG export.
     Thermal(ThermalArgs),
+    /// List what a scan source holds: streams, counts, rates, time span, and what a scan lacks.
+    Inspect(InspectArgs),
+    /// Convert a ROS 1 bag, MCAP file or RTAB-Map database to the recording layout (or a
+    /// recording folder to a bag or MCAP file).
+    Convert(ConvertArgs),
+}
+
+/// How to read a bag, MCAP file or RTAB-Map database as a scan.
+#[derive(Debug, Args, Clone, Default)]
+pub struct SourceArgs {
+    /// A rig.toml (from mrtmap calibrate): its thermal camera and extrinsic are used, and its
+    /// depth/colour cameras where the source has no CameraInfo.
+    #[arg(long, value_name = "FILE")]
+    pub rig: Option<PathBuf>,
+    /// Depth image topic (default: /camera/aligned_depth_to_color/image_raw, or any 16UC1 depth).
+    #[arg(long, value_name = "TOPIC")]
+    pub depth_topic: Option<String>,
+    /// Thermal image topic (default: any mono16 image topic).
+    #[arg(long, value_name = "TOPIC")]
+    pub thermal_topic: Option<String>,
+    /// Colour image topic (default: /camera/color/image_raw).
+    #[arg(long, value_name = "TOPIC")]
+    pub rgb_topic: Option<String>,
+    /// Pose topic, nav_msgs/Odometry or geometry_msgs/PoseStamped (default: /camera/odom/sample,
+    /// else any; else /tf).
+    #[arg(long, value_name = "TOPIC")]
+    pub pose_topic: Option<String>,
+    /// Raw depth units per metre of 16-bit depth (default 1000, RealSense).
+    #[arg(long)]
+    pub depth_scale: Option<f64>,
+    /// Thermal frames for a source without them (an RTAB-Map database): a bag/MCAP with a mono16
+    /// topic, or a folder of 16-bit thermal images named by timestamp.
+    #[arg(long, value_name = "SRC")]
+    pub thermal: Option<PathBuf>,
+}
+
+/// `mrtmap inspect`.
+#[derive(Debug, Args)]
+#[command(after_long_help = "Examples:
+  mrtmap inspect scan.bag
+  mrtmap inspect rtabmap.db --json
+  mrtmap inspect scan/")]
+pub struct InspectArgs {
+    /// A recording folder, ROS 1 bag, MCAP file or RTAB-Map database.
+    pub source: PathBuf,
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// Reading options.
+    #[command(flatten)]
+    pub src: SourceArgs,
+}
+
+/// Container of `convert`'s output when it is a file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum CompressionArg {
+    /// Stored.
+    None,
+    /// bzip2 (bags) / zstd (MCAP).
+    Bz2,
+    /// LZ4.
+    Lz4,
+}
+
+/// RTAB-Map database schema to write.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SchemaArg {
+    /// 0.23.
+    Current,
+    /// 0.20.
+    Legacy,
+}
+
+/// `mrtmap convert`.
+#[derive(Debug, Args)]
+#[command(after_long_help = "Examples:
+  mrtmap convert scan.bag --out scan --rig rig.toml
+  mrtmap convert scan.mcap --out scan --thermal-topic /lepton/image_raw
+  mrtmap convert rtabmap.db --out scan --thermal thermal.bag --rig rig.toml
+  mrtmap convert scan --out scan.bag            (recording folder → RealSense-style bag)
+  mrtmap convert scan --out scan.db             (recording folder → RTAB-Map-layout database)
+
+A bag, MCAP file or database becomes the recording layout (depth/, thermal/, rgb/, lists,
+trajectory.txt, rig.toml, source.json saying what was chosen). A recording folder with an output
+ending in .bag or .mcap becomes a RealSense-style bag or MCAP file, and one ending in .db a
+database in RTAB-Map's layout with a node per colour frame (to test readers and pipelines).")]
+pub struct ConvertArgs {
+    /// The source.
+    pub source: PathBuf,
+    /// Output folder (or .bag / .mcap file for a recording folder).
+    #[arg(long, value_name = "OUT")]
+    pub out: PathBuf,
+    /// Chunk compression when writing a bag or MCAP file.
+    #[arg(long, value_enum, default_value_t = CompressionArg::Lz4)]
+    pub compression: CompressionArg,
+    /// Schema when writing an RTAB-Map-layout database (.db): current (0.23, RVL depth,
+    /// optimised poses) or legacy (0.20, PNG depth, odometry only).
+    #[arg(long, value_enum, default_value_t = SchemaArg::Current)]
+    pub schema: SchemaArg,
+    /// Reading options.
+    #[command(flatten)]
+    pub src: SourceArgs,
 }
 
 /// `mrtmap thermal`.
@@ -193,8 +295,12 @@ pub struct SimulateBoardArgs {
 #[derive(Debug, Args)]
 #[command(after_long_help = crate::project::PROJECT_EXAMPLE)]
 pub struct RunArgs {
-    /// The recording folder (shared/spec/recording.md).
+    /// The recording: a folder (shared/spec/recording.md), a ROS 1 bag, an MCAP file or an
+    /// RTAB-Map database (converted into OUT/recording first).
     pub recording: PathBuf,
+    /// How to read a bag, MCAP file or database.
+    #[command(flatten)]
+    pub src: SourceArgs,
     /// Output folder: fuse/, segment/, map-H.HHm/ per height, report.html, run.json.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
@@ -311,8 +417,12 @@ pub enum OnOff {
 /// `mrtmap fuse`.
 #[derive(Debug, Args)]
 pub struct FuseArgs {
-    /// The recording folder (shared/spec/recording.md).
+    /// The recording: a folder (shared/spec/recording.md), a ROS 1 bag, an MCAP file or an
+    /// RTAB-Map database (converted into OUT/recording first).
     pub recording: PathBuf,
+    /// How to read a bag, MCAP file or database.
+    #[command(flatten)]
+    pub src: SourceArgs,
     /// Output folder for cloud.ply, fusion.json and the refined trajectory.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,

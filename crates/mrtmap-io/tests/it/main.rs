@@ -3,4 +3,5 @@
 
 mod formats;
 mod recording;
+mod sources;
 mod thermal_files;

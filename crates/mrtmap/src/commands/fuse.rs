@@ -28,7 +28,8 @@ pub fn run(a: &FuseArgs) -> anyhow::Result<()> {
             a.sync_tolerance_ms
         );
     }
-    let rec = Recording::open(&a.recording)?;
+    let dir = super::source::recording_dir(&a.recording, &a.out, &a.src)?;
+    let rec = Recording::open(&dir)?;
     for w in &rec.warnings {
         eprintln!("warning: {w}");
     }

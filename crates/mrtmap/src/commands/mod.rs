@@ -7,9 +7,11 @@ mod fuse;
 mod globe;
 mod map;
 mod mrt;
+mod rtabmap;
 mod run;
 mod segment;
 mod simulate;
+mod source;
 mod thermal;
 mod validate;
 
@@ -36,6 +38,8 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Calibrate(a) => calibrate::run(&a),
         Command::SimulateBoard(a) => calibrate::simulate_board(&a),
         Command::Thermal(a) => thermal::run(&a),
+        Command::Inspect(a) => source::inspect(&a),
+        Command::Convert(a) => source::convert(&a),
     }
 }
 

@@ -87,7 +87,8 @@ pub fn run(a: &RunArgs) -> anyhow::Result<()> {
     let p = settings(a)?;
     let t0 = Instant::now();
     let bar = crate::commands::fuse::progress_bar("");
-    let outcome = run_pipeline(&a.recording, &a.out, &p, a.force, &|stage, done, total| {
+    let recording = super::source::recording_dir(&a.recording, &a.out, &a.src)?;
+    let outcome = run_pipeline(&recording, &a.out, &p, a.force, &|stage, done, total| {
         bar.set_message(stage.to_string());
         bar.set_length(total);
         bar.set_position(done);

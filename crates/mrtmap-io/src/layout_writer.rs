@@ -1,0 +1,132 @@
+//! Writes the recording layout (`shared/spec/recording.md`) frame by frame: what `convert` and
+//! every reader of another format end in. The folder appears under its final name only when
+//! [`LayoutWriter::finish`] succeeds.
+
+use std::path::{Path, PathBuf};
+
+use nalgebra::Isometry3;
+
+use crate::atomic::PartialDir;
+use crate::error::FileError;
+use crate::image16::{Image16, encode_png16};
+use crate::rig::Rig;
+use crate::streams::stream_list_text;
+use crate::trajectory::Trajectory;
+
+/// A recording folder being written.
+pub struct LayoutWriter {
+    dir: PartialDir,
+    depth: Vec<(f64, String)>,
+    thermal: Vec<(f64, String)>,
+    rgb: Vec<(f64, String)>,
+    poses: Vec<(f64, Isometry3<f64>)>,
+    header: String,
+}
+
+fn write(dir: &Path, rel: &str, bytes: &[u8]) -> Result<(), FileError> {
+    let p = dir.join(rel);
+    if let Some(parent) = p.parent() {
+        std::fs::create_dir_all(parent).map_err(|e| FileError::io(parent, e))?;
+    }
+    std::fs::write(&p, bytes).map_err(|e| FileError::io(&p, e))
+}
+
+impl LayoutWriter {
+    /// Starts `out` (written as `out.partial` until finished); `header` goes atop every list.
+    pub fn create(out: &Path, header: &str) -> Result<Self, FileError> {
+        Ok(Self {
+            dir: PartialDir::create(out)?,
+            depth: Vec::new(),
+            thermal: Vec::new(),
+            rgb: Vec::new(),
+            poses: Vec::new(),
+            header: header.to_string(),
+        })
+    }
+
+    /// Adds a 16-bit depth frame.
+    pub fn depth(&mut self, t: f64, img: &Image16) -> Result<(), FileError> {
+        let rel = format!("depth/{:06}.png", self.depth.len());
+        write(self.dir.path(), &rel, &encode_png16(img))?;
+        self.depth.push((t, rel));
+        Ok(())
+    }
+
+    /// Adds a 16-bit centikelvin thermal frame.
+    pub fn thermal(&mut self, t: f64, img: &Image16) -> Result<(), FileError> {
+        let rel = format!("thermal/{:06}.png", self.thermal.len());
+        write(self.dir.path(), &rel, &encode_png16(img))?;
+        self.thermal.push((t, rel));
+        Ok(())
+    }
+
+    /// Adds an encoded colour frame (`ext` "png" or "jpg").
+    pub fn rgb(&mut self, t: f64, bytes: &[u8], ext: &str) -> Result<(), FileError> {
+        let rel = format!("rgb/{:06}.{ext}", self.rgb.len());
+        write(self.dir.path(), &rel, bytes)?;
+        self.rgb.push((t, rel));
+        Ok(())
+    }
+
+    /// Adds a world_from_depth pose (its quaternion written with w ≥ 0).
+    pub fn pose(&mut self, t: f64, mut p: Isometry3<f64>) {
+        if p.rotation.w < 0.0 {
+            p.rotation = nalgebra::UnitQuaternion::new_unchecked(-p.rotation.into_inner());
+        }
+        self.poses.push((t, p));
+    }
+
+    /// Frames written so far: (depth, thermal, rgb, poses).
+    pub fn counts(&self) -> (usize, usize, usize, usize) {
+        (
+            self.depth.len(),
+            self.thermal.len(),
+            self.rgb.len(),
+            self.poses.len(),
+        )
+    }
+
+    /// Writes the lists, trajectory, rig and `source.json`, then moves the folder into place.
+    pub fn finish(mut self, rig: &Rig, source_json: &str) -> Result<PathBuf, FileError> {
+        let d = self.dir.path().to_path_buf();
+        let sort = |v: &mut Vec<(f64, String)>| v.sort_by(|a, b| a.0.total_cmp(&b.0));
+        sort(&mut self.depth);
+        sort(&mut self.thermal);
+        sort(&mut self.rgb);
+        write(
+            &d,
+            "depth.txt",
+            stream_list_text(&self.header, &self.depth).as_bytes(),
+        )?;
+        write(
+            &d,
+            "thermal.txt",
+            stream_list_text(&self.header, &self.thermal).as_bytes(),
+        )?;
+        if !self.rgb.is_empty() {
+            write(
+                &d,
+                "rgb.txt",
+                stream_list_text(&self.header, &self.rgb).as_bytes(),
+            )?;
+        }
+        self.poses.sort_by(|a, b| a.0.total_cmp(&b.0));
+        self.poses.dedup_by(|b, a| b.0 <= a.0);
+        let traj = Trajectory {
+            stamps: self.poses.iter().map(|p| p.0).collect(),
+            poses: self.poses.iter().map(|p| p.1).collect(),
+        };
+        write(
+            &d,
+            "trajectory.txt",
+            traj.to_tum(&format!(
+                "{}\nworld_from_depth: timestamp tx ty tz qx qy qz qw",
+                self.header
+            ))
+            .as_bytes(),
+        )?;
+        write(&d, "rig.toml", rig.to_toml().as_bytes())?;
+        write(&d, "source.json", source_json.as_bytes())?;
+        self.dir.finish()
+    }
+}

@@ -1,0 +1,269 @@
+//! MCAP files (ROS 2's default bag storage since Iron; CDR or ROS 1 messages).
+//!
+//! The top-level records are walked here so that every error names a byte offset; the `mcap`
+//! crate parses each record and decompresses chunks (zstd, lz4), after their declared size has
+//! been checked against [`crate::bag::MAX_CHUNK_BYTES`].
+
+use std::collections::HashMap;
+
+use mcap::records::Record;
+
+use crate::bag::MAX_CHUNK_BYTES;
+use crate::bytes::{Bytes, Corrupt, Endian};
+use crate::ros_msg::Wire;
+
+/// The MCAP magic.
+pub const MAGIC: &[u8] = b"\x89MCAP0\r\n";
+
+/// One message as stored.
+#[derive(Clone, Copy, Debug)]
+pub struct McapMessage<'a> {
+    /// Topic.
+    pub topic: &'a str,
+    /// Schema name (`sensor_msgs/msg/Image`).
+    pub datatype: &'a str,
+    /// Log time, s.
+    pub time: f64,
+    /// Serialised message.
+    pub data: &'a [u8],
+    /// How it is serialised.
+    pub wire: Wire,
+    /// File offset of the record (of its chunk, for chunked messages).
+    pub offset: u64,
+}
+
+/// What a pass found besides the messages.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct McapSummary {
+    /// Chunks read.
+    pub chunks: usize,
+    /// Messages delivered.
+    pub messages: usize,
+    /// No footer: the recording was cut or never closed.
+    pub unfinished: bool,
+    /// Messages skipped because their encoding is neither CDR nor ROS 1.
+    pub other_encoding: usize,
+}
+
+#[derive(Default)]
+struct State {
+    schemas: HashMap<u16, String>,
+    channels: HashMap<u16, (String, u16, String)>,
+}
+
+impl State {
+    fn record(
+        &mut self,
+        rec: Record<'_>,
+        at: u64,
+        summary: &mut McapSummary,
+        f: &mut dyn FnMut(McapMessage<'_>) -> Result<(), Corrupt>,
+    ) -> Result<(), Corrupt> {
+        match rec {
+            Record::Schema { header, .. } => {
+                self.schemas.insert(header.id, header.name);
+            }
+            Record::Channel(c) => {
+                self.channels
+                    .insert(c.id, (c.topic, c.schema_id, c.message_encoding));
+            }
+            Record::Message { header, data } => {
+                let (topic, schema, enc) =
+                    self.channels.get(&header.channel_id).ok_or_else(|| {
+                        Corrupt::new(
+                            at,
+                            format!(
+                                "message on channel {}, which no record defines",
+                                header.channel_id
+                            ),
+                        )
+                    })?;
+                let wire = match enc.as_str() {
+                    "cdr" => Wire::Cdr,
+                    "ros1" => Wire::Ros1,
+                    _ => {
+                        summary.other_encoding += 1;
+                        return Ok(());
+                    }
+                };
+                let datatype = self.schemas.get(schema).map_or("", String::as_str);
+                summary.messages += 1;
+                f(McapMessage {
+                    topic,
+                    datatype,
+                    time: header.log_time as f64 * 1e-9,
+                    data: &data,
+                    wire,
+                    offset: at,
+                })?;
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+}
+
+/// Calls `f` for every CDR or ROS 1 message of an MCAP file, in file order.
+pub fn for_each_message(
+    file: &[u8],
+    f: &mut dyn FnMut(McapMessage<'_>) -> Result<(), Corrupt>,
+) -> Result<McapSummary, Corrupt> {
+    if !file.starts_with(MAGIC) {
+        return Err(Corrupt::new(0, "not an MCAP file (no MCAP magic)"));
+    }
+    let b = Bytes::new(file, Endian::Little);
+    let mut state = State::default();
+    let mut summary = McapSummary {
+        unfinished: true,
+        ..Default::default()
+    };
+    let mut pos = MAGIC.len();
+    while pos < b.len() {
+        let op = b.u8(pos, "a record opcode")?;
+        let len = b.u32(pos + 1, "a record length")? as u64
+            | (b.u32(pos + 5, "a record length")? as u64) << 32;
+        let len = usize::try_from(len).unwrap_or(usize::MAX);
+        let body = b.slice(pos + 9, len, &format!("record (opcode 0x{op:02x})"))?;
+        let at = pos as u64;
+        if op == 0x02 {
+            summary.unfinished = false;
+            break;
+        }
+        let rec = mcap::parse_record(op, body)
+            .map_err(|e| Corrupt::new(at, format!("MCAP record (opcode 0x{op:02x}): {e}")))?;
+        if let Record::Chunk { header, data } = rec {
+            summary.chunks += 1;
+            if header.uncompressed_size > MAX_CHUNK_BYTES as u64 {
+                return Err(Corrupt::new(
+                    at,
+                    format!(
+                        "chunk claims {} bytes decompressed (more than the {MAX_CHUNK_BYTES} accepted)",
+                        header.uncompressed_size
+                    ),
+                ));
+            }
+            let compression = header.compression.clone();
+            let reader = mcap::read::ChunkReader::new(header, &data)
+                .map_err(|e| Corrupt::new(at, format!("chunk ({compression}): {e}")))?;
+            for r in reader {
+                let r = r.map_err(|e| {
+                    Corrupt::new(at, format!("inside the chunk ({compression}): {e}"))
+                })?;
+                state.record(r, at, &mut summary, f)?;
+            }
+        } else {
+            state.record(rec, at, &mut summary, f)?;
+        }
+        pos += 9 + len;
+    }
+    Ok(summary)
+}
+
+/// Writes an MCAP file of CDR messages (for tests and round trips).
+pub struct McapWriter {
+    w: mcap::Writer<std::io::Cursor<Vec<u8>>>,
+    channels: HashMap<String, u16>,
+}
+
+impl McapWriter {
+    /// A writer; `compression` is `None`, `Some("zstd")` or `Some("lz4")`.
+    pub fn new(compression: Option<&str>, chunk_size: u64) -> Result<Self, String> {
+        let c = match compression {
+            None => None,
+            Some("zstd") => Some(mcap::Compression::Zstd),
+            Some("lz4") => Some(mcap::Compression::Lz4),
+            Some(o) => return Err(format!("unknown MCAP compression {o}")),
+        };
+        let w = mcap::WriteOptions::new()
+            .compression(c)
+            .chunk_size(Some(chunk_size))
+            .profile("ros2")
+            .create(std::io::Cursor::new(Vec::new()))
+            .map_err(|e| e.to_string())?;
+        Ok(Self {
+            w,
+            channels: HashMap::new(),
+        })
+    }
+
+    /// Adds a CDR message.
+    pub fn write(
+        &mut self,
+        topic: &str,
+        datatype: &str,
+        time: f64,
+        data: &[u8],
+    ) -> Result<(), String> {
+        let id = match self.channels.get(topic) {
+            Some(&id) => id,
+            None => {
+                let s = self
+                    .w
+                    .add_schema(datatype, "ros2msg", b"")
+                    .map_err(|e| e.to_string())?;
+                let id = self
+                    .w
+                    .add_channel(s, topic, "cdr", &Default::default())
+                    .map_err(|e| e.to_string())?;
+                self.channels.insert(topic.to_string(), id);
+                id
+            }
+        };
+        let ns = (time * 1e9).round() as u64;
+        self.w
+            .write_to_known_channel(
+                &mcap::records::MessageHeader {
+                    channel_id: id,
+                    sequence: 0,
+                    log_time: ns,
+                    publish_time: ns,
+                },
+                data,
+            )
+            .map_err(|e| e.to_string())
+    }
+
+    /// The file's bytes.
+    pub fn finish(mut self) -> Result<Vec<u8>, String> {
+        self.w.finish().map_err(|e| e.to_string())?;
+        Ok(self.w.into_inner().into_inner())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn round_trips_compressed_and_not_and_cut_files_are_errors() {
+        for c in [None, Some("zstd"), Some("lz4")] {
+            let mut w = McapWriter::new(c, 300).unwrap();
+            for i in 0..30 {
+                let data = vec![0u8, 1, 0, 0, i as u8, 7, 7, 7];
+                w.write(
+                    if i % 3 == 0 { "/x" } else { "/y" },
+                    "std_msgs/msg/String",
+                    5.0 + i as f64,
+                    &data,
+                )
+                .unwrap();
+            }
+            let file = w.finish().unwrap();
+            let mut got = Vec::new();
+            let s = for_each_message(&file, &mut |m| {
+                got.push((m.topic.to_string(), m.time, m.data[4], m.wire));
+                Ok(())
+            })
+            .unwrap();
+            assert!(!s.unfinished, "{c:?}");
+            assert_eq!(got.len(), 30);
+            assert_eq!(got[4], ("/y".to_string(), 9.0, 4, Wire::Cdr));
+            for cut in (0..file.len()).step_by(53) {
+                match for_each_message(&file[..cut], &mut |_| Ok(())) {
+                    Err(_) => {}
+                    Ok(s) => assert!(s.unfinished, "{c:?} cut at {cut}"),
+                }
+            }
+        }
+    }
+}

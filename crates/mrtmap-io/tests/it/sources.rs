@@ -1,0 +1,421 @@
+//! Bags, MCAP files and RTAB-Map databases built with this crate's writers (and the same
+//! `mcap`, `bzip2`, `lz4_flex`, `rusqlite` crates), read back through the same path `convert`
+//! takes: every frame, pose and camera must come back; broken files must give errors with offsets.
+
+use std::path::Path;
+
+use mrtmap_geometry::camera::{BrownConrady, PinholeCamera};
+use mrtmap_io::bag::{BagWriter, Compression};
+use mrtmap_io::ros_msg::{Wire, encode};
+use mrtmap_io::ros_scan::{self, Container, RosOptions, RosWriteOptions, names};
+use mrtmap_io::rtabmap::{self, Schema};
+use mrtmap_io::{
+    FileErrorKind, Image16, Recording, RgbCamera, Rig, ThermalEncoding, encode_png_rgb8,
+    encode_png16, read_image16,
+};
+use nalgebra::{Isometry3, Vector3};
+
+fn rig() -> Rig {
+    let mut thermal = PinholeCamera::new(16, 12, 14.7, 14.7, 7.5, 5.5);
+    thermal.distortion = BrownConrady::from_array([-0.1, 0.05, 0.0, 0.0, 0.0]);
+    let depth = PinholeCamera::new(20, 15, 19.0, 19.0, 9.5, 7.0);
+    Rig {
+        depth,
+        depth_scale: 1000.0,
+        thermal,
+        thermal_encoding: ThermalEncoding::Centikelvin,
+        depth_from_thermal: Isometry3::new(
+            Vector3::new(0.04, -0.02, 0.005),
+            Vector3::new(0.0, 0.02, 0.01),
+        ),
+        rgb: Some(RgbCamera {
+            camera: depth,
+            depth_from_rgb: Isometry3::identity(),
+        }),
+    }
+}
+
+fn pose_at(t: f64) -> Isometry3<f64> {
+    Isometry3::new(
+        Vector3::new(0.3 * t, -0.1 * t, 0.05 * t * t),
+        Vector3::new(0.1 * t, 0.4 * t, -0.2 * t),
+    )
+}
+
+/// A 1 s recording: depth at 10 Hz, thermal at 5 Hz, colour at 5 Hz, poses at 50 Hz.
+fn recording(dir: &Path) -> Recording {
+    let r = rig();
+    for sub in ["depth", "thermal", "rgb"] {
+        std::fs::create_dir_all(dir.join(sub)).unwrap();
+    }
+    std::fs::write(dir.join("rig.toml"), r.to_toml()).unwrap();
+    let t0 = 1_700_000_000.0;
+    let mut lists = [String::new(), String::new(), String::new()];
+    for i in 0..10 {
+        let t = t0 + 0.1 * i as f64 + 0.003;
+        let d = Image16 {
+            width: 20,
+            height: 15,
+            data: (0..300)
+                .map(|k| {
+                    if k % 7 == 0 {
+                        0
+                    } else {
+                        1000 + k as u16 + 13 * i
+                    }
+                })
+                .collect(),
+        };
+        std::fs::write(dir.join(format!("depth/{i}.png")), encode_png16(&d)).unwrap();
+        lists[0] += &format!("{t:.6} depth/{i}.png\n");
+        if i % 2 == 0 {
+            let th = Image16 {
+                width: 16,
+                height: 12,
+                data: (0..192).map(|k| 29_315 + k as u16 * 3 + i).collect(),
+            };
+            std::fs::write(dir.join(format!("thermal/{i}.png")), encode_png16(&th)).unwrap();
+            lists[1] += &format!("{:.6} thermal/{i}.png\n", t + 0.01);
+            let rgb: Vec<u8> = (0..300 * 3).map(|k| (k * 7 + i as usize) as u8).collect();
+            std::fs::write(
+                dir.join(format!("rgb/{i}.png")),
+                encode_png_rgb8(20, 15, &rgb),
+            )
+            .unwrap();
+            lists[2] += &format!("{t:.6} rgb/{i}.png\n");
+        }
+    }
+    std::fs::write(dir.join("depth.txt"), &lists[0]).unwrap();
+    std::fs::write(dir.join("thermal.txt"), &lists[1]).unwrap();
+    std::fs::write(dir.join("rgb.txt"), &lists[2]).unwrap();
+    let traj = mrtmap_io::Trajectory {
+        stamps: (0..=50).map(|i| t0 + 0.02 * i as f64).collect(),
+        poses: (0..=50).map(|i| pose_at(0.02 * i as f64)).collect(),
+    };
+    std::fs::write(dir.join("trajectory.txt"), traj.to_tum("test")).unwrap();
+    Recording::open(dir).unwrap()
+}
+
+fn same_pose(a: &Isometry3<f64>, b: &Isometry3<f64>, tol: f64) -> bool {
+    (a.translation.vector - b.translation.vector).norm() < tol
+        && a.rotation.angle_to(&b.rotation) < tol
+}
+
+/// The converted folder holds the same frames, poses and rig as the original.
+fn assert_same(orig: &Recording, conv: &Recording, pose_tol: f64) {
+    assert_eq!(conv.depth.len(), orig.depth.len());
+    assert_eq!(conv.thermal.len(), orig.thermal.len());
+    assert_eq!(conv.rgb.len(), orig.rgb.len());
+    for (a, b) in orig.depth.iter().zip(&conv.depth) {
+        assert!((a.t - b.t).abs() < 1e-6);
+        assert_eq!(orig.read_depth(a).unwrap(), conv.read_depth(b).unwrap());
+    }
+    for (a, b) in orig.thermal.iter().zip(&conv.thermal) {
+        assert!((a.t - b.t).abs() < 1e-6);
+        assert_eq!(orig.read_thermal(a).unwrap(), conv.read_thermal(b).unwrap());
+    }
+    for (a, b) in orig.rgb.iter().zip(&conv.rgb) {
+        let x = image::open(orig.path_of(a)).unwrap().to_rgb8();
+        let y = image::open(conv.path_of(b)).unwrap().to_rgb8();
+        assert_eq!(x, y);
+    }
+    assert_eq!(conv.trajectory.len(), orig.trajectory.len());
+    for (p, q) in orig.trajectory.poses.iter().zip(&conv.trajectory.poses) {
+        assert!(same_pose(p, q, pose_tol), "{p} vs {q}");
+    }
+    assert_eq!(conv.rig.depth, orig.rig.depth);
+    assert_eq!(conv.rig.thermal, orig.rig.thermal);
+    assert!(same_pose(
+        &conv.rig.depth_from_thermal,
+        &orig.rig.depth_from_thermal,
+        1e-12
+    ));
+}
+
+#[test]
+fn bags_and_mcap_files_round_trip_with_every_compression() {
+    let dir = tempfile::tempdir().unwrap();
+    let orig = recording(&dir.path().join("scan"));
+    for (container, compression) in [
+        (Container::Bag, Compression::None),
+        (Container::Bag, Compression::Bz2),
+        (Container::Bag, Compression::Lz4),
+        (Container::Mcap, Compression::None),
+        (Container::Mcap, Compression::Bz2),
+        (Container::Mcap, Compression::Lz4),
+    ] {
+        let bytes = ros_scan::write_ros(&orig, &RosWriteOptions::t265_like(container, compression))
+            .unwrap();
+        let s = ros_scan::survey(container, &bytes).unwrap();
+        assert!(!s.unfinished);
+        assert_eq!(s.topics[names::DEPTH].count, 10);
+        assert_eq!(s.topics[names::THERMAL].encoding, "mono16");
+        assert!((s.topics[names::DEPTH].rate_hz() - 10.0).abs() < 1e-3);
+        let p = ros_scan::plan(&s, &RosOptions::default());
+        assert!(p.missing.is_empty(), "{:?}", p.missing);
+        let out = dir.path().join(format!("{container:?}-{compression:?}"));
+        let rep = ros_scan::export(Path::new("x"), &bytes, &s, &p, &out).unwrap();
+        assert_eq!(
+            (rep.depth, rep.thermal, rep.rgb, rep.poses, rep.skipped),
+            (10, 5, 5, 51, 0)
+        );
+        // The T265-style pose frame is carried back to the depth camera through /tf_static.
+        assert_same(&orig, &Recording::open(&out).unwrap(), 1e-9);
+    }
+}
+
+#[test]
+fn poses_from_tf_and_a_missing_thermal_calibration() {
+    let dir = tempfile::tempdir().unwrap();
+    let orig = recording(&dir.path().join("scan"));
+    let r = rig();
+    let base_from_depth =
+        Isometry3::new(Vector3::new(0.1, 0.0, 0.2), Vector3::new(-1.2, 1.2, -1.2));
+    let mut w = BagWriter::new(Compression::Lz4, 4096);
+    let t0 = orig.trajectory.stamps[0];
+    w.write(
+        "/tf_static",
+        "tf2_msgs/TFMessage",
+        t0,
+        &encode::tf_message(
+            Wire::Ros1,
+            &[
+                (t0, "base_link", "cam_optical", base_from_depth),
+                (t0, "cam_optical", "lepton", r.depth_from_thermal),
+            ],
+        ),
+    );
+    w.write(
+        "/cam/camera_info",
+        "sensor_msgs/CameraInfo",
+        t0,
+        &encode::camera_info(Wire::Ros1, t0, "cam_optical", &r.depth),
+    );
+    for (t, p) in orig.trajectory.stamps.iter().zip(&orig.trajectory.poses) {
+        let world_from_base = p * base_from_depth.inverse();
+        w.write(
+            "/tf",
+            "tf2_msgs/TFMessage",
+            *t,
+            &encode::tf_message(Wire::Ros1, &[(*t, "map", "base_link", world_from_base)]),
+        );
+    }
+    for e in &orig.depth {
+        let img = orig.read_depth(e).unwrap();
+        let le: Vec<u8> = img.data.iter().flat_map(|v| v.to_le_bytes()).collect();
+        w.write(
+            "/cam/depth",
+            "sensor_msgs/Image",
+            e.t,
+            &encode::image(Wire::Ros1, e.t, "cam_optical", 20, 15, "16UC1", 40, &le),
+        );
+    }
+    for e in &orig.thermal {
+        let img = orig.read_thermal(e).unwrap();
+        let le: Vec<u8> = img.data.iter().flat_map(|v| v.to_le_bytes()).collect();
+        w.write(
+            "/lepton/image",
+            "sensor_msgs/Image",
+            e.t,
+            &encode::image(Wire::Ros1, e.t, "lepton", 16, 12, "mono16", 32, &le),
+        );
+    }
+    let bag = w.finish();
+    let s = ros_scan::survey(Container::Bag, &bag).unwrap();
+    // No thermal CameraInfo: the plan says so, and a rig supplies it.
+    let p = ros_scan::plan(
+        &s,
+        &RosOptions {
+            depth_topic: Some("/cam/depth".into()),
+            ..Default::default()
+        },
+    );
+    assert_eq!(p.thermal.as_deref(), Some("/lepton/image"));
+    assert!(
+        p.missing.iter().any(|m| m.contains("thermal intrinsics")),
+        "{:?}",
+        p.missing
+    );
+    assert!(ros_scan::export(Path::new("b.bag"), &bag, &s, &p, &dir.path().join("no")).is_err());
+    assert!(
+        !dir.path().join("no").exists(),
+        "nothing written on failure"
+    );
+    let p = ros_scan::plan(
+        &s,
+        &RosOptions {
+            depth_topic: Some("/cam/depth".into()),
+            rig: Some(r),
+            ..Default::default()
+        },
+    );
+    assert!(p.missing.is_empty(), "{:?}", p.missing);
+    assert_eq!(
+        p.poses,
+        Some(ros_scan::PoseSource::Tf("map".into(), "base_link".into()))
+    );
+    let out = dir.path().join("tf");
+    ros_scan::export(Path::new("b.bag"), &bag, &s, &p, &out).unwrap();
+    let conv = Recording::open(&out).unwrap();
+    for (a, b) in orig.trajectory.poses.iter().zip(&conv.trajectory.poses) {
+        assert!(same_pose(a, b, 1e-9), "{a} vs {b}");
+    }
+    // A topic named but absent.
+    let p = ros_scan::plan(
+        &s,
+        &RosOptions {
+            thermal_topic: Some("/nope".into()),
+            ..Default::default()
+        },
+    );
+    assert!(p.missing.iter().any(|m| m.contains("/nope")));
+}
+
+#[test]
+fn broken_bags_and_mcap_files_name_the_offset() {
+    let dir = tempfile::tempdir().unwrap();
+    let orig = recording(&dir.path().join("scan"));
+    let bag = ros_scan::write_ros(
+        &orig,
+        &RosWriteOptions::t265_like(Container::Bag, Compression::Bz2),
+    )
+    .unwrap();
+    // Corrupt bytes inside the first chunk's compressed data.
+    let mut bad = bag.clone();
+    let at = mrtmap_io::bag::MAGIC.len() + 4096 + 120;
+    for b in &mut bad[at..at + 32] {
+        *b = !*b;
+    }
+    let e = ros_scan::survey(Container::Bag, &bad).unwrap_err();
+    assert!(e.to_string().contains("chunk"), "{e}");
+    assert!(
+        e.offset >= (mrtmap_io::bag::MAGIC.len() + 4096) as u64,
+        "{e}"
+    );
+    // A chunk header that claims 3 GB decompressed is refused before anything is allocated.
+    let mut w = BagWriter::new(Compression::None, 1 << 20);
+    w.write("/a", "std_msgs/String", 1.0, b"abc");
+    let mut big = w.finish();
+    let pos = big.windows(5).position(|x| x == b"size=").unwrap() + 5;
+    big[pos..pos + 4].copy_from_slice(&3_000_000_000u32.to_le_bytes());
+    let e = ros_scan::survey(Container::Bag, &big).unwrap_err();
+    assert!(e.what.contains("more than"), "{e}");
+    // MCAP cut short: an error with an offset, or the part before the cut flagged unfinished.
+    let mcap = ros_scan::write_ros(
+        &orig,
+        &RosWriteOptions::t265_like(Container::Mcap, Compression::None),
+    )
+    .unwrap();
+    for cut in [9, 100, mcap.len() / 3, mcap.len() - 20] {
+        match ros_scan::survey(Container::Mcap, &mcap[..cut]) {
+            Err(e) => assert!(e.offset <= cut as u64, "{e}"),
+            Ok(s) => assert!(s.unfinished),
+        }
+    }
+    // A depth message whose data is shorter than its size says is skipped, counted and named.
+    let mut w = BagWriter::new(Compression::None, 1 << 20);
+    let info = encode::camera_info(Wire::Ros1, 1.0, "c", &rig().depth);
+    w.write(names::DEPTH_INFO, "sensor_msgs/CameraInfo", 1.0, &info);
+    w.write(
+        names::DEPTH,
+        "sensor_msgs/Image",
+        1.0,
+        &encode::image(Wire::Ros1, 1.0, "c", 20, 15, "16UC1", 40, &[0; 100]),
+    );
+    let s = ros_scan::survey(Container::Bag, &w.finish()).unwrap();
+    assert_eq!(s.topics[names::DEPTH].undecodable, 1);
+    let p = ros_scan::plan(&s, &RosOptions::default());
+    assert!(
+        p.notes
+            .iter()
+            .any(|n| n.contains("do not decode") && n.contains("20×15")),
+        "{:?}",
+        p.notes
+    );
+}
+
+#[test]
+fn rtabmap_databases_of_both_schemas_read_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let orig = recording(&dir.path().join("scan"));
+    for schema in [Schema::Current, Schema::Legacy] {
+        let db = dir.path().join(format!("{schema:?}.db"));
+        let n = rtabmap::write_recording(&orig, &db, schema).unwrap();
+        assert_eq!(n, 5);
+        let s = rtabmap::summarize(&db).unwrap();
+        assert_eq!((s.nodes, s.images, s.depths), (5, 5, 5));
+        assert_eq!(s.rvl, if schema == Schema::Current { 5 } else { 0 });
+        assert_eq!(s.optimised, if schema == Schema::Current { 5 } else { 0 });
+        assert!(s.poses.starts_with(if schema == Schema::Current {
+            "optimised"
+        } else {
+            "odometry"
+        }));
+        let cal = s.calibration.unwrap();
+        assert_eq!(cal.camera, rig().depth);
+        let mut nodes = Vec::new();
+        let bad = rtabmap::for_each_node(&db, &mut |n| {
+            nodes.push(n);
+            Ok(())
+        })
+        .unwrap();
+        assert!(bad.is_empty());
+        let limits = mrtmap_io::InterpolationLimits::default();
+        for (node, e) in nodes.iter().zip(&orig.rgb) {
+            let want = orig.trajectory.interpolate(e.t, &limits).unwrap();
+            // f32 blobs: 1e-6 relative.
+            assert!(
+                same_pose(&(node.pose * cal.local), &want, 1e-5),
+                "{schema:?}"
+            );
+            let d = orig
+                .depth
+                .iter()
+                .find(|d| (d.t - e.t).abs() < 0.02)
+                .unwrap();
+            assert_eq!(node.depth.as_ref().unwrap(), &orig.read_depth(d).unwrap());
+        }
+    }
+}
+
+#[test]
+fn broken_rtabmap_databases_are_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let orig = recording(&dir.path().join("scan"));
+    let db = dir.path().join("a.db");
+    rtabmap::write_recording(&orig, &db, Schema::Current).unwrap();
+    {
+        let c = rusqlite::Connection::open(&db).unwrap();
+        c.execute("UPDATE Node SET pose = x'0011' WHERE id = 2", [])
+            .unwrap();
+        c.execute(
+            "UPDATE Data SET depth = substr(depth, 1, 40) WHERE id = 3",
+            [],
+        )
+        .unwrap();
+    }
+    let mut ok = 0;
+    let bad = rtabmap::for_each_node(&db, &mut |_| {
+        ok += 1;
+        Ok(())
+    })
+    .unwrap();
+    assert_eq!(ok, 3);
+    assert_eq!(bad.len(), 2);
+    assert_eq!(bad[0].0, 2);
+    assert!(bad[0].1.contains("2 bytes, expected 48"), "{}", bad[0].1);
+    assert!(bad[1].1.contains("RVL"), "{}", bad[1].1);
+    // An old schema and a non-database are refused with one sentence.
+    {
+        let c = rusqlite::Connection::open(&db).unwrap();
+        c.execute("UPDATE Admin SET version = '0.17.6'", [])
+            .unwrap();
+    }
+    let e = rtabmap::summarize(&db).unwrap_err();
+    assert!(e.to_string().contains("older than 0.18"), "{e}");
+    let not = dir.path().join("x.db");
+    std::fs::write(&not, b"SQLite format 3\0garbage").unwrap();
+    let e = rtabmap::summarize(&not).unwrap_err();
+    assert!(matches!(e.kind, FileErrorKind::Syntax(_)), "{e}");
+    assert!(read_image16(&not).is_err());
+}
