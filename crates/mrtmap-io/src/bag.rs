@@ -149,7 +149,17 @@ fn connection(r: &Record<'_>) -> Result<(u32, Connection), Corrupt> {
     Ok((id, Connection { topic, datatype }))
 }
 
-fn decompress(r: &Record<'_>) -> Result<Vec<u8>, Corrupt> {
+/// Buffers reused from chunk to chunk: allocating (and zeroing) them afresh for each chunk cost
+/// more than decompressing it.
+#[derive(Default)]
+struct Buffers {
+    out: Vec<u8>,
+    lz4: Option<lz4_flex::frame::FrameDecoder<std::io::Cursor<Vec<u8>>>>,
+}
+
+/// Decompresses a chunk into `bufs.out`.
+fn decompress(r: &Record<'_>, bufs: &mut Buffers) -> Result<(), Corrupt> {
+    let out = &mut bufs.out;
     let size = r.u32_field("size")? as usize;
     let compression = r.str_field("compression")?;
     if size > MAX_CHUNK_BYTES {
@@ -161,7 +171,8 @@ fn decompress(r: &Record<'_>) -> Result<Vec<u8>, Corrupt> {
         ));
     }
     let src = r.data.data;
-    let mut out = Vec::with_capacity(size.min(16 << 20));
+    out.clear();
+    out.reserve(size.min(16 << 20));
     let res = match compression {
         "none" => {
             out.extend_from_slice(src);
@@ -169,10 +180,22 @@ fn decompress(r: &Record<'_>) -> Result<Vec<u8>, Corrupt> {
         }
         "bz2" => bzip2::read::BzDecoder::new(src)
             .take(size as u64 + 1)
-            .read_to_end(&mut out),
-        "lz4" => lz4_flex::frame::FrameDecoder::new(src)
-            .take(size as u64 + 1)
-            .read_to_end(&mut out),
+            .read_to_end(out),
+        "lz4" => {
+            let dec = bufs.lz4.get_or_insert_with(|| {
+                lz4_flex::frame::FrameDecoder::new(std::io::Cursor::new(Vec::new()))
+            });
+            let cur = dec.get_mut();
+            cur.get_mut().clear();
+            cur.get_mut().extend_from_slice(src);
+            cur.set_position(0);
+            let r = dec.take(size as u64 + 1).read_to_end(out);
+            if r.is_err() {
+                // A broken frame may leave the decoder mid-frame: start afresh next time.
+                bufs.lz4 = None;
+            }
+            r
+        }
         other => {
             return Err(Corrupt::new(
                 r.at,
@@ -195,7 +218,7 @@ fn decompress(r: &Record<'_>) -> Result<Vec<u8>, Corrupt> {
             ),
         ));
     }
-    Ok(out)
+    Ok(())
 }
 
 /// What a pass over a bag found besides its messages.
@@ -275,6 +298,7 @@ pub fn for_each_message(
     };
     let mut seen_header = false;
     let mut summary = BagSummary::default();
+    let mut bufs = Buffers::default();
     let mut count = |m: BagMessage<'_>| {
         summary.messages += 1;
         f(m)
@@ -295,7 +319,8 @@ pub fn for_each_message(
             }
             OP_CHUNK => {
                 summary.chunks += 1;
-                let data = decompress(&r)?;
+                decompress(&r, &mut bufs)?;
+                let data = &bufs.out;
                 let compressed = r.field("compression") != Some(b"none".as_slice());
                 // Offsets inside a compressed chunk do not exist in the file: name the chunk.
                 let inner = Bytes {

@@ -836,8 +836,37 @@ pub enum SourceKind {
 
 /// Tells the kind of a source by its content (a folder, or a file's magic bytes).
 pub fn source_kind(path: &Path) -> Result<SourceKind, FileError> {
+    resolve_source(path).map(|(k, _)| k)
+}
+
+/// The kind of a source and the file to read: a ROS 2 bag folder (`metadata.yaml` beside one
+/// `.mcap` file) resolves to its MCAP file.
+pub fn resolve_source(path: &Path) -> Result<(SourceKind, std::path::PathBuf), FileError> {
     if path.is_dir() {
-        return Ok(SourceKind::Folder);
+        if path.join("metadata.yaml").is_file() {
+            let mut files: Vec<_> = std::fs::read_dir(path)
+                .map_err(|e| FileError::io(path, e))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .collect();
+            files.sort();
+            let mcaps: Vec<_> = files
+                .iter()
+                .filter(|p| p.extension().is_some_and(|e| e == "mcap"))
+                .collect();
+            let bad = |m: String| Err(FileError::new(path, None, FileErrorKind::Syntax(m)));
+            return match mcaps.as_slice() {
+                [one] => Ok((SourceKind::Mcap, one.to_path_buf())),
+                [] if files.iter().any(|p| p.extension().is_some_and(|e| e == "db3")) => bad(
+                    "a ROS 2 bag in SQLite storage (.db3) is not read: record with --storage mcap, or convert it with `ros2 bag convert`".into(),
+                ),
+                [] => bad("a ROS 2 bag folder without an .mcap file".into()),
+                many => bad(format!(
+                    "a ROS 2 bag split into {} .mcap files: give one file",
+                    many.len()
+                )),
+            };
+        }
+        return Ok((SourceKind::Folder, path.to_path_buf()));
     }
     let mut head = [0u8; 16];
     let n = {
@@ -846,21 +875,22 @@ pub fn source_kind(path: &Path) -> Result<SourceKind, FileError> {
         f.read(&mut head).map_err(|e| FileError::io(path, e))?
     };
     let head = &head[..n];
-    if head.starts_with(crate::bag::MAGIC) {
-        Ok(SourceKind::Bag)
+    let kind = if head.starts_with(crate::bag::MAGIC) {
+        SourceKind::Bag
     } else if head.starts_with(crate::mcap_file::MAGIC) {
-        Ok(SourceKind::Mcap)
+        SourceKind::Mcap
     } else if head.starts_with(b"SQLite format 3\0") {
-        Ok(SourceKind::RtabMap)
+        SourceKind::RtabMap
     } else {
-        Err(FileError::new(
+        return Err(FileError::new(
             path,
             None,
             FileErrorKind::Syntax(
-                "not a scan source: expected a recording folder, a ROS 1 bag, an MCAP file or an RTAB-Map database".into(),
+                "not a scan source: expected a recording folder, a ROS 1 bag, an MCAP file (or ROS 2 bag folder) or an RTAB-Map database".into(),
             ),
-        ))
-    }
+        ));
+    };
+    Ok((kind, path.to_path_buf()))
 }
 
 /// Topic and frame names [`write_ros`] uses (RealSense driver + a PureThermal Lepton + a T265).

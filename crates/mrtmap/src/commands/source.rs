@@ -49,14 +49,14 @@ fn fmt_span(t0: f64, t1: f64) -> String {
 }
 
 pub fn inspect(a: &InspectArgs) -> anyhow::Result<()> {
-    let kind = ros_scan::source_kind(&a.source)?;
+    let (kind, file) = ros_scan::resolve_source(&a.source)?;
     match kind {
         SourceKind::Folder => inspect_folder(a),
         SourceKind::RtabMap => super::rtabmap::inspect(a),
         SourceKind::Bag | SourceKind::Mcap => {
             let c = container(kind).unwrap_or(Container::Bag);
-            let bytes = read_file(&a.source)?;
-            let s = ros_scan::survey(c, &bytes).map_err(|e| e.in_file(&a.source))?;
+            let bytes = read_file(&file)?;
+            let s = ros_scan::survey(c, &bytes).map_err(|e| e.in_file(&file))?;
             let p = ros_scan::plan(&s, &ros_options(&a.src)?);
             if a.json {
                 print!(
@@ -208,7 +208,8 @@ fn inspect_folder(a: &InspectArgs) -> anyhow::Result<()> {
 
 /// Converts `source` into the recording layout at `out`; prints what it did.
 pub(crate) fn to_layout(source: &Path, out: &Path, a: &SourceArgs) -> anyhow::Result<()> {
-    let kind = ros_scan::source_kind(source)?;
+    let (kind, file) = ros_scan::resolve_source(source)?;
+    let source = file.as_path();
     match kind {
         SourceKind::Folder => bail!(
             "{} is already a recording folder (convert to a .bag or .mcap file by naming one as --out)",
