@@ -324,7 +324,7 @@ pub fn for_each_message(
                 let compressed = r.field("compression") != Some(b"none".as_slice());
                 // Offsets inside a compressed chunk do not exist in the file: name the chunk.
                 let inner = Bytes {
-                    data: &data,
+                    data,
                     base: if compressed { r.at } else { r.data.base },
                     endian: Endian::Little,
                 };

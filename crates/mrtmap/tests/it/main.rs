@@ -4,6 +4,7 @@
 mod calibrate;
 mod cli;
 mod pipeline;
+mod sources;
 
 /// Runs the built binary.
 fn mrtmap(args: &[&str]) -> std::process::Output {

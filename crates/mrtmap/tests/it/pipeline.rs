@@ -11,7 +11,7 @@ use crate::{mrtmap, ok};
 
 /// A 20 s noise-free office scan at 160×120 depth (the accuracy under noise is tested in
 /// mrtmap-scan), simulated once for all tests here.
-fn recording() -> &'static Path {
+pub fn recording() -> &'static Path {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
         let dir = tempfile::tempdir().unwrap().keep();
