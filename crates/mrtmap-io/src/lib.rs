@@ -12,6 +12,12 @@
 //!    masks.txt, masks/ instance PNG + labels JSON       → Image16 + MaskLabels
 //! ```
 //!
+//! Other sources become that layout: ROS 1 bags ([`bag`]) and MCAP files ([`mcap_file`]) through
+//! [`ros_scan`] (messages decoded by [`ros_msg`]), RTAB-Map databases ([`rtabmap`], depth in
+//! [`rvl`]); [`layout_writer`] writes the folder. Single thermal images in camera formats (FLIR
+//! R-JPEG/FFF in [`flir`], Lepton, radiometric TIFF) are read by [`read_thermal_file`]. Binary
+//! parsers read through [`bytes`], whose errors carry the byte offset.
+//!
 //! Accepted beyond the spec: `masks.txt` (instance masks, see [`masks`]), `distortion` for the depth
 //! and colour cameras, duplicate timestamps in a trajectory (the first pose is kept). Errors name
 //! the file and line (or the image size); [`write_atomic`] and [`PartialDir`] make outputs appear

@@ -1,0 +1,121 @@
+//! Writes small seed inputs for every fuzz target into corpus/<target>/ (run by fuzz/run).
+use std::path::Path;
+
+use mrtmap_io::bag::{BagWriter, Compression};
+use mrtmap_io::mcap_file::McapWriter;
+use mrtmap_io::ros_msg::{Wire, encode};
+use mrtmap_io::{Image16, rtabmap, rvl};
+use nalgebra::{Isometry3, Vector3};
+
+fn put(target: &str, name: &str, bytes: &[u8]) {
+    let d = Path::new("corpus").join(target);
+    std::fs::create_dir_all(&d).expect("corpus folder");
+    std::fs::write(d.join(name), bytes).expect("seed");
+}
+
+fn messages(wire: Wire) -> Vec<(&'static str, &'static str, Vec<u8>)> {
+    let cam = mrtmap_geometry::camera::PinholeCamera::new(4, 3, 3.0, 3.0, 1.5, 1.0);
+    let p = Isometry3::new(Vector3::new(0.1, 0.2, 0.3), Vector3::new(0.0, 0.1, 0.0));
+    let px: Vec<u8> = (0..24u8).collect();
+    vec![
+        (
+            "/tf_static",
+            "tf2_msgs/TFMessage",
+            encode::tf_message(wire, &[(1.0, "a", "b", p), (1.0, "b", "c", p)]),
+        ),
+        (
+            "/camera/aligned_depth_to_color/camera_info",
+            "sensor_msgs/CameraInfo",
+            encode::camera_info(wire, 1.0, "b", &cam),
+        ),
+        (
+            "/camera/aligned_depth_to_color/image_raw",
+            "sensor_msgs/Image",
+            encode::image(wire, 1.0, "b", 4, 3, "16UC1", 8, &px),
+        ),
+        (
+            "/thermal/image_raw",
+            "sensor_msgs/Image",
+            encode::image(wire, 1.1, "c", 4, 3, "mono16", 8, &px),
+        ),
+        (
+            "/camera/color/image_raw/compressed",
+            "sensor_msgs/CompressedImage",
+            encode::compressed_image(wire, 1.0, "b", "jpeg", &px),
+        ),
+        (
+            "/camera/odom/sample",
+            "nav_msgs/Odometry",
+            encode::odometry(wire, 1.0, "odom", "a", &p),
+        ),
+        (
+            "/tf",
+            "tf2_msgs/TFMessage",
+            encode::tf_message(wire, &[(1.2, "map", "a", p)]),
+        ),
+    ]
+}
+
+fn main() {
+    for (i, (_, _, m)) in messages(Wire::Ros1).into_iter().enumerate() {
+        put("ros_msg", &format!("ros1-{i}"), &m);
+    }
+    for (i, (_, _, m)) in messages(Wire::Cdr).into_iter().enumerate() {
+        put("ros_msg", &format!("cdr-{i}"), &m);
+    }
+    for (name, c) in [
+        ("none", Compression::None),
+        ("bz2", Compression::Bz2),
+        ("lz4", Compression::Lz4),
+    ] {
+        let mut w = BagWriter::new(c, 300);
+        for (k, (topic, ty, m)) in messages(Wire::Ros1).into_iter().enumerate() {
+            w.write(topic, ty, 1.0 + k as f64 * 0.01, &m);
+        }
+        put("bag", name, &w.finish());
+    }
+    for (name, c) in [("none", None), ("zstd", Some("zstd")), ("lz4", Some("lz4"))] {
+        let mut w = McapWriter::new(c, 300).expect("mcap");
+        for (k, (topic, ty, m)) in messages(Wire::Cdr).into_iter().enumerate() {
+            let (pkg, n) = ty.split_once('/').expect("type");
+            w.write(topic, &format!("{pkg}/msg/{n}"), 1.0 + k as f64 * 0.01, &m)
+                .expect("write");
+        }
+        put("mcap", name, &w.finish().expect("finish"));
+    }
+    let depth = Image16 {
+        width: 8,
+        height: 6,
+        data: (0..48)
+            .map(|i| if i % 5 == 0 { 0 } else { 900 + i * 7 })
+            .collect(),
+    };
+    put(
+        "rtabmap_blobs",
+        "rvl",
+        &rvl::encode_rtabmap(8, 6, &depth.data),
+    );
+    put("rtabmap_blobs", "png", &mrtmap_io::encode_png16(&depth));
+    let cam = mrtmap_geometry::camera::PinholeCamera::new(8, 6, 6.0, 6.0, 3.5, 2.5);
+    put(
+        "rtabmap_blobs",
+        "calibration",
+        &rtabmap::calibration_blob(&cam, &rtabmap::base_from_optical(), [0, 23, 1]),
+    );
+    let mut raw = 48u16.to_le_bytes().to_vec();
+    raw.extend(rvl::encode(&depth.data));
+    put("rtabmap_blobs", "raw-rvl", &raw);
+    let lepton: Vec<u8> = (0..160 * 120)
+        .flat_map(|i: u32| (29_000 + (i % 160) as u16).to_le_bytes())
+        .collect();
+    put("thermal_file", "lepton.y16", &lepton);
+    put(
+        "thermal_file",
+        "lepton.png",
+        &mrtmap_io::encode_png16(&Image16 {
+            width: 16,
+            height: 12,
+            data: (0..192).map(|i| 29_000 + i).collect(),
+        }),
+    );
+}
