@@ -391,9 +391,13 @@ pub fn plan(s: &Survey, o: &RosOptions) -> Plan {
         &DEPTH_DEFAULTS,
         "depth images",
         |t| {
+            // Float images are depth wherever they are; 16-bit ones when the topic says so.
             is_image(t)
-                && t.topic.contains("depth")
-                && matches!(t.encoding.as_str(), "16UC1" | "32FC1" | "mono16")
+                && (t.encoding == "32FC1"
+                    || (t.topic.to_ascii_lowercase().contains("depth")
+                        && ["16UC1", "mono16"]
+                            .iter()
+                            .any(|e| t.encoding.starts_with(e))))
         },
         &mut missing,
     );
@@ -405,7 +409,7 @@ pub fn plan(s: &Survey, o: &RosOptions) -> Plan {
         |t| {
             is_image(t)
                 && Some(&t.topic) != depth.as_ref()
-                && !t.topic.contains("depth")
+                && !t.topic.to_ascii_lowercase().contains("depth")
                 && matches!(t.encoding.as_str(), "mono16" | "16UC1")
         },
         &mut missing,
@@ -417,7 +421,7 @@ pub fn plan(s: &Survey, o: &RosOptions) -> Plan {
         "colour images",
         |t| {
             is_image(t)
-                && !t.topic.contains("depth")
+                && !t.topic.to_ascii_lowercase().contains("depth")
                 && (matches!(t.encoding.as_str(), "rgb8" | "bgr8" | "rgba8" | "bgra8")
                     || t.encoding.contains("jpeg"))
         },
@@ -635,6 +639,54 @@ fn depth_image(i: &ros_msg::ImageMsg<'_>, scale: f64) -> Result<Image16, String>
     })
 }
 
+/// A 16-bit image from an Image (16UC1/mono16, or 32FC1 metres × `scale`) or a CompressedImage
+/// (a 16-bit PNG, or image_transport's compressedDepth: a 12-byte header, then the PNG).
+fn image16_msg(
+    m: &RosMsg<'_>,
+    kind: MsgKind,
+    scale: f64,
+    thermal: bool,
+) -> Result<(f64, Image16), String> {
+    if kind == MsgKind::CompressedImage {
+        let c = ros_msg::compressed_image(m.data, m.wire, m.offset).map_err(|e| e.to_string())?;
+        let png = if c.data.starts_with(b"\x89PNG") {
+            c.data
+        } else if c.format.contains("compressedDepth") && c.data.len() > 12 {
+            &c.data[12..]
+        } else {
+            return Err(format!(
+                "compressed image format {:?} is not a 16-bit PNG",
+                c.format
+            ));
+        };
+        let img = image::load_from_memory_with_format(png, image::ImageFormat::Png)
+            .map_err(|e| format!("compressed image: {e}"))?;
+        let image::DynamicImage::ImageLuma16(b) = img else {
+            return Err(format!(
+                "compressed image is {:?}, not 16-bit grey",
+                img.color()
+            ));
+        };
+        let (w, h) = b.dimensions();
+        return Ok((
+            stamp_or(c.header.stamp, m.time),
+            Image16 {
+                width: w,
+                height: h,
+                data: b.into_raw(),
+            },
+        ));
+    }
+    let i = ros_msg::image(m.data, m.wire, m.offset).map_err(|e| e.to_string())?;
+    if thermal && !matches!(i.encoding.as_str(), "mono16" | "16UC1") {
+        return Err(format!(
+            "thermal encoding {} is not mono16/16UC1",
+            i.encoding
+        ));
+    }
+    Ok((stamp_or(i.header.stamp, m.time), depth_image(&i, scale)?))
+}
+
 /// A colour image as PNG/JPEG bytes and extension.
 fn rgb_image(i: &ros_msg::ImageMsg<'_>) -> Result<Vec<u8>, String> {
     let (w, h) = (i.width as usize, i.height as usize);
@@ -725,33 +777,23 @@ pub fn export(
         let kind = MsgKind::of(m.datatype);
         let r: Result<(), String> = (|| {
             if topic == p.depth {
-                let i = ros_msg::image(m.data, m.wire, m.offset).map_err(|e| e.to_string())?;
-                let img = depth_image(&i, rig.depth_scale)?;
+                let (t, img) = image16_msg(&m, kind, rig.depth_scale, false)?;
                 if (img.width, img.height) != (rig.depth.width, rig.depth.height) {
                     return Err(format!(
                         "depth image is {}×{}, the depth camera {}×{}",
                         img.width, img.height, rig.depth.width, rig.depth.height
                     ));
                 }
-                w.depth(stamp_or(i.header.stamp, m.time), &img)
-                    .map_err(|e| e.to_string())?;
+                w.depth(t, &img).map_err(|e| e.to_string())?;
             } else if topic == p.thermal {
-                let i = ros_msg::image(m.data, m.wire, m.offset).map_err(|e| e.to_string())?;
-                if !matches!(i.encoding.as_str(), "mono16" | "16UC1") {
-                    return Err(format!(
-                        "thermal encoding {} is not mono16/16UC1",
-                        i.encoding
-                    ));
-                }
-                let img = depth_image(&i, 1.0)?;
+                let (t, img) = image16_msg(&m, kind, 1.0, true)?;
                 if (img.width, img.height) != (rig.thermal.width, rig.thermal.height) {
                     return Err(format!(
                         "thermal image is {}×{}, the thermal camera {}×{}",
                         img.width, img.height, rig.thermal.width, rig.thermal.height
                     ));
                 }
-                w.thermal(stamp_or(i.header.stamp, m.time), &img)
-                    .map_err(|e| e.to_string())?;
+                w.thermal(t, &img).map_err(|e| e.to_string())?;
             } else if topic == p.rgb {
                 if kind == MsgKind::CompressedImage {
                     let c = ros_msg::compressed_image(m.data, m.wire, m.offset)

@@ -419,3 +419,100 @@ fn broken_rtabmap_databases_are_reported() {
     assert!(matches!(e.kind, FileErrorKind::Syntax(_)), "{e}");
     assert!(read_image16(&not).is_err());
 }
+
+#[test]
+fn compressed_depth_and_float_depth_topics() {
+    let dir = tempfile::tempdir().unwrap();
+    let orig = recording(&dir.path().join("scan"));
+    let r = rig();
+    for variant in ["compressedDepth", "32FC1"] {
+        let mut w = BagWriter::new(Compression::None, 1 << 16);
+        let t0 = orig.trajectory.stamps[0];
+        w.write(
+            "/d/camera_info",
+            "sensor_msgs/CameraInfo",
+            t0,
+            &encode::camera_info(Wire::Ros1, t0, "cam", &r.depth),
+        );
+        for (t, p) in orig.trajectory.stamps.iter().zip(&orig.trajectory.poses) {
+            w.write(
+                "/odom",
+                "nav_msgs/Odometry",
+                *t,
+                &encode::odometry(Wire::Ros1, *t, "map", "cam", p),
+            );
+        }
+        for e in &orig.depth {
+            let img = orig.read_depth(e).unwrap();
+            if variant == "compressedDepth" {
+                let mut data = vec![0u8; 12];
+                data.extend(encode_png16(&img));
+                w.write(
+                    "/d/image_raw/compressedDepth",
+                    "sensor_msgs/CompressedImage",
+                    e.t,
+                    &encode::compressed_image(
+                        Wire::Ros1,
+                        e.t,
+                        "cam",
+                        "16UC1; compressedDepth png",
+                        &data,
+                    ),
+                );
+            } else {
+                let f: Vec<u8> = img
+                    .data
+                    .iter()
+                    .flat_map(|&v| (v as f32 / 1000.0).to_le_bytes())
+                    .collect();
+                w.write(
+                    "/d/image_raw",
+                    "sensor_msgs/Image",
+                    e.t,
+                    &encode::image(Wire::Ros1, e.t, "cam", 20, 15, "32FC1", 80, &f),
+                );
+            }
+        }
+        for e in &orig.thermal {
+            let img = orig.read_thermal(e).unwrap();
+            let le: Vec<u8> = img.data.iter().flat_map(|v| v.to_le_bytes()).collect();
+            w.write(
+                "/t/image",
+                "sensor_msgs/Image",
+                e.t,
+                &encode::image(Wire::Ros1, e.t, "lepton", 16, 12, "mono16", 32, &le),
+            );
+        }
+        let bag = w.finish();
+        let s = ros_scan::survey(Container::Bag, &bag).unwrap();
+        let p = ros_scan::plan(
+            &s,
+            &RosOptions {
+                rig: Some(r),
+                ..Default::default()
+            },
+        );
+        assert!(p.missing.is_empty(), "{variant}: {:?}", p.missing);
+        assert!(
+            p.depth.as_deref().unwrap().starts_with("/d/image_raw"),
+            "{variant}: {:?}",
+            p.depth
+        );
+        let out = dir.path().join(variant);
+        let rep = ros_scan::export(Path::new("v.bag"), &bag, &s, &p, &out).unwrap();
+        assert_eq!(
+            (rep.depth, rep.skipped),
+            (10, 0),
+            "{variant}: {:?}",
+            rep.skipped_reasons
+        );
+        let conv = Recording::open(&out).unwrap();
+        for (a, b) in orig.depth.iter().zip(&conv.depth) {
+            assert_eq!(
+                orig.read_depth(a).unwrap(),
+                conv.read_depth(b).unwrap(),
+                "{variant}"
+            );
+        }
+    }
+}
