@@ -715,6 +715,19 @@ fn rgb_image(i: &ros_msg::ImageMsg<'_>) -> Result<Vec<u8>, String> {
     Ok(encode_png_rgb8(i.width, i.height, &rgb))
 }
 
+/// Why a message was not written: it is unusable (skipped and counted), or the output cannot be
+/// written (the export stops).
+enum Step {
+    Skip(String),
+    Write(FileError),
+}
+
+impl From<String> for Step {
+    fn from(s: String) -> Self {
+        Self::Skip(s)
+    }
+}
+
 /// What an export wrote and skipped.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct ExportReport {
@@ -775,25 +788,25 @@ pub fn export(
     let res = for_each(s.container, file, &mut |m| {
         let topic = Some(m.topic.to_string());
         let kind = MsgKind::of(m.datatype);
-        let r: Result<(), String> = (|| {
+        let r: Result<(), Step> = (|| {
             if topic == p.depth {
                 let (t, img) = image16_msg(&m, kind, rig.depth_scale, false)?;
                 if (img.width, img.height) != (rig.depth.width, rig.depth.height) {
-                    return Err(format!(
+                    return Err(Step::Skip(format!(
                         "depth image is {}×{}, the depth camera {}×{}",
                         img.width, img.height, rig.depth.width, rig.depth.height
-                    ));
+                    )));
                 }
-                w.depth(t, &img).map_err(|e| e.to_string())?;
+                w.depth(t, &img).map_err(Step::Write)?;
             } else if topic == p.thermal {
                 let (t, img) = image16_msg(&m, kind, 1.0, true)?;
                 if (img.width, img.height) != (rig.thermal.width, rig.thermal.height) {
-                    return Err(format!(
+                    return Err(Step::Skip(format!(
                         "thermal image is {}×{}, the thermal camera {}×{}",
                         img.width, img.height, rig.thermal.width, rig.thermal.height
-                    ));
+                    )));
                 }
-                w.thermal(t, &img).map_err(|e| e.to_string())?;
+                w.thermal(t, &img).map_err(Step::Write)?;
             } else if topic == p.rgb {
                 if kind == MsgKind::CompressedImage {
                     let c = ros_msg::compressed_image(m.data, m.wire, m.offset)
@@ -804,12 +817,12 @@ pub fn export(
                         "jpg"
                     };
                     w.rgb(stamp_or(c.header.stamp, m.time), c.data, ext)
-                        .map_err(|e| e.to_string())?;
+                        .map_err(Step::Write)?;
                 } else {
                     let i = ros_msg::image(m.data, m.wire, m.offset).map_err(|e| e.to_string())?;
                     let png = rgb_image(&i)?;
                     w.rgb(stamp_or(i.header.stamp, m.time), &png, "png")
-                        .map_err(|e| e.to_string())?;
+                        .map_err(Step::Write)?;
                 }
             } else if topic == pose_topic {
                 let x = if kind == MsgKind::Odometry {
@@ -831,12 +844,13 @@ pub fn export(
             }
             Ok(())
         })();
-        if let Err(why) = r {
-            if why.contains("No space") || why.contains("Permission") {
-                err = Some(FileError::new(out, None, FileErrorKind::Syntax(why)));
+        match r {
+            Ok(()) => {}
+            Err(Step::Write(e)) => {
+                err = Some(e);
                 return Err(Corrupt::new(m.offset, "stopped: cannot write the output"));
             }
-            skip(&mut rep, m.topic, m.offset, why);
+            Err(Step::Skip(why)) => skip(&mut rep, m.topic, m.offset, why),
         }
         Ok(())
     });
