@@ -5,6 +5,7 @@
 //! been checked against [`crate::bag::MAX_CHUNK_BYTES`].
 
 use std::collections::HashMap;
+use std::io::Read;
 
 use mcap::records::Record;
 
@@ -103,6 +104,16 @@ impl State {
     }
 }
 
+/// The record at `pos`: opcode, body, position after it (the length checked against what is left).
+fn record_at<'a>(b: &Bytes<'a>, pos: usize) -> Result<(u8, &'a [u8], usize), Corrupt> {
+    let op = b.u8(pos, "a record opcode")?;
+    let len = b.u32(pos + 1, "a record length")? as u64
+        | (b.u32(pos + 5, "a record length")? as u64) << 32;
+    let len = usize::try_from(len).unwrap_or(usize::MAX);
+    let body = b.slice(pos + 9, len, &format!("record (opcode 0x{op:02x})"))?;
+    Ok((op, body, pos + 9 + len))
+}
+
 /// Calls `f` for every CDR or ROS 1 message of an MCAP file, in file order.
 pub fn for_each_message(
     file: &[u8],
@@ -118,12 +129,9 @@ pub fn for_each_message(
         ..Default::default()
     };
     let mut pos = MAGIC.len();
+    let mut chunk = Vec::new();
     while pos < b.len() {
-        let op = b.u8(pos, "a record opcode")?;
-        let len = b.u32(pos + 1, "a record length")? as u64
-            | (b.u32(pos + 5, "a record length")? as u64) << 32;
-        let len = usize::try_from(len).unwrap_or(usize::MAX);
-        let body = b.slice(pos + 9, len, &format!("record (opcode 0x{op:02x})"))?;
+        let (op, body, next) = record_at(&b, pos)?;
         let at = pos as u64;
         if op == 0x02 {
             summary.unfinished = false;
@@ -142,19 +150,59 @@ pub fn for_each_message(
                     ),
                 ));
             }
-            let compression = header.compression.clone();
-            let reader = mcap::read::ChunkReader::new(header, &data)
-                .map_err(|e| Corrupt::new(at, format!("chunk ({compression}): {e}")))?;
-            for r in reader {
-                let r = r.map_err(|e| {
-                    Corrupt::new(at, format!("inside the chunk ({compression}): {e}"))
+            let compression = header.compression.as_str();
+            let size = header.uncompressed_size as usize;
+            // Decompressed here, not by mcap's ChunkReader: that one reserves whatever length a
+            // record inside the chunk claims (found by fuzzing: a 3 TB reservation, an abort).
+            chunk.clear();
+            chunk.reserve(size.min(16 << 20));
+            let res = match compression {
+                "" => {
+                    chunk.extend_from_slice(&data);
+                    Ok(data.len())
+                }
+                "zstd" => zstd::stream::read::Decoder::new(&data[..])
+                    .and_then(|d| d.take(size as u64 + 1).read_to_end(&mut chunk)),
+                "lz4" => lz4_flex::frame::FrameDecoder::new(&data[..])
+                    .take(size as u64 + 1)
+                    .read_to_end(&mut chunk),
+                other => {
+                    return Err(Corrupt::new(
+                        at,
+                        format!("chunk compression '{other}' is not one of none, zstd, lz4"),
+                    ));
+                }
+            };
+            if let Err(e) = res {
+                return Err(Corrupt::new(at, format!("broken {compression} chunk: {e}")));
+            }
+            if chunk.len() != size {
+                return Err(Corrupt::new(
+                    at,
+                    format!(
+                        "{compression} chunk decompresses to {} bytes but its header says {size}",
+                        chunk.len()
+                    ),
+                ));
+            }
+            let inner = Bytes::new(&chunk, Endian::Little);
+            let mut p = 0;
+            while p < inner.len() {
+                let (op, body, next) = record_at(&inner, p)
+                    .map_err(|e| Corrupt::new(at, format!("inside the chunk: {}", e.what)))?;
+                let r = mcap::parse_record(op, body).map_err(|e| {
+                    Corrupt::new(
+                        at,
+                        format!("inside the chunk, record (opcode 0x{op:02x}): {e}"),
+                    )
                 })?;
                 state.record(r, at, &mut summary, f)?;
+                p = next;
             }
         } else {
             state.record(rec, at, &mut summary, f)?;
         }
-        pos += 9 + len;
+        pos = next;
     }
     Ok(summary)
 }
@@ -265,5 +313,28 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_record_inside_a_chunk_claiming_terabytes_is_an_error_not_an_abort() {
+        // Found by fuzzing: mcap's ChunkReader reserved the claimed length.
+        let mut w = McapWriter::new(None, 1 << 20).unwrap();
+        w.write("/x", "std_msgs/msg/String", 1.0, &[0, 1, 0, 0, 9])
+            .unwrap();
+        let mut file = w.finish().unwrap();
+        let mut pos = MAGIC.len();
+        let chunk = loop {
+            let len = u64::from_le_bytes(file[pos + 1..pos + 9].try_into().unwrap()) as usize;
+            if file[pos] == 0x06 {
+                break pos;
+            }
+            pos += 9 + len;
+        };
+        // Chunk body: start, end, size, crc, compression "", records length, then the records.
+        let first = chunk + 9 + 8 + 8 + 8 + 4 + 4 + 8;
+        file[first + 1..first + 9].copy_from_slice(&(3u64 << 40).to_le_bytes());
+        let e = for_each_message(&file, &mut |_| Ok(())).unwrap_err();
+        assert_eq!(e.offset, chunk as u64, "{e}");
+        assert!(e.what.contains("inside the chunk"), "{e}");
     }
 }
