@@ -143,13 +143,16 @@ fn pose12(v: &[f64], what: &str) -> Result<Isometry3<f64>, String> {
         return Err(format!("{what} has a non-finite value"));
     }
     let m = Matrix3::new(v[0], v[1], v[2], v[4], v[5], v[6], v[8], v[9], v[10]);
-    if (m.determinant() - 1.0).abs() > 1e-2 {
+    // Checked before orthonormalising: nalgebra's from_matrix iterates until it converges, and on
+    // a matrix far from a rotation that can be forever (found by fuzzing).
+    let off = (m.transpose() * m - Matrix3::identity()).abs().max();
+    if off > 1e-2 || (m.determinant() - 1.0).abs() > 1e-2 {
         return Err(format!(
-            "{what} rotation has determinant {:.4}, not 1",
+            "{what} is not a rotation (|RᵀR − I| up to {off:.3}, determinant {:.4})",
             m.determinant()
         ));
     }
-    let r = Rotation3::from_matrix(&m);
+    let r = Rotation3::from_matrix_eps(&m, 1e-12, 100, Rotation3::identity());
     Ok(Isometry3::from_parts(
         Translation3::new(v[3], v[7], v[11]),
         UnitQuaternion::from_rotation_matrix(&r),
@@ -807,5 +810,17 @@ mod tests {
         let huge = compress(&data, i32::MAX, i32::MAX, 5);
         assert!(uncompress(&huge, "x").unwrap_err().contains("too large"));
         assert!(pose_blob(&[0; 40], "p").is_err());
+        // Determinant 1 but far from a rotation: refused (it used to loop forever).
+        let skew: Vec<u8> = [
+            100.0f32, 0.0, 0.0, 0.0, 0.0, 0.01, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0,
+        ]
+        .iter()
+        .flat_map(|x| x.to_le_bytes())
+        .collect();
+        assert!(
+            pose_blob(&skew, "p")
+                .unwrap_err()
+                .contains("not a rotation")
+        );
     }
 }
