@@ -104,6 +104,10 @@ impl State {
     }
 }
 
+/// Opcodes parsed: schema, channel, message, chunk. Others are skipped unparsed — the `mcap`
+/// crate's parser panics on a short attachment record (found by fuzzing), and a scan needs none.
+const NEEDED: [u8; 4] = [0x03, 0x04, 0x05, 0x06];
+
 /// The record at `pos`: opcode, body, position after it (the length checked against what is left).
 fn record_at<'a>(b: &Bytes<'a>, pos: usize) -> Result<(u8, &'a [u8], usize), Corrupt> {
     let op = b.u8(pos, "a record opcode")?;
@@ -136,6 +140,10 @@ pub fn for_each_message(
         if op == 0x02 {
             summary.unfinished = false;
             break;
+        }
+        if !NEEDED.contains(&op) {
+            pos = next;
+            continue;
         }
         let rec = mcap::parse_record(op, body)
             .map_err(|e| Corrupt::new(at, format!("MCAP record (opcode 0x{op:02x}): {e}")))?;
@@ -190,6 +198,10 @@ pub fn for_each_message(
             while p < inner.len() {
                 let (op, body, next) = record_at(&inner, p)
                     .map_err(|e| Corrupt::new(at, format!("inside the chunk: {}", e.what)))?;
+                if !NEEDED.contains(&op) {
+                    p = next;
+                    continue;
+                }
                 let r = mcap::parse_record(op, body).map_err(|e| {
                     Corrupt::new(
                         at,
@@ -336,5 +348,22 @@ mod tests {
         let e = for_each_message(&file, &mut |_| Ok(())).unwrap_err();
         assert_eq!(e.offset, chunk as u64, "{e}");
         assert!(e.what.contains("inside the chunk"), "{e}");
+    }
+
+    #[test]
+    fn a_short_attachment_record_is_skipped_not_a_panic() {
+        // Found by fuzzing: mcap::parse_record slices past the end of a short attachment.
+        let mut w = McapWriter::new(None, 1 << 20).unwrap();
+        w.write("/x", "std_msgs/msg/String", 1.0, &[0, 1, 0, 0, 9])
+            .unwrap();
+        let file = w.finish().unwrap();
+        let mut bad = file[..MAGIC.len()].to_vec();
+        bad.push(0x09);
+        // Times, two empty strings and a data length: 32 bytes, then one more (no room for the CRC).
+        bad.extend_from_slice(&33u64.to_le_bytes());
+        bad.extend_from_slice(&[0u8; 33]);
+        bad.extend_from_slice(&file[MAGIC.len()..]);
+        let s = for_each_message(&bad, &mut |_| Ok(())).unwrap();
+        assert_eq!(s.messages, 1);
     }
 }
