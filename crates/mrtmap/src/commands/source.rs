@@ -328,12 +328,21 @@ pub(crate) fn recording_dir(source: &Path, out: &Path, a: &SourceArgs) -> anyhow
     let dir = out.join("recording");
     let meta =
         std::fs::metadata(source).with_context(|| format!("{}: cannot read", source.display()))?;
+    // The source, the options, and the files the options name (a rig edited since, or new
+    // thermal frames, mean converting again).
+    let named = |p: &Option<PathBuf>| {
+        p.as_deref()
+            .and_then(|p| std::fs::metadata(p).ok())
+            .map(|m| (m.len(), m.modified().ok()))
+    };
     let stamp = format!(
-        "{} {} {:?} {:?}",
+        "{} {} {:?} {:?} {:?} {:?}",
         source.display(),
         meta.len(),
         meta.modified().ok(),
-        a
+        a,
+        named(&a.rig),
+        named(&a.thermal)
     );
     let stamp_path = out.join("recording.source");
     if dir.join("rig.toml").is_file()
