@@ -8,7 +8,7 @@
 //! error names the byte offset of the record at fault.
 
 use std::collections::HashMap;
-use std::io::Read;
+use std::io::{Read, Seek, SeekFrom};
 
 use crate::bytes::{Bytes, Corrupt, Endian};
 use crate::ros_msg::Wire;
@@ -233,32 +233,117 @@ pub struct BagSummary {
     pub unindexed: bool,
 }
 
+/// Largest record header accepted (headers hold a few short fields).
+const MAX_HEADER_BYTES: usize = 1 << 20;
+
+fn io_err(at: u64, e: &std::io::Error) -> Corrupt {
+    Corrupt::new(at, format!("cannot read: {e}"))
+}
+
+/// The op of a record header (its fields, unparsed otherwise).
+fn header_op(h: &[u8]) -> Option<u8> {
+    let mut p = 0;
+    while p + 4 <= h.len() {
+        let n = u32::from_le_bytes([h[p], h[p + 1], h[p + 2], h[p + 3]]) as usize;
+        let f = h.get(p + 4..p + 4 + n)?;
+        if let Some(v) = f.strip_prefix(b"op=") {
+            return (v.len() == 1).then(|| v[0]);
+        }
+        p += 4 + n;
+    }
+    None
+}
+
+/// Reads the top-level record at `pos` into `buf` in file layout (its data only when `want`
+/// says so; otherwise with an empty data part) and returns (op, position after it).
+fn read_record<R: Read + Seek + ?Sized>(
+    r: &mut R,
+    len: u64,
+    pos: u64,
+    buf: &mut Vec<u8>,
+    want: fn(u8) -> bool,
+) -> Result<(u8, u64), Corrupt> {
+    let left = |at: u64| len.saturating_sub(at);
+    let need = |at: u64, n: u64, what: &str| {
+        if n > left(at) {
+            Err(Corrupt::new(
+                at,
+                format!(
+                    "{what} needs {n} bytes but only {} are left (file cut short?)",
+                    left(at)
+                ),
+            ))
+        } else {
+            Ok(())
+        }
+    };
+    need(pos, 4, "a record header length")?;
+    r.seek(SeekFrom::Start(pos)).map_err(|e| io_err(pos, &e))?;
+    let mut n4 = [0u8; 4];
+    r.read_exact(&mut n4).map_err(|e| io_err(pos, &e))?;
+    let hlen = u32::from_le_bytes(n4) as u64;
+    need(pos + 4, hlen, "a record header")?;
+    if hlen as usize > MAX_HEADER_BYTES {
+        return Err(Corrupt::new(
+            pos,
+            format!("record header of {hlen} bytes (more than 1 MiB)"),
+        ));
+    }
+    buf.clear();
+    buf.extend_from_slice(&n4);
+    buf.resize(4 + hlen as usize, 0);
+    r.read_exact(&mut buf[4..])
+        .map_err(|e| io_err(pos + 4, &e))?;
+    let dpos = pos + 4 + hlen;
+    need(dpos, 4, "a record data length")?;
+    r.read_exact(&mut n4).map_err(|e| io_err(dpos, &e))?;
+    let dlen = u32::from_le_bytes(n4) as u64;
+    need(dpos + 4, dlen, "a record's data")?;
+    let op = header_op(&buf[4..])
+        .ok_or_else(|| Corrupt::new(pos, "a record without a one-byte 'op' field"))?;
+    if want(op) {
+        if dlen as usize > MAX_CHUNK_BYTES {
+            return Err(Corrupt::new(
+                dpos,
+                format!("record data of {dlen} bytes (more than the {MAX_CHUNK_BYTES} accepted)"),
+            ));
+        }
+        buf.extend_from_slice(&n4);
+        let at = buf.len();
+        buf.resize(at + dlen as usize, 0);
+        r.read_exact(&mut buf[at..])
+            .map_err(|e| io_err(dpos + 4, &e))?;
+    } else {
+        buf.extend_from_slice(&0u32.to_le_bytes());
+    }
+    Ok((op, dpos + 4 + dlen))
+}
+
 /// Calls `f` for every message of a bag, in file order (chunks decompressed one at a time).
 pub fn for_each_message(
     file: &[u8],
     f: &mut dyn FnMut(BagMessage<'_>) -> Result<(), Corrupt>,
 ) -> Result<BagSummary, Corrupt> {
-    if !file.starts_with(MAGIC) {
+    for_each_message_in(&mut std::io::Cursor::new(file), f)
+}
+
+/// [`for_each_message`] reading from a file (or anything seekable), a record at a time: memory
+/// stays at one chunk, whatever the bag's size.
+pub fn for_each_message_in<R: Read + Seek + ?Sized>(
+    r: &mut R,
+    f: &mut dyn FnMut(BagMessage<'_>) -> Result<(), Corrupt>,
+) -> Result<BagSummary, Corrupt> {
+    let len = r.seek(SeekFrom::End(0)).map_err(|e| io_err(0, &e))?;
+    let mut magic = [0u8; 13];
+    r.seek(SeekFrom::Start(0)).map_err(|e| io_err(0, &e))?;
+    if len < MAGIC.len() as u64 || r.read_exact(&mut magic).is_err() || magic != MAGIC {
         return Err(Corrupt::new(
             0,
             "not a ROS 1 bag (no \"#ROSBAG V2.0\" line)",
         ));
     }
-    let b = Bytes::new(file, Endian::Little);
     let mut conns: HashMap<u32, Connection> = HashMap::new();
-    // First the connection records outside chunks (the index section), so that messages can be
-    // named even in chunks that do not repeat them.
-    let mut pos = MAGIC.len();
-    let mut top = Vec::new();
-    while pos < b.len() {
-        let (r, next) = record(&b, pos)?;
-        if r.op == OP_CONN {
-            let (id, c) = connection(&r)?;
-            conns.insert(id, c);
-        }
-        top.push(pos);
-        pos = next;
-    }
+    let mut buf = Vec::new();
     let handle = |r: &Record<'_>,
                   conns: &mut HashMap<u32, Connection>,
                   offset: u64,
@@ -296,7 +381,6 @@ pub fn for_each_message(
         }
         Ok(())
     };
-    let mut seen_header = false;
     let mut summary = BagSummary::default();
     let mut bufs = Buffers::default();
     let mut count = |m: BagMessage<'_>| {
@@ -304,57 +388,102 @@ pub fn for_each_message(
         f(m)
     };
     let f = &mut count;
-    for pos in top {
-        let (r, _) = record(&b, pos)?;
-        match r.op {
-            OP_HEADER => {
-                seen_header = true;
-                let ip = match r.field("index_pos") {
-                    Some(v) if v.len() == 8 => {
-                        u64::from_le_bytes([v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]])
-                    }
-                    _ => return Err(Corrupt::new(r.at, "bag header without an 8-byte index_pos")),
-                };
-                summary.unindexed = ip == 0 || ip >= file.len() as u64;
+    // The header record first: it says where the index section (with every connection) starts.
+    let first = MAGIC.len() as u64;
+    let (op, mut pos) = read_record(r, len, first, &mut buf, |_| false)?;
+    if op != OP_HEADER {
+        return Err(Corrupt::new(first, "the bag has no header record"));
+    }
+    let (h, _) = record(
+        &Bytes {
+            data: &buf,
+            base: first,
+            endian: Endian::Little,
+        },
+        0,
+    )?;
+    let index_pos = match h.field("index_pos") {
+        Some(v) if v.len() == 8 => {
+            u64::from_le_bytes([v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]])
+        }
+        _ => {
+            return Err(Corrupt::new(
+                first,
+                "bag header without an 8-byte index_pos",
+            ));
+        }
+    };
+    let unindexed = index_pos <= first || index_pos >= len;
+    if !unindexed {
+        // Connections from the index section, so that messages can be named even in chunks that
+        // do not repeat them.
+        let mut p = index_pos;
+        while p < len {
+            let (op, next) = read_record(r, len, p, &mut buf, |op| op == OP_CONN)?;
+            if op == OP_CONN {
+                let (rec, _) = record(
+                    &Bytes {
+                        data: &buf,
+                        base: p,
+                        endian: Endian::Little,
+                    },
+                    0,
+                )?;
+                let (id, c) = connection(&rec)?;
+                conns.insert(id, c);
             }
+            p = next;
+        }
+    }
+    let end = if unindexed { len } else { index_pos };
+    while pos < end {
+        let at = pos;
+        let (op, next) = read_record(r, len, at, &mut buf, |op| {
+            matches!(op, OP_CHUNK | OP_MSG | OP_CONN)
+        })?;
+        pos = next;
+        let (rec, _) = record(
+            &Bytes {
+                data: &buf,
+                base: at,
+                endian: Endian::Little,
+            },
+            0,
+        )?;
+        match op {
             OP_CHUNK => {
                 summary.chunks += 1;
-                decompress(&r, &mut bufs)?;
+                decompress(&rec, &mut bufs)?;
                 let data = &bufs.out;
-                let compressed = r.field("compression") != Some(b"none".as_slice());
+                let compressed = rec.field("compression") != Some(b"none".as_slice());
                 // Offsets inside a compressed chunk do not exist in the file: name the chunk.
                 let inner = Bytes {
                     data,
-                    base: if compressed { r.at } else { r.data.base },
+                    base: if compressed { rec.at } else { rec.data.base },
                     endian: Endian::Little,
                 };
                 let mut p = 0;
                 while p < inner.len() {
                     let (m, next) = record(&inner, p).map_err(|e| {
                         if compressed {
-                            Corrupt::new(r.at, format!("inside the compressed chunk: {}", e.what))
+                            Corrupt::new(rec.at, format!("inside the compressed chunk: {}", e.what))
                         } else {
                             e
                         }
                     })?;
-                    let off = if compressed { r.at } else { m.data.base };
+                    let off = if compressed { rec.at } else { m.data.base };
                     handle(&m, &mut conns, off, f)?;
                     p = next;
                 }
             }
-            OP_MSG => handle(&r, &mut conns, r.data.base, f)?,
-            OP_CONN | OP_INDEX | OP_CHUNK_INFO => {}
+            OP_MSG | OP_CONN => handle(&rec, &mut conns, rec.data.base, f)?,
+            OP_INDEX | OP_CHUNK_INFO => {}
             op => {
-                return Err(Corrupt::new(r.at, format!("unknown record op 0x{op:02x}")));
+                return Err(Corrupt::new(at, format!("unknown record op 0x{op:02x}")));
             }
         }
     }
-    if !seen_header {
-        return Err(Corrupt::new(
-            MAGIC.len() as u64,
-            "the bag has no header record",
-        ));
-    }
+    summary.unindexed = unindexed;
     Ok(summary)
 }
 

@@ -5,7 +5,7 @@
 //! been checked against [`crate::bag::MAX_CHUNK_BYTES`].
 
 use std::collections::HashMap;
-use std::io::Read;
+use std::io::{Read, Seek, SeekFrom};
 
 use mcap::records::Record;
 
@@ -123,28 +123,75 @@ pub fn for_each_message(
     file: &[u8],
     f: &mut dyn FnMut(McapMessage<'_>) -> Result<(), Corrupt>,
 ) -> Result<McapSummary, Corrupt> {
-    if !file.starts_with(MAGIC) {
+    for_each_message_in(&mut std::io::Cursor::new(file), f)
+}
+
+/// [`for_each_message`] reading from a file (or anything seekable) a record at a time: memory
+/// stays at one chunk, whatever the file's size. Records a scan does not need are skipped unread.
+pub fn for_each_message_in<R: Read + Seek + ?Sized>(
+    r: &mut R,
+    f: &mut dyn FnMut(McapMessage<'_>) -> Result<(), Corrupt>,
+) -> Result<McapSummary, Corrupt> {
+    let io = |at: u64, e: std::io::Error| Corrupt::new(at, format!("cannot read: {e}"));
+    let len = r.seek(SeekFrom::End(0)).map_err(|e| io(0, e))?;
+    r.seek(SeekFrom::Start(0)).map_err(|e| io(0, e))?;
+    let mut magic = [0u8; 8];
+    if len < 8 || r.read_exact(&mut magic).is_err() || magic != MAGIC {
         return Err(Corrupt::new(0, "not an MCAP file (no MCAP magic)"));
     }
-    let b = Bytes::new(file, Endian::Little);
     let mut state = State::default();
     let mut summary = McapSummary {
         unfinished: true,
         ..Default::default()
     };
-    let mut pos = MAGIC.len();
+    let mut pos = MAGIC.len() as u64;
     let mut chunk = Vec::new();
-    while pos < b.len() {
-        let (op, body, next) = record_at(&b, pos)?;
-        let at = pos as u64;
+    let mut body_buf = Vec::new();
+    while pos < len {
+        let at = pos;
+        let left = len - pos;
+        if left < 9 {
+            return Err(Corrupt::new(
+                at,
+                format!(
+                    "a record opcode and length need 9 bytes but only {left} are left (file cut short?)"
+                ),
+            ));
+        }
+        let mut h = [0u8; 9];
+        r.seek(SeekFrom::Start(pos)).map_err(|e| io(at, e))?;
+        r.read_exact(&mut h).map_err(|e| io(at, e))?;
+        let op = h[0];
+        let blen = u64::from_le_bytes([h[1], h[2], h[3], h[4], h[5], h[6], h[7], h[8]]);
+        if blen > left - 9 {
+            return Err(Corrupt::new(
+                at + 9,
+                format!(
+                    "record (opcode 0x{op:02x}) needs {blen} bytes but only {} are left (file cut short?)",
+                    left - 9
+                ),
+            ));
+        }
+        pos = at + 9 + blen;
         if op == 0x02 {
             summary.unfinished = false;
             break;
         }
         if !NEEDED.contains(&op) {
-            pos = next;
             continue;
         }
+        if blen > MAX_CHUNK_BYTES as u64 {
+            return Err(Corrupt::new(
+                at,
+                format!(
+                    "record (opcode 0x{op:02x}) of {blen} bytes (more than the {MAX_CHUNK_BYTES} accepted)"
+                ),
+            ));
+        }
+        body_buf.clear();
+        body_buf.resize(blen as usize, 0);
+        r.read_exact(&mut body_buf).map_err(|e| io(at + 9, e))?;
+        let body = &body_buf[..];
         let rec = mcap::parse_record(op, body)
             .map_err(|e| Corrupt::new(at, format!("MCAP record (opcode 0x{op:02x}): {e}")))?;
         if let Record::Chunk { header, data } = rec {
@@ -214,7 +261,6 @@ pub fn for_each_message(
         } else {
             state.record(rec, at, &mut summary, f)?;
         }
-        pos = next;
     }
     Ok(summary)
 }

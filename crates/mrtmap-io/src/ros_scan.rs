@@ -47,14 +47,60 @@ pub enum Container {
     Mcap,
 }
 
+/// Where a bag or MCAP file is read from: bytes in memory, or a file read a record at a time.
+#[derive(Clone, Copy, Debug)]
+pub enum Input<'a> {
+    /// In memory.
+    Bytes(&'a [u8]),
+    /// A file.
+    File(&'a Path),
+}
+
+impl<'a> From<&'a [u8]> for Input<'a> {
+    fn from(b: &'a [u8]) -> Self {
+        Self::Bytes(b)
+    }
+}
+
+impl<'a> From<&'a Vec<u8>> for Input<'a> {
+    fn from(b: &'a Vec<u8>) -> Self {
+        Self::Bytes(b)
+    }
+}
+
+impl<'a> From<&'a Path> for Input<'a> {
+    fn from(p: &'a Path) -> Self {
+        Self::File(p)
+    }
+}
+
+/// Something to read records from.
+pub trait ReadSeek: std::io::Read + std::io::Seek {}
+impl<T: std::io::Read + std::io::Seek> ReadSeek for T {}
+
+impl<'a> Input<'a> {
+    fn open(self) -> Result<Box<dyn ReadSeek + 'a>, Corrupt> {
+        match self {
+            Self::Bytes(b) => Ok(Box::new(std::io::Cursor::new(b))),
+            Self::File(p) => {
+                let f = std::fs::File::open(p)
+                    .map_err(|e| Corrupt::new(0, format!("cannot open: {e}")))?;
+                Ok(Box::new(std::io::BufReader::with_capacity(1 << 20, f)))
+            }
+        }
+    }
+}
+
 /// Reads every message; returns whether the file was cut or never closed.
-pub fn for_each(
+pub fn for_each<'a>(
     container: Container,
-    file: &[u8],
+    input: impl Into<Input<'a>>,
     f: &mut dyn FnMut(RosMsg<'_>) -> Result<(), Corrupt>,
 ) -> Result<bool, Corrupt> {
+    let mut r = input.into().open()?;
+    let r = &mut *r;
     match container {
-        Container::Bag => crate::bag::for_each_message(file, &mut |m| {
+        Container::Bag => crate::bag::for_each_message_in(r, &mut |m| {
             f(RosMsg {
                 topic: m.topic,
                 datatype: m.datatype,
@@ -65,7 +111,7 @@ pub fn for_each(
             })
         })
         .map(|s| s.unindexed),
-        Container::Mcap => crate::mcap_file::for_each_message(file, &mut |m| {
+        Container::Mcap => crate::mcap_file::for_each_message_in(r, &mut |m| {
             f(RosMsg {
                 topic: m.topic,
                 datatype: m.datatype,
@@ -157,7 +203,8 @@ fn stamp_or(t: f64, record: f64) -> f64 {
 }
 
 /// Surveys a bag or MCAP file (one pass; images are not decoded).
-pub fn survey(container: Container, file: &[u8]) -> Result<Survey, Corrupt> {
+pub fn survey<'a>(container: Container, file: impl Into<Input<'a>>) -> Result<Survey, Corrupt> {
+    let file = file.into();
     let mut s = Survey {
         container,
         topics: BTreeMap::new(),
@@ -746,13 +793,14 @@ pub struct ExportReport {
 }
 
 /// Writes the recording layout for a plan whose rig is complete.
-pub fn export(
+pub fn export<'a>(
     path: &Path,
-    file: &[u8],
+    file: impl Into<Input<'a>>,
     s: &Survey,
     p: &Plan,
     out: &Path,
 ) -> Result<ExportReport, FileError> {
+    let file = file.into();
     let Some(rig) = p.rig else {
         return Err(FileError::new(
             path,
@@ -1202,12 +1250,13 @@ pub fn write_ros(
 
 /// The frames of one mono16/16UC1 image topic (the thermal stream for a source that lacks one):
 /// (stamp, image); the topic is `topic` or the plan's thermal choice.
-pub fn image_frames(
+pub fn image_frames<'a>(
     path: &Path,
     container: Container,
-    file: &[u8],
+    file: impl Into<Input<'a>>,
     topic: Option<&str>,
 ) -> Result<(String, Vec<(f64, Image16)>), FileError> {
+    let file = file.into();
     let topic = match topic {
         Some(t) => t.to_string(),
         None => {

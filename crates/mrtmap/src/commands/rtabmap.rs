@@ -133,16 +133,16 @@ fn thermal_frames(src: &Path, a: &SourceArgs) -> anyhow::Result<(String, Vec<(f6
                 .collect::<anyhow::Result<Vec<_>>>()?;
             Ok((format!("{} (thermal.txt)", src.display()), frames))
         }
-        Ok(SourceKind::Bag | SourceKind::Mcap) => {
-            let c = if ros_scan::source_kind(src)? == SourceKind::Bag {
+        Ok(k @ (SourceKind::Bag | SourceKind::Mcap)) => {
+            let c = if k == SourceKind::Bag {
                 Container::Bag
             } else {
                 Container::Mcap
             };
-            let bytes =
-                std::fs::read(src).with_context(|| format!("{}: cannot read", src.display()))?;
+            // A ROS 2 bag folder resolves to its .mcap file.
+            let (_, file) = ros_scan::resolve_source(src)?;
             let (topic, frames) =
-                ros_scan::image_frames(src, c, &bytes, a.thermal_topic.as_deref())?;
+                ros_scan::image_frames(&file, c, file.as_path(), a.thermal_topic.as_deref())?;
             Ok((format!("{} {topic}", src.display()), frames))
         }
         Ok(SourceKind::Folder) => {

@@ -12,10 +12,6 @@ use serde_json::json;
 use crate::cli::{CompressionArg, ConvertArgs, InspectArgs, SchemaArg, SourceArgs};
 use crate::output::{json, write_atomic};
 
-fn read_file(path: &Path) -> anyhow::Result<Vec<u8>> {
-    std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))
-}
-
 fn ros_options(a: &SourceArgs) -> anyhow::Result<RosOptions> {
     if let Some(s) = a.depth_scale
         && !(s > 0.0 && s.is_finite())
@@ -55,8 +51,10 @@ pub fn inspect(a: &InspectArgs) -> anyhow::Result<()> {
         SourceKind::RtabMap => super::rtabmap::inspect(a),
         SourceKind::Bag | SourceKind::Mcap => {
             let c = container(kind).unwrap_or(Container::Bag);
-            let bytes = read_file(&file)?;
-            let s = ros_scan::survey(c, &bytes).map_err(|e| e.in_file(&file))?;
+            let size = std::fs::metadata(&file)
+                .with_context(|| format!("{}: cannot read", file.display()))?
+                .len();
+            let s = ros_scan::survey(c, file.as_path()).map_err(|e| e.in_file(&file))?;
             let p = ros_scan::plan(&s, &ros_options(&a.src)?);
             if a.json {
                 print!(
@@ -79,7 +77,7 @@ pub fn inspect(a: &InspectArgs) -> anyhow::Result<()> {
                     Container::Bag => "ROS 1 bag",
                     Container::Mcap => "MCAP",
                 },
-                bytes.len(),
+                size,
                 if s.unfinished {
                     ", cut or never closed"
                 } else {
@@ -218,8 +216,7 @@ pub(crate) fn to_layout(source: &Path, out: &Path, a: &SourceArgs) -> anyhow::Re
         SourceKind::RtabMap => super::rtabmap::convert(source, out, a),
         SourceKind::Bag | SourceKind::Mcap => {
             let c = container(kind).unwrap_or(Container::Bag);
-            let bytes = read_file(source)?;
-            let s = ros_scan::survey(c, &bytes).map_err(|e| e.in_file(source))?;
+            let s = ros_scan::survey(c, source).map_err(|e| e.in_file(source))?;
             let p = ros_scan::plan(&s, &ros_options(a)?);
             if !p.missing.is_empty() || p.rig.is_none() {
                 print_plan(&p);
@@ -229,7 +226,7 @@ pub(crate) fn to_layout(source: &Path, out: &Path, a: &SourceArgs) -> anyhow::Re
                     p.missing.join("; ")
                 );
             }
-            let rep = ros_scan::export(source, &bytes, &s, &p, out)?;
+            let rep = ros_scan::export(source, source, &s, &p, out)?;
             println!(
                 "wrote {}: {} depth, {} thermal, {} colour frames, {} poses{}",
                 out.display(),
