@@ -11,7 +11,7 @@ use std::collections::HashMap;
 use std::io::{Read, Seek, SeekFrom};
 
 use crate::bytes::{Bytes, Corrupt, Endian};
-use crate::ros_msg::Wire;
+use crate::ros_msg::{Message, Wire};
 
 /// The bag magic line.
 pub const MAGIC: &[u8] = b"#ROSBAG V2.0\n";
@@ -24,21 +24,6 @@ const OP_INDEX: u8 = 0x04;
 const OP_CHUNK: u8 = 0x05;
 const OP_CHUNK_INFO: u8 = 0x06;
 const OP_CONN: u8 = 0x07;
-
-/// One message as stored.
-#[derive(Clone, Copy, Debug)]
-pub struct BagMessage<'a> {
-    /// Topic.
-    pub topic: &'a str,
-    /// ROS type (`sensor_msgs/Image`).
-    pub datatype: &'a str,
-    /// Record time, s.
-    pub time: f64,
-    /// Serialised message.
-    pub data: &'a [u8],
-    /// File offset of `data` (inside a compressed chunk: the chunk's offset).
-    pub offset: u64,
-}
 
 /// A connection (topic and type).
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -322,7 +307,7 @@ fn read_record<R: Read + Seek + ?Sized>(
 /// Calls `f` for every message of a bag, in file order (chunks decompressed one at a time).
 pub fn for_each_message(
     file: &[u8],
-    f: &mut dyn FnMut(BagMessage<'_>) -> Result<(), Corrupt>,
+    f: &mut dyn FnMut(Message<'_>) -> Result<(), Corrupt>,
 ) -> Result<BagSummary, Corrupt> {
     for_each_message_in(&mut std::io::Cursor::new(file), f)
 }
@@ -331,7 +316,7 @@ pub fn for_each_message(
 /// stays at one chunk, whatever the bag's size.
 pub fn for_each_message_in<R: Read + Seek + ?Sized>(
     r: &mut R,
-    f: &mut dyn FnMut(BagMessage<'_>) -> Result<(), Corrupt>,
+    f: &mut dyn FnMut(Message<'_>) -> Result<(), Corrupt>,
 ) -> Result<BagSummary, Corrupt> {
     let len = r.seek(SeekFrom::End(0)).map_err(|e| io_err(0, &e))?;
     let mut magic = [0u8; 13];
@@ -347,7 +332,7 @@ pub fn for_each_message_in<R: Read + Seek + ?Sized>(
     let handle = |r: &Record<'_>,
                   conns: &mut HashMap<u32, Connection>,
                   offset: u64,
-                  f: &mut dyn FnMut(BagMessage<'_>) -> Result<(), Corrupt>|
+                  f: &mut dyn FnMut(Message<'_>) -> Result<(), Corrupt>|
      -> Result<(), Corrupt> {
         match r.op {
             OP_CONN => {
@@ -369,11 +354,12 @@ pub fn for_each_message_in<R: Read + Seek + ?Sized>(
                         format!("message on connection {id}, which no record defines"),
                     )
                 })?;
-                f(BagMessage {
+                f(Message {
                     topic: &c.topic,
                     datatype: &c.datatype,
                     time: t,
                     data: r.data.data,
+                    wire: Wire::Ros1,
                     offset,
                 })?;
             }
@@ -383,7 +369,7 @@ pub fn for_each_message_in<R: Read + Seek + ?Sized>(
     };
     let mut summary = BagSummary::default();
     let mut bufs = Buffers::default();
-    let mut count = |m: BagMessage<'_>| {
+    let mut count = |m: Message<'_>| {
         summary.messages += 1;
         f(m)
     };

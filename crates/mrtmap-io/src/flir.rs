@@ -190,14 +190,15 @@ pub struct FlirFile {
 }
 
 /// FFF bytes and where each piece came from in the file (for error offsets).
-struct Fff {
-    data: Vec<u8>,
+struct Fff<'a> {
+    /// The FFF bytes: the file itself, or the JPEG's segments joined.
+    data: std::borrow::Cow<'a, [u8]>,
     /// (offset in `data`, offset in the file) of each contiguous piece.
     pieces: Vec<(usize, u64)>,
     segments: usize,
 }
 
-impl Fff {
+impl Fff<'_> {
     fn file_offset(&self, at: u64) -> u64 {
         let mut best = (0usize, 0u64);
         for &(d, f) in &self.pieces {
@@ -214,7 +215,7 @@ impl Fff {
 }
 
 /// The FFF data of a JPEG's APP1 "FLIR" segments, in segment order.
-fn jpeg_fff(file: &[u8]) -> Result<Fff, Corrupt> {
+fn jpeg_fff(file: &[u8]) -> Result<Fff<'static>, Corrupt> {
     let b = Bytes::new(file, Endian::Big);
     let mut pos = 2usize;
     let mut segs: Vec<(u8, u8, usize, usize)> = Vec::new();
@@ -289,7 +290,7 @@ fn jpeg_fff(file: &[u8]) -> Result<Fff, Corrupt> {
         ));
     }
     Ok(Fff {
-        data,
+        data: data.into(),
         pieces,
         segments: segs.len(),
     })
@@ -566,7 +567,7 @@ fn camera_info(rec: Bytes<'_>) -> Result<(FlirParams, Metadata, Option<u16>), Co
 }
 
 /// Parses FFF data.
-fn parse_fff(fff: &Fff) -> Result<FlirFile, Corrupt> {
+fn parse_fff(fff: &Fff<'_>) -> Result<FlirFile, Corrupt> {
     let all = Bytes::new(&fff.data, Endian::Big);
     let magic = all.slice(0, 4, "the FFF header")?;
     if magic != b"FFF\0" && magic != b"AFF\0" {
@@ -648,7 +649,7 @@ pub fn parse_flir(bytes: &[u8]) -> Result<FlirFile, Corrupt> {
         jpeg_fff(bytes)?
     } else {
         Fff {
-            data: bytes.to_vec(),
+            data: bytes.into(),
             pieces: vec![(0, 0)],
             segments: 0,
         }

@@ -11,27 +11,10 @@ use mcap::records::Record;
 
 use crate::bag::MAX_CHUNK_BYTES;
 use crate::bytes::{Bytes, Corrupt, Endian};
-use crate::ros_msg::Wire;
+use crate::ros_msg::{Message, Wire};
 
 /// The MCAP magic.
 pub const MAGIC: &[u8] = b"\x89MCAP0\r\n";
-
-/// One message as stored.
-#[derive(Clone, Copy, Debug)]
-pub struct McapMessage<'a> {
-    /// Topic.
-    pub topic: &'a str,
-    /// Schema name (`sensor_msgs/msg/Image`).
-    pub datatype: &'a str,
-    /// Log time, s.
-    pub time: f64,
-    /// Serialised message.
-    pub data: &'a [u8],
-    /// How it is serialised.
-    pub wire: Wire,
-    /// File offset of the record (of its chunk, for chunked messages).
-    pub offset: u64,
-}
 
 /// What a pass found besides the messages.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -58,7 +41,7 @@ impl State {
         rec: Record<'_>,
         at: u64,
         summary: &mut McapSummary,
-        f: &mut dyn FnMut(McapMessage<'_>) -> Result<(), Corrupt>,
+        f: &mut dyn FnMut(Message<'_>) -> Result<(), Corrupt>,
     ) -> Result<(), Corrupt> {
         match rec {
             Record::Schema { header, .. } => {
@@ -89,7 +72,7 @@ impl State {
                 };
                 let datatype = self.schemas.get(schema).map_or("", String::as_str);
                 summary.messages += 1;
-                f(McapMessage {
+                f(Message {
                     topic,
                     datatype,
                     time: header.log_time as f64 * 1e-9,
@@ -121,7 +104,7 @@ fn record_at<'a>(b: &Bytes<'a>, pos: usize) -> Result<(u8, &'a [u8], usize), Cor
 /// Calls `f` for every CDR or ROS 1 message of an MCAP file, in file order.
 pub fn for_each_message(
     file: &[u8],
-    f: &mut dyn FnMut(McapMessage<'_>) -> Result<(), Corrupt>,
+    f: &mut dyn FnMut(Message<'_>) -> Result<(), Corrupt>,
 ) -> Result<McapSummary, Corrupt> {
     for_each_message_in(&mut std::io::Cursor::new(file), f)
 }
@@ -130,7 +113,7 @@ pub fn for_each_message(
 /// stays at one chunk, whatever the file's size. Records a scan does not need are skipped unread.
 pub fn for_each_message_in<R: Read + Seek + ?Sized>(
     r: &mut R,
-    f: &mut dyn FnMut(McapMessage<'_>) -> Result<(), Corrupt>,
+    f: &mut dyn FnMut(Message<'_>) -> Result<(), Corrupt>,
 ) -> Result<McapSummary, Corrupt> {
     let io = |at: u64, e: std::io::Error| Corrupt::new(at, format!("cannot read: {e}"));
     let len = r.seek(SeekFrom::End(0)).map_err(|e| io(0, e))?;

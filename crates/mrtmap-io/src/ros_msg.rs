@@ -18,6 +18,23 @@ pub enum Wire {
     Cdr,
 }
 
+/// One stored message of a bag or MCAP file, still serialised.
+#[derive(Clone, Copy, Debug)]
+pub struct Message<'a> {
+    /// Topic.
+    pub topic: &'a str,
+    /// Type name (`sensor_msgs/Image`, `sensor_msgs/msg/Image`).
+    pub datatype: &'a str,
+    /// Record (log) time, s.
+    pub time: f64,
+    /// Serialised bytes.
+    pub data: &'a [u8],
+    /// Serialisation.
+    pub wire: Wire,
+    /// File offset of the data (inside a compressed chunk: the chunk's offset).
+    pub offset: u64,
+}
+
 /// A message's stamp and frame.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Header {

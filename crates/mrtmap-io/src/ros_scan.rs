@@ -19,24 +19,7 @@ use crate::error::{FileError, FileErrorKind};
 use crate::image16::{Image16, encode_png_rgb8};
 use crate::layout_writer::LayoutWriter;
 use crate::rig::{RgbCamera, Rig, ThermalEncoding};
-use crate::ros_msg::{self, CameraInfoMsg, MsgKind, StampedTransform, Wire};
-
-/// A message from either container.
-#[derive(Clone, Copy, Debug)]
-pub struct RosMsg<'a> {
-    /// Topic.
-    pub topic: &'a str,
-    /// Type name.
-    pub datatype: &'a str,
-    /// Record (log) time, s.
-    pub time: f64,
-    /// Serialised bytes.
-    pub data: &'a [u8],
-    /// Serialisation.
-    pub wire: Wire,
-    /// File offset (of the record, or of its compressed chunk).
-    pub offset: u64,
-}
+use crate::ros_msg::{self, CameraInfoMsg, Message, MsgKind, StampedTransform, Wire};
 
 /// The container.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -95,33 +78,13 @@ impl<'a> Input<'a> {
 pub fn for_each<'a>(
     container: Container,
     input: impl Into<Input<'a>>,
-    f: &mut dyn FnMut(RosMsg<'_>) -> Result<(), Corrupt>,
+    f: &mut dyn FnMut(Message<'_>) -> Result<(), Corrupt>,
 ) -> Result<bool, Corrupt> {
     let mut r = input.into().open()?;
     let r = &mut *r;
     match container {
-        Container::Bag => crate::bag::for_each_message_in(r, &mut |m| {
-            f(RosMsg {
-                topic: m.topic,
-                datatype: m.datatype,
-                time: m.time,
-                data: m.data,
-                wire: Wire::Ros1,
-                offset: m.offset,
-            })
-        })
-        .map(|s| s.unindexed),
-        Container::Mcap => crate::mcap_file::for_each_message_in(r, &mut |m| {
-            f(RosMsg {
-                topic: m.topic,
-                datatype: m.datatype,
-                time: m.time,
-                data: m.data,
-                wire: m.wire,
-                offset: m.offset,
-            })
-        })
-        .map(|s| s.unfinished),
+        Container::Bag => crate::bag::for_each_message_in(r, f).map(|s| s.unindexed),
+        Container::Mcap => crate::mcap_file::for_each_message_in(r, f).map(|s| s.unfinished),
     }
 }
 
@@ -689,7 +652,7 @@ fn depth_image(i: &ros_msg::ImageMsg<'_>, scale: f64) -> Result<Image16, String>
 /// A 16-bit image from an Image (16UC1/mono16, or 32FC1 metres × `scale`) or a CompressedImage
 /// (a 16-bit PNG, or image_transport's compressedDepth: a 12-byte header, then the PNG).
 fn image16_msg(
-    m: &RosMsg<'_>,
+    m: &Message<'_>,
     kind: MsgKind,
     scale: f64,
     thermal: bool,

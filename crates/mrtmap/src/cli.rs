@@ -183,8 +183,8 @@ pub struct ThermalArgs {
     #[arg(long)]
     pub json: bool,
     /// Size of a raw .y16/.bin file, WxH (default: 160x120 or 80x60 from the file length).
-    #[arg(long, value_name = "WxH")]
-    pub size: Option<String>,
+    #[arg(long, value_name = "WxH", value_parser = parse_image_size)]
+    pub size: Option<(u32, u32)>,
     /// Kelvin per count of 16-bit PNG/TIFF/raw values.
     #[arg(long)]
     pub scale: Option<f64>,
@@ -677,13 +677,32 @@ fn parse_point(s: &str) -> Result<[f64; 3], String> {
     Ok([v[0], v[1], v[2]])
 }
 
-pub(crate) fn parse_grid(s: &str) -> Result<(usize, usize), String> {
-    let bad = || format!("expected COLSxROWS such as 20x20, got '{s}'");
+/// "AxB" (also "A×B") as two numbers; `bad` says what was expected.
+fn parse_pair(s: &str, bad: &dyn Fn() -> String) -> Result<(usize, usize), String> {
     let (a, b) = s.split_once(['x', 'X', '×']).ok_or_else(bad)?;
-    let (a, b) = (
+    Ok((
         a.trim().parse::<usize>().map_err(|_| bad())?,
         b.trim().parse::<usize>().map_err(|_| bad())?,
-    );
+    ))
+}
+
+/// An image size WIDTHxHEIGHT, 1…16384 pixels a side.
+pub(crate) fn parse_image_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = parse_pair(s, &|| {
+        format!("expected WIDTHxHEIGHT such as 160x120, got '{s}'")
+    })?;
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(format!(
+            "an image of {w}×{h} pixels is outside 1…16384 a side"
+        ));
+    }
+    Ok((w as u32, h as u32))
+}
+
+pub(crate) fn parse_grid(s: &str) -> Result<(usize, usize), String> {
+    let (a, b) = parse_pair(s, &|| {
+        format!("expected COLSxROWS such as 20x20, got '{s}'")
+    })?;
     if a == 0 || b == 0 || a * b > 1_000_000 {
         return Err(format!(
             "a grid of {a}×{b} nodes is not allowed (1 to 1,000,000 nodes)"

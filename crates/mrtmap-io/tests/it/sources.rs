@@ -96,6 +96,30 @@ fn recording(dir: &Path) -> Recording {
     Recording::open(dir).unwrap()
 }
 
+/// 16-bit pixels as little-endian bytes (a ROS image's data).
+fn le16(img: &Image16) -> Vec<u8> {
+    img.data.iter().flat_map(|v| v.to_le_bytes()).collect()
+}
+
+/// A recording's thermal frames as mono16 images on `topic` (frame "lepton").
+fn write_thermal(w: &mut BagWriter, rec: &Recording, topic: &str) {
+    for e in &rec.thermal {
+        let img = rec.read_thermal(e).unwrap();
+        let (width, height) = (img.width, img.height);
+        let m = encode::image(
+            Wire::Ros1,
+            e.t,
+            "lepton",
+            width,
+            height,
+            "mono16",
+            2 * width,
+            &le16(&img),
+        );
+        w.write(topic, "sensor_msgs/Image", e.t, &m);
+    }
+}
+
 fn same_pose(a: &Isometry3<f64>, b: &Isometry3<f64>, tol: f64) -> bool {
     (a.translation.vector - b.translation.vector).norm() < tol
         && a.rotation.angle_to(&b.rotation) < tol
@@ -202,7 +226,7 @@ fn poses_from_tf_and_a_missing_thermal_calibration() {
     }
     for e in &orig.depth {
         let img = orig.read_depth(e).unwrap();
-        let le: Vec<u8> = img.data.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let le = le16(&img);
         w.write(
             "/cam/depth",
             "sensor_msgs/Image",
@@ -210,16 +234,7 @@ fn poses_from_tf_and_a_missing_thermal_calibration() {
             &encode::image(Wire::Ros1, e.t, "cam_optical", 20, 15, "16UC1", 40, &le),
         );
     }
-    for e in &orig.thermal {
-        let img = orig.read_thermal(e).unwrap();
-        let le: Vec<u8> = img.data.iter().flat_map(|v| v.to_le_bytes()).collect();
-        w.write(
-            "/lepton/image",
-            "sensor_msgs/Image",
-            e.t,
-            &encode::image(Wire::Ros1, e.t, "lepton", 16, 12, "mono16", 32, &le),
-        );
-    }
+    write_thermal(&mut w, &orig, "/lepton/image");
     let bag = w.finish();
     let s = ros_scan::survey(Container::Bag, &bag).unwrap();
     // No thermal CameraInfo: the plan says so, and a rig supplies it.
@@ -473,16 +488,7 @@ fn compressed_depth_and_float_depth_topics() {
                 );
             }
         }
-        for e in &orig.thermal {
-            let img = orig.read_thermal(e).unwrap();
-            let le: Vec<u8> = img.data.iter().flat_map(|v| v.to_le_bytes()).collect();
-            w.write(
-                "/t/image",
-                "sensor_msgs/Image",
-                e.t,
-                &encode::image(Wire::Ros1, e.t, "lepton", 16, 12, "mono16", 32, &le),
-            );
-        }
+        write_thermal(&mut w, &orig, "/t/image");
         let bag = w.finish();
         let s = ros_scan::survey(Container::Bag, &bag).unwrap();
         let p = ros_scan::plan(

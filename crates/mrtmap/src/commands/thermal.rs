@@ -1,31 +1,12 @@
 //! `mrtmap thermal`: one thermal image → metadata, statistics, CSV / PNG.
 
-use anyhow::{Context, bail};
+use anyhow::bail;
 use mrtmap_io::flir::FlirOverrides;
 use mrtmap_io::{ThermalImage, ThermalOptions, encode_png_rgb8, encode_png16, iron};
 use serde::Serialize;
 
 use crate::cli::ThermalArgs;
 use crate::output::{json, write_atomic};
-
-/// Parses "WxH".
-pub(crate) fn parse_size(s: &str) -> anyhow::Result<(u32, u32)> {
-    let (w, h) = s
-        .split_once(['x', 'X', '×'])
-        .with_context(|| format!("size {s:?} is not WxH (for example 160x120)"))?;
-    let w: u32 = w
-        .trim()
-        .parse()
-        .with_context(|| format!("size {s:?}: bad width"))?;
-    let h: u32 = h
-        .trim()
-        .parse()
-        .with_context(|| format!("size {s:?}: bad height"))?;
-    if w == 0 || h == 0 || w > 16384 || h > 16384 {
-        bail!("size {s:?} is outside 1…16384 pixels a side");
-    }
-    Ok((w, h))
-}
 
 pub(crate) fn options(a: &ThermalArgs) -> anyhow::Result<ThermalOptions> {
     if let Some(e) = a.emissivity
@@ -49,7 +30,7 @@ pub(crate) fn options(a: &ThermalArgs) -> anyhow::Result<ThermalOptions> {
         bail!("--scale {s} must be a positive number of kelvin per count");
     }
     Ok(ThermalOptions {
-        size: a.size.as_deref().map(parse_size).transpose()?,
+        size: a.size,
         scale_k: a.scale,
         offset_k: a.offset_k,
         flir: FlirOverrides {
