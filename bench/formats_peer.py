@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 from rosbags.rosbag1 import Reader as Reader1, Writer as Writer1
-from rosbags.rosbag2 import Reader as Reader2, Writer as Writer2, StoragePlugin
+from rosbags.rosbag2 import Reader as Reader2, Writer as Writer2, StoragePlugin, CompressionMode, CompressionFormat
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 mrtmap, scan, work = sys.argv[1], Path(sys.argv[2]), Path(sys.argv[3])
@@ -72,13 +72,31 @@ def iso(t, q):
 # 1. mrtmap writes, rosbags reads.
 print("1. mrtmap writes, rosbags reads")
 traj = trajectory(scan)
-for ext, comp in [("bag", "bz2"), ("bag", "lz4"), ("mcap", "lz4"), ("mcap", "bz2")]:
+for ext, comp in [("bag", "bz2"), ("bag", "lz4"), ("mcap", "lz4"), ("mcap", "bz2"), ("db3", "none")]:
     label = "zstd" if (ext, comp) == ("mcap", "bz2") else comp
     f = work / f"mrtmap-{label}.{ext}"
     run("convert", scan, "--out", f, "--compression", comp)
     counts, poses, static = {}, [], {}
     if ext == "bag":
         reader, ts, des = Reader1(f), ts1, "deserialize_ros1"
+    elif ext == "db3":
+        # rosbag2's SQLite storage: read the tables with Python's sqlite3, deserialise with rosbags.
+        import sqlite3
+        reader = None
+        con = sqlite3.connect(f)
+        for topic, msgtype, stamp, data in con.execute(
+                "SELECT t.name, t.type, m.timestamp, m.data FROM messages m JOIN topics t ON m.topic_id = t.id ORDER BY m.timestamp"):
+            msg = ts2.deserialize_cdr(bytes(data), msgtype)
+            counts[topic] = counts.get(topic, 0) + 1
+            if topic == "/camera/odom/sample":
+                p = msg.pose.pose
+                poses.append((stamp * 1e-9, iso([p.position.x, p.position.y, p.position.z],
+                                                [p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w])))
+            if topic == "/tf_static":
+                for tr in msg.transforms:
+                    t, q = tr.transform.translation, tr.transform.rotation
+                    static[(tr.header.frame_id, tr.child_frame_id)] = iso([t.x, t.y, t.z], [q.x, q.y, q.z, q.w])
+        con.close()
     else:
         # rosbags reads MCAP inside a ROS 2 bag folder; give it one.
         d = work / f"mrtmap-{comp}-rosbag2"
@@ -231,44 +249,49 @@ def compare(folder):
     return same, err
 
 
+def fill(w, ts, ros1):
+    """Writes the scan's messages with a rosbags writer (ROS 1 or ROS 2)."""
+    conns = {}
+
+    def write(topic, typ, t, msg):
+        if topic not in conns:
+            conns[topic] = w.add_connection(topic, typ, typestore=ts)
+        data = ts.serialize_ros1(msg, typ) if ros1 else ts.serialize_cdr(msg, typ)
+        w.write(conns[topic], int(round(t * 1e9)), data)
+
+    with w:
+        write_all(write, ts, ros1)
+
+
+def check(src, label):
+    """mrtmap converts what rosbags wrote; its frames and poses must be the scan's."""
+    out = work / f"from-{src.name.replace('.', '-')}"
+    run("convert", src, "--out", out)
+    same, err = compare(out)
+    print(f"  {label} → mrtmap convert: depth frames identical {same}, max position error {err:.2e} m")
+    assert same and err < 1e-6
+
+
 for comp in ["bz2", "lz4"]:
     f = work / f"rosbags-{comp}.bag"
     f.unlink(missing_ok=True)
     w = Writer1(f)
     w.set_compression(Writer1.CompressionFormat.BZ2 if comp == "bz2" else Writer1.CompressionFormat.LZ4)
-    with w:
-        conns = {}
+    fill(w, ts1, True)
+    check(f, f"{f.name:<30}")
 
-        def write(topic, typ, t, msg):
-            if topic not in conns:
-                conns[topic] = w.add_connection(topic, typ, typestore=ts1)
-            w.write(conns[topic], int(round(t * 1e9)), ts1.serialize_ros1(msg, typ))
-
-        write_all(write, ts1, True)
-    out = work / f"from-rosbags-{comp}"
-    run("convert", f, "--out", out)
-    same, err = compare(out)
-    print(f"  {f.name:<22} → mrtmap convert: depth frames identical {same}, max position error {err:.2e} m")
-    assert same and err < 1e-6
-
-d = work / "rosbags-rosbag2"
-if d.exists():
-    import shutil
-    shutil.rmtree(d)
-with Writer2(d, version=8, storage_plugin=StoragePlugin.MCAP) as w:
-    conns = {}
-
-    def write(topic, typ, t, msg):
-        if topic not in conns:
-            conns[topic] = w.add_connection(topic, typ, typestore=ts2)
-        w.write(conns[topic], int(round(t * 1e9)), ts2.serialize_cdr(msg, typ))
-
-    write_all(write, ts2, False)
-out = work / "from-rosbags-rosbag2"
-run("convert", d, "--out", out)
-same, err = compare(out)
-print(f"  {d.name:<22} (ROS 2 bag folder, MCAP storage, CDR) → mrtmap convert: depth frames identical {same}, max position error {err:.2e} m")
-assert same and err < 1e-6
+for storage, compress in [("mcap", False), ("sqlite3", False), ("sqlite3", True)]:
+    d = work / f"rosbags-rosbag2-{storage}{'-zstd' if compress else ''}"
+    if d.exists():
+        import shutil
+        shutil.rmtree(d)
+    plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
+    w = Writer2(d, version=8, storage_plugin=plugin)
+    if compress:
+        # Each message zstd-compressed on its own (rosbag2's compression_mode: message).
+        w.set_compression(CompressionMode.MESSAGE, CompressionFormat.ZSTD)
+    fill(w, ts2, False)
+    check(d, f"{d.name:<30} (ROS 2 bag folder, {storage} storage{', zstd per message' if compress else ''}, CDR)")
 
 # 3. Speed.
 print("3. reading every message (median of 3)")
@@ -293,3 +316,21 @@ size = f.stat().st_size / 1e6
 print(f"  {f.name} ({size:.1f} MB, {n} messages): rosbags deserialise every message {th:.2f} s;"
       f" mrtmap inspect (decompress + decode every message) {sv:.2f} s, {th / sv:.1f}x rosbags' speed;"
       f" mrtmap convert (also decode images, write the PNG folder) {o:.2f} s")
+
+d = work / "rosbags-rosbag2-sqlite3"
+ours, theirs = [], []
+for _ in range(3):
+    t = time.perf_counter()
+    run("inspect", d)
+    ours.append(time.perf_counter() - t)
+    t = time.perf_counter()
+    n = 0
+    with Reader2(d) as r:
+        for conn, _, raw in r.messages():
+            ts2.deserialize_cdr(raw, conn.msgtype)
+            n += 1
+    theirs.append(time.perf_counter() - t)
+o, th = statistics.median(ours), statistics.median(theirs)
+size = sum(p.stat().st_size for p in d.glob("*.db3")) / 1e6
+print(f"  {d.name} (ROS 2 SQLite storage, {size:.1f} MB, {n} messages): rosbags deserialise every message {th:.2f} s;"
+      f" mrtmap inspect {o:.2f} s, {th / o:.1f}x rosbags' speed")

@@ -83,6 +83,20 @@ fn main() {
         }
         put("mcap", name, &w.finish().expect("finish"));
     }
+    for (name, zstd) in [("plain", false), ("zstd", true)] {
+        let mut w = mrtmap_io::rosbag2::Db3Writer::new().expect("db3");
+        for (k, (topic, ty, m)) in messages(Wire::Cdr).into_iter().enumerate() {
+            let (pkg, n) = ty.split_once('/').expect("type");
+            let m = if zstd {
+                ::zstd::encode_all(&m[..], 3).expect("zstd")
+            } else {
+                m
+            };
+            w.write(topic, &format!("{pkg}/msg/{n}"), 1.0 + k as f64 * 0.01, &m)
+                .expect("write");
+        }
+        put("db3", name, &w.finish().expect("finish"));
+    }
     let depth = Image16 {
         width: 8,
         height: 6,

@@ -361,6 +361,7 @@ pub fn for_each_message_in<R: Read + Seek + ?Sized>(
                     data: r.data.data,
                     wire: Wire::Ros1,
                     offset,
+                    record: None,
                 })?;
             }
             _ => {}

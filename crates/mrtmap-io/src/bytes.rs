@@ -6,12 +6,20 @@ use std::path::Path;
 use crate::error::FileError;
 
 /// A problem at a byte offset of a file (the path is added by [`Corrupt::in_file`]).
+///
+/// In a rosbag2 SQLite file a message has no file offset: `record` is then its row id in the
+/// `messages` table and `offset` counts from the start of its data. In a bag split over several
+/// files, `part` names the file.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Corrupt {
-    /// Byte offset from the start of the file.
+    /// Byte offset from the start of the file (or of the record's data).
     pub offset: u64,
     /// What is wrong.
     pub what: String,
+    /// The message's row id, where the file is a database.
+    pub record: Option<u64>,
+    /// The file of a split bag.
+    pub part: Option<String>,
 }
 
 impl Corrupt {
@@ -20,18 +28,52 @@ impl Corrupt {
         Self {
             offset,
             what: what.into(),
+            record: None,
+            part: None,
         }
+    }
+
+    /// The same problem, inside database message `record` (if not already placed in one).
+    #[must_use]
+    pub fn in_record(mut self, record: Option<u64>) -> Self {
+        self.record = self.record.or(record);
+        self
+    }
+
+    /// The same problem, in file `part` of a split bag.
+    #[must_use]
+    pub fn in_part(mut self, part: &str) -> Self {
+        self.part.get_or_insert_with(|| part.to_string());
+        self
     }
 
     /// As a file error.
     pub fn in_file(self, path: &Path) -> FileError {
-        FileError::corrupt(path, self.offset, self.what)
+        if self.record.is_none() && self.part.is_none() {
+            FileError::corrupt(path, self.offset, self.what)
+        } else {
+            FileError::new(
+                path,
+                None,
+                crate::error::FileErrorKind::Syntax(self.to_string()),
+            )
+        }
     }
 }
 
 impl std::fmt::Display for Corrupt {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "at byte {}: {}", self.offset, self.what)
+        if let Some(p) = &self.part {
+            write!(f, "{p}, ")?;
+        }
+        match self.record {
+            Some(r) => write!(
+                f,
+                "message {r}, at byte {} of its data: {}",
+                self.offset, self.what
+            ),
+            None => write!(f, "at byte {}: {}", self.offset, self.what),
+        }
     }
 }
 

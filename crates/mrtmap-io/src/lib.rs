@@ -12,9 +12,9 @@
 //!    masks.txt, masks/ instance PNG + labels JSON       → Image16 + MaskLabels
 //! ```
 //!
-//! Other sources become that layout: ROS 1 bags ([`bag`]) and MCAP files ([`mcap_file`]) through
-//! [`ros_scan`] (messages decoded by [`ros_msg`]), RTAB-Map databases ([`rtabmap`], depth in
-//! [`rvl`]); [`layout_writer`] writes the folder. Single thermal images in camera formats (FLIR
+//! Other sources become that layout: ROS 1 bags ([`bag`]), MCAP files ([`mcap_file`]) and ROS 2
+//! SQLite bags ([`rosbag2`]) through [`ros_scan`] (messages decoded by [`ros_msg`]), RTAB-Map
+//! databases ([`rtabmap`], depth in [`rvl`]); [`layout_writer`] writes the folder. Single thermal images in camera formats (FLIR
 //! R-JPEG/FFF in [`flir`], Lepton, radiometric TIFF) are read by [`read_thermal_file`]. Binary
 //! parsers read through [`bytes`], whose errors carry the byte offset.
 //!
@@ -37,6 +37,7 @@ mod recording;
 mod rig;
 pub mod ros_msg;
 pub mod ros_scan;
+pub mod rosbag2;
 pub mod rtabmap;
 pub mod rvl;
 mod streams;

@@ -79,6 +79,7 @@ impl State {
                     data: &data,
                     wire,
                     offset: at,
+                    record: None,
                 })?;
             }
             _ => {}

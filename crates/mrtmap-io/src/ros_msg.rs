@@ -18,7 +18,7 @@ pub enum Wire {
     Cdr,
 }
 
-/// One stored message of a bag or MCAP file, still serialised.
+/// One stored message of a bag, an MCAP file or a rosbag2 SQLite file, still serialised.
 #[derive(Clone, Copy, Debug)]
 pub struct Message<'a> {
     /// Topic.
@@ -31,8 +31,20 @@ pub struct Message<'a> {
     pub data: &'a [u8],
     /// Serialisation.
     pub wire: Wire,
-    /// File offset of the data (inside a compressed chunk: the chunk's offset).
+    /// File offset of the data (inside a compressed chunk: the chunk's offset; in a database: 0).
     pub offset: u64,
+    /// The row id in a rosbag2 SQLite file's `messages` table.
+    pub record: Option<u64>,
+}
+
+impl Message<'_> {
+    /// Where the message is, for reports: `at byte N` or `message N`.
+    pub fn place(&self) -> String {
+        match self.record {
+            Some(r) => format!("message {r}"),
+            None => format!("at byte {}", self.offset),
+        }
+    }
 }
 
 /// A message's stamp and frame.

@@ -28,9 +28,12 @@ pub enum Container {
     Bag,
     /// MCAP.
     Mcap,
+    /// ROS 2 bag in SQLite storage (`.db3`).
+    Db3,
 }
 
-/// Where a bag or MCAP file is read from: bytes in memory, or a file read a record at a time.
+/// Where a bag, MCAP or `.db3` file is read from: bytes in memory, or a file read a record at a
+/// time. A folder stands for a ROS 2 bag split into several files, read in order.
 #[derive(Clone, Copy, Debug)]
 pub enum Input<'a> {
     /// In memory.
@@ -80,12 +83,67 @@ pub fn for_each<'a>(
     input: impl Into<Input<'a>>,
     f: &mut dyn FnMut(Message<'_>) -> Result<(), Corrupt>,
 ) -> Result<bool, Corrupt> {
-    let mut r = input.into().open()?;
+    let input = input.into();
+    if let Input::File(dir) = input
+        && dir.is_dir()
+    {
+        let mut unfinished = false;
+        for file in storage_files(dir, container)? {
+            let name = file
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            unfinished |=
+                for_each(container, Input::File(&file), f).map_err(|e| e.in_part(&name))?;
+        }
+        return Ok(unfinished);
+    }
+    if container == Container::Db3 {
+        let c = match input {
+            Input::Bytes(b) => crate::rosbag2::open_bytes(b)?,
+            Input::File(p) => crate::rosbag2::open_file(p)?,
+        };
+        return crate::rosbag2::for_each_message(&c, f).map(|_| false);
+    }
+    let mut r = input.open()?;
     let r = &mut *r;
     match container {
         Container::Bag => crate::bag::for_each_message_in(r, f).map(|s| s.unindexed),
         Container::Mcap => crate::mcap_file::for_each_message_in(r, f).map(|s| s.unfinished),
+        Container::Db3 => Ok(false),
     }
+}
+
+/// The storage files of a ROS 2 bag folder for `container` (`.mcap` or `.db3`), in recording
+/// order: rosbag2 names them `<bag>_<n>`, so they are sorted by that trailing number.
+pub fn storage_files(dir: &Path, container: Container) -> Result<Vec<std::path::PathBuf>, Corrupt> {
+    let ext = match container {
+        Container::Mcap => "mcap",
+        Container::Db3 => "db3",
+        Container::Bag => "bag",
+    };
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .map_err(|e| Corrupt::new(0, format!("cannot list the folder: {e}")))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_file() && p.extension().is_some_and(|e| e == ext))
+        .collect();
+    files.sort_by_key(|p| {
+        let stem = p
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let digits = stem.len() - stem.trim_end_matches(|c: char| c.is_ascii_digit()).len();
+        let (head, n) = stem.split_at(stem.len() - digits);
+        (
+            head.to_string(),
+            n.parse::<u64>().unwrap_or(0),
+            stem.clone(),
+        )
+    });
+    if files.is_empty() {
+        return Err(Corrupt::new(0, format!("a folder without .{ext} files")));
+    }
+    Ok(files)
 }
 
 /// Stream choices and rig overrides.
@@ -165,7 +223,8 @@ fn stamp_or(t: f64, record: f64) -> f64 {
     if t > 0.0 { t } else { record }
 }
 
-/// Surveys a bag or MCAP file (one pass; images are not decoded).
+/// Surveys a bag, MCAP or `.db3` file, or a split ROS 2 bag's folder (one pass; images are not
+/// decoded).
 pub fn survey<'a>(container: Container, file: impl Into<Input<'a>>) -> Result<Survey, Corrupt> {
     let file = file.into();
     let mut s = Survey {
@@ -243,7 +302,7 @@ pub fn survey<'a>(container: Container, file: impl Into<Input<'a>>) -> Result<Su
         if let Err(e) = res {
             st.undecodable += 1;
             if st.first_error.is_none() {
-                st.first_error = Some(e.to_string());
+                st.first_error = Some(e.in_record(m.record).to_string());
             }
         }
         st.t0 = st.t0.min(t);
@@ -781,11 +840,10 @@ pub fn export<'a>(
     let mut w = LayoutWriter::create(out, &format!("converted by mrtmap from {}", path.display()))?;
     let mut rep = ExportReport::default();
     let mut err: Option<FileError> = None;
-    let skip = |rep: &mut ExportReport, topic: &str, off: u64, why: String| {
+    let skip = |rep: &mut ExportReport, topic: &str, place: String, why: String| {
         rep.skipped += 1;
         if rep.skipped_reasons.len() < 5 {
-            rep.skipped_reasons
-                .push(format!("{topic} at byte {off}: {why}"));
+            rep.skipped_reasons.push(format!("{topic} {place}: {why}"));
         }
     };
     let tf_pose = match &p.poses {
@@ -861,7 +919,7 @@ pub fn export<'a>(
                 err = Some(e);
                 return Err(Corrupt::new(m.offset, "stopped: cannot write the output"));
             }
-            Err(Step::Skip(why)) => skip(&mut rep, m.topic, m.offset, why),
+            Err(Step::Skip(why)) => skip(&mut rep, m.topic, m.place(), why),
         }
         Ok(())
     });
@@ -897,8 +955,22 @@ pub enum SourceKind {
     Bag,
     /// MCAP.
     Mcap,
+    /// ROS 2 bag in SQLite storage (`.db3`).
+    Db3,
     /// RTAB-Map database (SQLite).
     RtabMap,
+}
+
+impl SourceKind {
+    /// The message container, for the kinds that have one.
+    pub fn container(self) -> Option<Container> {
+        match self {
+            Self::Bag => Some(Container::Bag),
+            Self::Mcap => Some(Container::Mcap),
+            Self::Db3 => Some(Container::Db3),
+            Self::Folder | Self::RtabMap => None,
+        }
+    }
 }
 
 /// Tells the kind of a source by its content (a folder, or a file's magic bytes).
@@ -906,31 +978,38 @@ pub fn source_kind(path: &Path) -> Result<SourceKind, FileError> {
     resolve_source(path).map(|(k, _)| k)
 }
 
-/// The kind of a source and the file to read: a ROS 2 bag folder (`metadata.yaml` beside one
-/// `.mcap` file) resolves to its MCAP file.
+/// The kind of a source and what to read. A ROS 2 bag folder (`metadata.yaml` beside its
+/// storage files) resolves to its one `.mcap` or `.db3` file, or stays the folder when the bag is
+/// split over several (they are then read in order). An SQLite file is a rosbag2 `.db3` when it
+/// has rosbag2's tables, else an RTAB-Map database.
 pub fn resolve_source(path: &Path) -> Result<(SourceKind, std::path::PathBuf), FileError> {
     if path.is_dir() {
         if path.join("metadata.yaml").is_file() {
-            let mut files: Vec<_> = std::fs::read_dir(path)
+            let files: Vec<_> = std::fs::read_dir(path)
                 .map_err(|e| FileError::io(path, e))?
                 .filter_map(|e| e.ok().map(|e| e.path()))
                 .collect();
-            files.sort();
-            let mcaps: Vec<_> = files
-                .iter()
-                .filter(|p| p.extension().is_some_and(|e| e == "mcap"))
-                .collect();
+            let with = |ext: &str| {
+                files
+                    .iter()
+                    .filter(|p| p.extension().is_some_and(|e| e == ext))
+                    .cloned()
+                    .collect::<Vec<_>>()
+            };
+            let one_or_all = |kind, v: Vec<std::path::PathBuf>| match v.as_slice() {
+                [one] => Ok((kind, one.clone())),
+                _ => Ok((kind, path.to_path_buf())),
+            };
+            let (mcaps, db3s) = (with("mcap"), with("db3"));
             let bad = |m: String| Err(FileError::new(path, None, FileErrorKind::Syntax(m)));
-            return match mcaps.as_slice() {
-                [one] => Ok((SourceKind::Mcap, one.to_path_buf())),
-                [] if files.iter().any(|p| p.extension().is_some_and(|e| e == "db3")) => bad(
-                    "a ROS 2 bag in SQLite storage (.db3) is not read: record with --storage mcap, or convert it with `ros2 bag convert`".into(),
+            return match (mcaps.is_empty(), db3s.is_empty()) {
+                (false, true) => one_or_all(SourceKind::Mcap, mcaps),
+                (true, false) => one_or_all(SourceKind::Db3, db3s),
+                (false, false) => bad("a ROS 2 bag folder with both .mcap and .db3 files: give one file".into()),
+                (true, true) if !with("zstd").is_empty() => bad(
+                    "a ROS 2 bag compressed file by file (.zstd): decompress it first (`ros2 bag convert`, or `zstd -d` on each file)".into(),
                 ),
-                [] => bad("a ROS 2 bag folder without an .mcap file".into()),
-                many => bad(format!(
-                    "a ROS 2 bag split into {} .mcap files: give one file",
-                    many.len()
-                )),
+                (true, true) => bad("a ROS 2 bag folder without .mcap or .db3 files".into()),
             };
         }
         return Ok((SourceKind::Folder, path.to_path_buf()));
@@ -947,13 +1026,16 @@ pub fn resolve_source(path: &Path) -> Result<(SourceKind, std::path::PathBuf), F
     } else if head.starts_with(crate::mcap_file::MAGIC) {
         SourceKind::Mcap
     } else if head.starts_with(b"SQLite format 3\0") {
-        SourceKind::RtabMap
+        match crate::rosbag2::open_file(path) {
+            Ok(c) if crate::rosbag2::is_rosbag2(&c) => SourceKind::Db3,
+            _ => SourceKind::RtabMap,
+        }
     } else {
         return Err(FileError::new(
             path,
             None,
             FileErrorKind::Syntax(
-                "not a scan source: expected a recording folder, a ROS 1 bag, an MCAP file (or ROS 2 bag folder) or an RTAB-Map database".into(),
+                "not a scan source: expected a recording folder, a ROS 1 bag, an MCAP file, a ROS 2 bag (folder or .db3) or an RTAB-Map database".into(),
             ),
         ));
     };
@@ -1025,12 +1107,14 @@ pub fn write_ros(
     use crate::ros_msg::encode;
     let wire = match o.container {
         Container::Bag => Wire::Ros1,
-        Container::Mcap => Wire::Cdr,
+        Container::Mcap | Container::Db3 => Wire::Cdr,
     };
     enum W {
         Bag(BagWriter),
         Mcap(Box<crate::mcap_file::McapWriter>),
+        Db3(crate::rosbag2::Db3Writer),
     }
+    let syntax = |e: String| FileError::new(&rec.dir, None, FileErrorKind::Syntax(e));
     let mut w = match o.container {
         Container::Bag => W::Bag(BagWriter::new(o.compression, 768 * 1024)),
         Container::Mcap => W::Mcap(Box::new(
@@ -1042,13 +1126,14 @@ pub fn write_ros(
                 },
                 768 * 1024,
             )
-            .map_err(|e| FileError::new(&rec.dir, None, FileErrorKind::Syntax(e)))?,
+            .map_err(syntax)?,
         )),
+        Container::Db3 => W::Db3(crate::rosbag2::Db3Writer::new().map_err(syntax)?),
     };
     let ty = |t: &str| -> String {
         match o.container {
             Container::Bag => t.to_string(),
-            Container::Mcap => {
+            Container::Mcap | Container::Db3 => {
                 let (pkg, name) = t.split_once('/').unwrap_or(("", t));
                 format!("{pkg}/msg/{name}")
             }
@@ -1060,9 +1145,8 @@ pub fn write_ros(
                 b.write(topic, &ty(datatype), t, data);
                 Ok(())
             }
-            W::Mcap(m) => m
-                .write(topic, &ty(datatype), t, data)
-                .map_err(|e| FileError::new(&rec.dir, None, FileErrorKind::Syntax(e))),
+            W::Mcap(m) => m.write(topic, &ty(datatype), t, data).map_err(syntax),
+            W::Db3(d) => d.write(topic, &ty(datatype), t, data).map_err(syntax),
         }
     };
     let rig = &rec.rig;
@@ -1205,9 +1289,8 @@ pub fn write_ros(
     }
     match w {
         W::Bag(b) => Ok(b.finish()),
-        W::Mcap(m) => m
-            .finish()
-            .map_err(|e| FileError::new(&rec.dir, None, FileErrorKind::Syntax(e))),
+        W::Mcap(m) => m.finish().map_err(syntax),
+        W::Db3(d) => d.finish().map_err(syntax),
     }
 }
 

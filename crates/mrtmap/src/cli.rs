@@ -53,8 +53,8 @@ pub enum Command {
     Thermal(ThermalArgs),
     /// List what a scan source holds: streams, counts, rates, time span, and what a scan lacks.
     Inspect(InspectArgs),
-    /// Convert a ROS 1 bag, MCAP file or RTAB-Map database to the recording layout (or a
-    /// recording folder to a bag or MCAP file).
+    /// Convert a ROS 1 bag, ROS 2 bag (MCAP or SQLite), MCAP file or RTAB-Map database to the
+    /// recording layout (or a recording folder to a bag, MCAP, .db3 or RTAB-Map-layout file).
     Convert(ConvertArgs),
 }
 
@@ -81,8 +81,8 @@ pub struct SourceArgs {
     /// Raw depth units per metre of 16-bit depth (default 1000, RealSense).
     #[arg(long)]
     pub depth_scale: Option<f64>,
-    /// Thermal frames for a source without them (an RTAB-Map database): a bag/MCAP with a mono16
-    /// topic, or a folder of 16-bit thermal images named by timestamp.
+    /// Thermal frames for a source without them (an RTAB-Map database): a bag/MCAP/ROS 2 bag with
+    /// a mono16 topic, or a folder of 16-bit thermal images named by timestamp.
     #[arg(long, value_name = "SRC")]
     pub thermal: Option<PathBuf>,
 }
@@ -91,10 +91,11 @@ pub struct SourceArgs {
 #[derive(Debug, Args)]
 #[command(after_long_help = "Examples:
   mrtmap inspect scan.bag
+  mrtmap inspect rosbag2_2026_11_22-10_00_00/     (ROS 2 bag folder: .mcap or .db3, split or not)
   mrtmap inspect rtabmap.db --json
   mrtmap inspect scan/")]
 pub struct InspectArgs {
-    /// A recording folder, ROS 1 bag, MCAP file or RTAB-Map database.
+    /// A recording folder, ROS 1 bag, MCAP file, ROS 2 bag (folder or .db3) or RTAB-Map database.
     pub source: PathBuf,
     /// Print JSON.
     #[arg(long)]
@@ -132,15 +133,17 @@ pub enum SchemaArg {
   mrtmap convert rtabmap.db --out scan --thermal thermal.bag --rig rig.toml
   mrtmap convert scan --out scan.bag            (recording folder → RealSense-style bag)
   mrtmap convert scan --out scan.db             (recording folder → RTAB-Map-layout database)
+  mrtmap convert scan --out scan.db3            (recording folder → ROS 2 bag, SQLite storage)
 
-A bag, MCAP file or database becomes the recording layout (depth/, thermal/, rgb/, lists,
+A bag (ROS 1, or a ROS 2 folder of .mcap or .db3 files), MCAP file or database becomes the recording layout (depth/, thermal/, rgb/, lists,
 trajectory.txt, rig.toml, source.json saying what was chosen). A recording folder with an output
-ending in .bag or .mcap becomes a RealSense-style bag or MCAP file, and one ending in .db a
+ending in .bag, .mcap or .db3 becomes a RealSense-style bag, MCAP or rosbag2 SQLite file, and one
+ending in .db a
 database in RTAB-Map's layout with a node per colour frame (to test readers and pipelines).")]
 pub struct ConvertArgs {
     /// The source.
     pub source: PathBuf,
-    /// Output folder (or .bag / .mcap file for a recording folder).
+    /// Output folder (or .bag / .mcap / .db3 / .db file for a recording folder).
     #[arg(long, value_name = "OUT")]
     pub out: PathBuf,
     /// Chunk compression when writing a bag or MCAP file.
@@ -295,8 +298,8 @@ pub struct SimulateBoardArgs {
 #[derive(Debug, Args)]
 #[command(after_long_help = crate::project::PROJECT_EXAMPLE)]
 pub struct RunArgs {
-    /// The recording: a folder (shared/spec/recording.md), a ROS 1 bag, an MCAP file or an
-    /// RTAB-Map database (converted into OUT/recording first).
+    /// The recording: a folder (shared/spec/recording.md), a ROS 1 bag, an MCAP file, a ROS 2 bag
+    /// (folder or .db3) or an RTAB-Map database (converted into OUT/recording first).
     pub recording: PathBuf,
     /// How to read a bag, MCAP file or database.
     #[command(flatten)]
@@ -417,8 +420,8 @@ pub enum OnOff {
 /// `mrtmap fuse`.
 #[derive(Debug, Args)]
 pub struct FuseArgs {
-    /// The recording: a folder (shared/spec/recording.md), a ROS 1 bag, an MCAP file or an
-    /// RTAB-Map database (converted into OUT/recording first).
+    /// The recording: a folder (shared/spec/recording.md), a ROS 1 bag, an MCAP file, a ROS 2 bag
+    /// (folder or .db3) or an RTAB-Map database (converted into OUT/recording first).
     pub recording: PathBuf,
     /// How to read a bag, MCAP file or database.
     #[command(flatten)]

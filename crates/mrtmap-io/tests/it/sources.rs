@@ -1,4 +1,4 @@
-//! Bags, MCAP files and RTAB-Map databases built with this crate's writers (and the same
+//! Bags (ROS 1, ROS 2 SQLite), MCAP files and RTAB-Map databases built with this crate's writers (and the same
 //! `mcap`, `bzip2`, `lz4_flex`, `rusqlite` crates), read back through the same path `convert`
 //! takes: every frame, pose and camera must come back; broken files must give errors with offsets.
 
@@ -167,6 +167,7 @@ fn bags_and_mcap_files_round_trip_with_every_compression() {
         (Container::Mcap, Compression::None),
         (Container::Mcap, Compression::Bz2),
         (Container::Mcap, Compression::Lz4),
+        (Container::Db3, Compression::None),
     ] {
         let bytes = ros_scan::write_ros(&orig, &RosWriteOptions::t265_like(container, compression))
             .unwrap();
@@ -521,4 +522,178 @@ fn compressed_depth_and_float_depth_topics() {
             );
         }
     }
+}
+
+/// Every message of a bag or MCAP file, owned: (topic, type, time, data).
+fn messages(c: Container, bytes: &[u8]) -> Vec<(String, String, f64, Vec<u8>)> {
+    let mut v = Vec::new();
+    ros_scan::for_each(c, bytes, &mut |m| {
+        v.push((
+            m.topic.to_string(),
+            m.datatype.to_string(),
+            m.time,
+            m.data.to_vec(),
+        ));
+        Ok(())
+    })
+    .unwrap();
+    v
+}
+
+#[test]
+fn ros2_bag_folders_split_over_files_read_in_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let orig = recording(&dir.path().join("scan"));
+    let mcap = ros_scan::write_ros(
+        &orig,
+        &RosWriteOptions::t265_like(Container::Mcap, Compression::None),
+    )
+    .unwrap();
+    let all = messages(Container::Mcap, &mcap);
+    // Twelve files: `_10` and `_11` sort after `_9` only when the number is read as one.
+    let parts = 12;
+    let per = all.len().div_ceil(parts);
+    for (c, ext) in [(Container::Mcap, "mcap"), (Container::Db3, "db3")] {
+        let bag = dir.path().join(format!("rosbag2_{ext}"));
+        std::fs::create_dir_all(&bag).unwrap();
+        std::fs::write(bag.join("metadata.yaml"), "rosbag2_bagfile_information:\n").unwrap();
+        for (i, chunk) in all.chunks(per).enumerate() {
+            let bytes = if c == Container::Mcap {
+                let mut w = mrtmap_io::mcap_file::McapWriter::new(None, 1 << 16).unwrap();
+                for (topic, ty, t, data) in chunk {
+                    w.write(topic, ty, *t, data).unwrap();
+                }
+                w.finish().unwrap()
+            } else {
+                let mut w = mrtmap_io::rosbag2::Db3Writer::new().unwrap();
+                for (topic, ty, t, data) in chunk {
+                    w.write(topic, ty, *t, data).unwrap();
+                }
+                w.finish().unwrap()
+            };
+            std::fs::write(bag.join(format!("rosbag2_{ext}_{i}.{ext}")), bytes).unwrap();
+        }
+        let (kind, file) = ros_scan::resolve_source(&bag).unwrap();
+        assert_eq!((kind.container(), file.as_path()), (Some(c), bag.as_path()));
+        let order: Vec<String> = ros_scan::storage_files(&bag, c)
+            .unwrap()
+            .iter()
+            .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
+            .collect();
+        let n = all.chunks(per).count();
+        assert!(n > 10, "{n} files");
+        let expected: Vec<String> = (0..n).map(|i| format!("rosbag2_{ext}_{i}")).collect();
+        assert_eq!(order, expected);
+        // Read in that order, the messages are the original ones in the original order.
+        let mut back = Vec::new();
+        ros_scan::for_each(c, bag.as_path(), &mut |m| {
+            back.push((m.topic.to_string(), m.time, m.data.to_vec()));
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(back.len(), all.len());
+        for (i, (a, b)) in back.iter().zip(&all).enumerate() {
+            // Times are f64 seconds: at 1.7e9 s they resolve 0.24 µs, so rewriting rounds them.
+            assert!(
+                a.0 == b.0 && (a.1 - b.2).abs() < 1e-6 && a.2 == b.3,
+                "{ext} message {i}: {} {} / {} {}",
+                a.0,
+                a.1,
+                b.0,
+                b.2
+            );
+        }
+        let s = ros_scan::survey(c, bag.as_path()).unwrap();
+        let p = ros_scan::plan(&s, &RosOptions::default());
+        let out = dir.path().join(format!("from-{ext}"));
+        let rep = ros_scan::export(&bag, bag.as_path(), &s, &p, &out).unwrap();
+        assert_eq!((rep.depth, rep.thermal, rep.rgb, rep.poses), (10, 5, 5, 51));
+        assert_same(&orig, &Recording::open(&out).unwrap(), 1e-9);
+        // A broken message in the ninth file is named by file and row.
+        let ninth = bag.join(format!("rosbag2_{ext}_8.{ext}"));
+        if c == Container::Db3 {
+            let db = rusqlite::Connection::open(&ninth).unwrap();
+            db.execute("UPDATE messages SET topic_id = 99 WHERE id = 2", [])
+                .unwrap();
+            drop(db);
+            let e = ros_scan::survey(c, bag.as_path()).unwrap_err();
+            assert_eq!(
+                e.in_file(&bag).to_string(),
+                format!(
+                    "{}: rosbag2_db3_8.db3, message 2, at byte 0 of its data: topic id 99, which the topics table does not list",
+                    bag.display()
+                )
+            );
+        } else {
+            // A message record that claims more bytes than the file has.
+            std::fs::write(&ninth, b"\x89MCAP0\r\n\x05\xff\xff\0\0\0\0\0\0").unwrap();
+            let e = ros_scan::survey(c, bag.as_path()).unwrap_err();
+            assert!(
+                e.to_string().starts_with("rosbag2_mcap_8.mcap, at byte"),
+                "{e}"
+            );
+        }
+    }
+    // A folder with no storage file, or one compressed file by file, is refused with the reason.
+    let empty = dir.path().join("empty_bag");
+    std::fs::create_dir_all(&empty).unwrap();
+    std::fs::write(empty.join("metadata.yaml"), "").unwrap();
+    let e = ros_scan::resolve_source(&empty).unwrap_err().to_string();
+    assert!(e.contains("without .mcap or .db3"), "{e}");
+    std::fs::write(empty.join("empty_bag_0.db3.zstd"), b"(\xb5/\xfd").unwrap();
+    let e = ros_scan::resolve_source(&empty).unwrap_err().to_string();
+    assert!(e.contains("decompress"), "{e}");
+}
+
+#[test]
+fn db3_files_are_told_from_rtabmap_databases_and_bad_messages_skipped() {
+    let dir = tempfile::tempdir().unwrap();
+    let orig = recording(&dir.path().join("scan"));
+    let db3 = ros_scan::write_ros(
+        &orig,
+        &RosWriteOptions::t265_like(Container::Db3, Compression::None),
+    )
+    .unwrap();
+    let f = dir.path().join("scan.db3");
+    std::fs::write(&f, &db3).unwrap();
+    assert_eq!(
+        ros_scan::source_kind(&f).unwrap(),
+        ros_scan::SourceKind::Db3
+    );
+    let rt = dir.path().join("rtabmap.db");
+    rtabmap::write_recording(&orig, &rt, Schema::Current).unwrap();
+    assert_eq!(
+        ros_scan::source_kind(&rt).unwrap(),
+        ros_scan::SourceKind::RtabMap
+    );
+    // Cut the data of the third depth message: it is skipped, counted and named by its row.
+    let db = rusqlite::Connection::open(&f).unwrap();
+    let id: i64 = db
+        .query_row(
+            "SELECT m.id FROM messages m JOIN topics t ON m.topic_id = t.id WHERE t.name = ?1 ORDER BY m.timestamp LIMIT 1 OFFSET 2",
+            [names::DEPTH],
+            |r| r.get(0),
+        )
+        .unwrap();
+    db.execute(
+        "UPDATE messages SET data = substr(data, 1, 100) WHERE id = ?1",
+        [id],
+    )
+    .unwrap();
+    drop(db);
+    let s = ros_scan::survey(Container::Db3, f.as_path()).unwrap();
+    assert_eq!(s.topics[names::DEPTH].undecodable, 1);
+    let first = s.topics[names::DEPTH].first_error.clone().unwrap();
+    assert!(
+        first.starts_with(&format!("message {id}, at byte ")),
+        "{first}"
+    );
+    let p = ros_scan::plan(&s, &RosOptions::default());
+    let rep = ros_scan::export(&f, f.as_path(), &s, &p, &dir.path().join("out")).unwrap();
+    assert_eq!((rep.depth, rep.skipped), (9, 1));
+    assert!(
+        rep.skipped_reasons[0].starts_with(&format!("{} message {id}: ", names::DEPTH)),
+        "{:?}",
+        rep.skipped_reasons
+    );
 }

@@ -133,14 +133,10 @@ fn thermal_frames(src: &Path, a: &SourceArgs) -> anyhow::Result<(String, Vec<(f6
                 .collect::<anyhow::Result<Vec<_>>>()?;
             Ok((format!("{} (thermal.txt)", src.display()), frames))
         }
-        Ok(k @ (SourceKind::Bag | SourceKind::Mcap)) => {
-            let c = if k == SourceKind::Bag {
-                Container::Bag
-            } else {
-                Container::Mcap
-            };
-            // A ROS 2 bag folder resolves to its .mcap file.
-            let (_, file) = ros_scan::resolve_source(src)?;
+        Ok(SourceKind::Bag | SourceKind::Mcap | SourceKind::Db3) => {
+            // A ROS 2 bag folder resolves to its one storage file (or stays a split bag's folder).
+            let (k, file) = ros_scan::resolve_source(src)?;
+            let c = k.container().unwrap_or(Container::Bag);
             let (topic, frames) =
                 ros_scan::image_frames(&file, c, file.as_path(), a.thermal_topic.as_deref())?;
             Ok((format!("{} {topic}", src.display()), frames))

@@ -28,12 +28,18 @@ fn ros_options(a: &SourceArgs) -> anyhow::Result<RosOptions> {
     })
 }
 
-fn container(kind: SourceKind) -> Option<Container> {
-    match kind {
-        SourceKind::Bag => Some(Container::Bag),
-        SourceKind::Mcap => Some(Container::Mcap),
-        _ => None,
-    }
+/// Bytes in a source file, or in a split bag's storage files.
+fn source_bytes(file: &Path, c: Container) -> anyhow::Result<u64> {
+    let files = if file.is_dir() {
+        ros_scan::storage_files(file, c).map_err(|e| e.in_file(file))?
+    } else {
+        vec![file.to_path_buf()]
+    };
+    files.iter().try_fold(0, |n, f| {
+        Ok(n + std::fs::metadata(f)
+            .with_context(|| format!("{}: cannot read", f.display()))?
+            .len())
+    })
 }
 
 fn fmt_span(t0: f64, t1: f64) -> String {
@@ -49,11 +55,9 @@ pub fn inspect(a: &InspectArgs) -> anyhow::Result<()> {
     match kind {
         SourceKind::Folder => inspect_folder(a),
         SourceKind::RtabMap => super::rtabmap::inspect(a),
-        SourceKind::Bag | SourceKind::Mcap => {
-            let c = container(kind).unwrap_or(Container::Bag);
-            let size = std::fs::metadata(&file)
-                .with_context(|| format!("{}: cannot read", file.display()))?
-                .len();
+        SourceKind::Bag | SourceKind::Mcap | SourceKind::Db3 => {
+            let c = kind.container().unwrap_or(Container::Bag);
+            let size = source_bytes(&file, c)?;
             let s = ros_scan::survey(c, file.as_path()).map_err(|e| e.in_file(&file))?;
             let p = ros_scan::plan(&s, &ros_options(&a.src)?);
             if a.json {
@@ -73,9 +77,12 @@ pub fn inspect(a: &InspectArgs) -> anyhow::Result<()> {
             println!(
                 "{}: {} ({} bytes){}",
                 a.source.display(),
-                match c {
-                    Container::Bag => "ROS 1 bag",
-                    Container::Mcap => "MCAP",
+                match (c, file.is_dir()) {
+                    (Container::Bag, _) => "ROS 1 bag",
+                    (Container::Mcap, false) => "MCAP",
+                    (Container::Mcap, true) => "ROS 2 bag split over several MCAP files",
+                    (Container::Db3, false) => "ROS 2 bag (SQLite storage)",
+                    (Container::Db3, true) => "ROS 2 bag split over several SQLite files",
                 },
                 size,
                 if s.unfinished {
@@ -210,12 +217,12 @@ pub(crate) fn to_layout(source: &Path, out: &Path, a: &SourceArgs) -> anyhow::Re
     let source = file.as_path();
     match kind {
         SourceKind::Folder => bail!(
-            "{} is already a recording folder (convert to a .bag or .mcap file by naming one as --out)",
+            "{} is already a recording folder (convert to a .bag, .mcap, .db3 or .db file by naming one as --out)",
             source.display()
         ),
         SourceKind::RtabMap => super::rtabmap::convert(source, out, a),
-        SourceKind::Bag | SourceKind::Mcap => {
-            let c = container(kind).unwrap_or(Container::Bag);
+        SourceKind::Bag | SourceKind::Mcap | SourceKind::Db3 => {
+            let c = kind.container().unwrap_or(Container::Bag);
             let s = ros_scan::survey(c, source).map_err(|e| e.in_file(source))?;
             let p = ros_scan::plan(&s, &ros_options(a)?);
             if !p.missing.is_empty() || p.rig.is_none() {
@@ -277,7 +284,7 @@ pub fn convert(a: &ConvertArgs) -> anyhow::Result<()> {
         println!("wrote {} ({n} nodes, {schema:?} schema)", a.out.display());
         return Ok(());
     }
-    if matches!(ext.as_str(), "bag" | "mcap") {
+    if matches!(ext.as_str(), "bag" | "mcap" | "db3") {
         let rec = mrtmap_io::Recording::open(&a.source).with_context(|| {
             format!(
                 "writing {} needs a recording folder as the source",
@@ -285,10 +292,10 @@ pub fn convert(a: &ConvertArgs) -> anyhow::Result<()> {
             )
         })?;
         let o = RosWriteOptions::t265_like(
-            if ext == "bag" {
-                Container::Bag
-            } else {
-                Container::Mcap
+            match ext.as_str() {
+                "bag" => Container::Bag,
+                "mcap" => Container::Mcap,
+                _ => Container::Db3,
             },
             match a.compression {
                 CompressionArg::None => Compression::None,

@@ -65,6 +65,7 @@ fn sources() -> &'static Path {
             "lz4",
         ]);
         ok(&["convert", &s("scan"), "--out", &s("scan.db")]);
+        ok(&["convert", &s("scan"), "--out", &s("scan.db3")]);
         ok(&[
             "convert",
             &s("scan"),
@@ -151,6 +152,14 @@ fn inspect_lists_streams_and_what_is_missing() {
         .find(|t| t["topic"] == "/camera/aligned_depth_to_color/image_raw")
         .unwrap();
     assert_eq!(depth["count"], 180);
+    // A ROS 2 bag in SQLite storage lists the same streams.
+    let text = ok(&["inspect", &s("scan.db3")]);
+    assert!(
+        text.contains("ROS 2 bag (SQLite storage)")
+            && text.contains("sensor_msgs/msg/Image")
+            && text.contains("ready"),
+        "{text}"
+    );
     assert!((depth["t1"].as_f64().unwrap() - depth["t0"].as_f64().unwrap() - 5.967).abs() < 0.01);
     // A database lacks thermal frames and the thermal camera until they are given.
     let text = ok(&["inspect", &s("scan.db")]);
@@ -191,6 +200,7 @@ fn convert_round_trips_every_source() {
     for (src, extra) in [
         ("scan.bag", vec![]),
         ("scan.mcap", vec![]),
+        ("scan.db3", vec![]),
         (
             "scan.db",
             vec![
@@ -293,7 +303,7 @@ fn fuse_reads_a_bag_and_a_database_directly() {
         "--rig",
         &s("scan/rig.toml"),
         "--thermal",
-        &s("scan.bag"),
+        &s("scan.db3"),
     ]);
     assert!(text.contains("optimised"), "{text}");
     let c = json(&out.path().join("db/fusion.json"));

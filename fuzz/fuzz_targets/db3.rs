@@ -1,0 +1,11 @@
+//! ROS 2 bags in SQLite storage: the file opened in memory, topics and messages read, CDR
+//! messages (some zstd-compressed) decoded.
+#![no_main]
+use libfuzzer_sys::fuzz_target;
+use mrtmap_io::ros_scan::{self, Container, RosOptions};
+
+fuzz_target!(|data: &[u8]| {
+    if let Ok(s) = ros_scan::survey(Container::Db3, data) {
+        let _ = ros_scan::plan(&s, &RosOptions::default());
+    }
+});
