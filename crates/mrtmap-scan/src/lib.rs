@@ -12,6 +12,7 @@
 pub mod frame;
 mod fuse;
 pub mod observe;
+pub mod pose_graph;
 pub mod segment;
 mod sync;
 pub mod voxels;

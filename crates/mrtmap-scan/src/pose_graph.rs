@@ -1,0 +1,362 @@
+//! Pose-graph optimisation: node poses from odometry and loop-closure constraints, as RTAB-Map
+//! keeps them in its `Link` table, solved with tiny-solver (Levenberg–Marquardt on SE(3), sparse
+//! Cholesky, automatic derivatives). Used when a database did not save its optimised graph.
+//!
+//! Each edge says where node `to` sits in node `from`'s frame, with a 6×6 information matrix over
+//! (x, y, z, roll, pitch, yaw) — RTAB-Map's order. The residual of an edge is
+//! `U · [t; θ]` of `measured⁻¹ · from⁻¹ · to`, with `Uᵀ U` the information (so each edge counts as
+//! much as the information says). The first node is held where it is (the gauge).
+
+use std::collections::{BTreeMap, HashMap};
+use std::sync::Arc;
+
+use mrtmap_geometry::nalgebra::{Isometry3, Matrix6, Quaternion, Translation3, UnitQuaternion};
+use tiny_solver::factors::Factor;
+use tiny_solver::manifold::se3::{SE3, SE3Manifold};
+use tiny_solver::na::{DVector, RealField};
+use tiny_solver::optimizer::Optimizer;
+
+/// One constraint between two nodes.
+#[derive(Clone, Debug)]
+pub struct Edge {
+    /// From node.
+    pub from: i64,
+    /// To node.
+    pub to: i64,
+    /// from_T_to as measured.
+    pub measured: Isometry3<f64>,
+    /// Information over (x, y, z, roll, pitch, yaw); not positive definite → identity.
+    pub information: Matrix6<f64>,
+}
+
+/// What the optimisation did.
+#[derive(Clone, Debug)]
+pub struct Optimised {
+    /// world_from_node for every node the edges reach from the first node.
+    pub poses: BTreeMap<i64, Isometry3<f64>>,
+    /// Weighted squared error before and after.
+    pub cost_before: f64,
+    /// After.
+    pub cost_after: f64,
+    /// Edges used.
+    pub edges: usize,
+    /// Edges whose information was not positive definite (weighted as identity).
+    pub identity_weighted: usize,
+}
+
+fn to_vec(p: &Isometry3<f64>) -> DVector<f64> {
+    let q = p.rotation.quaternion();
+    let t = p.translation.vector;
+    DVector::from_vec(vec![q.i, q.j, q.k, q.w, t.x, t.y, t.z])
+}
+
+fn from_vec(v: &DVector<f64>) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        Translation3::new(v[4], v[5], v[6]),
+        UnitQuaternion::from_quaternion(Quaternion::new(v[3], v[0], v[1], v[2])),
+    )
+}
+
+struct Between {
+    measured_inv: DVector<f64>,
+    sqrt_info: Matrix6<f64>,
+}
+
+impl<T: RealField> Factor<T> for Between {
+    fn residual_func(&self, p: &[DVector<T>]) -> DVector<T> {
+        let a = SE3::from_vec(p[0].as_view());
+        let b = SE3::from_vec(p[1].as_view());
+        let z = SE3::from_vec(self.measured_inv.as_view()).cast::<T>();
+        let l = (z * (a.inverse() * b)).log();
+        // tiny-solver's log is (θ, t); RTAB-Map's information is over (t, θ).
+        let e = [
+            l[3].clone(),
+            l[4].clone(),
+            l[5].clone(),
+            l[0].clone(),
+            l[1].clone(),
+            l[2].clone(),
+        ];
+        DVector::from_fn(6, |i, _| {
+            let mut s = T::zero();
+            for (j, ej) in e.iter().enumerate() {
+                let u = self.sqrt_info[(i, j)];
+                if u != 0.0 {
+                    s += T::from_f64(u).unwrap_or_else(T::zero) * ej.clone();
+                }
+            }
+            s
+        })
+    }
+}
+
+/// Holds the first node: a stiff prior on its 7 parameters.
+struct Anchor {
+    at: DVector<f64>,
+}
+
+impl<T: RealField> Factor<T> for Anchor {
+    fn residual_func(&self, p: &[DVector<T>]) -> DVector<T> {
+        let w = T::from_f64(1e4).unwrap_or_else(T::one);
+        DVector::from_fn(7, |i, _| {
+            (p[0][i].clone() - T::from_f64(self.at[i]).unwrap_or_else(T::zero)) * w.clone()
+        })
+    }
+}
+
+fn cost(initial: &HashMap<String, DVector<f64>>, factors: &[(Between, [String; 2])]) -> f64 {
+    factors
+        .iter()
+        .map(|(f, [a, b])| {
+            let r: DVector<f64> = f.residual_func(&[initial[a].clone(), initial[b].clone()]);
+            r.norm_squared()
+        })
+        .sum()
+}
+
+/// Optimises the graph. Nodes the edges do not connect to the first node keep their initial
+/// poses and are left out of the result; edges naming unknown nodes are an error.
+pub fn optimise(
+    initial: &BTreeMap<i64, Isometry3<f64>>,
+    edges: &[Edge],
+) -> Result<Optimised, String> {
+    let Some((&first, first_pose)) = initial.iter().next() else {
+        return Err("no nodes".into());
+    };
+    for e in edges {
+        for id in [e.from, e.to] {
+            if !initial.contains_key(&id) {
+                return Err(format!("a link names node {id}, which has no pose"));
+            }
+        }
+    }
+    // Nodes connected to the first one.
+    let mut adj: HashMap<i64, Vec<i64>> = HashMap::new();
+    for e in edges {
+        adj.entry(e.from).or_default().push(e.to);
+        adj.entry(e.to).or_default().push(e.from);
+    }
+    let mut reached = std::collections::BTreeSet::from([first]);
+    let mut stack = vec![first];
+    while let Some(n) = stack.pop() {
+        for &m in adj.get(&n).map(Vec::as_slice).unwrap_or(&[]) {
+            if reached.insert(m) {
+                stack.push(m);
+            }
+        }
+    }
+    let name = |id: i64| format!("x{id}");
+    let values: HashMap<String, DVector<f64>> = reached
+        .iter()
+        .map(|&id| (name(id), to_vec(&initial[&id])))
+        .collect();
+    let mut problem = tiny_solver::Problem::new();
+    let mut factors = Vec::new();
+    let mut identity_weighted = 0;
+    for e in edges.iter().filter(|e| e.from != e.to) {
+        let info = (e.information + e.information.transpose()) * 0.5;
+        let sqrt_info = match info.cholesky() {
+            Some(c) if info.iter().all(|x| x.is_finite()) => c.l().transpose(),
+            _ => {
+                identity_weighted += 1;
+                Matrix6::identity()
+            }
+        };
+        let f = Between {
+            measured_inv: to_vec(&e.measured.inverse()),
+            sqrt_info,
+        };
+        let names = [name(e.from), name(e.to)];
+        factors.push((
+            Between {
+                measured_inv: f.measured_inv.clone(),
+                sqrt_info,
+            },
+            names.clone(),
+        ));
+        problem.add_residual_block(6, &[&names[0], &names[1]], Box::new(f), None);
+    }
+    problem.add_residual_block(
+        7,
+        &[&name(first)],
+        Box::new(Anchor {
+            at: to_vec(first_pose),
+        }),
+        None,
+    );
+    for id in &reached {
+        problem.set_variable_manifold(&name(*id), Arc::new(SE3Manifold));
+    }
+    let cost_before = cost(&values, &factors);
+    let result = tiny_solver::LevenbergMarquardtOptimizer::default()
+        .optimize(&problem, &values, None)
+        .ok_or("the pose graph optimisation did not converge")?;
+    let cost_after = cost(&result, &factors);
+    let poses = reached
+        .iter()
+        .map(|&id| (id, from_vec(&result[&name(id)])))
+        .collect();
+    Ok(Optimised {
+        poses,
+        cost_before,
+        cost_after,
+        edges: factors.len(),
+        identity_weighted,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mrtmap_geometry::nalgebra::Vector3;
+
+    /// A loop around a 4 m × 3 m room: 40 nodes, turning as it goes.
+    fn truth() -> BTreeMap<i64, Isometry3<f64>> {
+        (0..40)
+            .map(|i| {
+                let a = i as f64 / 40.0 * std::f64::consts::TAU;
+                (
+                    i as i64 + 1,
+                    Isometry3::new(
+                        Vector3::new(2.0 * a.cos(), 1.5 * a.sin(), 1.2 + 0.1 * (3.0 * a).sin()),
+                        Vector3::new(0.05 * a.sin(), 0.0, a + 1.0),
+                    ),
+                )
+            })
+            .collect()
+    }
+
+    fn info(sigma_t: f64, sigma_r: f64) -> Matrix6<f64> {
+        Matrix6::from_diagonal(&mrtmap_geometry::nalgebra::Vector6::new(
+            1.0 / sigma_t.powi(2),
+            1.0 / sigma_t.powi(2),
+            1.0 / sigma_t.powi(2),
+            1.0 / sigma_r.powi(2),
+            1.0 / sigma_r.powi(2),
+            1.0 / sigma_r.powi(2),
+        ))
+    }
+
+    fn max_error(a: &BTreeMap<i64, Isometry3<f64>>, b: &BTreeMap<i64, Isometry3<f64>>) -> f64 {
+        a.iter()
+            .map(|(id, p)| (p.translation.vector - b[id].translation.vector).norm())
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn loop_closures_remove_odometry_drift() {
+        let truth = truth();
+        let ids: Vec<i64> = truth.keys().copied().collect();
+        // Odometry: each step's yaw 0.01 rad too large and its length 2 % too long.
+        let bias = Isometry3::new(Vector3::zeros(), Vector3::new(0.0, 0.0, 0.01));
+        let mut edges = Vec::new();
+        let mut odom = BTreeMap::from([(ids[0], truth[&ids[0]])]);
+        for w in ids.windows(2) {
+            let rel = truth[&w[0]].inverse() * truth[&w[1]];
+            let meas = Isometry3::from_parts(
+                Translation3::from(rel.translation.vector * 1.02),
+                rel.rotation,
+            ) * bias;
+            odom.insert(w[1], odom[&w[0]] * meas);
+            edges.push(Edge {
+                from: w[0],
+                to: w[1],
+                measured: meas,
+                information: info(0.02, 0.01),
+            });
+        }
+        // Loop closures, exact and trusted: the last node sees the first, and two chords.
+        for (a, b) in [(40, 1), (30, 10), (20, 1)] {
+            edges.push(Edge {
+                from: a,
+                to: b,
+                measured: truth[&a].inverse() * truth[&b],
+                information: info(0.002, 0.001),
+            });
+        }
+        let before = max_error(&odom, &truth);
+        let r = optimise(&odom, &edges).unwrap();
+        let after = max_error(&r.poses, &truth);
+        println!("largest position error: odometry {before:.3} m, optimised {after:.4} m");
+        assert_eq!(r.poses.len(), 40);
+        assert_eq!((r.edges, r.identity_weighted), (42, 0));
+        assert!(before > 0.5, "odometry drift {before} m");
+        assert!(after < before / 5.0, "{before} m → {after} m");
+        assert!(
+            r.cost_after < r.cost_before / 10.0,
+            "{} → {}",
+            r.cost_before,
+            r.cost_after
+        );
+        // The first node stays put.
+        assert!((r.poses[&1].translation.vector - truth[&1].translation.vector).norm() < 1e-6);
+    }
+
+    #[test]
+    fn consistent_edges_recover_the_truth_from_a_bad_start() {
+        let truth = truth();
+        let ids: Vec<i64> = truth.keys().copied().collect();
+        let mut edges: Vec<Edge> = ids
+            .windows(2)
+            .map(|w| Edge {
+                from: w[0],
+                to: w[1],
+                measured: truth[&w[0]].inverse() * truth[&w[1]],
+                // All zeros, as some writers leave it: weighted as identity.
+                information: Matrix6::zeros(),
+            })
+            .collect();
+        edges.push(Edge {
+            from: 40,
+            to: 1,
+            measured: truth[&40].inverse() * truth[&1],
+            information: Matrix6::identity(),
+        });
+        let start: BTreeMap<i64, Isometry3<f64>> = truth
+            .iter()
+            .map(|(&id, p)| {
+                let k = id as f64;
+                let off = Isometry3::new(
+                    Vector3::new(0.05 * (k * 0.7).sin(), 0.04 * (k * 1.3).cos(), 0.03),
+                    Vector3::new(0.0, 0.02 * (k * 0.9).sin(), 0.03 * (k * 0.5).cos()),
+                );
+                (id, if id == 1 { *p } else { p * off })
+            })
+            .collect();
+        let r = optimise(&start, &edges).unwrap();
+        assert_eq!(r.identity_weighted, 39);
+        assert!(
+            max_error(&r.poses, &truth) < 1e-4,
+            "{}",
+            max_error(&r.poses, &truth)
+        );
+        for (id, p) in &r.poses {
+            assert!(p.rotation.angle_to(&truth[id].rotation) < 1e-4, "node {id}");
+        }
+    }
+
+    #[test]
+    fn unknown_nodes_and_disconnected_parts() {
+        let truth = truth();
+        let e = Edge {
+            from: 1,
+            to: 99,
+            measured: Isometry3::identity(),
+            information: Matrix6::identity(),
+        };
+        assert!(optimise(&truth, &[e]).unwrap_err().contains("node 99"));
+        // Only nodes 1–3 are linked: the rest are left out.
+        let edges: Vec<Edge> = [(1, 2), (2, 3)]
+            .iter()
+            .map(|&(a, b)| Edge {
+                from: a,
+                to: b,
+                measured: truth[&a].inverse() * truth[&b],
+                information: Matrix6::identity(),
+            })
+            .collect();
+        let r = optimise(&truth, &edges).unwrap();
+        assert_eq!(r.poses.keys().copied().collect::<Vec<_>>(), vec![1, 2, 3]);
+        assert!(optimise(&BTreeMap::new(), &[]).is_err());
+    }
+}
