@@ -377,17 +377,28 @@ pub fn summarize(path: &Path) -> Result<DbSummary, FileError> {
         None => None,
     };
     Ok(DbSummary {
+        poses: if opt.is_empty() {
+            let closures: usize = links
+                .iter()
+                .filter(|(n, _)| n.contains("closure") || n == "user")
+                .map(|(_, k)| k)
+                .sum();
+            if closures > 0 {
+                format!(
+                    "odometry (Node.pose; no optimised poses saved) — the Link graph has {closures} loop closures: convert optimises it"
+                )
+            } else {
+                "odometry (Node.pose; no optimised poses saved, no loop closures in Link)".into()
+            }
+        } else {
+            "optimised (Admin.opt_poses)".into()
+        },
         version,
         nodes,
         images,
         depths,
         rvl,
         links,
-        poses: if opt.is_empty() {
-            "odometry (Node.pose; no optimised poses saved)".into()
-        } else {
-            "optimised (Admin.opt_poses)".into()
-        },
         optimised: opt.len(),
         span,
         calibration,
@@ -454,6 +465,99 @@ pub fn depth_blob(b: &[u8]) -> Result<Image16, String> {
 
 const MAGIC_RVL: &[u8] = crate::rvl::MAGIC;
 
+/// One row of the `Link` table.
+#[derive(Clone, Debug)]
+pub struct GraphLink {
+    /// From node.
+    pub from: i64,
+    /// To node.
+    pub to: i64,
+    /// RTAB-Map's link type (0 neighbour, 1 global closure, 2 local-space, 3 local-time, 4 user,
+    /// 5 virtual, 6 neighbour merged, 7 pose prior, 8 landmark, 9 gravity).
+    pub kind: i64,
+    /// Pose of `to` in `from`'s frame.
+    pub transform: Isometry3<f64>,
+    /// 6×6 information over (x, y, z, roll, pitch, yaw), row-major; zeros when not stored.
+    pub information: [f64; 36],
+}
+
+/// The pose graph: every node's odometry pose (world_from_base) and the links, with the rows
+/// that could not be read as (what, reason).
+pub type Graph = (
+    std::collections::BTreeMap<i64, Isometry3<f64>>,
+    Vec<GraphLink>,
+    Vec<String>,
+);
+
+/// Reads the odometry poses and the `Link` table (for optimising a graph RTAB-Map did not save).
+pub fn graph(path: &Path) -> Result<Graph, FileError> {
+    let (c, _) = open(path)?;
+    let mut bad = Vec::new();
+    let mut nodes = std::collections::BTreeMap::new();
+    {
+        let mut st = c
+            .prepare("SELECT id, pose FROM Node ORDER BY id")
+            .map_err(|e| sql_err(path, e))?;
+        let mut rows = st.query([]).map_err(|e| sql_err(path, e))?;
+        while let Some(r) = rows.next().map_err(|e| sql_err(path, e))? {
+            let id: i64 = r.get(0).map_err(|e| sql_err(path, e))?;
+            let b: Option<Vec<u8>> = r.get(1).unwrap_or(None);
+            match pose_blob(&b.unwrap_or_default(), "pose blob") {
+                Ok(p) => {
+                    nodes.insert(id, p);
+                }
+                Err(e) => bad.push(format!("node {id}: {e}")),
+            }
+        }
+    }
+    let cols = columns(&c, "Link");
+    let has_info = cols.iter().any(|x| x == "information_matrix");
+    let sql = format!(
+        "SELECT from_id, to_id, type, transform, {} FROM Link",
+        if has_info {
+            "information_matrix"
+        } else {
+            "NULL"
+        }
+    );
+    let mut st = c.prepare(&sql).map_err(|e| sql_err(path, e))?;
+    let mut rows = st.query([]).map_err(|e| sql_err(path, e))?;
+    let mut links = Vec::new();
+    while let Some(r) = rows.next().map_err(|e| sql_err(path, e))? {
+        let row: Result<GraphLink, String> = (|| {
+            let from: i64 = r.get(0).map_err(|e| e.to_string())?;
+            let to: i64 = r.get(1).map_err(|e| e.to_string())?;
+            let kind: i64 = r.get(2).map_err(|e| e.to_string())?;
+            let t: Option<Vec<u8>> = r.get(3).map_err(|e| e.to_string())?;
+            let transform = pose_blob(
+                &t.unwrap_or_default(),
+                &format!("link {from} → {to} transform"),
+            )?;
+            let info: Option<Vec<u8>> = r.get(4).map_err(|e| e.to_string())?;
+            let mut information = [0.0; 36];
+            if let Some(b) = info.filter(|b| b.len() == 288) {
+                for (k, v) in information.iter_mut().enumerate() {
+                    let mut x = [0u8; 8];
+                    x.copy_from_slice(&b[8 * k..8 * k + 8]);
+                    *v = f64::from_le_bytes(x);
+                }
+            }
+            Ok(GraphLink {
+                from,
+                to,
+                kind,
+                transform,
+                information,
+            })
+        })();
+        match row {
+            Ok(l) => links.push(l),
+            Err(e) => bad.push(format!("link: {e}")),
+        }
+    }
+    Ok((nodes, links, bad))
+}
+
 /// One node read back.
 #[derive(Clone, Debug)]
 pub struct Node {
@@ -470,14 +574,18 @@ pub struct Node {
 }
 
 /// Reads every node in id order; `f` gets each (problems with a node's blobs are returned to
-/// the caller as (id, reason) and the node is skipped).
+/// the caller as (id, reason) and the node is skipped). Poses are `poses` when given (a graph
+/// optimised by the caller), else the saved optimised poses, else the odometry.
 pub fn for_each_node(
     path: &Path,
+    poses: Option<&std::collections::BTreeMap<i64, Isometry3<f64>>>,
     f: &mut dyn FnMut(Node) -> Result<(), FileError>,
 ) -> Result<Vec<(i64, String)>, FileError> {
     let (c, _) = open(path)?;
-    let opt: std::collections::HashMap<i64, Isometry3<f64>> =
-        optimised(&c, path)?.into_iter().collect();
+    let opt: std::collections::HashMap<i64, Isometry3<f64>> = match poses {
+        Some(p) => p.iter().map(|(k, v)| (*k, *v)).collect(),
+        None => optimised(&c, path)?.into_iter().collect(),
+    };
     let mut s = c
         .prepare("SELECT Node.id, Node.stamp, Node.pose, Data.image, Data.depth FROM Node LEFT JOIN Data ON Data.id = Node.id ORDER BY Node.id")
         .map_err(|e| sql_err(path, e))?;
@@ -540,6 +648,21 @@ pub struct WriteNode<'a> {
     pub image: &'a [u8],
     /// Depth, mm.
     pub depth: &'a Image16,
+}
+
+/// A diagonal 6×6 information matrix (f64, as RTAB-Map stores it) for standard deviations in
+/// metres and radians.
+fn information_bytes(sigma_t: f64, sigma_r: f64) -> Vec<u8> {
+    (0..36)
+        .flat_map(|k| {
+            let v = match k {
+                0 | 7 | 14 => sigma_t.powi(-2),
+                21 | 28 | 35 => sigma_r.powi(-2),
+                _ => 0.0,
+            };
+            v.to_le_bytes()
+        })
+        .collect()
 }
 
 fn pose_bytes(p: &Isometry3<f64>) -> Vec<u8> {
@@ -657,10 +780,23 @@ pub fn write_database(
             let rel = nodes[i - 1].odom.inverse() * n.odom;
             tx.execute(
                 "INSERT INTO Link (from_id, to_id, type, information_matrix, transform) VALUES (?1, ?2, 0, ?3, ?4)",
-                rusqlite::params![id - 1, id, vec![0u8; 288], pose_bytes(&rel)],
+                rusqlite::params![id - 1, id, information_bytes(0.01, 0.01), pose_bytes(&rel)],
             )
             .map_err(e)?;
         }
+    }
+    // A global loop closure from the last node back to the first, measured on the true poses.
+    if nodes.len() >= 3 {
+        let (a, b) = (&nodes[nodes.len() - 1], &nodes[0]);
+        tx.execute(
+            "INSERT INTO Link (from_id, to_id, type, information_matrix, transform) VALUES (?1, 1, 1, ?2, ?3)",
+            rusqlite::params![
+                nodes.len() as i64,
+                information_bytes(0.001, 0.001),
+                pose_bytes(&(a.optimised.inverse() * b.optimised))
+            ],
+        )
+        .map_err(e)?;
     }
     match schema {
         Schema::Current => {
@@ -701,9 +837,11 @@ pub fn base_from_optical() -> Isometry3<f64> {
 }
 
 /// Writes a recording as an RTAB-Map-layout database: a node per colour frame with the nearest
-/// depth frame (within 20 ms) and the interpolated pose. With [`Schema::Current`] the optimised
-/// poses are the recording's and the odometry poses drift 1 cm per node along x, so a reader
-/// that takes the wrong ones is caught. Returns the number of nodes.
+/// depth frame (within 20 ms) and the interpolated pose. The odometry poses drift 1 cm per node
+/// along x; a loop closure from the last node to the first is measured on the recording's poses.
+/// With [`Schema::Current`] the optimised poses (the recording's) are saved, so a reader that takes
+/// the wrong ones is caught; with [`Schema::Legacy`] they are not, and optimising the graph gives
+/// them back. Returns the number of nodes.
 pub fn write_recording(
     rec: &crate::recording::Recording,
     path: &Path,
@@ -753,15 +891,10 @@ pub fn write_recording(
         .enumerate()
         .map(|(i, (t, pose, img, depth))| WriteNode {
             stamp: *t,
-            odom: match schema {
-                Schema::Current => {
-                    Isometry3::from_parts(
-                        Translation3::new(0.01 * i as f64, 0.0, 0.0),
-                        Default::default(),
-                    ) * pose
-                }
-                Schema::Legacy => *pose,
-            },
+            odom: Isometry3::from_parts(
+                Translation3::new(0.01 * i as f64, 0.0, 0.0),
+                Default::default(),
+            ) * pose,
             optimised: *pose,
             image: img,
             depth,

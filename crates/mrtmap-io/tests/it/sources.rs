@@ -370,15 +370,36 @@ fn rtabmap_databases_of_both_schemas_read_back() {
         let cal = s.calibration.unwrap();
         assert_eq!(cal.camera, rig().depth);
         let mut nodes = Vec::new();
-        let bad = rtabmap::for_each_node(&db, &mut |n| {
+        let bad = rtabmap::for_each_node(&db, None, &mut |n| {
             nodes.push(n);
             Ok(())
         })
         .unwrap();
         assert!(bad.is_empty());
         let limits = mrtmap_io::InterpolationLimits::default();
-        for (node, e) in nodes.iter().zip(&orig.rgb) {
+        // The graph: odometry poses (drifting 1 cm per node), 4 neighbour links and a loop
+        // closure, with their information.
+        let (odom, links, unread) = rtabmap::graph(&db).unwrap();
+        assert!(unread.is_empty());
+        assert_eq!(odom.len(), 5);
+        let kinds: Vec<i64> = links.iter().map(|l| l.kind).collect();
+        assert_eq!(kinds, [0, 0, 0, 0, 1]);
+        assert_eq!((links[4].from, links[4].to), (5, 1));
+        assert!((links[0].information[0] - 1e4).abs() < 1e-6 && links[0].information[1] == 0.0);
+        for (i, (node, e)) in nodes.iter().zip(&orig.rgb).enumerate() {
             let want = orig.trajectory.interpolate(e.t, &limits).unwrap();
+            let drift = Isometry3::translation(0.01 * i as f64, 0.0, 0.0);
+            assert!(same_pose(
+                &(odom[&node.id] * cal.local),
+                &(drift * want),
+                1e-5
+            ));
+            // Saved optimised poses are the recording's; without them, the odometry.
+            let want = if schema == Schema::Current {
+                want
+            } else {
+                drift * want
+            };
             // f32 blobs: 1e-6 relative.
             assert!(
                 same_pose(&(node.pose * cal.local), &want, 1e-5),
@@ -411,7 +432,7 @@ fn broken_rtabmap_databases_are_reported() {
         .unwrap();
     }
     let mut ok = 0;
-    let bad = rtabmap::for_each_node(&db, &mut |_| {
+    let bad = rtabmap::for_each_node(&db, None, &mut |_| {
         ok += 1;
         Ok(())
     })

@@ -1,8 +1,10 @@
 //! RTAB-Map databases in `inspect` and `convert` (and so in `fuse` / `run`).
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::{Context, bail};
+use mrtmap_geometry::nalgebra::{Isometry3, Matrix6};
 use mrtmap_io::layout_writer::LayoutWriter;
 use mrtmap_io::ros_scan::{self, Container, SourceKind};
 use mrtmap_io::rtabmap::{self, DbSummary};
@@ -119,6 +121,61 @@ fn stem_time(p: &Path) -> Option<f64> {
     })
 }
 
+/// Node poses by id.
+type Poses = BTreeMap<i64, Isometry3<f64>>;
+
+/// Without saved optimised poses, the `Link` graph (odometry and loop closures) optimised here,
+/// when it has loop closures: the poses and what was done, in words.
+fn optimise_graph(source: &Path) -> anyhow::Result<(Option<Poses>, String)> {
+    use mrtmap_scan::pose_graph::{Edge, optimise};
+    let (odom, links, unread) = rtabmap::graph(source)?;
+    for u in unread.iter().take(3) {
+        println!("  graph: skipped {u}");
+    }
+    // Neighbour, loop-closure, user and merged links; virtual links, priors, landmarks and
+    // gravity are not relative-pose constraints between two nodes.
+    let edges: Vec<Edge> = links
+        .iter()
+        .filter(|l| matches!(l.kind, 0..=4 | 6))
+        .filter(|l| odom.contains_key(&l.from) && odom.contains_key(&l.to))
+        .map(|l| Edge {
+            from: l.from,
+            to: l.to,
+            measured: l.transform,
+            information: Matrix6::from_row_slice(&l.information),
+        })
+        .collect();
+    let closures = links.iter().filter(|l| matches!(l.kind, 1..=4)).count();
+    if closures == 0 {
+        return Ok((
+            None,
+            "odometry (Node.pose; no optimised poses saved, no loop closures to optimise)".into(),
+        ));
+    }
+    let r = optimise(&odom, &edges)
+        .map_err(|e| anyhow::anyhow!("{}: the Link graph: {e}", source.display()))?;
+    let mut said = format!(
+        "graph optimised here: {} nodes, {} links of which {closures} loop closures, weighted squared error {:.3e} → {:.3e}",
+        r.poses.len(),
+        r.edges,
+        r.cost_before,
+        r.cost_after
+    );
+    if r.identity_weighted > 0 {
+        said += &format!(
+            "; {} links without a usable information matrix weighted as identity",
+            r.identity_weighted
+        );
+    }
+    if r.poses.len() < odom.len() {
+        said += &format!(
+            "; {} nodes not linked to the first are left out",
+            odom.len() - r.poses.len()
+        );
+    }
+    Ok((Some(r.poses), said))
+}
+
 /// Thermal frames from another source.
 fn thermal_frames(src: &Path, a: &SourceArgs) -> anyhow::Result<(String, Vec<(f64, Image16)>)> {
     match ros_scan::source_kind(src) {
@@ -213,9 +270,14 @@ pub fn convert(source: &Path, out: &Path, a: &SourceArgs) -> anyhow::Result<()> 
         out,
         &format!("converted by mrtmap from {}", source.display()),
     )?;
+    let (graph, poses_said) = if s.optimised == 0 {
+        optimise_graph(source)?
+    } else {
+        (None, s.poses.clone())
+    };
     let mut depth_size = None;
     let mut err = None;
-    let bad = rtabmap::for_each_node(source, &mut |n| {
+    let bad = rtabmap::for_each_node(source, graph.as_ref(), &mut |n| {
         let world_from_cam = n.pose * cal.local;
         w.pose(n.stamp, world_from_cam);
         if let Some(d) = &n.depth {
@@ -276,15 +338,15 @@ pub fn convert(source: &Path, out: &Path, a: &SourceArgs) -> anyhow::Result<()> 
         "source": source.display().to_string(),
         "container": "rtabmap",
         "database": s,
+        "poses": poses_said,
         "thermal": thermal_name,
         "rig": rig_path.display().to_string(),
         "skipped_nodes": bad.iter().map(|(id, e)| format!("node {id}: {e}")).collect::<Vec<_>>(),
     }))?;
     w.finish(&rig, &source_json)?;
     println!(
-        "wrote {}: {nd} depth, {nt} thermal ({thermal_name}), {nc} colour frames, {np} poses ({})",
+        "wrote {}: {nd} depth, {nt} thermal ({thermal_name}), {nc} colour frames, {np} poses ({poses_said})",
         out.display(),
-        s.poses
     );
     if !bad.is_empty() {
         println!("  skipped {} nodes:", bad.len());
