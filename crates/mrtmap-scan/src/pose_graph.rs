@@ -25,7 +25,8 @@ pub struct Edge {
     pub to: i64,
     /// from_T_to as measured.
     pub measured: Isometry3<f64>,
-    /// Information over (x, y, z, roll, pitch, yaw); not positive definite → identity.
+    /// Information over (x, y, z, roll, pitch, yaw); not positive definite, or not finite and
+    /// below 1e12, → identity.
     pub information: Matrix6<f64>,
 }
 
@@ -129,6 +130,19 @@ pub fn optimise(
                 return Err(format!("a link names node {id}, which has no pose"));
             }
         }
+        let m = e.measured;
+        if !m
+            .translation
+            .vector
+            .iter()
+            .all(|x| x.is_finite() && x.abs() < 1e6)
+            || !m.rotation.coords.iter().all(|x| x.is_finite())
+        {
+            return Err(format!(
+                "the link {} → {} has a non-finite or implausible transform",
+                e.from, e.to
+            ));
+        }
     }
     // Nodes connected to the first one.
     let mut adj: HashMap<i64, Vec<i64>> = HashMap::new();
@@ -156,7 +170,8 @@ pub fn optimise(
     for e in edges.iter().filter(|e| e.from != e.to) {
         let info = (e.information + e.information.transpose()) * 0.5;
         let sqrt_info = match info.cholesky() {
-            Some(c) if info.iter().all(|x| x.is_finite()) => c.l().transpose(),
+            // RTAB-Map's largest is 1/0.0001² = 1e8; far beyond is a broken matrix.
+            Some(c) if info.iter().all(|x| x.is_finite() && x.abs() < 1e12) => c.l().transpose(),
             _ => {
                 identity_weighted += 1;
                 Matrix6::identity()
@@ -192,10 +207,17 @@ pub fn optimise(
         .optimize(&problem, &values, None)
         .ok_or("the pose graph optimisation did not converge")?;
     let cost_after = cost(&result, &factors);
-    let poses = reached
+    let poses: BTreeMap<i64, Isometry3<f64>> = reached
         .iter()
-        .map(|&id| (id, from_vec(&result[&name(id)])))
+        .filter_map(|&id| result.get(&name(id)).map(|v| (id, from_vec(v))))
         .collect();
+    let finite = |p: &Isometry3<f64>| {
+        p.translation.vector.iter().all(|x| x.is_finite())
+            && p.rotation.coords.iter().all(|x| x.is_finite())
+    };
+    if poses.len() != reached.len() || !poses.values().all(finite) || !cost_after.is_finite() {
+        return Err("the pose graph optimisation diverged (non-finite poses)".into());
+    }
     Ok(Optimised {
         poses,
         cost_before,
@@ -358,5 +380,21 @@ mod tests {
         let r = optimise(&truth, &edges).unwrap();
         assert_eq!(r.poses.keys().copied().collect::<Vec<_>>(), vec![1, 2, 3]);
         assert!(optimise(&BTreeMap::new(), &[]).is_err());
+        // Implausible measurements are refused, not optimised into NaN.
+        let wild = Edge {
+            from: 1,
+            to: 2,
+            measured: Isometry3::translation(1e30, 0.0, 0.0),
+            information: Matrix6::identity(),
+        };
+        assert!(optimise(&truth, &[wild]).unwrap_err().contains("1 → 2"));
+        // An information matrix of 1e300 counts as identity.
+        let huge = Edge {
+            from: 1,
+            to: 2,
+            measured: truth[&1].inverse() * truth[&2],
+            information: Matrix6::identity() * 1e300,
+        };
+        assert_eq!(optimise(&truth, &[huge]).unwrap().identity_weighted, 1);
     }
 }
