@@ -58,6 +58,7 @@ fn from_vec(v: &DVector<f64>) -> Isometry3<f64> {
     )
 }
 
+#[derive(Clone)]
 struct Between {
     measured_inv: DVector<f64>,
     sqrt_info: Matrix6<f64>,
@@ -182,14 +183,8 @@ pub fn optimise(
             sqrt_info,
         };
         let names = [name(e.from), name(e.to)];
-        factors.push((
-            Between {
-                measured_inv: f.measured_inv.clone(),
-                sqrt_info,
-            },
-            names.clone(),
-        ));
-        problem.add_residual_block(6, &[&names[0], &names[1]], Box::new(f), None);
+        problem.add_residual_block(6, &[&names[0], &names[1]], Box::new(f.clone()), None);
+        factors.push((f, names));
     }
     problem.add_residual_block(
         7,

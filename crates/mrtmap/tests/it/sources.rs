@@ -180,7 +180,9 @@ fn inspect_lists_streams_and_what_is_missing() {
         &s("scan"),
     ]);
     assert!(
-        text.contains("odometry (Node.pose") && text.contains("ready"),
+        text.contains("odometry (Node.pose")
+            && text.contains("1 loop closures: convert optimises it")
+            && text.contains("ready"),
         "{text}"
     );
     let text = ok(&["inspect", &s("scan")]);
