@@ -385,7 +385,8 @@ pub fn summarize(path: &Path) -> Result<DbSummary, FileError> {
                 .sum();
             if closures > 0 {
                 format!(
-                    "odometry (Node.pose; no optimised poses saved) — the Link graph has {closures} loop closures: convert optimises it"
+                    "odometry (Node.pose; no optimised poses saved) — the Link graph has {closures} loop closure{}: convert optimises it",
+                    if closures == 1 { "" } else { "s" }
                 )
             } else {
                 "odometry (Node.pose; no optimised poses saved, no loop closures in Link)".into()

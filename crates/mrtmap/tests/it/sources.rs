@@ -181,7 +181,7 @@ fn inspect_lists_streams_and_what_is_missing() {
     ]);
     assert!(
         text.contains("odometry (Node.pose")
-            && text.contains("1 loop closures: convert optimises it")
+            && text.contains("1 loop closure: convert optimises it")
             && text.contains("ready"),
         "{text}"
     );
