@@ -295,22 +295,29 @@ for storage, compress in [("mcap", False), ("sqlite3", False), ("sqlite3", True)
 
 # 3. Speed.
 print("3. reading every message (median of 3)")
+def timed(fn):
+    t = time.perf_counter()
+    out = fn()
+    return time.perf_counter() - t, out
+
+
+def rosbags_read_all(reader, deserialize):
+    """rosbags deserialising every message; the count."""
+    n = 0
+    with reader as r:
+        for conn, _, raw in r.messages():
+            deserialize(raw, conn.msgtype)
+            n += 1
+    return n
+
+
 f = work / "mrtmap-lz4.bag"
 ours, survey, theirs = [], [], []
 for _ in range(3):
-    t = time.perf_counter()
-    run("convert", f, "--out", work / "speed")
-    ours.append(time.perf_counter() - t)
-    t = time.perf_counter()
-    run("inspect", f)
-    survey.append(time.perf_counter() - t)
-    t = time.perf_counter()
-    n = 0
-    with Reader1(f) as r:
-        for conn, _, raw in r.messages():
-            ts1.deserialize_ros1(raw, conn.msgtype)
-            n += 1
-    theirs.append(time.perf_counter() - t)
+    ours.append(timed(lambda: run("convert", f, "--out", work / "speed"))[0])
+    survey.append(timed(lambda: run("inspect", f))[0])
+    dt, n = timed(lambda: rosbags_read_all(Reader1(f), ts1.deserialize_ros1))
+    theirs.append(dt)
 o, sv, th = statistics.median(ours), statistics.median(survey), statistics.median(theirs)
 size = f.stat().st_size / 1e6
 print(f"  {f.name} ({size:.1f} MB, {n} messages): rosbags deserialise every message {th:.2f} s;"
@@ -320,16 +327,9 @@ print(f"  {f.name} ({size:.1f} MB, {n} messages): rosbags deserialise every mess
 d = work / "rosbags-rosbag2-sqlite3"
 ours, theirs = [], []
 for _ in range(3):
-    t = time.perf_counter()
-    run("inspect", d)
-    ours.append(time.perf_counter() - t)
-    t = time.perf_counter()
-    n = 0
-    with Reader2(d) as r:
-        for conn, _, raw in r.messages():
-            ts2.deserialize_cdr(raw, conn.msgtype)
-            n += 1
-    theirs.append(time.perf_counter() - t)
+    ours.append(timed(lambda: run("inspect", d))[0])
+    dt, n = timed(lambda: rosbags_read_all(Reader2(d), ts2.deserialize_cdr))
+    theirs.append(dt)
 o, th = statistics.median(ours), statistics.median(theirs)
 size = sum(p.stat().st_size for p in d.glob("*.db3")) / 1e6
 print(f"  {d.name} (ROS 2 SQLite storage, {size:.1f} MB, {n} messages): rosbags deserialise every message {th:.2f} s;"
