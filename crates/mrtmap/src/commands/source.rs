@@ -330,20 +330,32 @@ pub(crate) fn recording_dir(source: &Path, out: &Path, a: &SourceArgs) -> anyhow
         return Ok(source.to_path_buf());
     }
     let dir = out.join("recording");
-    let meta =
-        std::fs::metadata(source).with_context(|| format!("{}: cannot read", source.display()))?;
+    std::fs::metadata(source).with_context(|| format!("{}: cannot read", source.display()))?;
     // The source, the options, and the files the options name (a rig edited since, or new
-    // thermal frames, mean converting again).
-    let named = |p: &Option<PathBuf>| {
-        p.as_deref()
-            .and_then(|p| std::fs::metadata(p).ok())
-            .map(|m| (m.len(), m.modified().ok()))
+    // thermal frames, mean converting again). A folder (a ROS 2 bag, thermal images) stands for
+    // the files in it.
+    let fingerprint = |p: &Path| -> Vec<(String, u64, Option<std::time::SystemTime>)> {
+        let mut files = vec![p.to_path_buf()];
+        if p.is_dir() {
+            files = std::fs::read_dir(p)
+                .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
+                .unwrap_or_default();
+            files.sort();
+        }
+        files
+            .iter()
+            .filter_map(|f| {
+                let m = std::fs::metadata(f).ok()?;
+                let name = f.file_name()?.to_string_lossy().into_owned();
+                Some((name, m.len(), m.modified().ok()))
+            })
+            .collect()
     };
+    let named = |p: &Option<PathBuf>| p.as_deref().map(fingerprint);
     let stamp = format!(
-        "{} {} {:?} {:?} {:?} {:?}",
+        "{} {:?} {:?} {:?} {:?}",
         source.display(),
-        meta.len(),
-        meta.modified().ok(),
+        fingerprint(source),
         a,
         named(&a.rig),
         named(&a.thermal)

@@ -329,6 +329,24 @@ fn fuse_reads_a_bag_and_a_database_directly() {
     // A second fuse reuses the conversion.
     let text = ok(&["fuse", &s("scan.mcap"), "--out", &o("mcap")]);
     assert!(text.contains("converted earlier"), "{text}");
+    // A ROS 2 bag folder: reused while its files are unchanged, converted again when one changes
+    // (the folder's own size and time do not change when a file inside is rewritten).
+    let ros2 = out.path().join("rosbag2_scan");
+    std::fs::create_dir_all(&ros2).unwrap();
+    std::fs::write(ros2.join("metadata.yaml"), "rosbag2_bagfile_information:\n").unwrap();
+    let db3 = std::fs::read(d.join("scan.db3")).unwrap();
+    std::fs::write(ros2.join("rosbag2_scan_0.db3"), &db3).unwrap();
+    let r2 = ros2.to_str().unwrap();
+    let text = ok(&["fuse", r2, "--out", &o("ros2")]);
+    assert!(!text.contains("converted earlier"), "{text}");
+    let c = json(&out.path().join("ros2/fusion.json"));
+    assert_eq!(a["voxels"], c["voxels"]);
+    let text = ok(&["fuse", r2, "--out", &o("ros2")]);
+    assert!(text.contains("converted earlier"), "{text}");
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    std::fs::write(ros2.join("rosbag2_scan_0.db3"), &db3).unwrap();
+    let text = ok(&["fuse", r2, "--out", &o("ros2")]);
+    assert!(!text.contains("converted earlier"), "{text}");
     let text = ok(&[
         "fuse",
         &s("scan.db"),
