@@ -116,8 +116,10 @@ fn cost(initial: &HashMap<String, DVector<f64>>, factors: &[(Between, [String; 2
         .sum()
 }
 
-/// Optimises the graph. Nodes the edges do not connect to the first node keep their initial
-/// poses and are left out of the result; edges naming unknown nodes are an error.
+/// Optimises the graph. Of `initial`, the first node's pose is kept (the gauge) and the ids say
+/// which nodes exist: the others start along a spanning tree of the edges, whatever frame their
+/// odometry was in. Nodes the edges do not connect to the first node are left out of the result;
+/// edges naming unknown nodes are an error.
 pub fn optimise(
     initial: &BTreeMap<i64, Isometry3<f64>>,
     edges: &[Edge],
@@ -160,10 +162,31 @@ pub fn optimise(
             }
         }
     }
+    // The start: the first node where it is, the others along a breadth-first spanning tree of the
+    // edges (as g2o and RTAB-Map start), so sessions whose odometry frames differ start together.
+    let mut start: HashMap<i64, Isometry3<f64>> = HashMap::from([(first, *first_pose)]);
+    let mut by_node: HashMap<i64, Vec<(i64, Isometry3<f64>)>> = HashMap::new();
+    for e in edges.iter().filter(|e| e.from != e.to) {
+        by_node.entry(e.from).or_default().push((e.to, e.measured));
+        by_node
+            .entry(e.to)
+            .or_default()
+            .push((e.from, e.measured.inverse()));
+    }
+    let mut queue = std::collections::VecDeque::from([first]);
+    while let Some(n) = queue.pop_front() {
+        let at = start[&n];
+        for (m, z) in by_node.get(&n).map(Vec::as_slice).unwrap_or(&[]) {
+            if !start.contains_key(m) {
+                start.insert(*m, at * z);
+                queue.push_back(*m);
+            }
+        }
+    }
     let name = |id: i64| format!("x{id}");
     let values: HashMap<String, DVector<f64>> = reached
         .iter()
-        .map(|&id| (name(id), to_vec(&initial[&id])))
+        .map(|&id| (name(id), to_vec(&start[&id])))
         .collect();
     let mut problem = tiny_solver::Problem::new();
     let mut factors = Vec::new();
@@ -307,6 +330,44 @@ mod tests {
         );
         // The first node stays put.
         assert!((r.poses[&1].translation.vector - truth[&1].translation.vector).norm() < 1e-6);
+    }
+
+    #[test]
+    fn a_second_session_in_another_frame_is_joined_by_its_closures() {
+        // Nodes 21–40 are a second session: its odometry frame is turned 3.2 rad about a tilted axis and 47 m away, so
+        // their initial poses are far off; neighbour links inside each session, closures between.
+        let truth = truth();
+        let away = Isometry3::new(Vector3::new(40.0, -25.0, 3.0), Vector3::new(1.2, -0.8, 2.9));
+        let initial: BTreeMap<i64, Isometry3<f64>> = truth
+            .iter()
+            .map(|(&id, p)| (id, if id > 20 { away * p } else { *p }))
+            .collect();
+        let rel = |a: i64, b: i64| truth[&a].inverse() * truth[&b];
+        let mut edges: Vec<Edge> = (1..40)
+            .filter(|&i| i != 20)
+            .map(|i| Edge {
+                from: i,
+                to: i + 1,
+                measured: rel(i, i + 1),
+                information: info(0.01, 0.01),
+            })
+            .collect();
+        for (a, b) in [(21, 20), (30, 10), (40, 1)] {
+            edges.push(Edge {
+                from: a,
+                to: b,
+                measured: rel(a, b),
+                information: info(0.005, 0.005),
+            });
+        }
+        let r = optimise(&initial, &edges).unwrap();
+        assert_eq!(r.poses.len(), 40);
+        assert!(
+            max_error(&r.poses, &truth) < 1e-4,
+            "{}",
+            max_error(&r.poses, &truth)
+        );
+        assert!(r.cost_after < 1e-6, "{}", r.cost_after);
     }
 
     #[test]
