@@ -1,7 +1,7 @@
 //! Ray casting against triangle soups.
 //!
 //! [`BvhRayCaster`] (the default, pure Rust) builds an eight-wide compressed BVH with `obvhs`;
-//! [`EmbreeRayCaster`] (cargo feature `embree`) hands the same triangles to Intel Embree. Both
+//! `EmbreeRayCaster` (cargo feature `embree`) hands the same triangles to Intel Embree. Both
 //! answer the same query: the nearest triangle a ray hits, or `None` on a miss.
 
 use glam::Vec3A;
