@@ -280,7 +280,7 @@ for comp in ["bz2", "lz4"]:
     fill(w, ts1, True)
     check(f, f"{f.name:<30}")
 
-for storage, compress in [("mcap", False), ("sqlite3", False), ("sqlite3", True)]:
+for storage, compress in [("mcap", False), ("mcap", True), ("sqlite3", False), ("sqlite3", True)]:
     d = work / f"rosbags-rosbag2-{storage}{'-zstd' if compress else ''}"
     if d.exists():
         import shutil

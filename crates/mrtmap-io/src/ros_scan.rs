@@ -109,7 +109,19 @@ pub fn for_each<'a>(
     let r = &mut *r;
     match container {
         Container::Bag => crate::bag::for_each_message_in(r, f).map(|s| s.unindexed),
-        Container::Mcap => crate::mcap_file::for_each_message_in(r, f).map(|s| s.unfinished),
+        Container::Mcap => {
+            // ROS 2 bags recorded with per-message compression keep each message zstd-compressed.
+            let mut buf = Vec::new();
+            let mut g = |m: Message<'_>| {
+                if m.wire != Wire::Cdr {
+                    return f(m);
+                }
+                let data = crate::rosbag2::inflate(m.data, &mut buf)
+                    .map_err(|e| Corrupt::new(m.offset, e))?;
+                f(Message { data, ..m })
+            };
+            crate::mcap_file::for_each_message_in(r, &mut g).map(|s| s.unfinished)
+        }
         Container::Db3 => Ok(false),
     }
 }

@@ -22,6 +22,26 @@ fn sql(e: &rusqlite::Error) -> Corrupt {
     Corrupt::new(0, format!("SQLite: {e}"))
 }
 
+/// A message as stored, or inflated into `buf` when rosbag2 compressed it on its own
+/// (`compression_mode: message`, zstd; a CDR message never starts with zstd's magic).
+pub fn inflate<'a>(data: &'a [u8], buf: &'a mut Vec<u8>) -> Result<&'a [u8], String> {
+    if !data.starts_with(&ZSTD_MAGIC) {
+        return Ok(data);
+    }
+    buf.clear();
+    let mut d = zstd::stream::read::Decoder::new(data)
+        .map_err(|e| format!("zstd-compressed message: {e}"))?;
+    let mut lim = std::io::Read::take(&mut d, MAX_MESSAGE_BYTES as u64 + 1);
+    std::io::Read::read_to_end(&mut lim, buf)
+        .map_err(|e| format!("zstd-compressed message: {e}"))?;
+    if buf.len() > MAX_MESSAGE_BYTES {
+        return Err(format!(
+            "zstd-compressed message inflates past {MAX_MESSAGE_BYTES} bytes"
+        ));
+    }
+    Ok(&buf[..])
+}
+
 /// Whether an open SQLite database has rosbag2's `topics` and `messages` tables.
 pub fn is_rosbag2(c: &Connection) -> bool {
     let has = |t: &str| {
@@ -103,22 +123,7 @@ pub fn for_each_message(
         if !cdr {
             continue;
         }
-        let data = if data.starts_with(&ZSTD_MAGIC) {
-            buf.clear();
-            let mut d = zstd::stream::read::Decoder::new(data)
-                .map_err(|e| bad(format!("zstd-compressed message: {e}")))?;
-            let mut lim = std::io::Read::take(&mut d, MAX_MESSAGE_BYTES as u64 + 1);
-            std::io::Read::read_to_end(&mut lim, &mut buf)
-                .map_err(|e| bad(format!("zstd-compressed message: {e}")))?;
-            if buf.len() > MAX_MESSAGE_BYTES {
-                return Err(bad(format!(
-                    "zstd-compressed message inflates past {MAX_MESSAGE_BYTES} bytes"
-                )));
-            }
-            &buf[..]
-        } else {
-            data
-        };
+        let data = inflate(data, &mut buf).map_err(bad)?;
         n += 1;
         f(Message {
             topic,

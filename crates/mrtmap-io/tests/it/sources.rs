@@ -579,16 +579,25 @@ fn ros2_bag_folders_split_over_files_read_in_order() {
         std::fs::create_dir_all(&bag).unwrap();
         std::fs::write(bag.join("metadata.yaml"), "rosbag2_bagfile_information:\n").unwrap();
         for (i, chunk) in all.chunks(per).enumerate() {
+            // Odd files hold each message zstd-compressed, as `ros2 bag record
+            // --compression-mode message` writes them.
+            let stored = |data: &Vec<u8>| {
+                if i % 2 == 1 {
+                    zstd::encode_all(&data[..], 3).unwrap()
+                } else {
+                    data.clone()
+                }
+            };
             let bytes = if c == Container::Mcap {
                 let mut w = mrtmap_io::mcap_file::McapWriter::new(None, 1 << 16).unwrap();
                 for (topic, ty, t, data) in chunk {
-                    w.write(topic, ty, *t, data).unwrap();
+                    w.write(topic, ty, *t, &stored(data)).unwrap();
                 }
                 w.finish().unwrap()
             } else {
                 let mut w = mrtmap_io::rosbag2::Db3Writer::new().unwrap();
                 for (topic, ty, t, data) in chunk {
-                    w.write(topic, ty, *t, data).unwrap();
+                    w.write(topic, ty, *t, &stored(data)).unwrap();
                 }
                 w.finish().unwrap()
             };
