@@ -98,17 +98,17 @@ pub fn for_each<'a>(
         }
         return Ok(unfinished);
     }
-    if container == Container::Db3 {
-        let c = match input {
-            Input::Bytes(b) => crate::rosbag2::open_bytes(b)?,
-            Input::File(p) => crate::rosbag2::open_file(p)?,
-        };
-        return crate::rosbag2::for_each_message(&c, f).map(|_| false);
-    }
-    let mut r = input.open()?;
-    let r = &mut *r;
     match container {
-        Container::Bag => crate::bag::for_each_message_in(r, f).map(|s| s.unindexed),
+        Container::Db3 => {
+            let c = match input {
+                Input::Bytes(b) => crate::rosbag2::open_bytes(b)?,
+                Input::File(p) => crate::rosbag2::open_file(p)?,
+            };
+            crate::rosbag2::for_each_message(&c, f).map(|_| false)
+        }
+        Container::Bag => {
+            crate::bag::for_each_message_in(&mut *input.open()?, f).map(|s| s.unindexed)
+        }
         Container::Mcap => {
             // ROS 2 bags recorded with per-message compression keep each message zstd-compressed.
             let mut buf = Vec::new();
@@ -120,9 +120,8 @@ pub fn for_each<'a>(
                     .map_err(|e| Corrupt::new(m.offset, e))?;
                 f(Message { data, ..m })
             };
-            crate::mcap_file::for_each_message_in(r, &mut g).map(|s| s.unfinished)
+            crate::mcap_file::for_each_message_in(&mut *input.open()?, &mut g).map(|s| s.unfinished)
         }
-        Container::Db3 => Ok(false),
     }
 }
 
@@ -997,28 +996,22 @@ pub fn source_kind(path: &Path) -> Result<SourceKind, FileError> {
 pub fn resolve_source(path: &Path) -> Result<(SourceKind, std::path::PathBuf), FileError> {
     if path.is_dir() {
         if path.join("metadata.yaml").is_file() {
-            let files: Vec<_> = std::fs::read_dir(path)
-                .map_err(|e| FileError::io(path, e))?
-                .filter_map(|e| e.ok().map(|e| e.path()))
-                .collect();
-            let with = |ext: &str| {
-                files
-                    .iter()
-                    .filter(|p| p.extension().is_some_and(|e| e == ext))
-                    .cloned()
-                    .collect::<Vec<_>>()
-            };
             let one_or_all = |kind, v: Vec<std::path::PathBuf>| match v.as_slice() {
                 [one] => Ok((kind, one.clone())),
                 _ => Ok((kind, path.to_path_buf())),
             };
-            let (mcaps, db3s) = (with("mcap"), with("db3"));
+            let files = |c| storage_files(path, c).unwrap_or_default();
+            let (mcaps, db3s) = (files(Container::Mcap), files(Container::Db3));
+            let zstd = std::fs::read_dir(path)
+                .map_err(|e| FileError::io(path, e))?
+                .filter_map(|e| e.ok())
+                .any(|e| e.path().extension().is_some_and(|x| x == "zstd"));
             let bad = |m: String| Err(FileError::new(path, None, FileErrorKind::Syntax(m)));
             return match (mcaps.is_empty(), db3s.is_empty()) {
                 (false, true) => one_or_all(SourceKind::Mcap, mcaps),
                 (true, false) => one_or_all(SourceKind::Db3, db3s),
                 (false, false) => bad("a ROS 2 bag folder with both .mcap and .db3 files: give one file".into()),
-                (true, true) if !with("zstd").is_empty() => bad(
+                (true, true) if zstd => bad(
                     "a ROS 2 bag compressed file by file (.zstd): decompress it first (`ros2 bag convert`, or `zstd -d` on each file)".into(),
                 ),
                 (true, true) => bad("a ROS 2 bag folder without .mcap or .db3 files".into()),
@@ -1306,8 +1299,8 @@ pub fn write_ros(
     }
 }
 
-/// The frames of one mono16/16UC1 image topic (the thermal stream for a source that lacks one):
-/// (stamp, image); the topic is `topic` or the plan's thermal choice.
+/// The frames of one mono16/16UC1 image topic, raw or as 16-bit PNGs (the thermal stream for a
+/// source that lacks one): (stamp, image); the topic is `topic` or the plan's thermal choice.
 pub fn image_frames<'a>(
     path: &Path,
     container: Container,
@@ -1334,9 +1327,11 @@ pub fn image_frames<'a>(
     let mut out = Vec::new();
     for_each(container, file, &mut |m| {
         if m.topic == topic {
-            let i = ros_msg::image(m.data, m.wire, m.offset)?;
-            let img = depth_image(&i, 1.0).map_err(|e| Corrupt::new(m.offset, e))?;
-            out.push((stamp_or(i.header.stamp, m.time), img));
+            // Raw or 16-bit-PNG compressed, as the export reads thermal frames.
+            out.push(
+                image16_msg(&m, MsgKind::of(m.datatype), 1.0, true)
+                    .map_err(|e| Corrupt::new(m.offset, e))?,
+            );
         }
         Ok(())
     })

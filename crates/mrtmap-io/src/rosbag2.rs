@@ -15,8 +15,8 @@ use crate::bytes::Corrupt;
 use crate::ros_msg::{Message, Wire};
 
 const ZSTD_MAGIC: [u8; 4] = [0x28, 0xB5, 0x2F, 0xFD];
-/// A decompressed message may not exceed this (a 4K 16-bit image is 16 MiB).
-const MAX_MESSAGE_BYTES: usize = 512 << 20;
+/// A decompressed message may not exceed what a bag chunk may (512 MiB).
+const MAX_MESSAGE_BYTES: usize = crate::bag::MAX_CHUNK_BYTES;
 
 fn sql(e: &rusqlite::Error) -> Corrupt {
     Corrupt::new(0, format!("SQLite: {e}"))

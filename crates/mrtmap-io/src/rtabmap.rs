@@ -324,6 +324,7 @@ pub fn summarize(path: &Path) -> Result<DbSummary, FileError> {
         })
         .map_err(|e| sql_err(path, e))?;
     let mut links = Vec::new();
+    let mut closures = 0;
     if columns(&c, "Link").iter().any(|x| x == "type") {
         let names = [
             "neighbour",
@@ -345,6 +346,9 @@ pub fn summarize(path: &Path) -> Result<DbSummary, FileError> {
             .and_then(|m| m.collect())
             .map_err(|e| sql_err(path, e))?;
         for (t, n) in rows {
+            if is_loop_closure(t) {
+                closures += n as usize;
+            }
             let name = names
                 .get(t as usize)
                 .map_or(format!("type {t}"), |s| s.to_string());
@@ -378,11 +382,6 @@ pub fn summarize(path: &Path) -> Result<DbSummary, FileError> {
     };
     Ok(DbSummary {
         poses: if opt.is_empty() {
-            let closures: usize = links
-                .iter()
-                .filter(|(n, _)| n.contains("closure") || n == "user")
-                .map(|(_, k)| k)
-                .sum();
             if closures > 0 {
                 format!(
                     "odometry (Node.pose; no optimised poses saved) — the Link graph has {closures} loop closure{}: convert optimises it",
@@ -465,6 +464,11 @@ pub fn depth_blob(b: &[u8]) -> Result<Image16, String> {
 }
 
 const MAGIC_RVL: &[u8] = crate::rvl::MAGIC;
+
+/// Whether a `Link` type is a loop closure: global, local-space, local-time or user.
+pub fn is_loop_closure(kind: i64) -> bool {
+    matches!(kind, 1..=4)
+}
 
 /// One row of the `Link` table.
 #[derive(Clone, Debug)]

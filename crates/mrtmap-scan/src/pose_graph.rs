@@ -147,21 +147,6 @@ pub fn optimise(
             ));
         }
     }
-    // Nodes connected to the first one.
-    let mut adj: HashMap<i64, Vec<i64>> = HashMap::new();
-    for e in edges {
-        adj.entry(e.from).or_default().push(e.to);
-        adj.entry(e.to).or_default().push(e.from);
-    }
-    let mut reached = std::collections::BTreeSet::from([first]);
-    let mut stack = vec![first];
-    while let Some(n) = stack.pop() {
-        for &m in adj.get(&n).map(Vec::as_slice).unwrap_or(&[]) {
-            if reached.insert(m) {
-                stack.push(m);
-            }
-        }
-    }
     // The start: the first node where it is, the others along a breadth-first spanning tree of the
     // edges (as g2o and RTAB-Map start), so sessions whose odometry frames differ start together.
     let mut start: HashMap<i64, Isometry3<f64>> = HashMap::from([(first, *first_pose)]);
@@ -183,6 +168,8 @@ pub fn optimise(
             }
         }
     }
+    // The nodes connected to the first one are the ones the tree reached; only their edges count.
+    let reached: std::collections::BTreeSet<i64> = start.keys().copied().collect();
     let name = |id: i64| format!("x{id}");
     let values: HashMap<String, DVector<f64>> = reached
         .iter()
@@ -191,7 +178,10 @@ pub fn optimise(
     let mut problem = tiny_solver::Problem::new();
     let mut factors = Vec::new();
     let mut identity_weighted = 0;
-    for e in edges.iter().filter(|e| e.from != e.to) {
+    for e in edges
+        .iter()
+        .filter(|e| e.from != e.to && reached.contains(&e.from))
+    {
         let info = (e.information + e.information.transpose()) * 0.5;
         let sqrt_info = match info.cholesky() {
             // RTAB-Map's largest is 1/0.0001² = 1e8; far beyond is a broken matrix.
@@ -423,8 +413,9 @@ mod tests {
             information: Matrix6::identity(),
         };
         assert!(optimise(&truth, &[e]).unwrap_err().contains("node 99"));
-        // Only nodes 1–3 are linked: the rest are left out.
-        let edges: Vec<Edge> = [(1, 2), (2, 3)]
+        // Only nodes 1–3 are linked to the first: the rest, linked among themselves or not at
+        // all, are left out.
+        let edges: Vec<Edge> = [(1, 2), (2, 3), (5, 6), (6, 7)]
             .iter()
             .map(|&(a, b)| Edge {
                 from: a,
@@ -435,6 +426,7 @@ mod tests {
             .collect();
         let r = optimise(&truth, &edges).unwrap();
         assert_eq!(r.poses.keys().copied().collect::<Vec<_>>(), vec![1, 2, 3]);
+        assert_eq!(r.edges, 2);
         assert!(optimise(&BTreeMap::new(), &[]).is_err());
         // Implausible measurements are refused, not optimised into NaN.
         let wild = Edge {

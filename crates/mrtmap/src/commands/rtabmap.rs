@@ -145,7 +145,10 @@ fn optimise_graph(source: &Path) -> anyhow::Result<(Option<Poses>, String)> {
             information: Matrix6::from_row_slice(&l.information),
         })
         .collect();
-    let closures = links.iter().filter(|l| matches!(l.kind, 1..=4)).count();
+    let closures = links
+        .iter()
+        .filter(|l| rtabmap::is_loop_closure(l.kind))
+        .count();
     if closures == 0 {
         return Ok((
             None,
@@ -178,8 +181,8 @@ fn optimise_graph(source: &Path) -> anyhow::Result<(Option<Poses>, String)> {
 
 /// Thermal frames from another source.
 fn thermal_frames(src: &Path, a: &SourceArgs) -> anyhow::Result<(String, Vec<(f64, Image16)>)> {
-    match ros_scan::source_kind(src) {
-        Ok(SourceKind::Folder)
+    match ros_scan::resolve_source(src) {
+        Ok((SourceKind::Folder, _))
             if src.join("thermal.txt").is_file() && src.join("rig.toml").is_file() =>
         {
             let rec = Recording::open(src)?;
@@ -190,15 +193,14 @@ fn thermal_frames(src: &Path, a: &SourceArgs) -> anyhow::Result<(String, Vec<(f6
                 .collect::<anyhow::Result<Vec<_>>>()?;
             Ok((format!("{} (thermal.txt)", src.display()), frames))
         }
-        Ok(SourceKind::Bag | SourceKind::Mcap | SourceKind::Db3) => {
-            // A ROS 2 bag folder resolves to its one storage file (or stays a split bag's folder).
-            let (k, file) = ros_scan::resolve_source(src)?;
+        // A ROS 2 bag folder resolves to its one storage file (or stays a split bag's folder).
+        Ok((k @ (SourceKind::Bag | SourceKind::Mcap | SourceKind::Db3), file)) => {
             let c = k.container().unwrap_or(Container::Bag);
             let (topic, frames) =
                 ros_scan::image_frames(&file, c, file.as_path(), a.thermal_topic.as_deref())?;
             Ok((format!("{} {topic}", src.display()), frames))
         }
-        Ok(SourceKind::Folder) => {
+        Ok((SourceKind::Folder, _)) => {
             let mut files: Vec<_> = std::fs::read_dir(src)
                 .with_context(|| format!("{}: cannot list", src.display()))?
                 .filter_map(|e| e.ok().map(|e| e.path()))
@@ -225,7 +227,7 @@ fn thermal_frames(src: &Path, a: &SourceArgs) -> anyhow::Result<(String, Vec<(f6
                 frames,
             ))
         }
-        Ok(SourceKind::RtabMap) => bail!(
+        Ok((SourceKind::RtabMap, _)) => bail!(
             "{}: an RTAB-Map database holds no thermal frames",
             src.display()
         ),
