@@ -1,10 +1,11 @@
 //! Writes small seed inputs for every fuzz target into corpus/<target>/ (run by fuzz/run).
 use std::path::Path;
 
-use mrtmap_io::bag::{BagWriter, Compression};
-use mrtmap_io::mcap_file::McapWriter;
-use mrtmap_io::ros_msg::{Wire, encode};
-use mrtmap_io::{Image16, rtabmap, rvl};
+use mrtmap_sources::ros::bag::{BagWriter, Compression};
+use mrtmap_sources::ros::mcap::McapWriter;
+use mrtmap_sources::ros::msg::{Wire, encode};
+use mrtmap_io::Image16;
+use mrtmap_sources::rtabmap::{self, rvl};
 use nalgebra::{Isometry3, Vector3};
 
 fn put(target: &str, name: &str, bytes: &[u8]) {
@@ -84,7 +85,7 @@ fn main() {
         put("mcap", name, &w.finish().expect("finish"));
     }
     for (name, zstd) in [("plain", false), ("zstd", true)] {
-        let mut w = mrtmap_io::rosbag2::Db3Writer::new().expect("db3");
+        let mut w = mrtmap_sources::ros::db3::Db3Writer::new().expect("db3");
         for (k, (topic, ty, m)) in messages(Wire::Cdr).into_iter().enumerate() {
             let (pkg, n) = ty.split_once('/').expect("type");
             let m = if zstd {

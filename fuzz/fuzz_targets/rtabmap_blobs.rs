@@ -2,7 +2,7 @@
 //! comes from the first two bytes.
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use mrtmap_io::{rtabmap, rvl};
+use mrtmap_sources::rtabmap::{self, rvl};
 
 fuzz_target!(|data: &[u8]| {
     let _ = rtabmap::depth_blob(data);

@@ -69,9 +69,11 @@ fn cast_all(c: &dyn RayCaster, rays: &[(Point3<f64>, Vector3<f64>)]) -> usize {
 
 fn bench(c: &mut Criterion) {
     let tris = bumpy_sphere(224);
-    let casters: Vec<Box<dyn RayCaster>> = vec![Box::new(BvhRayCaster::new(&tris))];
-    #[cfg(feature = "embree")]
-    casters.push(Box::new(mrtmap_geometry::EmbreeRayCaster::new(&tris)));
+    let casters: Vec<Box<dyn RayCaster>> = vec![
+        Box::new(BvhRayCaster::new(&tris)),
+        #[cfg(feature = "embree")]
+        Box::new(mrtmap_geometry::EmbreeRayCaster::new(&tris)),
+    ];
     for (name, one) in [
         ("raycast_100k_incoherent", false),
         ("raycast_100k_from_one_point", true),

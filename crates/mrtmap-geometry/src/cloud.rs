@@ -43,19 +43,26 @@ pub fn voxel_downsample_from(
         .collect()
 }
 
+/// The centroid of points and their scatter matrix Σ (p − c)(p − c)ᵀ (the covariance times the
+/// count), the input of every PCA fit here.
+pub fn centroid_and_scatter(points: &[Point3<f64>]) -> (Point3<f64>, Matrix3<f64>) {
+    let c = points.iter().fold(Vector3::zeros(), |a, p| a + p.coords) / points.len().max(1) as f64;
+    let mut scatter = Matrix3::zeros();
+    for p in points {
+        let d = p.coords - c;
+        scatter += d * d.transpose();
+    }
+    (Point3::from(c), scatter)
+}
+
 /// Unit normal of a set of points by PCA (the eigenvector of the smallest eigenvalue of their
 /// covariance), or `None` for fewer than 3 points or no plane. The sign is arbitrary.
 pub fn pca_normal(points: &[Point3<f64>]) -> Option<Vector3<f64>> {
     if points.len() < 3 {
         return None;
     }
-    let c = points.iter().fold(Vector3::zeros(), |a, p| a + p.coords) / points.len() as f64;
-    let mut cov = Matrix3::zeros();
-    for p in points {
-        let d = p.coords - c;
-        cov += d * d.transpose();
-    }
-    let eig = nalgebra::SymmetricEigen::new(cov);
+    let (_, scatter) = centroid_and_scatter(points);
+    let eig = nalgebra::SymmetricEigen::new(scatter);
     let (k, _) = eig
         .eigenvalues
         .iter()

@@ -35,7 +35,7 @@ pub use plane::{Plane, RansacParams, intersect_three, ransac_plane};
 pub use polygon::{Containment, NotSimple, PlaneFrame};
 #[cfg(feature = "embree")]
 pub use ray::EmbreeRayCaster;
-pub use ray::{BvhRayCaster, RayCaster, RayHit, Tri, box_triangles};
+pub use ray::{BOX_TRIANGLES, BvhRayCaster, RayCaster, RayHit, Tri, box_corners, box_triangles};
 pub use sampling::DirectionSet;
 pub use solid_angle::{polygon_solid_angle, sphere_view_factor, triangle_solid_angle};
 

@@ -45,20 +45,15 @@ impl Plane {
         if points.len() < 3 {
             return None;
         }
-        let c = points.iter().fold(Vector3::zeros(), |a, p| a + p.coords) / points.len() as f64;
-        let mut cov = Matrix3::zeros();
-        for p in points {
-            let d = p.coords - c;
-            cov += d * d.transpose();
-        }
-        let eig = nalgebra::SymmetricEigen::new(cov);
+        let (c, scatter) = crate::cloud::centroid_and_scatter(points);
+        let eig = nalgebra::SymmetricEigen::new(scatter);
         let mut idx = [0usize, 1, 2];
         idx.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
         if eig.eigenvalues[idx[1]] <= 1e-12 {
             return None;
         }
         let n = Unit::try_new(eig.eigenvectors.column(idx[0]).into_owned(), 1e-9)?;
-        Some(Self::from_point_normal(&Point3::from(c), n))
+        Some(Self::from_point_normal(&c, n))
     }
 }
 

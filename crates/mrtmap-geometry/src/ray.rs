@@ -258,16 +258,21 @@ mod embree_caster {
     }
 }
 
-/// The twelve triangles of an axis-aligned box.
-pub fn box_triangles(min: &Point3<f64>, max: &Point3<f64>) -> Vec<Tri> {
-    let c = |i: usize| {
+/// The eight corners of an axis-aligned box: corner `i` takes max along x when bit 0 of `i` is
+/// set, along y for bit 1, along z for bit 2.
+pub fn box_corners(min: &Point3<f64>, max: &Point3<f64>) -> [Point3<f64>; 8] {
+    std::array::from_fn(|i| {
         Point3::new(
             if i & 1 == 0 { min.x } else { max.x },
             if i & 2 == 0 { min.y } else { max.y },
             if i & 4 == 0 { min.z } else { max.z },
         )
-    };
-    // Faces as quads of corner indices (bit 0 = x, bit 1 = y, bit 2 = z).
+    })
+}
+
+/// The twelve triangles of a box as indices into [`box_corners`], facing outwards.
+pub const BOX_TRIANGLES: [[usize; 3]; 12] = {
+    // Faces as quads of corner indices, each split along its first diagonal.
     const FACES: [[usize; 4]; 6] = [
         [0, 2, 6, 4],
         [1, 5, 7, 3],
@@ -276,8 +281,22 @@ pub fn box_triangles(min: &Point3<f64>, max: &Point3<f64>) -> Vec<Tri> {
         [0, 1, 3, 2],
         [4, 6, 7, 5],
     ];
-    FACES
+    let mut t = [[0; 3]; 12];
+    let mut k = 0;
+    while k < 6 {
+        let f = FACES[k];
+        t[2 * k] = [f[0], f[1], f[2]];
+        t[2 * k + 1] = [f[0], f[2], f[3]];
+        k += 1;
+    }
+    t
+};
+
+/// The twelve triangles of an axis-aligned box.
+pub fn box_triangles(min: &Point3<f64>, max: &Point3<f64>) -> Vec<Tri> {
+    let c = box_corners(min, max);
+    BOX_TRIANGLES
         .iter()
-        .flat_map(|f| [[c(f[0]), c(f[1]), c(f[2])], [c(f[0]), c(f[2]), c(f[3])]])
+        .map(|t| [c[t[0]], c[t[1]], c[t[2]]])
         .collect()
 }

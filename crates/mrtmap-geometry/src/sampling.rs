@@ -20,6 +20,16 @@ pub enum DirectionSet {
     Fibonacci,
 }
 
+impl DirectionSet {
+    /// The set in words ("Fibonacci-lattice", "random").
+    pub fn describe(self) -> &'static str {
+        match self {
+            Self::Random => "random",
+            Self::Fibonacci => "Fibonacci-lattice",
+        }
+    }
+}
+
 /// A uniform random direction.
 pub fn uniform_direction<R: Rng + ?Sized>(rng: &mut R) -> Vector3<f64> {
     let z: f64 = 1.0 - 2.0 * rng.random::<f64>();

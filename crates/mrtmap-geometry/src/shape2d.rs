@@ -1,5 +1,5 @@
 //! Small 2D shape tools: convex hull, minimum-area rectangle, line intersection, polygon
-//! simplification.
+//! simplification, clipping.
 
 use nalgebra::{Point2, Vector2};
 
@@ -127,4 +127,34 @@ fn dp(pts: &[Point2<f64>], tol: f64) -> Vec<Point2<f64>> {
     left.pop();
     left.extend(right);
     left
+}
+
+/// One Sutherland–Hodgman step: the part of polygon `p` where `side(q) ≥ 0` (`side` linear, such
+/// as a signed distance to a line).
+pub fn clip_half_plane(p: &[Point2<f64>], side: impl Fn(&Point2<f64>) -> f64) -> Vec<Point2<f64>> {
+    let mut out = Vec::with_capacity(p.len() + 1);
+    for k in 0..p.len() {
+        let (c, d) = (p[k], p[(k + 1) % p.len()]);
+        let (sc, sd) = (side(&c), side(&d));
+        if sc >= 0.0 {
+            out.push(c);
+        }
+        if (sc >= 0.0) != (sd >= 0.0) {
+            out.push(c + (d - c) * (sc / (sc - sd)));
+        }
+    }
+    out
+}
+
+/// Polygon `p` clipped to the convex polygon `clip` (both counter-clockwise; Sutherland–Hodgman).
+pub fn clip_convex(p: &[Point2<f64>], clip: &[Point2<f64>]) -> Vec<Point2<f64>> {
+    let mut out = p.to_vec();
+    for i in 0..clip.len() {
+        let (a, b) = (clip[i], clip[(i + 1) % clip.len()]);
+        out = clip_half_plane(&out, |q| (b - a).perp(&(q - a)));
+        if out.is_empty() {
+            break;
+        }
+    }
+    out
 }

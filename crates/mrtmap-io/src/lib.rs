@@ -1,7 +1,8 @@
 //! # mrtmap-io
 //!
-//! Every file format in and out of mrtmap's scan pipeline. Today: the recording layout
-//! (`shared/spec/recording.md`), with
+//! The file formats every stage of mrtmap shares, in three families:
+//!
+//! - [`layout`]: the recording layout, one folder per scan (docs/recording.md):
 //!
 //! ```text
 //!  scan/
@@ -12,48 +13,38 @@
 //!    masks.txt, masks/ instance PNG + labels JSON       → Image16 + MaskLabels
 //! ```
 //!
-//! Other sources become that layout: ROS 1 bags ([`bag`]), MCAP files ([`mcap_file`]) and ROS 2
-//! SQLite bags ([`rosbag2`]) through [`ros_scan`] (messages decoded by [`ros_msg`]), RTAB-Map
-//! databases ([`rtabmap`], depth in [`rvl`]); [`layout_writer`] writes the folder. Single thermal images in camera formats (FLIR
-//! R-JPEG/FFF in [`flir`], Lepton, radiometric TIFF) are read by [`read_thermal_file`]. Binary
-//! parsers read through [`bytes`], whose errors carry the byte offset.
+//! - [`thermal`]: single thermal images in camera formats (FLIR R-JPEG/FFF, Lepton, radiometric
+//!   TIFF).
+//! - thermal point clouds as PLY ([`write_cloud_ply`], [`read_cloud_ply`]), 16-bit images
+//!   ([`Image16`]), atomic files and folders ([`write_atomic`], [`PartialDir`]), and bounds-checked
+//!   byte readers whose errors carry the offset ([`bytes`]).
 //!
-//! Accepted beyond the spec: `masks.txt` (instance masks, see [`masks`]), `distortion` for the depth
-//! and colour cameras, duplicate timestamps in a trajectory (the first pose is kept). Errors name
-//! the file and line (or the image size); [`write_atomic`] and [`PartialDir`] make outputs appear
-//! only when complete.
+//! ROS bags, MCAP files and RTAB-Map databases live in `mrtmap-sources`, which turns them into
+//! this layout; crates that need only the layout do not compile SQLite or the compressors.
+//!
+//! Accepted beyond the layout's contract: `masks.txt` (instance masks, see [`masks`]),
+//! `distortion` for the depth and colour cameras, duplicate timestamps in a trajectory (the first
+//! pose is kept). Errors name the file and line (or the image size); [`write_atomic`] and
+//! [`PartialDir`] make outputs appear only when complete.
 
 mod atomic;
-pub mod bag;
 pub mod bytes;
 mod error;
-pub mod flir;
 mod image16;
-pub mod layout_writer;
-pub mod masks;
-pub mod mcap_file;
+pub mod layout;
 mod ply;
-mod recording;
-mod rig;
-pub mod ros_msg;
-pub mod ros_scan;
-pub mod rosbag2;
-pub mod rtabmap;
-pub mod rvl;
-mod streams;
-mod thermal_file;
-mod trajectory;
+pub mod thermal;
 
 pub use atomic::{PartialDir, write_atomic};
 pub use error::{FileError, FileErrorKind};
 pub use image16::{Image16, encode_png_rgb8, encode_png16, gaussian_blur, read_image16};
-pub use ply::{ReadCloud, ThermalCloud, cloud_ply_bytes, iron, read_cloud_ply, write_cloud_ply};
-pub use recording::Recording;
-pub use rig::{PoseFile, RgbCamera, Rig, ThermalEncoding};
-pub use streams::{StreamEntry, parse_stream_list, stream_list_text};
-pub use thermal_file::{
-    ThermalFileKind, ThermalImage, ThermalOptions, decode_thermal, read_thermal_file,
+pub use layout::masks;
+pub use layout::{
+    InterpolationLimits, LayoutWriter, PoseFile, QUATERNION_NORM_TOLERANCE, Recording, RgbCamera,
+    Rig, StreamEntry, ThermalEncoding, Trajectory, parse_stream_list, quaternion_xyzw,
+    stream_list_text, unit_quaternion,
 };
-pub use trajectory::{
-    InterpolationLimits, QUATERNION_NORM_TOLERANCE, Trajectory, quaternion_xyzw, unit_quaternion,
+pub use ply::{ReadCloud, ThermalCloud, cloud_ply_bytes, iron, read_cloud_ply, write_cloud_ply};
+pub use thermal::{
+    ThermalFileKind, ThermalImage, ThermalOptions, decode_thermal, flir, read_thermal_file,
 };

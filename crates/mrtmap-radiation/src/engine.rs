@@ -150,6 +150,25 @@ impl Method {
             Method::Auto(_) => "auto",
         }
     }
+
+    /// The method for people; `engine` names the ray caster of a Monte Carlo method.
+    pub fn describe(&self, engine: Option<&str>) -> String {
+        match self {
+            Method::Exact => "exact view factors (solid angles)".to_string(),
+            Method::Auto(mc) => format!(
+                "exact view factors (solid angles), Monte Carlo ({} rays) where surfaces hide each other",
+                mc.rays
+            ),
+            Method::MonteCarlo(mc) => format!(
+                "Monte Carlo view factors ({} rays per point, {} directions in {} replicates, seed {}{})",
+                mc.rays,
+                mc.directions.describe(),
+                mc.replicates,
+                mc.seed,
+                engine.map(|e| format!(", {e}")).unwrap_or_default()
+            ),
+        }
+    }
 }
 
 /// Why an MRT could not be computed.

@@ -69,26 +69,7 @@ pub struct SceneScore {
 
 /// Area of the intersection of two convex polygons (counter-clockwise).
 fn convex_intersection_area(a: &[Point2<f64>], b: &[Point2<f64>]) -> f64 {
-    let mut out = a.to_vec();
-    for i in 0..b.len() {
-        let (p, q) = (b[i], b[(i + 1) % b.len()]);
-        let side = |x: &Point2<f64>| (q - p).perp(&(x - p));
-        let input = std::mem::take(&mut out);
-        for k in 0..input.len() {
-            let (c, d) = (input[k], input[(k + 1) % input.len()]);
-            let (sc, sd) = (side(&c), side(&d));
-            if sc >= 0.0 {
-                out.push(c);
-            }
-            if (sc >= 0.0) != (sd >= 0.0) {
-                out.push(c + (d - c) * (sc / (sc - sd)));
-            }
-        }
-        if out.len() < 3 {
-            return 0.0;
-        }
-    }
-    signed_area(&out).abs()
+    signed_area(&mrtmap_geometry::shape2d::clip_convex(a, b)).abs()
 }
 
 fn ccw(mut p: Vec<Point2<f64>>) -> Vec<Point2<f64>> {

@@ -568,15 +568,8 @@ impl Room {
             .iter()
             .enumerate()
             .map(|(k, b)| {
-                let corners: Vec<Point3<f64>> = (0..8)
-                    .map(|c| {
-                        Point3::new(
-                            if c & 1 == 0 { b.min[0] } else { b.max[0] },
-                            if c & 2 == 0 { b.min[1] } else { b.max[1] },
-                            if c & 4 == 0 { b.min[2] } else { b.max[2] },
-                        )
-                    })
-                    .collect();
+                let corners =
+                    mrtmap_geometry::box_corners(&Point3::from(b.min), &Point3::from(b.max));
                 let slug: String = b
                     .label
                     .to_lowercase()
@@ -591,22 +584,10 @@ impl Room {
                         None,
                     )
                 } else {
-                    const QUADS: [[usize; 4]; 6] = [
-                        [0, 2, 6, 4],
-                        [1, 5, 7, 3],
-                        [0, 4, 5, 1],
-                        [2, 3, 7, 6],
-                        [0, 1, 3, 2],
-                        [4, 6, 7, 5],
-                    ];
-                    let tris = QUADS
-                        .iter()
-                        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-                        .collect();
                     (
                         None,
                         Some(corners.iter().map(|c| w(*c)).collect()),
-                        Some(tris),
+                        Some(mrtmap_geometry::BOX_TRIANGLES.to_vec()),
                     )
                 };
                 OccluderFile {
@@ -659,27 +640,12 @@ impl Room {
 
 /// Clips a 2D polygon to the band y ∈ [y0, y1] (Sutherland–Hodgman against two half-planes).
 fn clip_band(poly: &[Point2<f64>], y0: f64, y1: f64) -> Vec<Point2<f64>> {
-    let clip = |pts: &[Point2<f64>], keep: &dyn Fn(&Point2<f64>) -> f64| -> Vec<Point2<f64>> {
-        let mut out = Vec::new();
-        let n = pts.len();
-        for i in 0..n {
-            let (a, b) = (pts[i], pts[(i + 1) % n]);
-            let (da, db) = (keep(&a), keep(&b));
-            if da >= 0.0 {
-                out.push(a);
-            }
-            if (da >= 0.0) != (db >= 0.0) {
-                let t = da / (da - db);
-                out.push(a + (b - a) * t);
-            }
-        }
-        out
-    };
-    let lower = clip(poly, &|p| p.y - y0);
+    use mrtmap_geometry::shape2d::clip_half_plane;
+    let lower = clip_half_plane(poly, |p| p.y - y0);
     if lower.is_empty() {
         return lower;
     }
-    let mut both = clip(&lower, &|p| y1 - p.y);
+    let mut both = clip_half_plane(&lower, |p| y1 - p.y);
     both.dedup_by(|a, b| (*a - *b).norm() < 1e-12);
     if both.len() > 1 && (both[0] - both[both.len() - 1]).norm() < 1e-12 {
         both.pop();

@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use mrtmap_pipeline::{DirectionChoice, MethodChoice, MrtSection};
 
 /// Map the mean radiant temperature (MRT) of a room.
 ///
@@ -85,6 +86,21 @@ pub struct SourceArgs {
     /// a mono16 topic, or a folder of 16-bit thermal images named by timestamp.
     #[arg(long, value_name = "SRC")]
     pub thermal: Option<PathBuf>,
+}
+
+impl SourceArgs {
+    /// The reading options these flags stand for.
+    pub fn options(&self) -> mrtmap_pipeline::source::SourceOptions {
+        mrtmap_pipeline::source::SourceOptions {
+            rig: self.rig.clone(),
+            depth_topic: self.depth_topic.clone(),
+            thermal_topic: self.thermal_topic.clone(),
+            rgb_topic: self.rgb_topic.clone(),
+            pose_topic: self.pose_topic.clone(),
+            depth_scale: self.depth_scale,
+            thermal: self.thermal.clone(),
+        }
+    }
 }
 
 /// `mrtmap inspect`.
@@ -296,10 +312,11 @@ pub struct SimulateBoardArgs {
 
 /// `mrtmap run`.
 #[derive(Debug, Args)]
-#[command(after_long_help = crate::project::PROJECT_EXAMPLE)]
+#[command(after_long_help = mrtmap_pipeline::settings::PROJECT_EXAMPLE)]
 pub struct RunArgs {
-    /// The recording: a folder (shared/spec/recording.md), a ROS 1 bag, an MCAP file, a ROS 2 bag
-    /// (folder or .db3) or an RTAB-Map database (converted into OUT/recording first).
+    /// The recording: a folder in the recording layout (docs/recording.md), a ROS 1 bag, an MCAP
+    /// file, a ROS 2 bag (folder or .db3) or an RTAB-Map database (converted into OUT/recording
+    /// first).
     pub recording: PathBuf,
     /// How to read a bag, MCAP file or database.
     #[command(flatten)]
@@ -420,8 +437,9 @@ pub enum OnOff {
 /// `mrtmap fuse`.
 #[derive(Debug, Args)]
 pub struct FuseArgs {
-    /// The recording: a folder (shared/spec/recording.md), a ROS 1 bag, an MCAP file, a ROS 2 bag
-    /// (folder or .db3) or an RTAB-Map database (converted into OUT/recording first).
+    /// The recording: a folder in the recording layout (docs/recording.md), a ROS 1 bag, an MCAP
+    /// file, a ROS 2 bag (folder or .db3) or an RTAB-Map database (converted into OUT/recording
+    /// first).
     pub recording: PathBuf,
     /// How to read a bag, MCAP file or database.
     #[command(flatten)]
@@ -523,45 +541,40 @@ pub struct SceneArgs {
     pub scene: Option<PathBuf>,
 }
 
-/// How view factors are computed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum MethodArg {
-    /// Exact solid angles where valid; Monte Carlo with occluders or where surfaces hide each
-    /// other (non-convex rooms).
-    Auto,
-    /// Exact solid angles (Van Oosterom–Strackee), features subtracted from their host.
-    Exact,
-    /// Monte Carlo ray tracing against a BVH (handles occluders and non-convex rooms).
-    Montecarlo,
-}
-
-/// Direction sets for Monte Carlo.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum DirectionsArg {
-    /// Randomly rotated spherical Fibonacci lattices (converges faster).
-    Fibonacci,
-    /// Independent uniform random directions.
-    Random,
-}
-
-/// View-factor settings shared by `mrt` and `map`.
+/// View-factor settings shared by `mrt` and `map` (`[mrt]` of project.toml).
 #[derive(Debug, Args, Clone)]
 pub struct MethodArgs {
-    /// View-factor method.
-    #[arg(long, value_enum, default_value_t = MethodArg::Auto)]
-    pub method: MethodArg,
+    /// View-factor method: exact solid angles where valid and Monte Carlo with occluders or where
+    /// surfaces hide each other (auto), exact solid angles only (exact), or Monte Carlo ray
+    /// tracing (montecarlo).
+    #[arg(long, value_enum, default_value_t = MethodChoice::Auto)]
+    pub method: MethodChoice,
     /// Monte Carlo: rays per point.
     #[arg(long, default_value_t = 20_000)]
     pub rays: usize,
     /// Monte Carlo: random seed (results are reproducible from it).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Monte Carlo: direction set.
-    #[arg(long, value_enum, default_value_t = DirectionsArg::Fibonacci)]
-    pub directions: DirectionsArg,
+    /// Monte Carlo: direction set (randomly rotated spherical Fibonacci lattices converge faster
+    /// than independent random directions).
+    #[arg(long, value_enum, default_value_t = DirectionChoice::Fibonacci)]
+    pub directions: DirectionChoice,
     /// Monte Carlo: independent replicates the standard errors come from.
     #[arg(long, default_value_t = 8)]
     pub replicates: usize,
+}
+
+impl MethodArgs {
+    /// The `[mrt]` settings these flags stand for.
+    pub fn section(&self) -> MrtSection {
+        MrtSection {
+            method: self.method,
+            rays: self.rays,
+            seed: self.seed,
+            directions: self.directions,
+            replicates: self.replicates,
+        }
+    }
 }
 
 /// `mrtmap map`.

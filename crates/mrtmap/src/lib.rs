@@ -6,10 +6,7 @@
 
 mod cli;
 mod commands;
-mod maps;
 mod output;
-mod pipeline;
-mod project;
 
 use std::process::ExitCode;
 

@@ -3,5 +3,4 @@
 
 mod formats;
 mod recording;
-mod sources;
 mod thermal_files;

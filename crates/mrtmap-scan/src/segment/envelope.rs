@@ -5,7 +5,7 @@
 use mrtmap_geometry::PlaneFrame;
 use mrtmap_geometry::nalgebra::{Isometry3, Point2, Point3, Unit, Vector2, Vector3};
 use mrtmap_geometry::plane::{Plane, RansacParams, intersect_three, ransac_plane};
-use mrtmap_geometry::polygon::signed_area;
+use mrtmap_geometry::polygon::{centroid, signed_area};
 use mrtmap_geometry::shape2d::line_intersection;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -80,6 +80,14 @@ fn percentile(v: &mut [f64], q: f64) -> f64 {
     v[((v.len() - 1) as f64 * q).round() as usize]
 }
 
+/// The mean of the cloud's points `idx`.
+fn mean_of(points: &[Point3<f64>], idx: &[usize]) -> Point3<f64> {
+    let sum = idx
+        .iter()
+        .fold(Vector3::zeros(), |a, &i| a + points[i].coords);
+    Point3::from(sum / idx.len().max(1) as f64)
+}
+
 /// Finds planes by repeated RANSAC, merging near-coplanar ones.
 pub fn find_planes(
     points: &[Point3<f64>],
@@ -114,11 +122,7 @@ pub fn find_planes(
     for (pl, inl) in found {
         let same = merged.iter_mut().find(|(m, _)| {
             m.normal.dot(&pl.normal).abs() > p.merge_deg.to_radians().cos() && {
-                let c = inl
-                    .iter()
-                    .fold(Vector3::zeros(), |a, &i| a + points[i].coords)
-                    / inl.len() as f64;
-                m.distance(&Point3::from(c)).abs() < p.merge_distance_m
+                m.distance(&mean_of(points, &inl)).abs() < p.merge_distance_m
             }
         });
         match same {
@@ -174,17 +178,7 @@ pub fn envelope(
         .collect();
     let heights: Vec<f64> = planes
         .iter()
-        .map(|f| {
-            height(
-                &Point3::from(
-                    f.inliers
-                        .iter()
-                        .fold(Vector3::zeros(), |a, &i| a + points[i].coords)
-                        / f.points.max(1) as f64,
-                ),
-                &up0,
-            )
-        })
+        .map(|f| height(&mean_of(points, &f.inliers), &up0))
         .collect();
     let plane_height = |k: usize| heights[k];
     let floor = *big
@@ -219,16 +213,15 @@ pub fn envelope(
     planes[floor].class = PlaneClass::Floor;
     planes[ceiling].class = PlaneClass::Ceiling;
     // The room's interior: the mean of points between floor and ceiling.
-    let inside: Vec<&Point3<f64>> = points
+    let inside: Vec<Point3<f64>> = points
         .iter()
         .filter(|q| {
             let h = height(q, &up);
             h > h_floor + 0.2 && h < h_ceiling - 0.2
         })
+        .copied()
         .collect();
-    let centre = Point3::from(
-        inside.iter().fold(Vector3::zeros(), |a, q| a + q.coords) / inside.len().max(1) as f64,
-    );
+    let centre = centroid(&inside);
     // Walls: vertical planes spanning enough of the room's height.
     let mut walls = Vec::new();
     #[allow(clippy::needless_range_loop)] // planes[k] is read and rewritten in the body
@@ -306,12 +299,8 @@ pub fn envelope(
             let n = Unit::new_normalize(
                 planes[k].plane.normal.as_ref() - up.as_ref() * planes[k].plane.normal.dot(&up),
             );
-            let c = planes[k]
-                .inliers
-                .iter()
-                .fold(Vector3::zeros(), |a, &i| a + points[i].coords)
-                / planes[k].points as f64;
-            let mut pl = Plane::from_point_normal(&Point3::from(c), n);
+            let c = mean_of(points, &planes[k].inliers);
+            let mut pl = Plane::from_point_normal(&c, n);
             if pl.distance(&centre) < 0.0 {
                 pl = pl.flipped();
             }
@@ -335,12 +324,8 @@ pub fn envelope(
                     continue;
                 }
                 let d = up.cross(&pa.normal);
-                let cb = planes[walls[b]]
-                    .inliers
-                    .iter()
-                    .fold(Vector3::zeros(), |s, &i| s + points[i].coords)
-                    / planes[walls[b]].points as f64;
-                if pa.distance(&Point3::from(cb)).abs() > p.merge_distance_m {
+                let cb = mean_of(points, &planes[walls[b]].inliers);
+                if pa.distance(&cb).abs() > p.merge_distance_m {
                     continue;
                 }
                 let span = |k: usize| {
@@ -365,9 +350,7 @@ pub fn envelope(
                 if let Some(f) = Plane::fit(&pts) {
                     let n =
                         Unit::new_normalize(f.normal.as_ref() - up.as_ref() * f.normal.dot(&up));
-                    let c =
-                        pts.iter().fold(Vector3::zeros(), |s, q| s + q.coords) / pts.len() as f64;
-                    let mut pl = Plane::from_point_normal(&Point3::from(c), n);
+                    let mut pl = Plane::from_point_normal(&centroid(&pts), n);
                     if pl.distance(&centre) < 0.0 {
                         pl = pl.flipped();
                     }

@@ -15,7 +15,7 @@ use mrtmap_geometry::nalgebra::{Point2, Point3};
 use mrtmap_geometry::polygon::{
     point_in_polygon_fast, polygon_inside, polygons_overlap, signed_area,
 };
-use mrtmap_geometry::shape2d::{convex_hull, min_area_rectangle, simplify_closed};
+use mrtmap_geometry::shape2d::{clip_convex, convex_hull, min_area_rectangle, simplify_closed};
 use mrtmap_physics::{RadiantAverage, Temperature};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -161,30 +161,6 @@ fn robust_background(samples: &[(f64, f64)], linear: bool) -> Background {
         }
     }
     best
-}
-
-/// Clips polygon `p` to the convex polygon `clip` (both counter-clockwise).
-fn clip_convex(p: &[Point2<f64>], clip: &[Point2<f64>]) -> Vec<Point2<f64>> {
-    let mut out = p.to_vec();
-    for i in 0..clip.len() {
-        let (a, b) = (clip[i], clip[(i + 1) % clip.len()]);
-        let side = |q: &Point2<f64>| (b - a).perp(&(q - a));
-        let input = std::mem::take(&mut out);
-        for k in 0..input.len() {
-            let (c, d) = (input[k], input[(k + 1) % input.len()]);
-            let (sc, sd) = (side(&c), side(&d));
-            if sc >= 0.0 {
-                out.push(c);
-            }
-            if (sc >= 0.0) != (sd >= 0.0) {
-                out.push(c + (d - c) * (sc / (sc - sd)));
-            }
-        }
-        if out.is_empty() {
-            break;
-        }
-    }
-    out
 }
 
 fn ccw(mut p: Vec<Point2<f64>>) -> Vec<Point2<f64>> {

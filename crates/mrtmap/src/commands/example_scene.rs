@@ -3,7 +3,7 @@
 use mrtmap_radiation::EXAMPLE_OFFICE_JSON;
 
 use crate::cli::ExampleSceneArgs;
-use crate::output::write_atomic;
+use mrtmap_io::write_atomic;
 
 pub fn run(args: &ExampleSceneArgs) -> anyhow::Result<()> {
     match &args.out {

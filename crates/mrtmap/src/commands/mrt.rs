@@ -4,7 +4,8 @@ use mrtmap_geometry::nalgebra::Point3;
 use mrtmap_radiation::{MrtEngine, PointRecord};
 use serde::Serialize;
 
-use super::{describe_method, load_scene, resolve_method};
+use mrtmap_pipeline::maps::load_scene;
+
 use crate::cli::MrtArgs;
 use crate::output::json;
 
@@ -16,8 +17,8 @@ struct MrtOut {
 }
 
 pub fn run(a: &MrtArgs) -> anyhow::Result<()> {
-    let (scene, source) = load_scene(&a.scene)?;
-    let method = resolve_method(&a.method, &scene)?;
+    let (scene, source) = load_scene(a.scene.scene.as_deref())?;
+    let method = a.method.section().method(&scene)?;
     let engine = MrtEngine::new(&scene, method)?;
     let mut points = Vec::with_capacity(a.at.len());
     for (k, p) in a.at.iter().enumerate() {
@@ -36,7 +37,7 @@ pub fn run(a: &MrtArgs) -> anyhow::Result<()> {
         return Ok(());
     }
     println!("scene: {source}");
-    println!("method: {}", describe_method(&method, engine.ray_engine()));
+    println!("method: {}", method.describe(engine.ray_engine()));
     for p in &points {
         println!();
         println!(

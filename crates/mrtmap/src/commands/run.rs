@@ -3,13 +3,13 @@
 use std::time::Instant;
 
 use anyhow::bail;
-use mrtmap_io::write_atomic;
-use serde_json::json;
+use mrtmap_pipeline::Project;
+use mrtmap_pipeline::report::{report_data, write_run_outputs};
+use mrtmap_pipeline::settings::PointEntry;
+use mrtmap_pipeline::source::prepare;
 
 use crate::cli::{OnOff, RunArgs};
-use crate::output::json;
-use crate::pipeline::{RunOutcome, report_data, run_pipeline};
-use crate::project::{PointEntry, Project};
+use crate::output::{Bar, print_conversion, print_run};
 
 /// The project from the file and the flags.
 fn settings(a: &RunArgs) -> anyhow::Result<Project> {
@@ -27,13 +27,13 @@ fn settings(a: &RunArgs) -> anyhow::Result<Project> {
         p.map.margin_m = m;
     }
     for (name, c) in &a.marks {
-        if c.len() != 3 {
+        let &[x, y, z] = c.as_slice() else {
             bail!("--mark {name}: give X,Y,Z in the scan's frame");
-        }
+        };
         p.points.retain(|q| &q.name != name);
         p.points.push(PointEntry {
             name: name.clone(),
-            xyz: [c[0], c[1], c[2]],
+            xyz: [x, y, z],
         });
     }
     if let Some(v) = a.voxel_m {
@@ -48,68 +48,35 @@ fn settings(a: &RunArgs) -> anyhow::Result<Project> {
     if let Some(t) = a.air_c {
         p.air.temperature_c = Some(t);
     }
-    if p.map.heights_m.is_empty() || p.map.heights_m.iter().any(|h| !(h.is_finite() && *h > 0.0)) {
-        bail!(
-            "map heights must be positive numbers, got {:?}",
-            p.map.heights_m
-        );
-    }
+    p.check()?;
     Ok(p)
-}
-
-/// Prints the end-of-run summary.
-pub(crate) fn print_summary(o: &RunOutcome, out: &std::path::Path, secs: f64) {
-    for st in &o.stages {
-        println!(
-            "  {:<14} {:>7.1} s{}",
-            st.stage,
-            st.secs,
-            if st.skipped {
-                "  (inputs unchanged: reused)"
-            } else {
-                ""
-            }
-        );
-    }
-    for (s, _) in &o.maps {
-        crate::commands::map::print_map(s);
-    }
-    for w in &o.warnings {
-        println!("warning: {w}");
-    }
-    println!(
-        "done in {secs:.1} s; report: {}",
-        out.join("report.html").display()
-    );
 }
 
 pub fn run(a: &RunArgs) -> anyhow::Result<()> {
     let p = settings(a)?;
     let t0 = Instant::now();
-    let bar = crate::commands::fuse::progress_bar("");
-    let recording = super::source::recording_dir(&a.recording, &a.out, &a.src)?;
-    let outcome = run_pipeline(&recording, &a.out, &p, a.force, &|stage, done, total| {
-        bar.set_message(stage.to_string());
-        bar.set_length(total);
-        bar.set_position(done);
-    })?;
-    bar.finish_and_clear();
+    let prepared = prepare(&a.recording, &a.out, &a.src.options())?;
+    if let Some(c) = &prepared.conversion {
+        print_conversion(c);
+    } else if prepared.reused {
+        println!(
+            "using {} (converted earlier from {})",
+            prepared.dir.display(),
+            a.recording.display()
+        );
+    }
+    let bar = Bar::new("");
+    let outcome = mrtmap_pipeline::run::run(&prepared.dir, &a.out, &p, a.force, &bar)?;
+    bar.finish();
     let data = report_data(
         &outcome,
         "Mean radiant temperature of a scanned room",
         &a.recording.display().to_string(),
         &p,
     );
-    write_atomic(
-        &a.out.join("report.html"),
-        mrtmap_report::render_html(&data).as_bytes(),
-    )?;
     let secs = t0.elapsed().as_secs_f64();
-    write_atomic(
-        &a.out.join("run.json"),
-        json(&json!({ "recording": a.recording.display().to_string(), "stages": outcome.stages, "warnings": outcome.warnings, "seconds": secs, "project": p }))?.as_bytes(),
-    )?;
+    write_run_outputs(&a.out, &data, &outcome, &a.recording, &p, secs)?;
     println!("ran {} into {}", a.recording.display(), a.out.display());
-    print_summary(&outcome, &a.out, secs);
+    print_run(&outcome, &a.out, secs);
     Ok(())
 }

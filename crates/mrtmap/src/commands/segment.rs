@@ -1,29 +1,20 @@
 //! `mrtmap segment`: thermal cloud → radiant scene.
 
-use anyhow::{Context, bail};
-use mrtmap_io::{Recording, Trajectory, read_cloud_ply, write_atomic, write_cloud_ply};
-use mrtmap_scan::segment::{MaskInput, SegmentParams, refined_poses, segment};
+use anyhow::bail;
+use mrtmap_io::Recording;
+use mrtmap_pipeline::run::segment_into;
+use mrtmap_pipeline::settings::SegmentSection;
 
 use crate::cli::SegmentArgs;
-use crate::output::json;
 
 pub fn run(a: &SegmentArgs) -> anyhow::Result<()> {
-    let cloud_path = a.fused.join("cloud.ply");
-    if !cloud_path.exists() {
+    if !a.fused.join("cloud.ply").exists() {
         bail!(
             "{} has no cloud.ply: give the output folder of `mrtmap fuse`",
             a.fused.display()
         );
     }
-    let cloud = read_cloud_ply(&cloud_path)?.cloud;
-    let poses = Trajectory::read(&a.fused.join("poses.txt"))
-        .with_context(|| format!("{} has no usable poses.txt", a.fused.display()))?;
-    let params = SegmentParams {
-        feature_threshold_k: a.feature_threshold_k,
-        feature_min_area_m2: a.feature_min_area_m2,
-        ..SegmentParams::default()
-    };
-    let rec = match &a.masks {
+    let masks = match &a.masks {
         Some(dir) => {
             let r = Recording::open(dir)?;
             if r.masks.is_empty() {
@@ -33,31 +24,13 @@ pub fn run(a: &SegmentArgs) -> anyhow::Result<()> {
         }
         None => None,
     };
-    let pose_fn = rec.as_ref().map(|r| refined_poses(r, &poses));
-    let mask_input = match (&rec, &pose_fn) {
-        (Some(r), Some(f)) => Some(MaskInput {
-            recording: r,
-            world_from_depth: f,
-        }),
-        _ => None,
+    let section = SegmentSection {
+        feature_threshold_k: a.feature_threshold_k,
+        feature_min_area_m2: a.feature_min_area_m2,
+        masks: masks.is_some(),
     };
-    let seg = segment(&cloud, &poses.poses, mask_input.as_ref(), &params)
-        .with_context(|| format!("cannot segment {}", cloud_path.display()))?;
-    write_atomic(
-        &a.out.join("scene.json"),
-        (seg.scene.to_json() + "\n").as_bytes(),
-    )?;
-    write_cloud_ply(
-        &a.out.join("segments.ply"),
-        &cloud,
-        "mrtmap segments: surface_id indexes segment.json's surfaces, feature_id its features (-1: none)",
-        &[
-            ("surface_id", &seg.surface_id),
-            ("feature_id", &seg.feature_id),
-        ],
-    )?;
-    write_atomic(&a.out.join("segment.json"), json(&seg.report)?.as_bytes())?;
-    let r = &seg.report;
+    let report = segment_into(&a.fused, masks.as_ref(), &section.params(), &a.out)?;
+    let r = &report;
     println!(
         "room: {} walls, {:.2} m high; {:.0} % of the cloud on no surface (furniture, clutter)",
         r.surfaces.len() - 2,

@@ -1,28 +1,13 @@
-//! `mrtmap simulate` and `mrtmap rooms`.
+//! `mrtmap simulate`: a handheld scan of a room, with exact truth.
 
 use std::time::Instant;
 
-use anyhow::{Context, bail};
-use mrtmap_sim::{Drift, NoiseLevel, PRESETS, Room, SimConfig, ThermalNoise, preset, simulate};
+use mrtmap_pipeline::Progress;
+use mrtmap_pipeline::simulation::{load_room, set_depth_size};
+use mrtmap_sim::{Drift, NoiseLevel, SimConfig, ThermalNoise, simulate};
 
-use crate::cli::{DriftArg, NoiseArg, RoomsArgs, SimulateArgs};
-
-/// A preset name or a TOML file.
-pub(crate) fn load_room(spec: &str) -> anyhow::Result<Room> {
-    if let Some(r) = preset(spec) {
-        return Ok(r?);
-    }
-    let path = std::path::Path::new(spec);
-    if !path.exists() {
-        let names: Vec<&str> = PRESETS.iter().map(|p| p.0).collect();
-        bail!(
-            "'{spec}' is neither a preset room ({}) nor a file",
-            names.join(", ")
-        );
-    }
-    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {spec}"))?;
-    Room::from_toml(&text).with_context(|| spec.to_string())
-}
+use crate::cli::{DriftArg, NoiseArg, SimulateArgs};
+use crate::output::Bar;
 
 pub fn run(a: &SimulateArgs) -> anyhow::Result<()> {
     let room = load_room(&a.room)?;
@@ -45,32 +30,16 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<()> {
         blur_sigma_px: a.thermal_blur,
         ..ThermalNoise::REALISTIC
     };
-    let s = a.depth_size.0 as f64 / cfg.depth_camera.width as f64;
-    if (a.depth_size.1 as f64 / cfg.depth_camera.height as f64 - s).abs() > 1e-9 {
-        bail!(
-            "--depth-size {}x{} must keep the 4:3 aspect of 640x480",
-            a.depth_size.0,
-            a.depth_size.1
-        );
-    }
-    cfg.depth_camera = cfg.depth_camera.scaled(s);
+    set_depth_size(&mut cfg, a.depth_size)?;
     cfg.depth_hz = a.depth_hz;
     cfg.thermal_hz = a.thermal_hz;
     cfg.rgb_hz = a.rgb_hz;
     cfg.truth_rays = a.truth_rays;
-    let bar = indicatif::ProgressBar::new(0);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} frames ({eta})")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
-            .progress_chars("=> "),
-    );
-    bar.set_message(format!("simulating {}", room.file.name));
+    let bar = Bar::new(" frames");
+    bar.begin(&format!("simulating {}", room.file.name));
     let t0 = Instant::now();
-    let summary = simulate(&room, &cfg, &a.out, &|done, total| {
-        bar.set_length(total);
-        bar.set_position(done);
-    })?;
-    bar.finish_and_clear();
+    let summary = simulate(&room, &cfg, &a.out, &|done, total| bar.advance(done, total))?;
+    bar.finish();
     println!(
         "simulated {:.0} s of scanning the {} room in {:.1} s: {} depth, {} thermal, {} colour + mask frames, {} poses; {:.1} MB in {}",
         a.seconds,
@@ -87,21 +56,5 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<()> {
         "truth.json: MRT at the validation points and on the 20×20 grid at 1.1 m ({} view factors)",
         summary.truth_method
     );
-    Ok(())
-}
-
-pub fn rooms(a: &RoomsArgs) -> anyhow::Result<()> {
-    match &a.name {
-        Some(n) => match PRESETS.iter().find(|p| p.0 == n) {
-            Some((_, text)) => print!("{text}"),
-            None => bail!("no preset room '{n}' (see `mrtmap rooms`)"),
-        },
-        None => {
-            for (name, text) in PRESETS {
-                let room = Room::from_toml(text)?;
-                println!("{name:<16} {}", room.file.description);
-            }
-        }
-    }
     Ok(())
 }

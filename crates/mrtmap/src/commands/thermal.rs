@@ -6,7 +6,9 @@ use mrtmap_io::{ThermalImage, ThermalOptions, encode_png_rgb8, encode_png16, iro
 use serde::Serialize;
 
 use crate::cli::ThermalArgs;
-use crate::output::{json, write_atomic};
+use mrtmap_io::write_atomic;
+
+use crate::output::json;
 
 pub(crate) fn options(a: &ThermalArgs) -> anyhow::Result<ThermalOptions> {
     if let Some(e) = a.emissivity

@@ -2,16 +2,16 @@
 //!
 //! | file | how |
 //! |---|---|
-//! | FLIR R-JPEG (`.jpg` with APP1 "FLIR") and FFF (`.fff`, `.seq` frame) | raw counts + the file's Planck constants and object parameters ([`crate::flir`]) |
+//! | FLIR R-JPEG (`.jpg` with APP1 "FLIR") and FFF (`.fff`, `.seq` frame) | raw counts + the file's Planck constants and object parameters ([`super::flir`]) |
 //! | 16-bit PNG / TIFF | `raw × scale` kelvin; scale 0.01 (Lepton TLinear centikelvin) unless given or the values only make sense at 0.04 (Tau / Boson / Duo TLinear low resolution) |
 //! | float TIFF | °C, or K when the median is above 150 |
 //! | raw `.y16` / `.bin` | little-endian 16-bit, size given or 160×120 / 80×60 from the file length |
 
 use std::path::Path;
 
+use super::flir::{FlirOverrides, RawKind, TiffPixels, decode_tiff, is_flir, parse_flir};
 use crate::bytes::Corrupt;
 use crate::error::{FileError, FileErrorKind};
-use crate::flir::{FlirOverrides, RawKind, TiffPixels, decode_tiff, is_flir, parse_flir};
 use crate::image16::Image16;
 
 /// Largest thermal image we read, pixels (4096 × 4096).

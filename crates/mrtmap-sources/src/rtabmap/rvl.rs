@@ -3,7 +3,7 @@
 //! variable-length nibbles packed into little-endian 32-bit words. RTAB-Map prefixes the stream
 //! with `DEPTHRVL`, then the width and height as u32.
 
-use crate::bytes::Corrupt;
+use mrtmap_io::bytes::Corrupt;
 
 /// RTAB-Map's magic.
 pub const MAGIC: &[u8] = b"DEPTHRVL";

@@ -11,12 +11,12 @@ use std::path::Path;
 
 use rusqlite::{Connection, MAIN_DB, OpenFlags};
 
-use crate::bytes::Corrupt;
-use crate::ros_msg::{Message, Wire};
+use super::msg::{Message, Wire};
+use mrtmap_io::bytes::Corrupt;
 
 const ZSTD_MAGIC: [u8; 4] = [0x28, 0xB5, 0x2F, 0xFD];
 /// A decompressed message may not exceed what a bag chunk may (512 MiB).
-const MAX_MESSAGE_BYTES: usize = crate::bag::MAX_CHUNK_BYTES;
+const MAX_MESSAGE_BYTES: usize = super::bag::MAX_CHUNK_BYTES;
 
 fn sql(e: &rusqlite::Error) -> Corrupt {
     Corrupt::new(0, format!("SQLite: {e}"))

@@ -2,16 +2,16 @@
 //!
 //! The top-level records are walked here so that every error names a byte offset; the `mcap`
 //! crate parses each record and decompresses chunks (zstd, lz4), after their declared size has
-//! been checked against [`crate::bag::MAX_CHUNK_BYTES`].
+//! been checked against [`super::bag::MAX_CHUNK_BYTES`].
 
 use std::collections::HashMap;
 use std::io::{Read, Seek, SeekFrom};
 
-use mcap::records::Record;
+use ::mcap::records::Record;
 
-use crate::bag::MAX_CHUNK_BYTES;
-use crate::bytes::{Bytes, Corrupt, Endian};
-use crate::ros_msg::{Message, Wire};
+use super::bag::MAX_CHUNK_BYTES;
+use super::msg::{Message, Wire};
+use mrtmap_io::bytes::{Bytes, Corrupt, Endian};
 
 /// The MCAP magic.
 pub const MAGIC: &[u8] = b"\x89MCAP0\r\n";
@@ -176,7 +176,7 @@ pub fn for_each_message_in<R: Read + Seek + ?Sized>(
         body_buf.resize(blen as usize, 0);
         r.read_exact(&mut body_buf).map_err(|e| io(at + 9, e))?;
         let body = &body_buf[..];
-        let rec = mcap::parse_record(op, body)
+        let rec = ::mcap::parse_record(op, body)
             .map_err(|e| Corrupt::new(at, format!("MCAP record (opcode 0x{op:02x}): {e}")))?;
         if let Record::Chunk { header, data } = rec {
             summary.chunks += 1;
@@ -233,7 +233,7 @@ pub fn for_each_message_in<R: Read + Seek + ?Sized>(
                     p = next;
                     continue;
                 }
-                let r = mcap::parse_record(op, body).map_err(|e| {
+                let r = ::mcap::parse_record(op, body).map_err(|e| {
                     Corrupt::new(
                         at,
                         format!("inside the chunk, record (opcode 0x{op:02x}): {e}"),
@@ -251,7 +251,7 @@ pub fn for_each_message_in<R: Read + Seek + ?Sized>(
 
 /// Writes an MCAP file of CDR messages (for tests and round trips).
 pub struct McapWriter {
-    w: mcap::Writer<std::io::Cursor<Vec<u8>>>,
+    w: ::mcap::Writer<std::io::Cursor<Vec<u8>>>,
     channels: HashMap<String, u16>,
 }
 
@@ -260,11 +260,11 @@ impl McapWriter {
     pub fn new(compression: Option<&str>, chunk_size: u64) -> Result<Self, String> {
         let c = match compression {
             None => None,
-            Some("zstd") => Some(mcap::Compression::Zstd),
-            Some("lz4") => Some(mcap::Compression::Lz4),
+            Some("zstd") => Some(::mcap::Compression::Zstd),
+            Some("lz4") => Some(::mcap::Compression::Lz4),
             Some(o) => return Err(format!("unknown MCAP compression {o}")),
         };
-        let w = mcap::WriteOptions::new()
+        let w = ::mcap::WriteOptions::new()
             .compression(c)
             .chunk_size(Some(chunk_size))
             .profile("ros2")
@@ -302,7 +302,7 @@ impl McapWriter {
         let ns = (time * 1e9).round() as u64;
         self.w
             .write_to_known_channel(
-                &mcap::records::MessageHeader {
+                &::mcap::records::MessageHeader {
                     channel_id: id,
                     sequence: 0,
                     log_time: ns,

@@ -5,14 +5,14 @@
 use std::path::Path;
 
 use mrtmap_geometry::camera::{BrownConrady, PinholeCamera};
-use mrtmap_io::bag::{BagWriter, Compression};
-use mrtmap_io::ros_msg::{Wire, encode};
-use mrtmap_io::ros_scan::{self, Container, RosOptions, RosWriteOptions, names};
-use mrtmap_io::rtabmap::{self, Schema};
 use mrtmap_io::{
     FileErrorKind, Image16, Recording, RgbCamera, Rig, ThermalEncoding, encode_png_rgb8,
     encode_png16, read_image16,
 };
+use mrtmap_sources::ros::bag::{BagWriter, Compression};
+use mrtmap_sources::ros::msg::{Wire, encode};
+use mrtmap_sources::ros::{self, Container, RosOptions, RosWriteOptions, names};
+use mrtmap_sources::rtabmap::{self, Schema};
 use nalgebra::{Isometry3, Vector3};
 
 fn rig() -> Rig {
@@ -169,17 +169,17 @@ fn bags_and_mcap_files_round_trip_with_every_compression() {
         (Container::Mcap, Compression::Lz4),
         (Container::Db3, Compression::None),
     ] {
-        let bytes = ros_scan::write_ros(&orig, &RosWriteOptions::t265_like(container, compression))
-            .unwrap();
-        let s = ros_scan::survey(container, &bytes).unwrap();
+        let bytes =
+            ros::write_ros(&orig, &RosWriteOptions::t265_like(container, compression)).unwrap();
+        let s = ros::survey(container, &bytes).unwrap();
         assert!(!s.unfinished);
         assert_eq!(s.topics[names::DEPTH].count, 10);
         assert_eq!(s.topics[names::THERMAL].encoding, "mono16");
         assert!((s.topics[names::DEPTH].rate_hz() - 10.0).abs() < 1e-3);
-        let p = ros_scan::plan(&s, &RosOptions::default());
+        let p = ros::plan(&s, &RosOptions::default());
         assert!(p.missing.is_empty(), "{:?}", p.missing);
         let out = dir.path().join(format!("{container:?}-{compression:?}"));
-        let rep = ros_scan::export(Path::new("x"), &bytes, &s, &p, &out).unwrap();
+        let rep = ros::export(Path::new("x"), &bytes, &s, &p, &out).unwrap();
         assert_eq!(
             (rep.depth, rep.thermal, rep.rgb, rep.poses, rep.skipped),
             (10, 5, 5, 51, 0)
@@ -237,9 +237,9 @@ fn poses_from_tf_and_a_missing_thermal_calibration() {
     }
     write_thermal(&mut w, &orig, "/lepton/image");
     let bag = w.finish();
-    let s = ros_scan::survey(Container::Bag, &bag).unwrap();
+    let s = ros::survey(Container::Bag, &bag).unwrap();
     // No thermal CameraInfo: the plan says so, and a rig supplies it.
-    let p = ros_scan::plan(
+    let p = ros::plan(
         &s,
         &RosOptions {
             depth_topic: Some("/cam/depth".into()),
@@ -252,12 +252,12 @@ fn poses_from_tf_and_a_missing_thermal_calibration() {
         "{:?}",
         p.missing
     );
-    assert!(ros_scan::export(Path::new("b.bag"), &bag, &s, &p, &dir.path().join("no")).is_err());
+    assert!(ros::export(Path::new("b.bag"), &bag, &s, &p, &dir.path().join("no")).is_err());
     assert!(
         !dir.path().join("no").exists(),
         "nothing written on failure"
     );
-    let p = ros_scan::plan(
+    let p = ros::plan(
         &s,
         &RosOptions {
             depth_topic: Some("/cam/depth".into()),
@@ -268,16 +268,16 @@ fn poses_from_tf_and_a_missing_thermal_calibration() {
     assert!(p.missing.is_empty(), "{:?}", p.missing);
     assert_eq!(
         p.poses,
-        Some(ros_scan::PoseSource::Tf("map".into(), "base_link".into()))
+        Some(ros::PoseSource::Tf("map".into(), "base_link".into()))
     );
     let out = dir.path().join("tf");
-    ros_scan::export(Path::new("b.bag"), &bag, &s, &p, &out).unwrap();
+    ros::export(Path::new("b.bag"), &bag, &s, &p, &out).unwrap();
     let conv = Recording::open(&out).unwrap();
     for (a, b) in orig.trajectory.poses.iter().zip(&conv.trajectory.poses) {
         assert!(same_pose(a, b, 1e-9), "{a} vs {b}");
     }
     // A topic named but absent.
-    let p = ros_scan::plan(
+    let p = ros::plan(
         &s,
         &RosOptions {
             thermal_topic: Some("/nope".into()),
@@ -291,39 +291,36 @@ fn poses_from_tf_and_a_missing_thermal_calibration() {
 fn broken_bags_and_mcap_files_name_the_offset() {
     let dir = tempfile::tempdir().unwrap();
     let orig = recording(&dir.path().join("scan"));
-    let bag = ros_scan::write_ros(
+    let bag = ros::write_ros(
         &orig,
         &RosWriteOptions::t265_like(Container::Bag, Compression::Bz2),
     )
     .unwrap();
     // Corrupt bytes inside the first chunk's compressed data.
     let mut bad = bag.clone();
-    let at = mrtmap_io::bag::MAGIC.len() + 4096 + 120;
+    let at = ros::bag::MAGIC.len() + 4096 + 120;
     for b in &mut bad[at..at + 32] {
         *b = !*b;
     }
-    let e = ros_scan::survey(Container::Bag, &bad).unwrap_err();
+    let e = ros::survey(Container::Bag, &bad).unwrap_err();
     assert!(e.to_string().contains("chunk"), "{e}");
-    assert!(
-        e.offset >= (mrtmap_io::bag::MAGIC.len() + 4096) as u64,
-        "{e}"
-    );
+    assert!(e.offset >= (ros::bag::MAGIC.len() + 4096) as u64, "{e}");
     // A chunk header that claims 3 GB decompressed is refused before anything is allocated.
     let mut w = BagWriter::new(Compression::None, 1 << 20);
     w.write("/a", "std_msgs/String", 1.0, b"abc");
     let mut big = w.finish();
     let pos = big.windows(5).position(|x| x == b"size=").unwrap() + 5;
     big[pos..pos + 4].copy_from_slice(&3_000_000_000u32.to_le_bytes());
-    let e = ros_scan::survey(Container::Bag, &big).unwrap_err();
+    let e = ros::survey(Container::Bag, &big).unwrap_err();
     assert!(e.what.contains("more than"), "{e}");
     // MCAP cut short: an error with an offset, or the part before the cut flagged unfinished.
-    let mcap = ros_scan::write_ros(
+    let mcap = ros::write_ros(
         &orig,
         &RosWriteOptions::t265_like(Container::Mcap, Compression::None),
     )
     .unwrap();
     for cut in [9, 100, mcap.len() / 3, mcap.len() - 20] {
-        match ros_scan::survey(Container::Mcap, &mcap[..cut]) {
+        match ros::survey(Container::Mcap, &mcap[..cut]) {
             Err(e) => assert!(e.offset <= cut as u64, "{e}"),
             Ok(s) => assert!(s.unfinished),
         }
@@ -338,9 +335,9 @@ fn broken_bags_and_mcap_files_name_the_offset() {
         1.0,
         &encode::image(Wire::Ros1, 1.0, "c", 20, 15, "16UC1", 40, &[0; 100]),
     );
-    let s = ros_scan::survey(Container::Bag, &w.finish()).unwrap();
+    let s = ros::survey(Container::Bag, &w.finish()).unwrap();
     assert_eq!(s.topics[names::DEPTH].undecodable, 1);
-    let p = ros_scan::plan(&s, &RosOptions::default());
+    let p = ros::plan(&s, &RosOptions::default());
     assert!(
         p.notes
             .iter()
@@ -512,8 +509,8 @@ fn compressed_depth_and_float_depth_topics() {
         }
         write_thermal(&mut w, &orig, "/t/image");
         let bag = w.finish();
-        let s = ros_scan::survey(Container::Bag, &bag).unwrap();
-        let p = ros_scan::plan(
+        let s = ros::survey(Container::Bag, &bag).unwrap();
+        let p = ros::plan(
             &s,
             &RosOptions {
                 rig: Some(r),
@@ -527,7 +524,7 @@ fn compressed_depth_and_float_depth_topics() {
             p.depth
         );
         let out = dir.path().join(variant);
-        let rep = ros_scan::export(Path::new("v.bag"), &bag, &s, &p, &out).unwrap();
+        let rep = ros::export(Path::new("v.bag"), &bag, &s, &p, &out).unwrap();
         assert_eq!(
             (rep.depth, rep.skipped),
             (10, 0),
@@ -548,7 +545,7 @@ fn compressed_depth_and_float_depth_topics() {
 /// Every message of a bag or MCAP file, owned: (topic, type, time, data).
 fn messages(c: Container, bytes: &[u8]) -> Vec<(String, String, f64, Vec<u8>)> {
     let mut v = Vec::new();
-    ros_scan::for_each(c, bytes, &mut |m| {
+    ros::for_each(c, bytes, &mut |m| {
         v.push((
             m.topic.to_string(),
             m.datatype.to_string(),
@@ -565,7 +562,7 @@ fn messages(c: Container, bytes: &[u8]) -> Vec<(String, String, f64, Vec<u8>)> {
 fn ros2_bag_folders_split_over_files_read_in_order() {
     let dir = tempfile::tempdir().unwrap();
     let orig = recording(&dir.path().join("scan"));
-    let mcap = ros_scan::write_ros(
+    let mcap = ros::write_ros(
         &orig,
         &RosWriteOptions::t265_like(Container::Mcap, Compression::None),
     )
@@ -589,13 +586,13 @@ fn ros2_bag_folders_split_over_files_read_in_order() {
                 }
             };
             let bytes = if c == Container::Mcap {
-                let mut w = mrtmap_io::mcap_file::McapWriter::new(None, 1 << 16).unwrap();
+                let mut w = ros::mcap::McapWriter::new(None, 1 << 16).unwrap();
                 for (topic, ty, t, data) in chunk {
                     w.write(topic, ty, *t, &stored(data)).unwrap();
                 }
                 w.finish().unwrap()
             } else {
-                let mut w = mrtmap_io::rosbag2::Db3Writer::new().unwrap();
+                let mut w = ros::db3::Db3Writer::new().unwrap();
                 for (topic, ty, t, data) in chunk {
                     w.write(topic, ty, *t, &stored(data)).unwrap();
                 }
@@ -603,9 +600,9 @@ fn ros2_bag_folders_split_over_files_read_in_order() {
             };
             std::fs::write(bag.join(format!("rosbag2_{ext}_{i}.{ext}")), bytes).unwrap();
         }
-        let (kind, file) = ros_scan::resolve_source(&bag).unwrap();
+        let (kind, file) = mrtmap_sources::resolve_source(&bag).unwrap();
         assert_eq!((kind.container(), file.as_path()), (Some(c), bag.as_path()));
-        let order: Vec<String> = ros_scan::storage_files(&bag, c)
+        let order: Vec<String> = ros::storage_files(&bag, c)
             .unwrap()
             .iter()
             .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
@@ -616,7 +613,7 @@ fn ros2_bag_folders_split_over_files_read_in_order() {
         assert_eq!(order, expected);
         // Read in that order, the messages are the original ones in the original order.
         let mut back = Vec::new();
-        ros_scan::for_each(c, bag.as_path(), &mut |m| {
+        ros::for_each(c, bag.as_path(), &mut |m| {
             back.push((m.topic.to_string(), m.time, m.data.to_vec()));
             Ok(())
         })
@@ -633,10 +630,10 @@ fn ros2_bag_folders_split_over_files_read_in_order() {
                 b.2
             );
         }
-        let s = ros_scan::survey(c, bag.as_path()).unwrap();
-        let p = ros_scan::plan(&s, &RosOptions::default());
+        let s = ros::survey(c, bag.as_path()).unwrap();
+        let p = ros::plan(&s, &RosOptions::default());
         let out = dir.path().join(format!("from-{ext}"));
-        let rep = ros_scan::export(&bag, bag.as_path(), &s, &p, &out).unwrap();
+        let rep = ros::export(&bag, bag.as_path(), &s, &p, &out).unwrap();
         assert_eq!((rep.depth, rep.thermal, rep.rgb, rep.poses), (10, 5, 5, 51));
         assert_same(&orig, &Recording::open(&out).unwrap(), 1e-9);
         // A broken message in the ninth file is named by file and row.
@@ -646,7 +643,7 @@ fn ros2_bag_folders_split_over_files_read_in_order() {
             db.execute("UPDATE messages SET topic_id = 99 WHERE id = 2", [])
                 .unwrap();
             drop(db);
-            let e = ros_scan::survey(c, bag.as_path()).unwrap_err();
+            let e = ros::survey(c, bag.as_path()).unwrap_err();
             assert_eq!(
                 e.in_file(&bag).to_string(),
                 format!(
@@ -657,7 +654,7 @@ fn ros2_bag_folders_split_over_files_read_in_order() {
         } else {
             // A message record that claims more bytes than the file has.
             std::fs::write(&ninth, b"\x89MCAP0\r\n\x05\xff\xff\0\0\0\0\0\0").unwrap();
-            let e = ros_scan::survey(c, bag.as_path()).unwrap_err();
+            let e = ros::survey(c, bag.as_path()).unwrap_err();
             assert!(
                 e.to_string().starts_with("rosbag2_mcap_8.mcap, at byte"),
                 "{e}"
@@ -668,10 +665,14 @@ fn ros2_bag_folders_split_over_files_read_in_order() {
     let empty = dir.path().join("empty_bag");
     std::fs::create_dir_all(&empty).unwrap();
     std::fs::write(empty.join("metadata.yaml"), "").unwrap();
-    let e = ros_scan::resolve_source(&empty).unwrap_err().to_string();
+    let e = mrtmap_sources::resolve_source(&empty)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("without .mcap or .db3"), "{e}");
     std::fs::write(empty.join("empty_bag_0.db3.zstd"), b"(\xb5/\xfd").unwrap();
-    let e = ros_scan::resolve_source(&empty).unwrap_err().to_string();
+    let e = mrtmap_sources::resolve_source(&empty)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("decompress"), "{e}");
 }
 
@@ -679,7 +680,7 @@ fn ros2_bag_folders_split_over_files_read_in_order() {
 fn db3_files_are_told_from_rtabmap_databases_and_bad_messages_skipped() {
     let dir = tempfile::tempdir().unwrap();
     let orig = recording(&dir.path().join("scan"));
-    let db3 = ros_scan::write_ros(
+    let db3 = ros::write_ros(
         &orig,
         &RosWriteOptions::t265_like(Container::Db3, Compression::None),
     )
@@ -687,14 +688,14 @@ fn db3_files_are_told_from_rtabmap_databases_and_bad_messages_skipped() {
     let f = dir.path().join("scan.db3");
     std::fs::write(&f, &db3).unwrap();
     assert_eq!(
-        ros_scan::source_kind(&f).unwrap(),
-        ros_scan::SourceKind::Db3
+        mrtmap_sources::source_kind(&f).unwrap(),
+        mrtmap_sources::SourceKind::Db3
     );
     let rt = dir.path().join("rtabmap.db");
     rtabmap::write_recording(&orig, &rt, Schema::Current).unwrap();
     assert_eq!(
-        ros_scan::source_kind(&rt).unwrap(),
-        ros_scan::SourceKind::RtabMap
+        mrtmap_sources::source_kind(&rt).unwrap(),
+        mrtmap_sources::SourceKind::RtabMap
     );
     // Cut the data of the third depth message: it is skipped, counted and named by its row.
     let db = rusqlite::Connection::open(&f).unwrap();
@@ -711,15 +712,15 @@ fn db3_files_are_told_from_rtabmap_databases_and_bad_messages_skipped() {
     )
     .unwrap();
     drop(db);
-    let s = ros_scan::survey(Container::Db3, f.as_path()).unwrap();
+    let s = ros::survey(Container::Db3, f.as_path()).unwrap();
     assert_eq!(s.topics[names::DEPTH].undecodable, 1);
     let first = s.topics[names::DEPTH].first_error.clone().unwrap();
     assert!(
         first.starts_with(&format!("message {id}, at byte ")),
         "{first}"
     );
-    let p = ros_scan::plan(&s, &RosOptions::default());
-    let rep = ros_scan::export(&f, f.as_path(), &s, &p, &dir.path().join("out")).unwrap();
+    let p = ros::plan(&s, &RosOptions::default());
+    let rep = ros::export(&f, f.as_path(), &s, &p, &dir.path().join("out")).unwrap();
     assert_eq!((rep.depth, rep.skipped), (9, 1));
     assert!(
         rep.skipped_reasons[0].starts_with(&format!("{} message {id}: ", names::DEPTH)),

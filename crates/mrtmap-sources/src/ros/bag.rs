@@ -10,8 +10,8 @@
 use std::collections::HashMap;
 use std::io::{Read, Seek, SeekFrom};
 
-use crate::bytes::{Bytes, Corrupt, Endian};
-use crate::ros_msg::{Message, Wire};
+use super::msg::{Message, Wire};
+use mrtmap_io::bytes::{Bytes, Corrupt, Endian};
 
 /// The bag magic line.
 pub const MAGIC: &[u8] = b"#ROSBAG V2.0\n";

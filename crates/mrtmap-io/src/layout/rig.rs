@@ -6,8 +6,8 @@ use mrtmap_geometry::camera::{BrownConrady, PinholeCamera};
 use mrtmap_geometry::nalgebra::{Isometry3, Translation3};
 use serde::{Deserialize, Serialize};
 
+use super::trajectory::{quaternion_xyzw, unit_quaternion};
 use crate::error::{FileError, FileErrorKind};
-use crate::trajectory::{quaternion_xyzw, unit_quaternion};
 
 /// A rigid transform as written in rig.toml.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

@@ -7,7 +7,7 @@
 
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
 
-use crate::bytes::{Bytes, Corrupt, Cursor, Endian};
+use mrtmap_io::bytes::{Bytes, Corrupt, Cursor, Endian};
 
 /// How a message is serialised.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

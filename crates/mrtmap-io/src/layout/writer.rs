@@ -6,12 +6,12 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::Isometry3;
 
+use super::rig::Rig;
+use super::streams::stream_list_text;
+use super::trajectory::Trajectory;
 use crate::atomic::PartialDir;
 use crate::error::FileError;
 use crate::image16::{Image16, encode_png16};
-use crate::rig::Rig;
-use crate::streams::stream_list_text;
-use crate::trajectory::Trajectory;
 
 /// A recording folder being written.
 pub struct LayoutWriter {

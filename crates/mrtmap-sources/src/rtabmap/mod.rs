@@ -7,6 +7,8 @@
 //! optimised poses). The version in `Admin.version` is checked first; columns are looked up with
 //! `PRAGMA table_info`. Every blob's size is checked before it is used.
 
+pub mod rvl;
+
 use std::io::Read;
 use std::path::Path;
 
@@ -15,9 +17,9 @@ use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion};
 use rusqlite::{Connection, OpenFlags};
 use serde::Serialize;
 
-use crate::bytes::{Bytes, Corrupt, Endian};
-use crate::error::{FileError, FileErrorKind};
-use crate::image16::Image16;
+use mrtmap_io::Image16;
+use mrtmap_io::bytes::{Bytes, Corrupt, Endian};
+use mrtmap_io::{FileError, FileErrorKind};
 
 /// Largest image side accepted from a blob.
 const MAX_SIDE: u32 = 8192;
@@ -417,8 +419,8 @@ pub fn depth_blob(b: &[u8]) -> Result<Image16, String> {
         if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
             return Err(format!("RVL depth blob says {w}×{h} pixels"));
         }
-        let px = crate::rvl::decode(&rest[8..], (w * h) as usize, 16)
-            .map_err(|e| format!("RVL depth: {e}"))?;
+        let px =
+            rvl::decode(&rest[8..], (w * h) as usize, 16).map_err(|e| format!("RVL depth: {e}"))?;
         return Ok(Image16 {
             width: w,
             height: h,
@@ -463,7 +465,7 @@ pub fn depth_blob(b: &[u8]) -> Result<Image16, String> {
     }
 }
 
-const MAGIC_RVL: &[u8] = crate::rvl::MAGIC;
+const MAGIC_RVL: &[u8] = rvl::MAGIC;
 
 /// Whether a `Link` type is a loop closure: global, local-space, local-time or user.
 pub fn is_loop_closure(kind: i64) -> bool {
@@ -771,10 +773,8 @@ pub fn write_database(
         )
         .map_err(e)?;
         let depth = match schema {
-            Schema::Current => {
-                crate::rvl::encode_rtabmap(n.depth.width, n.depth.height, &n.depth.data)
-            }
-            Schema::Legacy => crate::image16::encode_png16(n.depth),
+            Schema::Current => rvl::encode_rtabmap(n.depth.width, n.depth.height, &n.depth.data),
+            Schema::Legacy => mrtmap_io::encode_png16(n.depth),
         };
         tx.execute(
             "INSERT INTO Data (id, image, depth, calibration) VALUES (?1, ?2, ?3, ?4)",
@@ -848,7 +848,7 @@ pub fn base_from_optical() -> Isometry3<f64> {
 /// the wrong ones is caught; with [`Schema::Legacy`] they are not, and optimising the graph gives
 /// them back. Returns the number of nodes.
 pub fn write_recording(
-    rec: &crate::recording::Recording,
+    rec: &mrtmap_io::Recording,
     path: &Path,
     schema: Schema,
 ) -> Result<usize, FileError> {
@@ -863,7 +863,7 @@ pub fn write_recording(
         ));
     }
     let local = base_from_optical();
-    let limits = crate::trajectory::InterpolationLimits::default();
+    let limits = mrtmap_io::InterpolationLimits::default();
     let mut images = Vec::new();
     for e in &rec.rgb {
         let Some(d) = rec

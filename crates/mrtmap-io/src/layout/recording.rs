@@ -3,11 +3,11 @@
 
 use std::path::{Path, PathBuf};
 
+use super::rig::Rig;
+use super::streams::{StreamEntry, parse_stream_list};
+use super::trajectory::{InterpolationLimits, Trajectory};
 use crate::error::{FileError, FileErrorKind};
 use crate::image16::{Image16, read_image16};
-use crate::rig::Rig;
-use crate::streams::{StreamEntry, parse_stream_list};
-use crate::trajectory::{InterpolationLimits, Trajectory};
 
 /// An opened recording: rig, stream lists and trajectories, checked; images are read on demand.
 #[derive(Clone, Debug)]
@@ -22,7 +22,7 @@ pub struct Recording {
     pub thermal: Vec<StreamEntry>,
     /// Colour frames (optional stream).
     pub rgb: Vec<StreamEntry>,
-    /// Instance-mask frames (optional stream, see [`crate::masks`]).
+    /// Instance-mask frames (optional stream, see [`super::masks`]).
     pub masks: Vec<StreamEntry>,
     /// world_from_depth poses.
     pub trajectory: Trajectory,

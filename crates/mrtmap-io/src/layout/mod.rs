@@ -1,0 +1,17 @@
+//! The recording layout: one folder per scan, read by [`Recording`] and written frame by frame by
+//! [`LayoutWriter`] (see the crate docs for the files and what is accepted beyond them).
+
+pub mod masks;
+mod recording;
+mod rig;
+mod streams;
+mod trajectory;
+mod writer;
+
+pub use recording::Recording;
+pub use rig::{PoseFile, RgbCamera, Rig, ThermalEncoding};
+pub use streams::{StreamEntry, parse_stream_list, stream_list_text};
+pub use trajectory::{
+    InterpolationLimits, QUATERNION_NORM_TOLERANCE, Trajectory, quaternion_xyzw, unit_quaternion,
+};
+pub use writer::LayoutWriter;

@@ -1,0 +1,468 @@
+//! Calibration runs behind `mrtmap calibrate`: every image of a folder read and searched for the
+//! board in parallel, the fit, rig.toml, and the report folder (corners drawn on every image,
+//! thermal-over-colour overlays, `calibration.json`, `index.html`).
+
+use std::path::{Path, PathBuf};
+
+use mrtmap_calib::report::{draw_corners, overlay, png};
+use mrtmap_calib::rig::{rig_toml, updated_rig};
+use mrtmap_calib::{
+    Board, DetectOptions, Detection, DistortionModel, Gray, ImagePair, MonoResult, PairInput,
+    PairStatus, StereoOptions, StereoResult, ViewError, calibrate_mono, calibrate_stereo, detect,
+    find_pairs, list_images,
+};
+use mrtmap_io::{PoseFile, Rig, write_atomic};
+use rayon::prelude::*;
+use serde_json::json;
+
+use crate::cache::write_json;
+use crate::error::{Error, Result};
+
+/// An image read and searched, or why not.
+pub struct Seen {
+    /// The image in grey (absent when it could not be read or had the wrong size).
+    pub gray: Option<Gray>,
+    /// The board's corners, when found.
+    pub det: Option<Detection>,
+    /// Why the image was left out.
+    pub problem: Option<String>,
+}
+
+fn see(path: &Path, board: &Board, size: Option<(u32, u32)>) -> Seen {
+    let g = match Gray::read(path) {
+        Err(e) => {
+            return Seen {
+                gray: None,
+                det: None,
+                problem: Some(e.to_string()),
+            };
+        }
+        Ok(g) => g,
+    };
+    if let Some((w, h)) = size
+        && (g.width, g.height) != (w, h)
+    {
+        return Seen {
+            problem: Some(format!(
+                "{}: image is {}×{} pixels but the first image of this camera is {w}×{h}",
+                path.display(),
+                g.width,
+                g.height
+            )),
+            gray: None,
+            det: None,
+        };
+    }
+    let det = detect(&g, (board.cols, board.rows), &DetectOptions::default());
+    Seen {
+        gray: Some(g),
+        det,
+        problem: None,
+    }
+}
+
+/// Reads and searches images in parallel; all must share the first readable image's size.
+pub fn see_all(paths: &[PathBuf], board: &Board) -> (Vec<Seen>, Option<(u32, u32)>) {
+    let size = paths.iter().find_map(|p| {
+        image::ImageReader::open(p)
+            .ok()?
+            .with_guessed_format()
+            .ok()?
+            .into_dimensions()
+            .ok()
+    });
+    let seen = paths.par_iter().map(|p| see(p, board, size)).collect();
+    (seen, size)
+}
+
+/// Every image of a folder searched for the board.
+pub struct ImageDetections {
+    /// The images.
+    pub paths: Vec<PathBuf>,
+    /// What was seen in each.
+    pub seen: Vec<Seen>,
+    /// Their size.
+    pub size: (u32, u32),
+}
+
+impl ImageDetections {
+    /// Images in which the board was found.
+    pub fn found(&self) -> usize {
+        self.seen.iter().filter(|s| s.det.is_some()).count()
+    }
+}
+
+/// Reads the images in `dir` and searches each for the board.
+pub fn detect_images(dir: &Path, board: &Board) -> Result<ImageDetections> {
+    let paths = list_images(dir)?;
+    if paths.is_empty() {
+        return Err(Error::source(dir, "holds no PNG, JPEG or TIFF images"));
+    }
+    let (seen, size) = see_all(&paths, board);
+    let Some(size) = size else {
+        return Err(Error::source(dir, "no image in it could be read"));
+    };
+    Ok(ImageDetections { paths, seen, size })
+}
+
+/// One camera's intrinsics from its images' detections.
+pub fn calibrate_images(
+    d: &ImageDetections,
+    board: &Board,
+    model: DistortionModel,
+) -> Result<MonoResult> {
+    let dets: Vec<Option<Detection>> = d.seen.iter().map(|s| s.det.clone()).collect();
+    Ok(calibrate_mono(board, d.size.0, d.size.1, &dets, model)?)
+}
+
+/// Pixels of a report image per image pixel: small thermal images are enlarged.
+fn scale_for_report(w: u32) -> u32 {
+    (640 / w.max(1)).clamp(1, 4)
+}
+
+fn corners_json(d: Option<&Detection>) -> serde_json::Value {
+    d.map_or(serde_json::Value::Null, |d| {
+        json!(
+            d.corners
+                .iter()
+                .map(|c| [c.i as f64, c.j as f64, c.x, c.y])
+                .collect::<Vec<_>>()
+        )
+    })
+}
+
+/// A file stem for people.
+pub fn file_stem(p: &Path) -> String {
+    p.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+fn create_dir(dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).map_err(|e| mrtmap_io::FileError::io(dir, e).into())
+}
+
+/// Writes the corners drawn on every image and `calibration.json` into `rep`.
+pub fn write_mono_report(
+    rep: &Path,
+    board: &Board,
+    d: &ImageDetections,
+    r: &MonoResult,
+) -> Result<()> {
+    create_dir(rep)?;
+    let mut views = Vec::new();
+    for (k, (p, s)) in d.paths.iter().zip(&d.seen).enumerate() {
+        let name = file_stem(p);
+        if let Some(g) = &s.gray {
+            let img = draw_corners(g, s.det.as_ref(), scale_for_report(g.width));
+            write_atomic(&rep.join(format!("{name}_corners.png")), &png(&img))?;
+        }
+        views.push(json!({
+            "name": name,
+            "path": p.display().to_string(),
+            "problem": s.problem,
+            "corners": corners_json(s.det.as_ref()),
+            "error": r.view_errors[k],
+            "rejected": r.rejected.contains(&k),
+        }));
+    }
+    let doc = json!({
+        "board": board,
+        "camera": r.camera,
+        "std": r.std,
+        "error": r.error,
+        "views": views,
+    });
+    write_json(&rep.join("calibration.json"), &doc)
+}
+
+/// Every pair of a folder searched for the board.
+pub struct PairDetections {
+    /// The pairs.
+    pub pairs: Vec<ImagePair>,
+    /// Images without a partner.
+    pub unmatched: Vec<PathBuf>,
+    /// What was seen in each colour image.
+    pub rgb_seen: Vec<Seen>,
+    /// What was seen in each thermal image.
+    pub thermal_seen: Vec<Seen>,
+    /// Colour image size.
+    pub rgb_size: (u32, u32),
+    /// Thermal image size.
+    pub thermal_size: (u32, u32),
+}
+
+/// Images of `seen` in which the board was found.
+pub fn found(seen: &[Seen]) -> usize {
+    seen.iter().filter(|s| s.det.is_some()).count()
+}
+
+/// Pairs the images in `dir` and searches each for the board.
+pub fn detect_pairs(dir: &Path, board: &Board, max_dt: f64) -> Result<PairDetections> {
+    let pairing = find_pairs(dir, max_dt)?;
+    let rgb_paths: Vec<PathBuf> = pairing.pairs.iter().map(|p| p.rgb.clone()).collect();
+    let th_paths: Vec<PathBuf> = pairing.pairs.iter().map(|p| p.thermal.clone()).collect();
+    let (rgb_seen, rgb_size) = see_all(&rgb_paths, board);
+    let (thermal_seen, th_size) = see_all(&th_paths, board);
+    let (Some(rgb_size), Some(thermal_size)) = (rgb_size, th_size) else {
+        return Err(Error::source(
+            dir,
+            "no colour or no thermal image in it could be read",
+        ));
+    };
+    Ok(PairDetections {
+        pairs: pairing.pairs,
+        unmatched: pairing.unmatched,
+        rgb_seen,
+        thermal_seen,
+        rgb_size,
+        thermal_size,
+    })
+}
+
+/// Both cameras and the thermal camera's pose from the pairs' detections.
+pub fn calibrate_pairs(
+    d: &PairDetections,
+    board: &Board,
+    opts: &StereoOptions,
+) -> Result<StereoResult> {
+    let inputs: Vec<PairInput> = d
+        .rgb_seen
+        .iter()
+        .zip(&d.thermal_seen)
+        .map(|(c, t)| PairInput {
+            rgb: c.det.as_ref(),
+            thermal: t.det.as_ref(),
+        })
+        .collect();
+    Ok(calibrate_stereo(
+        board,
+        d.rgb_size,
+        d.thermal_size,
+        &inputs,
+        opts,
+    )?)
+}
+
+/// Writes the result into the rig.toml `out`, updating an existing one (its `[depth]` is kept);
+/// returns whether one existed.
+pub fn write_rig(out: &Path, board: &Board, d: &PairDetections, r: &StereoResult) -> Result<bool> {
+    let existing = if out.exists() {
+        Some(Rig::read(out).map_err(|e| {
+            Error::source(out, format!("exists but is not a rig.toml to update: {e}"))
+        })?)
+    } else {
+        None
+    };
+    let names: Vec<String> = d.pairs.iter().map(|p| p.name.clone()).collect();
+    let rig = updated_rig(r, existing.as_ref());
+    write_atomic(out, rig_toml(&rig, r, board, &names).as_bytes())?;
+    Ok(existing.is_some())
+}
+
+/// A pair's name made safe for file names.
+fn safe_name(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '.' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// Writes pair `k`'s images (corners on each, the overlay of a used pair); returns their names.
+fn pair_images(
+    rep: &Path,
+    board: &Board,
+    d: &PairDetections,
+    r: &StereoResult,
+    k: usize,
+) -> Result<Vec<String>> {
+    let safe = safe_name(&d.pairs[k].name);
+    let (rgb, th) = (&d.rgb_seen[k], &d.thermal_seen[k]);
+    let mut cells = Vec::new();
+    if let Some(g) = &rgb.gray {
+        let f = format!("{safe}_rgb.png");
+        write_atomic(&rep.join(&f), &png(&draw_corners(g, rgb.det.as_ref(), 1)))?;
+        cells.push(f);
+    }
+    if let Some(g) = &th.gray {
+        let f = format!("{safe}_thermal.png");
+        let img = draw_corners(g, th.det.as_ref(), scale_for_report(g.width));
+        write_atomic(&rep.join(&f), &png(&img))?;
+        cells.push(f);
+    }
+    if let (Some(cg), Some(tg), Some(pose), PairStatus::Used) = (
+        &rgb.gray,
+        &th.gray,
+        r.rgb_alone.poses[k],
+        &r.pairs[k].status,
+    ) {
+        let f = format!("{safe}_overlay.png");
+        let img = overlay(
+            cg,
+            tg,
+            &r.rgb,
+            &r.thermal,
+            &pose,
+            &r.rgb_from_thermal,
+            board,
+        );
+        write_atomic(&rep.join(&f), &png(&img))?;
+        cells.push(f);
+    }
+    Ok(cells)
+}
+
+/// A reprojection error for a table cell.
+pub fn error_cell(x: Option<ViewError>) -> String {
+    x.map_or("—".into(), |e| format!("{:.3}", e.mean_px))
+}
+
+/// A pair's status in words.
+pub fn status_text(s: &PairStatus) -> String {
+    match s {
+        PairStatus::Used => "used".to_string(),
+        PairStatus::Rejected(why) => format!("rejected: {why}"),
+    }
+}
+
+/// Pair `k`'s two rows of the report's table.
+fn pair_rows(d: &PairDetections, r: &StereoResult, k: usize, cells: &[String]) -> String {
+    let pr = &r.pairs[k];
+    format!(
+        "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n<tr><td colspan=6>{}</td></tr>\n",
+        mrtmap_report::esc(&d.pairs[k].name),
+        pr.rgb_corners,
+        pr.thermal_corners,
+        error_cell(pr.rgb_error),
+        error_cell(pr.thermal_error),
+        mrtmap_report::esc(&status_text(&pr.status)),
+        cells
+            .iter()
+            .map(|f| format!("<img src=\"{f}\" loading=lazy>"))
+            .collect::<String>()
+    )
+}
+
+/// Pair `k` in calibration.json.
+fn pair_json(d: &PairDetections, r: &StereoResult, k: usize) -> serde_json::Value {
+    let p = &d.pairs[k];
+    json!({
+        "name": p.name,
+        "rgb_path": p.rgb.display().to_string(),
+        "thermal_path": p.thermal.display().to_string(),
+        "result": r.pairs[k],
+        "rgb_corners": corners_json(d.rgb_seen[k].det.as_ref()),
+        "thermal_corners": corners_json(d.thermal_seen[k].det.as_ref()),
+        "thermal_corners_tied": r.thermal_labels[k].as_ref().map(|c| c.iter().map(|c| [c.i as f64, c.j as f64, c.x, c.y]).collect::<Vec<_>>()),
+    })
+}
+
+/// The report page around the pairs' table rows.
+fn index_html(board: &Board, r: &StereoResult, rows: &str) -> String {
+    let t = r.rgb_from_thermal.translation.vector * 1e3;
+    format!(
+        "<!doctype html><html><head><meta charset=utf-8><title>mrtmap calibrate</title><style>body{{font-family:sans-serif;margin:1.5em}}td{{padding:2px 8px}}img{{max-width:32%;margin:2px;image-rendering:pixelated}}</style></head><body>\n<h1>Rig calibration</h1>\n<p>Board {}x{} inner corners, {} mm squares. Colour {}×{} fx {:.2} fy {:.2}; thermal {}×{} fx {:.2} fy {:.2}. Thermal camera in the colour frame at ({:.1}, {:.1}, {:.1}) mm, turned {:.2}°.</p>\n<p>Mean reprojection error: colour {:.3} px, thermal {:.3} px. Each pair: corners drawn (rows coloured, the (0,0) corner circled twice), and the thermal image laid over the colour image on the board's plane through the result: the thermal squares should sit on the colour squares.</p>\n<table><tr><th>pair</th><th>colour corners</th><th>thermal corners</th><th>MRE colour px</th><th>MRE thermal px</th><th>status</th></tr>\n{rows}</table></body></html>\n",
+        board.cols,
+        board.rows,
+        board.square_m * 1e3,
+        r.rgb.width,
+        r.rgb.height,
+        r.rgb.fx,
+        r.rgb.fy,
+        r.thermal.width,
+        r.thermal.height,
+        r.thermal.fx,
+        r.thermal.fy,
+        t.x,
+        t.y,
+        t.z,
+        r.rgb_from_thermal.rotation.angle().to_degrees(),
+        r.rgb_error.mean_px,
+        r.thermal_error.mean_px,
+    )
+}
+
+/// Writes the report folder `rep`: every pair's images, calibration.json and index.html.
+pub fn write_stereo_report(
+    rep: &Path,
+    board: &Board,
+    d: &PairDetections,
+    r: &StereoResult,
+) -> Result<()> {
+    create_dir(rep)?;
+    let mut rows = String::new();
+    let mut pairs = Vec::new();
+    for k in 0..d.pairs.len() {
+        let cells = pair_images(rep, board, d, r, k)?;
+        rows.push_str(&pair_rows(d, r, k, &cells));
+        pairs.push(pair_json(d, r, k));
+    }
+    let doc = json!({
+        "board": board,
+        "rgb": r.rgb,
+        "thermal": r.thermal,
+        "rgb_from_thermal": PoseFile::from_isometry(&r.rgb_from_thermal),
+        "std": r.std,
+        "rgb_error": r.rgb_error,
+        "thermal_error": r.thermal_error,
+        "rgb_alone": r.rgb_alone,
+        "thermal_alone": r.thermal_alone,
+        "pairs": pairs,
+    });
+    write_json(&rep.join("calibration.json"), &doc)?;
+    write_atomic(
+        &rep.join("index.html"),
+        index_html(board, r, &rows).as_bytes(),
+    )?;
+    Ok(())
+}
+
+/// Checks a board's square size.
+pub fn board(cols: u32, rows: u32, square_m: f64) -> Result<Board> {
+    Board::new(cols, rows, square_m).ok_or_else(|| {
+        Error::setting(
+            "--square-m",
+            format!("must be a positive number of metres, got {square_m}"),
+        )
+    })
+}
+
+/// Renders synthetic board pairs of the default synthetic rig into `out` (rgb/, thermal/ as
+/// 16-bit centikelvin, truth.json); returns how many were written.
+pub fn simulate_boards(out: &Path, o: &mrtmap_calib::synth::SynthOptions) -> Result<usize> {
+    use mrtmap_calib::synth::{SynthRig, render_pairs};
+    use mrtmap_geometry::camera::PinholeCamera;
+    let rig = SynthRig::default();
+    let pairs = render_pairs(&rig, o);
+    if pairs.len() < o.pairs {
+        return Err(Error::setting(
+            format!("{} board poses", o.pairs),
+            format!(
+                "are too many: the board fits in only {} of them",
+                pairs.len()
+            ),
+        ));
+    }
+    let (rd, td) = (out.join("rgb"), out.join("thermal"));
+    for (k, p) in pairs.iter().enumerate() {
+        let name = format!("{k:04}.png");
+        let rgb = mrtmap_io::encode_png_rgb8(p.rgb.width(), p.rgb.height(), p.rgb.as_raw());
+        write_atomic(&rd.join(&name), &rgb)?;
+        write_atomic(&td.join(&name), &mrtmap_io::encode_png16(&p.thermal))?;
+    }
+    let cam = |c: &PinholeCamera| json!({"width": c.width, "height": c.height, "fx": c.fx, "fy": c.fy, "cx": c.cx, "cy": c.cy, "distortion": c.distortion.to_array()});
+    let truth = json!({
+        "board": {"cols": o.board.cols, "rows": o.board.rows, "square_m": o.board.square_m},
+        "rgb": cam(&rig.rgb),
+        "thermal": cam(&rig.thermal),
+        "rgb_from_thermal": PoseFile::from_isometry(&rig.rgb_from_thermal),
+        "rgb_from_board": pairs.iter().map(|p| PoseFile::from_isometry(&p.rgb_from_board)).collect::<Vec<_>>(),
+    });
+    write_json(&out.join("truth.json"), &truth)?;
+    Ok(pairs.len())
+}

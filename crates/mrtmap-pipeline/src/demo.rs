@@ -1,0 +1,290 @@
+//! The demo: simulate a scan of a preset room, run the pipeline on it, and compare with the exact
+//! truth (the seed paper's table at points A–D, and the error over the truth's grid).
+
+use std::path::{Path, PathBuf};
+
+use mrtmap_geometry::nalgebra::Point3;
+use mrtmap_physics::{
+    Globe, GlobeMethod, GlobeReading, Temperature, globe_temperature, mrt_from_globe,
+};
+use mrtmap_radiation::{Method, MonteCarlo, MrtEngine, RadiantScene};
+use mrtmap_report::ComparisonRow;
+use mrtmap_sim::{NoiseLevel, SimConfig, Truth, simulate};
+use serde::Serialize;
+
+use crate::cache::{Fingerprint, Stage, StageOutcome, read_json, run_or_reuse, write_json};
+use crate::error::Result;
+use crate::progress::Progress;
+use crate::report::report_data;
+use crate::run::{RunOutcome, run};
+use crate::settings::{PointEntry, Project};
+use crate::simulation::{load_room, set_depth_size};
+
+/// Rays per validation point when comparing with the truth.
+const POINT_RAYS: usize = 100_000;
+/// Rays per grid node when comparing with the truth.
+const GRID_RAYS: usize = 20_000;
+/// First random stream of the grid nodes (the points use 0…).
+const GRID_STREAM0: u64 = 10_000;
+
+/// What the demo simulates.
+#[derive(Clone, Debug)]
+pub struct DemoSettings {
+    /// A preset room.
+    pub room: String,
+    /// Length of the scan (s).
+    pub seconds: f64,
+    /// Seed of the simulation.
+    pub seed: u64,
+    /// Sensor noise.
+    pub noise: NoiseLevel,
+    /// Air speed at the simulated globes (m/s).
+    pub air_speed_m_s: f64,
+    /// Depth image size.
+    pub depth_size: (usize, usize),
+    /// Rerun every stage.
+    pub force: bool,
+}
+
+/// The error over the truth's grid.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct GridError {
+    /// Nodes compared.
+    pub nodes: usize,
+    /// Largest |ours − truth| (K).
+    pub max_abs_error_k: f64,
+    /// RMS of ours − truth (K).
+    pub rmse_k: f64,
+}
+
+/// What the demo did and found.
+#[derive(Clone, Debug)]
+pub struct DemoOutcome {
+    /// The room's name.
+    pub room: String,
+    /// The simulation stage.
+    pub simulate: StageOutcome,
+    /// The recording.
+    pub recording: PathBuf,
+    /// The run folder (report.html).
+    pub run_dir: PathBuf,
+    /// The run.
+    pub run: RunOutcome,
+    /// The seed paper's table: truth, globe, ours at the validation points.
+    pub rows: Vec<ComparisonRow>,
+    /// The error over the grid.
+    pub grid: GridError,
+}
+
+/// Simulates the scan into `out/recording` unless it holds this simulation already.
+fn simulate_stage(
+    out: &Path,
+    s: &DemoSettings,
+    progress: &dyn Progress,
+) -> Result<(StageOutcome, String)> {
+    let room = load_room(&s.room)?;
+    let rec_dir = out.join("recording");
+    let mut cfg = SimConfig {
+        seconds: s.seconds,
+        seed: s.seed,
+        noise: s.noise,
+        ..SimConfig::default()
+    };
+    set_depth_size(&mut cfg, s.depth_size)?;
+    let fingerprint = Fingerprint::new()
+        .setting("room", &room.file)
+        .setting("seconds", &s.seconds)
+        .setting("seed", &s.seed)
+        .setting("noise", &s.noise)
+        .setting("depth_size", &s.depth_size);
+    let stage = Stage {
+        name: "simulate".into(),
+        stamp: out.join("simulate.json"),
+        outputs: vec![rec_dir.join("truth.json")],
+    };
+    let outcome = run_or_reuse(&stage, fingerprint, s.force, || {
+        progress.begin(&format!(
+            "simulating {:.0} s of scanning the {} room",
+            s.seconds, room.file.name
+        ));
+        simulate(&room, &cfg, &rec_dir, &|d, t| progress.advance(d, t))?;
+        Ok(())
+    })?;
+    Ok((outcome, room.file.name))
+}
+
+/// The project of a simulated scan: its validation points, its air.
+fn demo_project(truth: &Truth, s: &DemoSettings) -> Project {
+    let mut project = Project {
+        points: truth
+            .points
+            .iter()
+            .map(|p| PointEntry {
+                name: p.name.clone(),
+                xyz: p.xyz_world,
+            })
+            .collect(),
+        ..Project::default()
+    };
+    project.air.temperature_c = Some(truth.air_temperature_c);
+    project.air.speed_m_s = s.air_speed_m_s;
+    if s.depth_size.0 < 640 {
+        project.fuse.depth_stride = 1; // small frames: every pixel
+    }
+    project
+}
+
+/// An engine with Monte Carlo of `rays` where needed.
+fn engine(scene: &RadiantScene, rays: usize) -> Result<MrtEngine<'_>> {
+    Ok(MrtEngine::new(
+        scene,
+        Method::Auto(MonteCarlo {
+            rays,
+            ..MonteCarlo::default()
+        }),
+    )?)
+}
+
+/// Ours against the truth at the validation points, with what a standard black globe would read:
+/// its equilibrium by the mixed-convection model, read back through the ISO 7726 formula, as the
+/// seed paper's reference globes were read.
+fn compare_points(
+    scene: &RadiantScene,
+    truth: &Truth,
+    air_speed: f64,
+) -> Result<Vec<ComparisonRow>> {
+    let engine = engine(scene, POINT_RAYS)?;
+    let air = Temperature::from_celsius(truth.air_temperature_c);
+    let mut rows = Vec::new();
+    for (k, p) in truth.points.iter().enumerate() {
+        let ours = engine
+            .at(&Point3::from(p.xyz_world), k as u64)?
+            .mrt
+            .celsius();
+        let tg = globe_temperature(
+            &Globe::STANDARD,
+            Temperature::from_celsius(p.mrt_c),
+            air,
+            air_speed,
+            GlobeMethod::MixedConvection,
+        )?;
+        let reading = GlobeReading {
+            globe: tg,
+            air,
+            air_speed_m_s: air_speed,
+        };
+        let globe_c = mrt_from_globe(&Globe::STANDARD, &reading, GlobeMethod::ISO)?
+            .mrt
+            .celsius();
+        rows.push(ComparisonRow {
+            name: p.name.clone(),
+            truth_c: p.mrt_c,
+            globe_c,
+            ours_c: ours,
+            diff_k: ours - p.mrt_c,
+        });
+    }
+    Ok(rows)
+}
+
+/// Ours against the truth on its grid (nodes where either has no value are left out).
+fn compare_grid(scene: &RadiantScene, truth: &Truth) -> Result<GridError> {
+    let engine = engine(scene, GRID_RAYS)?;
+    let diffs: Vec<f64> = truth
+        .grid
+        .nodes
+        .iter()
+        .enumerate()
+        .filter_map(|(k, n)| {
+            let t = n.mrt_c?;
+            let o = engine
+                .at(&Point3::from(n.xyz_world), GRID_STREAM0 + k as u64)
+                .ok()?;
+            Some(o.mrt.celsius() - t)
+        })
+        .collect();
+    let max_abs = diffs.iter().fold(0.0f64, |m, d| m.max(d.abs()));
+    let rmse = (diffs.iter().map(|d| d * d).sum::<f64>() / diffs.len().max(1) as f64).sqrt();
+    Ok(GridError {
+        nodes: diffs.len(),
+        max_abs_error_k: max_abs,
+        rmse_k: rmse,
+    })
+}
+
+/// demo.json.
+#[derive(Serialize)]
+struct DemoFile<'a> {
+    points: &'a [ComparisonRow],
+    grid: GridError,
+    stages: &'a [StageOutcome],
+    seconds: f64,
+    simulate_seconds: f64,
+    scan_seconds: f64,
+}
+
+/// Writes the run's report (with the comparison) and `out/demo.json`.
+fn write_demo_outputs(
+    out: &Path,
+    s: &DemoSettings,
+    d: &DemoOutcome,
+    project: &Project,
+    seconds: f64,
+) -> Result<()> {
+    let mut data = report_data(
+        &d.run,
+        &format!(
+            "mrtmap demo: simulated {:.0} s scan of the {} room",
+            s.seconds, d.room
+        ),
+        &d.recording.display().to_string(),
+        project,
+    );
+    data.comparison = d.rows.clone();
+    data.grid_error = Some((d.grid.max_abs_error_k, d.grid.rmse_k, d.grid.nodes));
+    let reused = if d.simulate.skipped { " (reused)" } else { "" };
+    data.timing.insert(
+        0,
+        ("simulate".into(), format!("{:.1}{reused}", d.simulate.secs)),
+    );
+    mrtmap_io::write_atomic(
+        &d.run_dir.join("report.html"),
+        mrtmap_report::render_html(&data).as_bytes(),
+    )?;
+    write_json(
+        &out.join("demo.json"),
+        &DemoFile {
+            points: &d.rows,
+            grid: d.grid,
+            stages: &d.run.stages,
+            seconds,
+            simulate_seconds: d.simulate.secs,
+            scan_seconds: s.seconds,
+        },
+    )
+}
+
+/// Runs the demo into `out` (recording in `out/recording`, the run in `out/run`).
+pub fn demo(out: &Path, s: &DemoSettings, progress: &dyn Progress) -> Result<DemoOutcome> {
+    let t0 = std::time::Instant::now();
+    let (simulated, room) = simulate_stage(out, s, progress)?;
+    let recording = out.join("recording");
+    let truth: Truth = read_json(&recording.join("truth.json"))?;
+    let project = demo_project(&truth, s);
+    let run_dir = out.join("run");
+    let outcome = run(&recording, &run_dir, &project, s.force, progress)?;
+    progress.begin("comparing with the truth");
+    let rows = compare_points(&outcome.scene, &truth, s.air_speed_m_s)?;
+    let grid = compare_grid(&outcome.scene, &truth)?;
+    let d = DemoOutcome {
+        room,
+        simulate: simulated,
+        recording,
+        run_dir,
+        run: outcome,
+        rows,
+        grid,
+    };
+    write_demo_outputs(out, s, &d, &project, t0.elapsed().as_secs_f64())?;
+    Ok(d)
+}

@@ -1,0 +1,55 @@
+//! # mrtmap-pipeline
+//!
+//! Orchestration: what runs in which order, where its files go, and when a stage's outputs can be
+//! reused. The CLI parses flags into these types, calls one function, and prints what comes back.
+//!
+//! ```text
+//!  source (bag, MCAP, ROS 2 bag, RTAB-Map db) ──source::prepare──► recording folder
+//!  recording ──run::run──► fuse/ ──► segment/ (scene.json) ──► map-H.HHm/ per height
+//!            └─ report::report_data ──► report.html, run.json
+//!  demo::demo = simulate (sim) + run + comparison with the exact truth
+//!  calibration: image pairs ──► rig.toml + report folder
+//! ```
+//!
+//! - [`settings`]: [`Project`] (project.toml; flags are merged into it once) and the typed choices
+//!   shared by flags and files ([`MethodChoice`], [`DirectionChoice`]).
+//! - [`cache`]: a stage's [`Fingerprint`] and [`run_or_reuse`]; the run's stages, source
+//!   conversion and the demo's simulation all use it.
+//! - [`progress`]: the [`Progress`] trait the CLI implements with progress bars.
+//! - [`source`], [`run`], [`maps`], [`report`], [`demo`], [`calibration`]: one job each.
+//!
+//! Everything here returns data and writes files; nothing prints.
+//!
+//! ```no_run
+//! use mrtmap_pipeline::{Project, Silent, run::run};
+//! # fn main() -> Result<(), mrtmap_pipeline::Error> {
+//! let outcome = run(
+//!     std::path::Path::new("scan"),
+//!     std::path::Path::new("out"),
+//!     &Project::default(),
+//!     false,
+//!     &Silent,
+//! )?;
+//! println!("{} maps", outcome.maps.len());
+//! # Ok(())
+//! # }
+//! ```
+
+pub mod cache;
+pub mod calibration;
+pub mod demo;
+mod error;
+pub mod maps;
+pub mod progress;
+pub mod report;
+mod rtabmap;
+pub mod run;
+pub mod settings;
+pub mod simulation;
+pub mod source;
+pub mod validation;
+
+pub use cache::{Fingerprint, Stage, StageOutcome, run_or_reuse};
+pub use error::{Error, Result};
+pub use progress::{Progress, Silent};
+pub use settings::{DirectionChoice, MethodChoice, MrtSection, Project};

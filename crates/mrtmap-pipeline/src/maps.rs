@@ -1,0 +1,153 @@
+//! Computing an MRT map and writing it: `mrt_grid.csv`, `mrt_map.png`, `mrt_map.svg` and
+//! `summary.json` (shared by `map`, `run` and `demo`).
+
+use std::path::Path;
+use std::time::Instant;
+
+use mrtmap_geometry::nalgebra::{Point2, Point3};
+use mrtmap_io::write_atomic;
+use mrtmap_radiation::{
+    GridSpec, MapFrame, Method, MrtEngine, MrtField, PointRecord, RadiantScene,
+};
+use mrtmap_report::{MapAxes, MapInput, MapMark, MapSummary, grid_csv, render_png, render_svg};
+use serde::{Deserialize, Serialize};
+
+use crate::cache::write_json;
+use crate::error::{Error, Result};
+
+/// A point to mark on a map: map coordinates U,V at the map's height, or scene coordinates X,Y,Z.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mark {
+    /// Name.
+    pub name: String,
+    /// Where.
+    pub at: MarkAt,
+}
+
+/// Where a mark is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MarkAt {
+    /// Map coordinates at the map's height.
+    Map([f64; 2]),
+    /// Scene coordinates.
+    Scene([f64; 3]),
+}
+
+/// `summary.json` of a map.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Summary {
+    /// Where the scene came from.
+    pub scene: String,
+    /// The map.
+    #[serde(flatten)]
+    pub map: MapSummary,
+    /// The marked points.
+    pub marks: Vec<PointRecord>,
+}
+
+/// A map computed and written.
+pub struct MapOutput {
+    /// Its summary (also in summary.json).
+    pub summary: Summary,
+    /// The method described for people.
+    pub method: String,
+    /// The PNG written.
+    pub png: Vec<u8>,
+}
+
+/// The MRT at each mark, with where it falls on the map.
+fn mark_records(
+    engine: &MrtEngine<'_>,
+    field: &MrtField,
+    spec: &GridSpec,
+    marks: &[Mark],
+) -> Result<(Vec<PointRecord>, Vec<MapMark>)> {
+    let mut records = Vec::new();
+    let mut map_marks = Vec::new();
+    for (k, m) in marks.iter().enumerate() {
+        let p = match m.at {
+            MarkAt::Map([u, v]) => field.frame.point(&Point2::new(u, v), spec.height_m),
+            MarkAt::Scene([x, y, z]) => Point3::new(x, y, z),
+        };
+        let r = engine
+            .at(&p, (spec.nx * spec.ny + k) as u64)
+            .map_err(|source| Error::Point {
+                name: m.name.clone(),
+                source,
+            })?;
+        records.push(PointRecord::new(Some(m.name.clone()), &r, engine.patches()));
+        map_marks.push(MapMark {
+            name: m.name.clone(),
+            uv: field.frame.uv(&p),
+        });
+    }
+    Ok((records, map_marks))
+}
+
+/// Computes the MRT map of `scene` (from `source`, for people) on `spec` with `marks`, and writes
+/// mrt_grid.csv, mrt_map.png, mrt_map.svg and summary.json into `out`.
+pub fn make_map(
+    scene: &RadiantScene,
+    source: &str,
+    method: Method,
+    spec: GridSpec,
+    marks: &[Mark],
+    out: &Path,
+) -> Result<MapOutput> {
+    let engine = MrtEngine::new(scene, method)?;
+    let frame = MapFrame::of_scene(scene).map_err(|source_err| Error::Map {
+        scene: source.to_string(),
+        source: source_err,
+    })?;
+    let t0 = Instant::now();
+    let field = MrtField::compute(&engine, frame, spec)?;
+    let secs = t0.elapsed().as_secs_f64();
+    let (records, map_marks) = mark_records(&engine, &field, &spec, marks)?;
+    let how = method.describe(engine.ray_engine());
+    let input = MapInput {
+        field: &field,
+        scene,
+        marks: &map_marks,
+        subtitle: format!("{source}; {}×{} grid, {how}", spec.nx, spec.ny),
+    };
+    let (rays, seed) = match method {
+        Method::MonteCarlo(mc) | Method::Auto(mc) => (Some(mc.rays), Some(mc.seed)),
+        Method::Exact => (None, None),
+    };
+    let summary = Summary {
+        scene: source.to_string(),
+        map: MapSummary {
+            height_m: spec.height_m,
+            grid: [spec.nx, spec.ny],
+            margin_m: spec.margin_m,
+            method: method.name().to_string(),
+            rays,
+            seed,
+            axes: MapAxes::of(&field),
+            field: field.summary(),
+            compute_secs: secs,
+        },
+        marks: records,
+    };
+    let png = render_png(&input)?;
+    write_atomic(&out.join("mrt_grid.csv"), grid_csv(&field).as_bytes())?;
+    write_atomic(&out.join("mrt_map.png"), &png)?;
+    write_atomic(&out.join("mrt_map.svg"), render_svg(&input)?.as_bytes())?;
+    write_json(&out.join("summary.json"), &summary)?;
+    Ok(MapOutput {
+        summary,
+        method: how,
+        png,
+    })
+}
+
+/// The scene in `path`, or the built-in example office; the string says which, for people.
+pub fn load_scene(path: Option<&Path>) -> Result<(RadiantScene, String)> {
+    Ok(match path {
+        Some(p) => (RadiantScene::load(p)?, p.display().to_string()),
+        None => (
+            mrtmap_radiation::example_office(),
+            "the built-in example office".to_string(),
+        ),
+    })
+}

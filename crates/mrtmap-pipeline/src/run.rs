@@ -1,0 +1,281 @@
+//! The whole run on a recording, one function per stage, each in its own folder of `out` and
+//! reused while its inputs have not changed (see [`crate::cache`]):
+//!
+//! ```text
+//!  recording ──fuse──► fuse/ (cloud.ply, fusion.json, poses.txt)
+//!            ──segment──► segment/ (scene.json, segment.json, segments.ply)
+//!            ──map──► map-H.HHm/ per height (mrt_grid.csv, mrt_map.png/.svg, summary.json)
+//! ```
+//!
+//! A new stage goes here: a `*_stage` function taking what it needs and returning its outcome,
+//! called in order by [`run`], with its files in its own folder.
+
+use std::path::Path;
+
+use mrtmap_io::{Recording, Trajectory, read_cloud_ply, write_atomic, write_cloud_ply};
+use mrtmap_radiation::{GridSpec, RadiantScene};
+use mrtmap_scan::segment::{MaskInput, SegmentParams, SegmentReport, refined_poses, segment};
+use mrtmap_scan::{FuseParams, FusionReport, fuse};
+
+use crate::cache::{Fingerprint, Stage, StageOutcome, read_json, run_or_reuse, write_json};
+use crate::error::{Error, Result};
+use crate::maps::{Mark, MarkAt, Summary, make_map};
+use crate::progress::Progress;
+use crate::settings::Project;
+
+/// Fuses `rec` into `out`: cloud.ply, fusion.json and poses.txt (the refined trajectory).
+pub fn fuse_into(
+    rec: &Recording,
+    params: &FuseParams,
+    out: &Path,
+    progress: &dyn Progress,
+) -> Result<FusionReport> {
+    progress.begin("fusing thermal frames");
+    let fused = fuse(rec, params, &|d, t| progress.advance(d, t));
+    let comment = format!(
+        "mrtmap thermal cloud of {}\ntemperature_c: radiant (T^4) weighted average of the observations; temperature_std in K\nvoxel {} m, ICP {}",
+        rec.dir.display(),
+        params.voxel_m,
+        if params.icp.enabled { "on" } else { "off" }
+    );
+    write_cloud_ply(&out.join("cloud.ply"), &fused.cloud, &comment, &[])?;
+    write_json(&out.join("fusion.json"), &fused.report)?;
+    let traj = Trajectory {
+        stamps: fused.poses.iter().map(|p| p.0).collect(),
+        poses: fused.poses.iter().map(|p| p.1).collect(),
+    };
+    write_atomic(
+        &out.join("poses.txt"),
+        traj.to_tum("world_from_depth of each fused thermal frame's depth frame, after ICP")
+            .as_bytes(),
+    )?;
+    Ok(fused.report)
+}
+
+/// Segments the fusion in `fused` (cloud.ply, poses.txt) into `out`: scene.json, segments.ply and
+/// segment.json. Features are labelled by the masks of `masks` when given.
+pub fn segment_into(
+    fused: &Path,
+    masks: Option<&Recording>,
+    params: &SegmentParams,
+    out: &Path,
+) -> Result<SegmentReport> {
+    let cloud_path = fused.join("cloud.ply");
+    let cloud = read_cloud_ply(&cloud_path)?.cloud;
+    let poses = Trajectory::read(&fused.join("poses.txt"))?;
+    let pose_fn = masks.map(|r| refined_poses(r, &poses));
+    let mask_input = masks.zip(pose_fn.as_ref()).map(|(r, f)| MaskInput {
+        recording: r,
+        world_from_depth: f,
+    });
+    let seg = segment(&cloud, &poses.poses, mask_input.as_ref(), params).map_err(|source| {
+        Error::Segment {
+            cloud: cloud_path.clone(),
+            source,
+        }
+    })?;
+    write_atomic(
+        &out.join("scene.json"),
+        (seg.scene.to_json() + "\n").as_bytes(),
+    )?;
+    write_cloud_ply(
+        &out.join("segments.ply"),
+        &cloud,
+        "mrtmap segments: surface_id indexes segment.json's surfaces, feature_id its features (-1: none)",
+        &[
+            ("surface_id", &seg.surface_id),
+            ("feature_id", &seg.feature_id),
+        ],
+    )?;
+    write_json(&out.join("segment.json"), &seg.report)?;
+    Ok(seg.report)
+}
+
+/// One map of a run.
+#[derive(Clone, Debug)]
+pub struct MapResult {
+    /// summary.json.
+    pub summary: Summary,
+    /// mrt_map.png.
+    pub png: Vec<u8>,
+    /// The grid CSV, relative to the run folder.
+    pub csv: String,
+}
+
+/// The outcome of a run.
+#[derive(Clone, Debug)]
+pub struct RunOutcome {
+    /// What each stage did.
+    pub stages: Vec<StageOutcome>,
+    /// The segmented scene.
+    pub scene: RadiantScene,
+    /// Fusion's report.
+    pub fusion: FusionReport,
+    /// Segmentation's report.
+    pub segment: SegmentReport,
+    /// Maps, by height.
+    pub maps: Vec<MapResult>,
+    /// Warnings gathered over the stages.
+    pub warnings: Vec<String>,
+}
+
+/// The fuse stage: `out/fuse`.
+fn fuse_stage(
+    rec: &Recording,
+    out: &Path,
+    p: &Project,
+    force: bool,
+    progress: &dyn Progress,
+) -> Result<(StageOutcome, FusionReport)> {
+    let dir = out.join("fuse");
+    let params = p.fuse.params()?;
+    let fingerprint = ["rig.toml", "depth.txt", "thermal.txt", "trajectory.txt"]
+        .iter()
+        .fold(Fingerprint::new(), |f, n| f.file(&rec.dir.join(n)))
+        .setting("fuse", &p.fuse);
+    let stage = Stage::in_dir("fuse", &dir, &["cloud.ply", "fusion.json", "poses.txt"]);
+    let outcome = run_or_reuse(&stage, fingerprint, force, || {
+        fuse_into(rec, &params, &dir, progress).map(|_| ())
+    })?;
+    Ok((outcome, read_json(&dir.join("fusion.json"))?))
+}
+
+/// The segment stage: `out/segment`.
+fn segment_stage(
+    rec: &Recording,
+    out: &Path,
+    p: &Project,
+    force: bool,
+    progress: &dyn Progress,
+) -> Result<(StageOutcome, SegmentReport)> {
+    let fused = out.join("fuse");
+    let dir = out.join("segment");
+    let use_masks = p.segment.masks && !rec.masks.is_empty();
+    let fingerprint = Fingerprint::new()
+        .file(&fused.join("cloud.ply"))
+        .file(&fused.join("poses.txt"))
+        .maybe_file(use_masks.then(|| rec.dir.join("masks.txt")).as_deref())
+        .setting("segment", &p.segment);
+    let stage = Stage::in_dir(
+        "segment",
+        &dir,
+        &["scene.json", "segment.json", "segments.ply"],
+    );
+    let outcome = run_or_reuse(&stage, fingerprint, force, || {
+        progress.begin("segmenting surfaces and features");
+        progress.advance(0, 1);
+        let masks = use_masks.then_some(rec);
+        segment_into(&fused, masks, &p.segment.params(), &dir).map(|_| ())
+    })?;
+    Ok((outcome, read_json(&dir.join("segment.json"))?))
+}
+
+/// The map stage at one height: `out/map-H.HHm`.
+fn map_stage(
+    scene: &RadiantScene,
+    out: &Path,
+    p: &Project,
+    height_m: f64,
+    force: bool,
+    progress: &dyn Progress,
+) -> Result<(StageOutcome, MapResult)> {
+    let name = format!("map-{height_m:.2}m");
+    let dir = out.join(&name);
+    let scene_path = out.join("segment").join("scene.json");
+    let spec = GridSpec {
+        nx: p.map.grid[0],
+        ny: p.map.grid[1],
+        height_m,
+        margin_m: p.map.margin_m,
+    };
+    let marks: Vec<Mark> = p
+        .points
+        .iter()
+        .map(|pt| Mark {
+            name: pt.name.clone(),
+            at: MarkAt::Scene(pt.xyz),
+        })
+        .collect();
+    // This map's own settings only: adding another height leaves it unchanged.
+    let fingerprint = Fingerprint::new()
+        .file(&scene_path)
+        .setting("grid", &p.map.grid)
+        .setting("margin_m", &p.map.margin_m)
+        .setting("mrt", &p.mrt)
+        .setting("points", &p.points)
+        .setting("height", &height_m);
+    let stage = Stage::in_dir(
+        format!("map at {height_m:.2} m"),
+        &dir,
+        &["summary.json", "mrt_map.png", "mrt_grid.csv"],
+    );
+    let method = p.mrt.method(scene)?;
+    let mut made = None;
+    let outcome = run_or_reuse(&stage, fingerprint, force, || {
+        progress.begin(&format!("mapping MRT at {height_m:.2} m"));
+        progress.advance(0, 1);
+        made = Some(make_map(
+            scene,
+            "the scanned room",
+            method,
+            spec,
+            &marks,
+            &dir,
+        )?);
+        Ok(())
+    })?;
+    let (summary, png) = match made {
+        Some(m) => (m.summary, m.png),
+        None => (
+            read_json(&dir.join("summary.json"))?,
+            std::fs::read(dir.join("mrt_map.png"))
+                .map_err(|e| mrtmap_io::FileError::io(&dir.join("mrt_map.png"), e))?,
+        ),
+    };
+    let csv = format!("{name}/mrt_grid.csv");
+    Ok((outcome, MapResult { summary, png, csv }))
+}
+
+/// Runs fuse → segment → maps on the recording folder `recording` into `out`.
+pub fn run(
+    recording: &Path,
+    out: &Path,
+    p: &Project,
+    force: bool,
+    progress: &dyn Progress,
+) -> Result<RunOutcome> {
+    p.check()?;
+    let rec = Recording::open(recording)?;
+    let mut warnings: Vec<String> = rec
+        .warnings
+        .iter()
+        .map(|w| format!("recording: {w}"))
+        .collect();
+    let (fused, fusion) = fuse_stage(&rec, out, p, force, progress)?;
+    for (why, n) in &fusion.skipped {
+        warnings.push(format!("fusion skipped {n} thermal frames: {why}"));
+    }
+    let (segmented, segment) = segment_stage(&rec, out, p, force, progress)?;
+    warnings.extend(
+        segment
+            .warnings
+            .iter()
+            .map(|w| format!("segmentation: {w}")),
+    );
+    let scene = RadiantScene::load(&out.join("segment").join("scene.json"))?;
+    let mut stages = vec![fused, segmented];
+    let mut maps = Vec::new();
+    for &h in &p.map.heights_m {
+        let (st, m) = map_stage(&scene, out, p, h, force, progress)?;
+        stages.push(st);
+        maps.push(m);
+    }
+    Ok(RunOutcome {
+        stages,
+        scene,
+        fusion,
+        segment,
+        maps,
+        warnings,
+    })
+}

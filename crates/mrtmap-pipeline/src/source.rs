@@ -1,0 +1,386 @@
+//! Scan sources: what a source holds ([`inspect`]), turning a bag, MCAP file, ROS 2 bag or RTAB-Map
+//! database into the recording layout ([`convert`]), a recording folder into one of those
+//! ([`write_container`]), and the recording folder `fuse` and `run` read ([`prepare`]: the
+//! source itself, or its conversion, reused while the source and options are unchanged).
+
+use std::path::{Path, PathBuf};
+
+use mrtmap_io::{FileError, Recording, Rig, StreamEntry};
+use mrtmap_sources::ros::{self, Container, Plan, RosOptions, RosWriteOptions, Survey};
+use mrtmap_sources::rtabmap::{self, DbSummary, Schema};
+use mrtmap_sources::{SourceKind, resolve_source};
+use serde::Serialize;
+
+use crate::cache::{Fingerprint, Stage, run_or_reuse};
+use crate::error::{Error, Result};
+
+/// How to read a bag, MCAP file or RTAB-Map database as a scan.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct SourceOptions {
+    /// A rig.toml: its thermal camera and extrinsic, and its depth/colour cameras where the
+    /// source has no CameraInfo.
+    pub rig: Option<PathBuf>,
+    /// Depth image topic.
+    pub depth_topic: Option<String>,
+    /// Thermal image topic.
+    pub thermal_topic: Option<String>,
+    /// Colour image topic.
+    pub rgb_topic: Option<String>,
+    /// Pose topic (Odometry or PoseStamped).
+    pub pose_topic: Option<String>,
+    /// Raw depth units per metre of 16-bit depth.
+    pub depth_scale: Option<f64>,
+    /// Thermal frames for a source without them (an RTAB-Map database).
+    pub thermal: Option<PathBuf>,
+}
+
+impl SourceOptions {
+    /// The ROS reader's options (reads the rig).
+    fn ros(&self) -> Result<RosOptions> {
+        if let Some(s) = self.depth_scale
+            && !(s > 0.0 && s.is_finite())
+        {
+            return Err(Error::setting(
+                format!("--depth-scale {s}"),
+                "must be a positive number of raw units per metre",
+            ));
+        }
+        Ok(RosOptions {
+            depth_topic: self.depth_topic.clone(),
+            thermal_topic: self.thermal_topic.clone(),
+            rgb_topic: self.rgb_topic.clone(),
+            pose_topic: self.pose_topic.clone(),
+            depth_scale: self.depth_scale,
+            rig: self.rig.as_deref().map(Rig::read).transpose()?,
+        })
+    }
+}
+
+/// One stream of a recording folder.
+#[derive(Clone, Debug, Serialize)]
+pub struct StreamSummary {
+    /// "depth", "thermal", "rgb", "masks" or "trajectory".
+    pub name: &'static str,
+    /// Frames or poses.
+    pub count: usize,
+    /// First stamp (s).
+    pub t0: f64,
+    /// Last stamp (s); below `t0` when empty.
+    pub t1: f64,
+}
+
+impl StreamSummary {
+    fn of(name: &'static str, v: &[StreamEntry]) -> Self {
+        let (t0, t1) = match (v.first(), v.last()) {
+            (Some(f), Some(l)) => (f.t, l.t),
+            _ => (0.0, -1.0),
+        };
+        Self {
+            name,
+            count: v.len(),
+            t0,
+            t1,
+        }
+    }
+
+    /// Frames per second over the span.
+    pub fn rate_hz(&self) -> f64 {
+        if self.count > 1 && self.t1 > self.t0 {
+            (self.count - 1) as f64 / (self.t1 - self.t0)
+        } else {
+            0.0
+        }
+    }
+}
+
+/// A recording folder at a glance.
+#[derive(Clone, Debug)]
+pub struct FolderSummary {
+    /// Depth, thermal, colour, masks, trajectory.
+    pub streams: Vec<StreamSummary>,
+    /// The rig.
+    pub rig: Rig,
+    /// What the reader noticed.
+    pub warnings: Vec<String>,
+}
+
+/// A bag, MCAP file or ROS 2 bag at a glance.
+#[derive(Clone, Debug)]
+pub struct RosSummary {
+    /// The container.
+    pub container: Container,
+    /// A ROS 2 bag split over several files.
+    pub split: bool,
+    /// Bytes in the file (or the split files).
+    pub bytes: u64,
+    /// Topics, transforms.
+    pub survey: Survey,
+    /// The streams a scan would use, and what it lacks.
+    pub plan: Plan,
+}
+
+impl RosSummary {
+    /// The container in words.
+    pub fn describe(&self) -> &'static str {
+        match (self.container, self.split) {
+            (Container::Bag, _) => "ROS 1 bag",
+            (Container::Mcap, false) => "MCAP",
+            (Container::Mcap, true) => "ROS 2 bag split over several MCAP files",
+            (Container::Db3, false) => "ROS 2 bag (SQLite storage)",
+            (Container::Db3, true) => "ROS 2 bag split over several SQLite files",
+        }
+    }
+}
+
+/// What a source holds.
+#[derive(Clone, Debug)]
+pub enum Inspection {
+    /// A recording folder.
+    Folder(FolderSummary),
+    /// A ROS 1 bag, MCAP file or ROS 2 bag.
+    Ros(Box<RosSummary>),
+    /// An RTAB-Map database, and what a scan still needs besides it.
+    RtabMap {
+        /// The database.
+        summary: DbSummary,
+        /// What a scan lacks.
+        missing: Vec<String>,
+    },
+}
+
+/// Bytes in a source file, or in a split bag's storage files.
+fn source_bytes(file: &Path, c: Container) -> Result<u64> {
+    let files = if file.is_dir() {
+        ros::storage_files(file, c).map_err(|e| e.in_file(file))?
+    } else {
+        vec![file.to_path_buf()]
+    };
+    files.iter().try_fold(0, |n, f| {
+        Ok(n + std::fs::metadata(f).map_err(|e| FileError::io(f, e))?.len())
+    })
+}
+
+/// Says what `source` holds and whether it can be made into a scan.
+pub fn inspect(source: &Path, o: &SourceOptions) -> Result<Inspection> {
+    let (kind, file) = resolve_source(source)?;
+    match kind {
+        SourceKind::Folder => {
+            let rec = Recording::open(source)?;
+            let traj = &rec.trajectory;
+            let poses = StreamSummary {
+                name: "trajectory",
+                count: traj.len(),
+                t0: traj.stamps.first().copied().unwrap_or(0.0),
+                t1: traj.stamps.last().copied().unwrap_or(-1.0),
+            };
+            Ok(Inspection::Folder(FolderSummary {
+                streams: vec![
+                    StreamSummary::of("depth", &rec.depth),
+                    StreamSummary::of("thermal", &rec.thermal),
+                    StreamSummary::of("rgb", &rec.rgb),
+                    StreamSummary::of("masks", &rec.masks),
+                    poses,
+                ],
+                rig: rec.rig,
+                warnings: rec.warnings,
+            }))
+        }
+        SourceKind::RtabMap => {
+            let summary = rtabmap::summarize(source)?;
+            let missing = crate::rtabmap::missing(&summary, o);
+            Ok(Inspection::RtabMap { summary, missing })
+        }
+        SourceKind::Bag | SourceKind::Mcap | SourceKind::Db3 => {
+            let c = container_of(kind);
+            let bytes = source_bytes(&file, c)?;
+            let survey = ros::survey(c, file.as_path()).map_err(|e| e.in_file(&file))?;
+            let plan = ros::plan(&survey, &o.ros()?);
+            Ok(Inspection::Ros(Box::new(RosSummary {
+                container: c,
+                split: file.is_dir(),
+                bytes,
+                survey,
+                plan,
+            })))
+        }
+    }
+}
+
+fn container_of(kind: SourceKind) -> Container {
+    kind.container().unwrap_or(Container::Bag)
+}
+
+/// What a conversion to the recording layout wrote.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Conversion {
+    /// The recording folder.
+    pub out: PathBuf,
+    /// Depth frames written.
+    pub depth: usize,
+    /// Thermal frames written.
+    pub thermal: usize,
+    /// Colour frames written.
+    pub rgb: usize,
+    /// Poses written.
+    pub poses: usize,
+    /// Where the thermal frames came from, when not from the source itself.
+    pub thermal_from: Option<String>,
+    /// Which poses were taken, when the source offers several kinds.
+    pub poses_from: Option<String>,
+    /// Messages (or database nodes) skipped.
+    pub skipped: usize,
+    /// "messages" or "nodes".
+    pub skipped_unit: &'static str,
+    /// The first reasons for skipping.
+    pub skipped_reasons: Vec<String>,
+    /// How things were decided.
+    pub notes: Vec<String>,
+}
+
+/// Converts `source` (a bag, MCAP file, ROS 2 bag or RTAB-Map database) into the recording layout
+/// at `out`.
+pub fn convert(source: &Path, out: &Path, o: &SourceOptions) -> Result<Conversion> {
+    let (kind, file) = resolve_source(source)?;
+    let source = file.as_path();
+    match kind {
+        SourceKind::Folder => Err(Error::source(
+            source,
+            "is already a recording folder (convert to a .bag, .mcap, .db3 or .db file by naming one as --out)",
+        )),
+        SourceKind::RtabMap => crate::rtabmap::convert(source, out, o),
+        SourceKind::Bag | SourceKind::Mcap | SourceKind::Db3 => {
+            let c = container_of(kind);
+            let s = ros::survey(c, source).map_err(|e| e.in_file(source))?;
+            let p = ros::plan(&s, &o.ros()?);
+            if !p.missing.is_empty() || p.rig.is_none() {
+                return Err(Error::NotAScan {
+                    path: source.to_path_buf(),
+                    missing: p.missing.clone(),
+                    plan: Some(Box::new(p)),
+                });
+            }
+            let rep = ros::export(source, source, &s, &p, out)?;
+            Ok(Conversion {
+                out: out.to_path_buf(),
+                depth: rep.depth,
+                thermal: rep.thermal,
+                rgb: rep.rgb,
+                poses: rep.poses,
+                skipped: rep.skipped,
+                skipped_unit: "messages",
+                skipped_reasons: rep.skipped_reasons,
+                notes: p.notes,
+                ..Conversion::default()
+            })
+        }
+    }
+}
+
+/// Containers a recording folder can be written as.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ContainerOut {
+    /// A RealSense-style ROS 1 bag, MCAP file or ROS 2 `.db3`.
+    Ros(Container, ros::bag::Compression),
+    /// An RTAB-Map-layout database.
+    RtabMap(Schema),
+}
+
+/// What [`write_container`] wrote.
+#[derive(Clone, Debug)]
+pub struct Written {
+    /// Bytes written (bags, MCAP, `.db3`).
+    pub bytes: Option<usize>,
+    /// Depth, thermal, colour frames and poses in the recording.
+    pub counts: [usize; 4],
+    /// Database nodes written (RTAB-Map).
+    pub nodes: Option<usize>,
+}
+
+/// Writes the recording folder `recording` as `out` (a bag, MCAP file, `.db3` or database).
+pub fn write_container(recording: &Path, out: &Path, what: ContainerOut) -> Result<Written> {
+    let rec = Recording::open(recording).map_err(|e| {
+        Error::source(
+            out,
+            format!("writing it needs a recording folder as the source: {e}"),
+        )
+    })?;
+    let rgb = if rec.rig.rgb.is_some() {
+        rec.rgb.len()
+    } else {
+        0
+    };
+    let counts = [
+        rec.depth.len(),
+        rec.thermal.len(),
+        rgb,
+        rec.trajectory.len(),
+    ];
+    match what {
+        ContainerOut::RtabMap(schema) => {
+            // SQLite writes in place: build beside the target and rename when complete.
+            let tmp = out.with_extension("db.partial");
+            let n = rtabmap::write_recording(&rec, &tmp, schema)?;
+            std::fs::rename(&tmp, out).map_err(|e| FileError::io(out, e))?;
+            Ok(Written {
+                bytes: None,
+                counts,
+                nodes: Some(n),
+            })
+        }
+        ContainerOut::Ros(container, compression) => {
+            let o = RosWriteOptions::t265_like(container, compression);
+            let bytes = ros::write_ros(&rec, &o)?;
+            mrtmap_io::write_atomic(out, &bytes)?;
+            Ok(Written {
+                bytes: Some(bytes.len()),
+                counts,
+                nodes: None,
+            })
+        }
+    }
+}
+
+/// The recording folder to fuse.
+#[derive(Clone, Debug)]
+pub struct Prepared {
+    /// The folder.
+    pub dir: PathBuf,
+    /// What a conversion wrote (when it ran now).
+    pub conversion: Option<Conversion>,
+    /// The conversion of an earlier run was reused.
+    pub reused: bool,
+}
+
+/// The recording folder for `fuse` / `run`: `source` itself when it is a folder, else
+/// `out/recording`, converted now unless it already holds this source's conversion with these
+/// options (the files the options name, a rig or thermal frames, count as inputs too).
+pub fn prepare(source: &Path, out: &Path, o: &SourceOptions) -> Result<Prepared> {
+    if resolve_source(source)?.0 == SourceKind::Folder {
+        return Ok(Prepared {
+            dir: source.to_path_buf(),
+            conversion: None,
+            reused: false,
+        });
+    }
+    let dir = out.join("recording");
+    let stage = Stage {
+        name: "convert".into(),
+        stamp: out.join("recording.stage.json"),
+        outputs: vec![dir.join("rig.toml")],
+    };
+    let fingerprint = Fingerprint::new()
+        .file(source)
+        .maybe_file(o.rig.as_deref())
+        .maybe_file(o.thermal.as_deref())
+        .setting("options", o);
+    let mut conversion = None;
+    let outcome = run_or_reuse(&stage, fingerprint, false, || {
+        conversion = Some(convert(source, &dir, o)?);
+        Ok(())
+    })?;
+    Ok(Prepared {
+        dir,
+        conversion,
+        reused: outcome.skipped,
+    })
+}
