@@ -2,7 +2,7 @@
 use std::path::Path;
 
 use mrtmap_sources::ros::bag::{BagWriter, Compression};
-use mrtmap_sources::ros::mcap::McapWriter;
+use mrtmap_sources::ros::mcap::{McapCompression, McapWriter};
 use mrtmap_sources::ros::msg::{Wire, encode};
 use mrtmap_io::Image16;
 use mrtmap_sources::rtabmap::{self, rvl};
@@ -73,9 +73,13 @@ fn main() {
         for (k, (topic, ty, m)) in messages(Wire::Ros1).into_iter().enumerate() {
             w.write(topic, ty, 1.0 + k as f64 * 0.01, &m);
         }
-        put("bag", name, &w.finish());
+        put("bag", name, &w.finish().expect("finish"));
     }
-    for (name, c) in [("none", None), ("zstd", Some("zstd")), ("lz4", Some("lz4"))] {
+    for (name, c) in [
+        ("none", None),
+        ("zstd", Some(McapCompression::Zstd)),
+        ("lz4", Some(McapCompression::Lz4)),
+    ] {
         let mut w = McapWriter::new(c, 300).expect("mcap");
         for (k, (topic, ty, m)) in messages(Wire::Cdr).into_iter().enumerate() {
             let (pkg, n) = ty.split_once('/').expect("type");
@@ -110,7 +114,7 @@ fn main() {
         "rvl",
         &rvl::encode_rtabmap(8, 6, &depth.data),
     );
-    put("rtabmap_blobs", "png", &mrtmap_io::encode_png16(&depth));
+    put("rtabmap_blobs", "png", &mrtmap_io::encode_png16(&depth).expect("encodes"));
     let cam = mrtmap_geometry::camera::PinholeCamera::new(8, 6, 6.0, 6.0, 3.5, 2.5);
     put(
         "rtabmap_blobs",
@@ -131,6 +135,6 @@ fn main() {
             width: 16,
             height: 12,
             data: (0..192).map(|i| 29_000 + i).collect(),
-        }),
+        }).expect("encodes"),
     );
 }

@@ -204,10 +204,11 @@ pub fn calibrate_mono(
         .filter(|&k| dets[k].as_ref().is_some_and(|d| d.corners.len() >= 6))
         .collect();
     if usable.len() < 3 {
-        return Err(CalibError::NotEnough(format!(
-            "the board was found in {} image(s) of {width}×{height}; at least 3 views at different angles are needed",
-            usable.len()
-        )));
+        return Err(CalibError::TooFewViews {
+            found: usable.len(),
+            width,
+            height,
+        });
     }
     let (cx, cy) = ((width as f64 - 1.0) / 2.0, (height as f64 - 1.0) / 2.0);
     let mut homs = Vec::new();
@@ -475,7 +476,10 @@ pub fn calibrate_stereo(
     let rgb_dets: Vec<Option<Detection>> = pairs.iter().map(|p| p.rgb.cloned()).collect();
     let th_dets: Vec<Option<Detection>> = pairs.iter().map(|p| p.thermal.cloned()).collect();
     let rgb_alone = calibrate_mono(board, rgb_size.0, rgb_size.1, &rgb_dets, model_rgb)
-        .map_err(|e| CalibError::NotEnough(format!("colour camera: {e}")))?;
+        .map_err(|e| CalibError::Camera {
+            camera: "colour",
+            source: Box::new(e),
+        })?;
     let thermal_alone = calibrate_mono(
         board,
         thermal_size.0,
@@ -483,7 +487,10 @@ pub fn calibrate_stereo(
         &th_dets,
         model_thermal,
     )
-    .map_err(|e| CalibError::NotEnough(format!("thermal camera: {e}")))?;
+    .map_err(|e| CalibError::Camera {
+        camera: "thermal",
+        source: Box::new(e),
+    })?;
     let n = pairs.len();
     let mut status: Vec<PairStatus> = (0..n)
         .map(|k| {
@@ -539,10 +546,10 @@ pub fn calibrate_stereo(
         .filter(|c| full(&rgb_dets[c.k]) && full(&th_dets[c.k]))
         .collect();
     if complete.is_empty() {
-        return Err(CalibError::NotEnough(format!(
-            "no pair shows all {}×{} inner corners in both images, which is needed to tie the thermal corners' numbering to the colour image's",
-            board.cols, board.rows
-        )));
+        return Err(CalibError::NoCompletePair {
+            cols: board.cols,
+            rows: board.rows,
+        });
     }
     let t0 = {
         let ts: Vec<Vector3<f64>> = complete

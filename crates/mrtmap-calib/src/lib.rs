@@ -45,9 +45,37 @@ pub enum CalibError {
         /// What is wrong.
         msg: String,
     },
-    /// Too little usable data, and what is missing.
-    #[error("{0}")]
-    NotEnough(String),
+    /// Too few views of the board for one camera's intrinsics.
+    #[error(
+        "the board was found in {found} image(s) of {width}×{height}; at least 3 views at different angles are needed"
+    )]
+    TooFewViews {
+        /// Views with the board.
+        found: usize,
+        /// Image width.
+        width: u32,
+        /// Image height.
+        height: u32,
+    },
+    /// One camera of a pair set could not be calibrated.
+    #[error("{camera} camera")]
+    Camera {
+        /// "colour" or "thermal".
+        camera: &'static str,
+        /// Why.
+        #[source]
+        source: Box<CalibError>,
+    },
+    /// No pair shows the whole board in both images.
+    #[error(
+        "no pair shows all {cols}×{rows} inner corners in both images, which is needed to tie the thermal corners' numbering to the colour image's"
+    )]
+    NoCompletePair {
+        /// Inner corners per row.
+        cols: u32,
+        /// Inner corners per column.
+        rows: u32,
+    },
 }
 
 impl CalibError {

@@ -137,6 +137,6 @@ pub fn overlay(
 }
 
 /// PNG bytes of an RGB image.
-pub fn png(img: &RgbImage) -> Vec<u8> {
+pub fn png(img: &RgbImage) -> Result<Vec<u8>, mrtmap_io::EncodeError> {
     mrtmap_io::encode_png_rgb8(img.width(), img.height(), img.as_raw())
 }

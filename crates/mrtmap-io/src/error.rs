@@ -64,6 +64,9 @@ pub enum FileErrorKind {
     /// An image that cannot be decoded or has the wrong pixel type.
     #[error("{0}")]
     Image(String),
+    /// An image that could not be encoded for writing.
+    #[error(transparent)]
+    Encode(#[from] crate::image16::EncodeError),
     /// A file listed in another that does not exist.
     #[error("listed file {0} does not exist")]
     Missing(String),
@@ -85,6 +88,11 @@ impl FileError {
             line,
             kind,
         }
+    }
+
+    /// An image that could not be encoded for this file.
+    pub fn encode(path: &Path, e: crate::image16::EncodeError) -> Self {
+        Self::new(path, None, FileErrorKind::Encode(e))
     }
 
     /// A syntax error at a line.

@@ -85,26 +85,49 @@ pub fn read_image16(path: &Path) -> Result<Image16, FileError> {
     }
 }
 
+/// An image that could not be encoded (its pixels do not fill its size, or it is empty).
+#[derive(Debug, thiserror::Error)]
+#[error("cannot encode a {width}×{height} PNG")]
+pub struct EncodeError {
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    /// Why.
+    #[source]
+    pub source: image::ImageError,
+}
+
+fn encode_png(
+    data: &[u8],
+    width: u32,
+    height: u32,
+    colour: ExtendedColorType,
+) -> Result<Vec<u8>, EncodeError> {
+    let mut out = Vec::new();
+    let enc = PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Adaptive);
+    enc.write_image(data, width, height, colour)
+        .map_err(|source| EncodeError {
+            width,
+            height,
+            source,
+        })?;
+    Ok(out)
+}
+
 /// Encodes a 16-bit single-channel PNG (fast compression).
-pub fn encode_png16(img: &Image16) -> Vec<u8> {
+pub fn encode_png16(img: &Image16) -> Result<Vec<u8>, EncodeError> {
     // image 0.25 takes 16-bit samples in native byte order and writes PNG's big-endian itself.
     let mut bytes = Vec::with_capacity(2 * img.data.len());
     for v in &img.data {
         bytes.extend_from_slice(&v.to_ne_bytes());
     }
-    let mut out = Vec::new();
-    let enc = PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Adaptive);
-    // Encoding into memory with a matching buffer cannot fail.
-    let _ = enc.write_image(&bytes, img.width, img.height, ExtendedColorType::L16);
-    out
+    encode_png(&bytes, img.width, img.height, ExtendedColorType::L16)
 }
 
 /// Encodes an 8-bit RGB PNG (fast compression).
-pub fn encode_png_rgb8(width: u32, height: u32, rgb: &[u8]) -> Vec<u8> {
-    let mut out = Vec::new();
-    let enc = PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Adaptive);
-    let _ = enc.write_image(rgb, width, height, ExtendedColorType::Rgb8);
-    out
+pub fn encode_png_rgb8(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>, EncodeError> {
+    encode_png(rgb, width, height, ExtendedColorType::Rgb8)
 }
 
 /// Separable Gaussian blur of a row-major image with edge clamping (σ in pixels; σ ≤ 0 copies).

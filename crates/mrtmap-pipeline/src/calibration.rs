@@ -11,7 +11,7 @@ use mrtmap_calib::{
     PairStatus, StereoOptions, StereoResult, ViewError, calibrate_mono, calibrate_stereo, detect,
     find_pairs, list_images,
 };
-use mrtmap_io::{PoseFile, Rig, write_atomic};
+use mrtmap_io::{FileError, PoseFile, Rig, write_atomic};
 use rayon::prelude::*;
 use serde_json::json;
 
@@ -115,6 +115,12 @@ pub fn calibrate_images(
     Ok(calibrate_mono(board, d.size.0, d.size.1, &dets, model)?)
 }
 
+/// Writes a report image as PNG.
+fn write_png(path: &Path, img: &image::RgbImage) -> Result<()> {
+    let bytes = png(img).map_err(|e| FileError::encode(path, e))?;
+    Ok(write_atomic(path, &bytes)?)
+}
+
 /// Pixels of a report image per image pixel: small thermal images are enlarged.
 fn scale_for_report(w: u32) -> u32 {
     (640 / w.max(1)).clamp(1, 4)
@@ -139,7 +145,7 @@ pub fn file_stem(p: &Path) -> String {
 }
 
 fn create_dir(dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|e| mrtmap_io::FileError::io(dir, e).into())
+    Ok(std::fs::create_dir_all(dir).map_err(|e| FileError::io(dir, e))?)
 }
 
 /// Writes the corners drawn on every image and `calibration.json` into `rep`.
@@ -155,7 +161,7 @@ pub fn write_mono_report(
         let name = file_stem(p);
         if let Some(g) = &s.gray {
             let img = draw_corners(g, s.det.as_ref(), scale_for_report(g.width));
-            write_atomic(&rep.join(format!("{name}_corners.png")), &png(&img))?;
+            write_png(&rep.join(format!("{name}_corners.png")), &img)?;
         }
         views.push(json!({
             "name": name,
@@ -286,13 +292,13 @@ fn pair_images(
     let mut cells = Vec::new();
     if let Some(g) = &rgb.gray {
         let f = format!("{safe}_rgb.png");
-        write_atomic(&rep.join(&f), &png(&draw_corners(g, rgb.det.as_ref(), 1)))?;
+        write_png(&rep.join(&f), &draw_corners(g, rgb.det.as_ref(), 1))?;
         cells.push(f);
     }
     if let Some(g) = &th.gray {
         let f = format!("{safe}_thermal.png");
         let img = draw_corners(g, th.det.as_ref(), scale_for_report(g.width));
-        write_atomic(&rep.join(&f), &png(&img))?;
+        write_png(&rep.join(&f), &img)?;
         cells.push(f);
     }
     if let (Some(cg), Some(tg), Some(pose), PairStatus::Used) = (
@@ -311,7 +317,7 @@ fn pair_images(
             &r.rgb_from_thermal,
             board,
         );
-        write_atomic(&rep.join(&f), &png(&img))?;
+        write_png(&rep.join(&f), &img)?;
         cells.push(f);
     }
     Ok(cells)
@@ -451,9 +457,9 @@ pub fn simulate_boards(out: &Path, o: &mrtmap_calib::synth::SynthOptions) -> Res
     let (rd, td) = (out.join("rgb"), out.join("thermal"));
     for (k, p) in pairs.iter().enumerate() {
         let name = format!("{k:04}.png");
-        let rgb = mrtmap_io::encode_png_rgb8(p.rgb.width(), p.rgb.height(), p.rgb.as_raw());
-        write_atomic(&rd.join(&name), &rgb)?;
-        write_atomic(&td.join(&name), &mrtmap_io::encode_png16(&p.thermal))?;
+        write_png(&rd.join(&name), &p.rgb)?;
+        let (path, thermal) = (td.join(&name), mrtmap_io::encode_png16(&p.thermal));
+        write_atomic(&path, &thermal.map_err(|e| FileError::encode(&path, e))?)?;
     }
     let cam = |c: &PinholeCamera| json!({"width": c.width, "height": c.height, "fx": c.fx, "fy": c.fy, "cx": c.cx, "cy": c.cy, "distortion": c.distortion.to_array()});
     let truth = json!({

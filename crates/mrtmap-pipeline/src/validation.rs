@@ -56,7 +56,7 @@ pub fn validate_map(map: &Path, globe: &Path, out: &Path) -> Result<Validation> 
     let rows = validate(&readings, &ours);
     mrtmap_io::write_atomic(
         &out.join("validation.csv"),
-        validation_csv(&rows).as_bytes(),
+        validation_csv(&rows)?.as_bytes(),
     )?;
     write_json(&out.join("validation.json"), &rows)?;
     Ok(Validation {

@@ -1,7 +1,5 @@
 //! The HTML report: one self-contained file (images embedded) that opens in any browser.
 
-use std::fmt::Write as _;
-
 use base64::Engine;
 use mrtmap_radiation::PointRecord;
 use serde::Serialize;
@@ -81,14 +79,14 @@ pub fn esc(s: &str) -> String {
 fn table(out: &mut String, headers: &[&str], rows: &[Vec<String>]) {
     out.push_str("<table><thead><tr>");
     for h in headers {
-        let _ = write!(out, "<th>{}</th>", esc(h));
+        out.push_str(&format!("<th>{}</th>", esc(h)));
     }
     out.push_str("</tr></thead><tbody>");
     for r in rows {
         out.push_str("<tr>");
         for c in r {
             // Cells are pre-escaped, and may carry a marked-up value.
-            let _ = write!(out, "<td>{c}</td>");
+            out.push_str(&format!("<td>{c}</td>"));
         }
         out.push_str("</tr>");
     }
@@ -105,240 +103,241 @@ td,th{border:1px solid #ccc;padding:.25em .6em;text-align:right}th{background:#f
 .ok{color:#176d1a}.bad{color:#b00020}.warn{background:#fff4d6;padding:.4em .8em;border-left:4px solid #e0a800}\
 img{max-width:100%;border:1px solid #ddd}pre{background:#f7f7f7;padding:.8em;overflow-x:auto}";
 
+fn map_section(o: &mut String, m: &ReportMap) {
+    let b64 = base64::engine::general_purpose::STANDARD;
+    let h = m.summary.height_m;
+    let key = format!("{h:.2}");
+    o.push_str(&format!(
+        "<h2>Mean radiant temperature at {h:.2} m</h2><img alt=\"MRT map at {key} m\" src=\"data:image/png;base64,{}\">",
+        b64.encode(&m.png)
+    ));
+    let Some(f) = &m.summary.field else {
+        return;
+    };
+    o.push_str(&format!(
+        "<p>{} nodes ({}×{} grid, {} m margin, {} view factors): min {} °C at ({:.2}, {:.2}, {:.2}), max {} °C at ({:.2}, {:.2}, {:.2}), mean {} °C; largest standard error {} K. Grid values: <code>{}</code>.</p>",
+        f.nodes,
+        m.summary.grid[0],
+        m.summary.grid[1],
+        m.summary.margin_m,
+        esc(&m.summary.method),
+        num(&format!("map-{key}-min"), f.min.mrt_c, 2),
+        f.min.xyz[0],
+        f.min.xyz[1],
+        f.min.xyz[2],
+        num(&format!("map-{key}-max"), f.max.mrt_c, 2),
+        f.max.xyz[0],
+        f.max.xyz[1],
+        f.max.xyz[2],
+        num(&format!("map-{key}-mean"), f.mean_c, 2),
+        num(&format!("map-{key}-maxse"), f.max_std_error_k, 3),
+        esc(&m.csv)
+    ));
+}
+
+fn comparison_section(o: &mut String, d: &ReportData) {
+    if d.comparison.is_empty() {
+        return;
+    }
+    o.push_str("<h2>Against the truth (simulated scan)</h2><p>Reference: the exact MRT of the simulated room, and what a standard black globe (0.15 m, ε 0.95) in the room's air would read back through the ISO 7726 formula.</p>");
+    let rows: Vec<Vec<String>> = d
+        .comparison
+        .iter()
+        .map(|c| {
+            vec![
+                esc(&c.name),
+                format!("{:.2}", c.truth_c),
+                format!("{:.2}", c.globe_c),
+                num(&format!("cmp-{}-ours", c.name), c.ours_c, 2),
+                format!(
+                    "<span class=\"{}\">{:+.2}</span>",
+                    if c.diff_k.abs() <= 0.2 { "ok" } else { "bad" },
+                    c.diff_k
+                ),
+            ]
+        })
+        .collect();
+    table(
+        o,
+        &[
+            "point",
+            "truth (°C)",
+            "globe via ISO (°C)",
+            "mrtmap (°C)",
+            "mrtmap − truth (K)",
+        ],
+        &rows,
+    );
+    if let Some((max, rmse, n)) = d.grid_error {
+        o.push_str(&format!(
+            "<p>Over the grid ({n} nodes): max |Δ| {} K, RMSE {} K.</p>",
+            num("grid-max-abs", max, 3),
+            num("grid-rmse", rmse, 3)
+        ));
+    }
+}
+
+fn validation_row(r: &ValidationRow) -> Vec<String> {
+    let f = |r: &Result<f64, String>| {
+        r.as_ref()
+            .map(|v| format!("{v:.2}"))
+            .unwrap_or_else(|e| format!("— ({})", esc(e)))
+    };
+    let yes = |b: Option<bool>| match b {
+        Some(true) => "<span class=\"ok\">yes</span>".to_string(),
+        Some(false) => "<span class=\"bad\">no</span>".to_string(),
+        None => "—".to_string(),
+    };
+    vec![
+        esc(&r.globe.label),
+        format!(
+            "{:.2} / {:.2} / {:.2}",
+            r.globe.tg_c, r.globe.ta_c, r.globe.va_m_s
+        ),
+        f(&r.mrt_iso_c),
+        f(&r.mrt_mixed_c),
+        r.ours_c
+            .as_ref()
+            .map(|(o, s)| format!("{o:.2} ± {s:.2}"))
+            .unwrap_or_else(|e| esc(e)),
+        r.diff_iso_k.map_or("—".into(), |v| format!("{v:+.2}")),
+        r.diff_mixed_k.map_or("—".into(), |v| format!("{v:+.2}")),
+        yes(r.meets_required),
+        yes(r.meets_desired),
+    ]
+}
+
+fn validation_section(o: &mut String, d: &ReportData) {
+    if d.validation.is_empty() {
+        return;
+    }
+    o.push_str(
+        "<h2>Validation against globe readings</h2><p>ISO 7726 requires ±2 K and desires ±0.2 K.</p>",
+    );
+    let rows: Vec<Vec<String>> = d.validation.iter().map(validation_row).collect();
+    table(
+        o,
+        &[
+            "location",
+            "Tg / Ta (°C) / v (m/s)",
+            "MRT ISO (°C)",
+            "MRT mixed conv. (°C)",
+            "mrtmap (°C)",
+            "Δ ISO (K)",
+            "Δ mixed (K)",
+            "±2 K",
+            "±0.2 K",
+        ],
+        &rows,
+    );
+}
+
+fn points_section(o: &mut String, d: &ReportData) {
+    if d.points.is_empty() {
+        return;
+    }
+    o.push_str("<h2>Marked points: MRT and view factors</h2>");
+    for p in &d.points {
+        let name = p.name.clone().unwrap_or_default();
+        o.push_str(&format!(
+            "<h3>{} at ({:.2}, {:.2}, {:.2}): {} °C ± {:.2} K</h3>",
+            esc(&name),
+            p.xyz[0],
+            p.xyz[1],
+            p.xyz[2],
+            num(&format!("point-{name}"), p.mrt_c, 2),
+            p.std_error_k
+        ));
+        let rows: Vec<Vec<String>> = p
+            .view_factors
+            .iter()
+            .filter(|v| v.view_factor > 0.0)
+            .map(|v| {
+                vec![
+                    esc(&v.id),
+                    esc(&v.label),
+                    format!("{:.4}", v.view_factor),
+                    format!("{:.2}", v.temperature_c),
+                ]
+            })
+            .collect();
+        table(o, &["surface / feature", "label", "F", "T (°C)"], &rows);
+    }
+}
+
+/// A table of plain text cells (escaped here) under a heading, unless it has no rows.
+fn plain_table<R: AsRef<[String]>>(o: &mut String, heading: &str, headers: &[&str], rows: &[R]) {
+    if rows.is_empty() {
+        return;
+    }
+    o.push_str(&format!("<h2>{heading}</h2>"));
+    let cells: Vec<Vec<String>> = rows
+        .iter()
+        .map(|r| r.as_ref().iter().map(|c| esc(c)).collect())
+        .collect();
+    table(o, headers, &cells);
+}
+
+fn key_value_rows(kv: &KeyValues) -> Vec<Vec<String>> {
+    kv.iter().map(|(k, v)| vec![k.clone(), v.clone()]).collect()
+}
+
 /// The report as one HTML document.
 pub fn render_html(d: &ReportData) -> String {
-    let b64 = base64::engine::general_purpose::STANDARD;
     let mut o = String::with_capacity(1 << 20);
-    let _ = write!(
-        o,
-        "<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}</title><style>{STYLE}</style></head><body>",
-        esc(&d.title)
-    );
-    let _ = write!(
-        o,
-        "<h1>{}</h1><p>Source: <code>{}</code></p>",
+    o.push_str(&format!(
+        "<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\"><title>{}</title><style>{STYLE}</style></head><body><h1>{}</h1><p>Source: <code>{}</code></p>",
+        esc(&d.title),
         esc(&d.title),
         esc(&d.source)
-    );
+    ));
     if !d.warnings.is_empty() {
         o.push_str("<h2>Warnings</h2>");
         for w in &d.warnings {
-            let _ = write!(o, "<p class=\"warn\">{}</p>", esc(w));
+            o.push_str(&format!("<p class=\"warn\">{}</p>", esc(w)));
         }
     }
     for m in &d.maps {
-        let h = m.summary.height_m;
-        let key = format!("{h:.2}");
-        let _ = write!(o, "<h2>Mean radiant temperature at {h:.2} m</h2>");
-        let _ = write!(
-            o,
-            "<img alt=\"MRT map at {key} m\" src=\"data:image/png;base64,{}\">",
-            b64.encode(&m.png)
-        );
-        if let Some(f) = &m.summary.field {
-            let _ = write!(
-                o,
-                "<p>{} nodes ({}×{} grid, {} m margin, {} view factors): min {} °C at ({:.2}, {:.2}, {:.2}), max {} °C at ({:.2}, {:.2}, {:.2}), mean {} °C; largest standard error {} K. Grid values: <code>{}</code>.</p>",
-                f.nodes,
-                m.summary.grid[0],
-                m.summary.grid[1],
-                m.summary.margin_m,
-                esc(&m.summary.method),
-                num(&format!("map-{key}-min"), f.min.mrt_c, 2),
-                f.min.xyz[0],
-                f.min.xyz[1],
-                f.min.xyz[2],
-                num(&format!("map-{key}-max"), f.max.mrt_c, 2),
-                f.max.xyz[0],
-                f.max.xyz[1],
-                f.max.xyz[2],
-                num(&format!("map-{key}-mean"), f.mean_c, 2),
-                num(&format!("map-{key}-maxse"), f.max_std_error_k, 3),
-                esc(&m.csv)
-            );
-        }
+        map_section(&mut o, m);
     }
-    if !d.comparison.is_empty() {
-        o.push_str("<h2>Against the truth (simulated scan)</h2><p>Reference: the exact MRT of the simulated room, and what a standard black globe (0.15 m, ε 0.95) in the room's air would read back through the ISO 7726 formula.</p>");
-        let rows: Vec<Vec<String>> = d
-            .comparison
-            .iter()
-            .map(|c| {
-                vec![
-                    esc(&c.name),
-                    format!("{:.2}", c.truth_c),
-                    format!("{:.2}", c.globe_c),
-                    num(&format!("cmp-{}-ours", c.name), c.ours_c, 2),
-                    format!(
-                        "<span class=\"{}\">{:+.2}</span>",
-                        if c.diff_k.abs() <= 0.2 { "ok" } else { "bad" },
-                        c.diff_k
-                    ),
-                ]
-            })
-            .collect();
-        table(
-            &mut o,
-            &[
-                "point",
-                "truth (°C)",
-                "globe via ISO (°C)",
-                "mrtmap (°C)",
-                "mrtmap − truth (K)",
-            ],
-            &rows,
-        );
-        if let Some((max, rmse, n)) = d.grid_error {
-            let _ = write!(
-                o,
-                "<p>Over the grid ({n} nodes): max |Δ| {} K, RMSE {} K.</p>",
-                num("grid-max-abs", max, 3),
-                num("grid-rmse", rmse, 3)
-            );
-        }
-    }
-    if !d.validation.is_empty() {
-        o.push_str("<h2>Validation against globe readings</h2><p>ISO 7726 requires ±2 K and desires ±0.2 K.</p>");
-        let f = |r: &Result<f64, String>| {
-            r.as_ref()
-                .map(|v| format!("{v:.2}"))
-                .unwrap_or_else(|e| format!("— ({})", esc(e)))
-        };
-        let rows: Vec<Vec<String>> = d
-            .validation
-            .iter()
-            .map(|r| {
-                let yes = |b: Option<bool>| match b {
-                    Some(true) => "<span class=\"ok\">yes</span>".to_string(),
-                    Some(false) => "<span class=\"bad\">no</span>".to_string(),
-                    None => "—".to_string(),
-                };
-                vec![
-                    esc(&r.globe.label),
-                    format!(
-                        "{:.2} / {:.2} / {:.2}",
-                        r.globe.tg_c, r.globe.ta_c, r.globe.va_m_s
-                    ),
-                    f(&r.mrt_iso_c),
-                    f(&r.mrt_mixed_c),
-                    r.ours_c
-                        .as_ref()
-                        .map(|(o, s)| format!("{o:.2} ± {s:.2}"))
-                        .unwrap_or_else(|e| esc(e)),
-                    r.diff_iso_k.map_or("—".into(), |v| format!("{v:+.2}")),
-                    r.diff_mixed_k.map_or("—".into(), |v| format!("{v:+.2}")),
-                    yes(r.meets_required),
-                    yes(r.meets_desired),
-                ]
-            })
-            .collect();
-        table(
-            &mut o,
-            &[
-                "location",
-                "Tg / Ta (°C) / v (m/s)",
-                "MRT ISO (°C)",
-                "MRT mixed conv. (°C)",
-                "mrtmap (°C)",
-                "Δ ISO (K)",
-                "Δ mixed (K)",
-                "±2 K",
-                "±0.2 K",
-            ],
-            &rows,
-        );
-    }
-    if !d.points.is_empty() {
-        o.push_str("<h2>Marked points: MRT and view factors</h2>");
-        for p in &d.points {
-            let name = p.name.clone().unwrap_or_default();
-            let _ = write!(
-                o,
-                "<h3>{} at ({:.2}, {:.2}, {:.2}): {} °C ± {:.2} K</h3>",
-                esc(&name),
-                p.xyz[0],
-                p.xyz[1],
-                p.xyz[2],
-                num(&format!("point-{name}"), p.mrt_c, 2),
-                p.std_error_k
-            );
-            let rows: Vec<Vec<String>> = p
-                .view_factors
-                .iter()
-                .filter(|v| v.view_factor > 0.0)
-                .map(|v| {
-                    vec![
-                        esc(&v.id),
-                        esc(&v.label),
-                        format!("{:.4}", v.view_factor),
-                        format!("{:.2}", v.temperature_c),
-                    ]
-                })
-                .collect();
-            table(
-                &mut o,
-                &["surface / feature", "label", "F", "T (°C)"],
-                &rows,
-            );
-        }
-    }
-    let plain = |rows: &[Vec<String>]| {
-        rows.iter()
-            .map(|r| r.iter().map(|c| esc(c)).collect())
-            .collect::<Vec<Vec<String>>>()
-    };
-    if !d.surfaces.is_empty() {
-        o.push_str("<h2>Surfaces</h2>");
-        table(
-            &mut o,
-            &["id", "kind", "T (°C)", "± (K)", "observed", "area (m²)"],
-            &plain(&d.surfaces.iter().map(|r| r.to_vec()).collect::<Vec<_>>()),
-        );
-    }
-    if !d.features.is_empty() {
-        o.push_str("<h2>Features</h2>");
-        table(
-            &mut o,
-            &["id", "on", "label", "T (°C)", "contrast (K)", "area (m²)"],
-            &plain(&d.features.iter().map(|r| r.to_vec()).collect::<Vec<_>>()),
-        );
-    }
-    if !d.furniture.is_empty() {
-        o.push_str("<h2>Furniture (occluders)</h2>");
-        table(
-            &mut o,
-            &["id", "label", "size (m)", "T (°C)"],
-            &plain(&d.furniture.iter().map(|r| r.to_vec()).collect::<Vec<_>>()),
-        );
-    }
-    if !d.coverage.is_empty() {
-        o.push_str("<h2>Coverage and uncertainty</h2>");
-        table(
-            &mut o,
-            &["", ""],
-            &plain(
-                &d.coverage
-                    .iter()
-                    .map(|(k, v)| vec![k.clone(), v.clone()])
-                    .collect::<Vec<_>>(),
-            ),
-        );
-    }
-    if !d.timing.is_empty() {
-        o.push_str("<h2>Time per stage</h2>");
-        table(
-            &mut o,
-            &["stage", "seconds"],
-            &plain(
-                &d.timing
-                    .iter()
-                    .map(|(k, v)| vec![k.clone(), v.clone()])
-                    .collect::<Vec<_>>(),
-            ),
-        );
-    }
+    comparison_section(&mut o, d);
+    validation_section(&mut o, d);
+    points_section(&mut o, d);
+    plain_table(
+        &mut o,
+        "Surfaces",
+        &["id", "kind", "T (°C)", "± (K)", "observed", "area (m²)"],
+        &d.surfaces,
+    );
+    plain_table(
+        &mut o,
+        "Features",
+        &["id", "on", "label", "T (°C)", "contrast (K)", "area (m²)"],
+        &d.features,
+    );
+    plain_table(
+        &mut o,
+        "Furniture (occluders)",
+        &["id", "label", "size (m)", "T (°C)"],
+        &d.furniture,
+    );
+    plain_table(
+        &mut o,
+        "Coverage and uncertainty",
+        &["", ""],
+        &key_value_rows(&d.coverage),
+    );
+    plain_table(
+        &mut o,
+        "Time per stage",
+        &["stage", "seconds"],
+        &key_value_rows(&d.timing),
+    );
     if !d.parameters.is_empty() {
-        let _ = write!(o, "<h2>Parameters</h2><pre>{}</pre>", esc(&d.parameters));
+        o.push_str(&format!(
+            "<h2>Parameters</h2><pre>{}</pre>",
+            esc(&d.parameters)
+        ));
     }
     o.push_str("<p><small>Generated by mrtmap.</small></p></body></html>\n");
     o

@@ -27,10 +27,26 @@ pub use validate::{
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum ReportError {
-    /// Drawing or encoding failed.
+    /// Drawing or encoding failed (plotters' and image's errors, in words).
     #[error("drawing the map failed: {0}")]
     Draw(String),
-    /// An input file is wrong (the message names the file and line).
-    #[error("{0}")]
-    Input(String),
+    /// A line of a globe readings file is wrong.
+    #[error("{file}:{line}: {problem}")]
+    Globe {
+        /// The file, as named to the parser.
+        file: String,
+        /// 1-based line (0 when unknown).
+        line: u64,
+        /// What is wrong.
+        problem: String,
+    },
+    /// A globe readings file holds no readings.
+    #[error("{file}: no readings")]
+    NoReadings {
+        /// The file.
+        file: String,
+    },
+    /// A CSV table could not be written.
+    #[error("cannot write CSV: {0}")]
+    Csv(String),
 }

@@ -2,29 +2,31 @@
 //! occluders drawn and named, marked points, a colour bar in °C and a title with the height.
 //! One drawing routine serves both the PNG and the SVG backend.
 
-use std::sync::Once;
+use std::sync::OnceLock;
 
 use mrtmap_geometry::nalgebra::{Point2, Vector3};
 use mrtmap_geometry::polygon::point_in_polygon_fast;
 use mrtmap_radiation::{MrtField, OccluderShape, RadiantScene, SurfaceKind};
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::ReportError;
 
-static FONT: Once = Once::new();
+static FONT: OnceLock<bool> = OnceLock::new();
 const FONT_FAMILY: &str = "sans-serif";
 
-fn register_font() {
-    FONT.call_once(|| {
-        // The embedded font is valid; were it not, text would fail to draw and say so.
-        let _ = plotters::style::register_font(
+/// Registers the embedded font once; whether it could be.
+fn register_font() -> bool {
+    *FONT.get_or_init(|| {
+        plotters::style::register_font(
             FONT_FAMILY,
             FontStyle::Normal,
             include_bytes!("../assets/DejaVuSans.ttf"),
-        );
-    });
+        )
+        .is_ok()
+    })
 }
 
 /// A named point to mark on the map, in map coordinates.
@@ -149,36 +151,51 @@ fn runs_inside(
     runs
 }
 
-fn draw<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    input: &MapInput<'_>,
-) -> Result<(), String> {
-    let e = |x: DrawingAreaErrorKind<DB::ErrorType>| x.to_string();
-    register_font();
-    let field = input.field;
-    let frame = &field.frame;
-    root.fill(&WHITE).map_err(e)?;
-    let (w, _h) = root.dim_in_pixel();
-    let title = format!(
-        "Mean radiant temperature at {:.2} m above the floor (°C)",
-        field.spec.height_m
-    );
-    root.draw(&Text::new(
-        title,
-        (20, 12),
-        (FONT_FAMILY, 22).into_font().color(&BLACK),
-    ))
-    .map_err(e)?;
-    root.draw(&Text::new(
-        input.subtitle.clone(),
-        (20, 42),
-        (FONT_FAMILY, 14).into_font().color(&RGBColor(80, 80, 80)),
-    ))
-    .map_err(e)?;
-    let body = root.margin(70, 10, 10, 10);
-    let (map_area, bar_area) = body.split_horizontally(w as i32 - 20 - 140);
+/// The map's chart: map coordinates (m) on both axes.
+type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
-    let ok: Vec<(usize, usize, Point2<f64>, f64)> = field
+/// A drawing error, in words.
+fn de<E: std::error::Error + Send + Sync>(x: DrawingAreaErrorKind<E>) -> ReportError {
+    ReportError::Draw(x.to_string())
+}
+
+/// A computed node: grid indices, map coordinates, MRT (°C).
+type Node = (usize, usize, Point2<f64>, f64);
+
+/// The colour scale: MRT range mapped onto the palette.
+#[derive(Clone, Copy)]
+struct Scale {
+    vmin: f64,
+    vmax: f64,
+}
+
+impl Scale {
+    /// The range of the computed nodes, widened to at least 0.1 K.
+    fn of(ok: &[Node]) -> Self {
+        let (vmin, vmax) = ok
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+                (a.min(x.3), b.max(x.3))
+            });
+        let (vmin, vmax) = if ok.is_empty() {
+            (0.0, 1.0)
+        } else if vmax - vmin < 0.05 {
+            ((vmin + vmax) / 2.0 - 0.05, (vmin + vmax) / 2.0 + 0.05)
+        } else {
+            (vmin, vmax)
+        };
+        Self { vmin, vmax }
+    }
+
+    /// A value's place on the palette, 0…1 within the range.
+    fn norm(&self, v: f64) -> f64 {
+        (v - self.vmin) / (self.vmax - self.vmin)
+    }
+}
+
+/// The computed nodes of a field.
+fn computed_nodes(field: &MrtField) -> Vec<Node> {
+    field
         .nodes
         .iter()
         .filter_map(|n| {
@@ -187,33 +204,49 @@ fn draw<DB: DrawingBackend>(
                 .ok()
                 .map(|r| (n.i, n.j, n.uv, r.mrt.celsius()))
         })
-        .collect();
-    let (vmin, vmax) = ok
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
-            (a.min(x.3), b.max(x.3))
-        });
-    let (vmin, vmax) = if ok.is_empty() {
-        (0.0, 1.0)
-    } else if vmax - vmin < 0.05 {
-        ((vmin + vmax) / 2.0 - 0.05, (vmin + vmax) / 2.0 + 0.05)
-    } else {
-        (vmin, vmax)
-    };
-    let norm = |v: f64| (v - vmin) / (vmax - vmin);
+        .collect()
+}
 
+fn draw_titles<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    input: &MapInput<'_>,
+) -> Result<(), ReportError> {
+    let title = format!(
+        "Mean radiant temperature at {:.2} m above the floor (°C)",
+        input.field.spec.height_m
+    );
+    root.draw(&Text::new(
+        title,
+        (20, 12),
+        (FONT_FAMILY, 22).into_font().color(&BLACK),
+    ))
+    .map_err(de)?;
+    root.draw(&Text::new(
+        input.subtitle.clone(),
+        (20, 42),
+        (FONT_FAMILY, 14).into_font().color(&RGBColor(80, 80, 80)),
+    ))
+    .map_err(de)
+}
+
+/// The chart over the floor's bounds, with its axes.
+fn build_chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    field: &MrtField,
+) -> Result<Chart<'a, DB>, ReportError> {
+    let frame = &field.frame;
     let (lo, hi) = frame.floor_bounds();
     let pad = 0.02 * (hi.x - lo.x).max(hi.y - lo.y);
     let (u_name, v_name) = (
         axis_name(&frame.plane.u, "u"),
         axis_name(&frame.plane.v, "v"),
     );
-    let mut chart = ChartBuilder::on(&map_area)
+    let mut chart = ChartBuilder::on(area)
         .margin(8)
         .x_label_area_size(40)
         .y_label_area_size(50)
         .build_cartesian_2d((lo.x - pad)..(hi.x + pad), (lo.y - pad)..(hi.y + pad))
-        .map_err(e)?;
+        .map_err(de)?;
     chart
         .configure_mesh()
         .disable_mesh()
@@ -222,9 +255,18 @@ fn draw<DB: DrawingBackend>(
         .label_style((FONT_FAMILY, 13))
         .axis_desc_style((FONT_FAMILY, 14))
         .draw()
-        .map_err(e)?;
+        .map_err(de)?;
+    Ok(chart)
+}
 
-    // Heat cells, centred on the nodes, clipped to the floor's bounds.
+/// Heat cells, centred on the nodes, clipped to the floor's bounds.
+fn draw_cells<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    field: &MrtField,
+    ok: &[Node],
+    scale: Scale,
+) -> Result<(), ReportError> {
+    let (lo, hi) = field.frame.floor_bounds();
     let half = |c: &[f64], k: usize| {
         let d = if c.len() > 1 {
             (c[c.len() - 1] - c[0]) / (c.len() - 1) as f64
@@ -239,116 +281,156 @@ fn draw<DB: DrawingBackend>(
             let (v0, v1) = half(&field.v, j);
             Rectangle::new(
                 [(u0.max(lo.x), v0.max(lo.y)), (u1.min(hi.x), v1.min(hi.y))],
-                palette(norm(v)).filled(),
+                palette(scale.norm(v)).filled(),
             )
         }))
-        .map_err(e)?;
+        .map_err(de)?;
+    Ok(())
+}
 
-    // Contours on the node grid; nodes without a value take their nearest computed neighbour's,
-    // and segments outside the floor are not drawn.
-    if ok.len() >= 4 && field.u.len() >= 2 && field.v.len() >= 2 {
-        let (nx, ny) = (field.u.len(), field.v.len());
-        let mut grid = vec![f64::NAN; nx * ny];
-        for &(i, j, _, v) in &ok {
-            grid[j * nx + i] = v;
-        }
-        let filled: Vec<f64> = (0..nx * ny)
-            .map(|k| {
-                if grid[k].is_finite() {
-                    return grid[k];
-                }
-                let (i, j) = ((k % nx) as f64, (k / nx) as f64);
-                ok.iter()
-                    .min_by(|a, b| {
-                        let da = (a.0 as f64 - i).powi(2) + (a.1 as f64 - j).powi(2);
-                        let db = (b.0 as f64 - i).powi(2) + (b.1 as f64 - j).powi(2);
-                        da.total_cmp(&db)
-                    })
-                    .map_or(vmin, |x| x.3)
-            })
-            .collect();
-        let step = contour_step(vmax - vmin);
-        let dec = decimals(step);
-        let first = (vmin / step).ceil() * step;
-        let levels: Vec<f64> = (0..)
-            .map(|k| first + k as f64 * step)
-            .take_while(|l| *l < vmax)
-            .filter(|l| *l > vmin)
-            .collect();
-        let du = (field.u[nx - 1] - field.u[0]) / (nx - 1) as f64;
-        let dv = (field.v[ny - 1] - field.v[0]) / (ny - 1) as f64;
-        // contour-rs places value k at k + 0.5 in grid units; shift so nodes land on their coordinates.
-        let (gx, gy) = (field.u[0] - du / 2.0, field.v[0] - dv / 2.0);
-        let grid_box = ((gx, gy), (gx + nx as f64 * du, gy + ny as f64 * dv));
-        let builder = contour::ContourBuilder::new(nx, ny, true)
-            .x_origin(gx)
-            .y_origin(gy)
-            .x_step(du)
-            .y_step(dv);
-        let mut placed: Vec<(i32, i32, i32, i32)> = input
-            .marks
-            .iter()
-            .map(|m| {
-                let (px, py) = chart.backend_coord(&(m.uv.x, m.uv.y));
-                (px - 10, py - 22, px + 30, py + 10)
-            })
-            .collect();
-        if let Ok(lines) = builder.lines(&filled, &levels) {
-            for line in lines {
-                let level = line.threshold();
-                let runs: Vec<Vec<(f64, f64)>> = line
-                    .geometry()
-                    .0
-                    .iter()
-                    .flat_map(|ls| runs_inside(&ls.0, &frame.floor_uv, grid_box.0, grid_box.1))
-                    .collect();
-                chart
-                    .draw_series(
-                        runs.iter()
-                            .map(|r| PathElement::new(r.clone(), BLACK.mix(0.75).stroke_width(1))),
-                    )
-                    .map_err(e)?;
-                // Label: along the longer runs first, at the first spot clear of earlier labels and marks.
-                let label = format!("{level:.dec$}");
-                let tw = 7 * label.len() as i32 + 6;
-                let mut sorted: Vec<&Vec<(f64, f64)>> = runs.iter().collect();
-                sorted.sort_by_key(|r| std::cmp::Reverse(r.len()));
-                let spot = sorted
-                    .iter()
-                    .flat_map(|r| {
-                        [0.5, 0.3, 0.7, 0.15, 0.85].map(|t| r[((r.len() - 1) as f64 * t) as usize])
-                    })
-                    .find_map(|at| {
-                        let (px, py) = chart.backend_coord(&at);
-                        let rect = (px - tw / 2 - 2, py - 10, px + tw / 2 + 2, py + 10);
-                        let clear = placed.iter().all(|b: &(i32, i32, i32, i32)| {
-                            rect.2 < b.0 || rect.0 > b.2 || rect.3 < b.1 || rect.1 > b.3
-                        });
-                        clear.then_some((px, py, rect))
-                    });
-                if let Some((px, py, rect)) = spot {
-                    placed.push(rect);
-                    root.draw(&Rectangle::new(
-                        [(px - tw / 2, py - 8), (px + tw / 2, py + 8)],
-                        WHITE.mix(0.85).filled(),
-                    ))
-                    .map_err(e)?;
-                    root.draw(&Text::new(
-                        label,
-                        (px, py),
-                        (FONT_FAMILY, 12)
-                            .into_font()
-                            .color(&BLACK)
-                            .pos(Pos::new(HPos::Center, VPos::Center)),
-                    ))
-                    .map_err(e)?;
-                }
-            }
-        }
+/// The node grid's values; nodes without a value take their nearest computed neighbour's.
+fn filled_grid(field: &MrtField, ok: &[Node], fallback: f64) -> Vec<f64> {
+    let (nx, ny) = (field.u.len(), field.v.len());
+    let mut grid = vec![f64::NAN; nx * ny];
+    for &(i, j, _, v) in ok {
+        grid[j * nx + i] = v;
     }
+    (0..nx * ny)
+        .map(|k| {
+            if grid[k].is_finite() {
+                return grid[k];
+            }
+            let (i, j) = ((k % nx) as f64, (k / nx) as f64);
+            ok.iter()
+                .min_by(|a, b| {
+                    let da = (a.0 as f64 - i).powi(2) + (a.1 as f64 - j).powi(2);
+                    let db = (b.0 as f64 - i).powi(2) + (b.1 as f64 - j).powi(2);
+                    da.total_cmp(&db)
+                })
+                .map_or(fallback, |x| x.3)
+        })
+        .collect()
+}
 
-    // Room outline.
-    let mut outline: Vec<(f64, f64)> = frame.floor_uv.iter().map(|p| (p.x, p.y)).collect();
+/// Contour levels strictly inside the range, at the scale's step.
+fn contour_levels(scale: Scale) -> Vec<f64> {
+    let step = contour_step(scale.vmax - scale.vmin);
+    let first = (scale.vmin / step).ceil() * step;
+    (0..)
+        .map(|k| first + k as f64 * step)
+        .take_while(|l| *l < scale.vmax)
+        .filter(|l| *l > scale.vmin)
+        .collect()
+}
+
+/// A pixel box (x0, y0, x1, y1) taken by a label or a mark.
+type PixelBox = (i32, i32, i32, i32);
+
+/// Labels a contour along its longer runs first, at the first spot clear of earlier labels and
+/// marks (`placed`, which the label joins).
+fn label_contour<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    chart: &Chart<'_, DB>,
+    runs: &[Vec<(f64, f64)>],
+    label: String,
+    placed: &mut Vec<PixelBox>,
+) -> Result<(), ReportError> {
+    let tw = 7 * label.len() as i32 + 6;
+    let mut sorted: Vec<&Vec<(f64, f64)>> = runs.iter().collect();
+    sorted.sort_by_key(|r| std::cmp::Reverse(r.len()));
+    let spot = sorted
+        .iter()
+        .flat_map(|r| [0.5, 0.3, 0.7, 0.15, 0.85].map(|t| r[((r.len() - 1) as f64 * t) as usize]))
+        .find_map(|at| {
+            let (px, py) = chart.backend_coord(&at);
+            let rect = (px - tw / 2 - 2, py - 10, px + tw / 2 + 2, py + 10);
+            let clear = placed
+                .iter()
+                .all(|b| rect.2 < b.0 || rect.0 > b.2 || rect.3 < b.1 || rect.1 > b.3);
+            clear.then_some((px, py, rect))
+        });
+    let Some((px, py, rect)) = spot else {
+        return Ok(());
+    };
+    placed.push(rect);
+    root.draw(&Rectangle::new(
+        [(px - tw / 2, py - 8), (px + tw / 2, py + 8)],
+        WHITE.mix(0.85).filled(),
+    ))
+    .map_err(de)?;
+    root.draw(&Text::new(
+        label,
+        (px, py),
+        (FONT_FAMILY, 12)
+            .into_font()
+            .color(&BLACK)
+            .pos(Pos::new(HPos::Center, VPos::Center)),
+    ))
+    .map_err(de)
+}
+
+/// Labelled contours on the node grid; segments outside the floor are not drawn.
+fn draw_contours<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    chart: &mut Chart<'_, DB>,
+    input: &MapInput<'_>,
+    ok: &[Node],
+    scale: Scale,
+) -> Result<(), ReportError> {
+    let field = input.field;
+    let (nx, ny) = (field.u.len(), field.v.len());
+    if ok.len() < 4 || nx < 2 || ny < 2 {
+        return Ok(());
+    }
+    let filled = filled_grid(field, ok, scale.vmin);
+    let dec = decimals(contour_step(scale.vmax - scale.vmin));
+    let levels = contour_levels(scale);
+    let du = (field.u[nx - 1] - field.u[0]) / (nx - 1) as f64;
+    let dv = (field.v[ny - 1] - field.v[0]) / (ny - 1) as f64;
+    // contour-rs places value k at k + 0.5 in grid units; shift so nodes land on their coordinates.
+    let (gx, gy) = (field.u[0] - du / 2.0, field.v[0] - dv / 2.0);
+    let grid_box = ((gx, gy), (gx + nx as f64 * du, gy + ny as f64 * dv));
+    let builder = contour::ContourBuilder::new(nx, ny, true)
+        .x_origin(gx)
+        .y_origin(gy)
+        .x_step(du)
+        .y_step(dv);
+    let mut placed: Vec<PixelBox> = input
+        .marks
+        .iter()
+        .map(|m| {
+            let (px, py) = chart.backend_coord(&(m.uv.x, m.uv.y));
+            (px - 10, py - 22, px + 30, py + 10)
+        })
+        .collect();
+    let Ok(lines) = builder.lines(&filled, &levels) else {
+        return Ok(());
+    };
+    for line in lines {
+        let level = line.threshold();
+        let runs: Vec<Vec<(f64, f64)>> = line
+            .geometry()
+            .0
+            .iter()
+            .flat_map(|ls| runs_inside(&ls.0, &field.frame.floor_uv, grid_box.0, grid_box.1))
+            .collect();
+        chart
+            .draw_series(
+                runs.iter()
+                    .map(|r| PathElement::new(r.clone(), BLACK.mix(0.75).stroke_width(1))),
+            )
+            .map_err(de)?;
+        label_contour(root, chart, &runs, format!("{level:.dec$}"), &mut placed)?;
+    }
+    Ok(())
+}
+
+/// The room's outline.
+fn draw_outline<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    field: &MrtField,
+) -> Result<(), ReportError> {
+    let mut outline: Vec<(f64, f64)> = field.frame.floor_uv.iter().map(|p| (p.x, p.y)).collect();
     if let Some(first) = outline.first().copied() {
         outline.push(first);
     }
@@ -357,10 +439,97 @@ fn draw<DB: DrawingBackend>(
             outline,
             BLACK.stroke_width(3),
         )))
-        .map_err(e)?;
+        .map_err(de)?;
+    Ok(())
+}
 
-    // Features: on walls as bands along the wall, on floor and ceiling as outlines.
-    let label_font = (FONT_FAMILY, 12).into_font().color(&RGBColor(20, 20, 20));
+/// A feature on a wall: a band along the wall in its colour, labelled just inside the room.
+fn draw_wall_feature<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    chart: &mut Chart<'_, DB>,
+    field: &MrtField,
+    uv: &[(f64, f64)],
+    colour: RGBColor,
+    text: String,
+) -> Result<(), ReportError> {
+    let frame = &field.frame;
+    let (lo, hi) = frame.floor_bounds();
+    // The projection is a segment along the wall: its two extreme points.
+    let c = uv.iter().fold((0.0, 0.0), |a, p| (a.0 + p.0, a.1 + p.1));
+    let c = (c.0 / uv.len() as f64, c.1 / uv.len() as f64);
+    let far = |from: (f64, f64)| {
+        uv.iter().copied().max_by(|a, b| {
+            let da = (a.0 - from.0).hypot(a.1 - from.1);
+            let db = (b.0 - from.0).hypot(b.1 - from.1);
+            da.total_cmp(&db)
+        })
+    };
+    let (Some(a), Some(b)) = (far(c), far(far(c).unwrap_or(c))) else {
+        return Ok(());
+    };
+    for style in [colour.stroke_width(7), BLACK.stroke_width(1)] {
+        chart
+            .draw_series(std::iter::once(PathElement::new(vec![a, b], style)))
+            .map_err(de)?;
+    }
+    let mid = Point2::new((a.0 + b.0) / 2.0, (a.1 + b.1) / 2.0);
+    let centre = frame.floor_uv.iter().fold(Point2::origin(), |acc, p| {
+        acc + p.coords / frame.floor_uv.len() as f64
+    });
+    let inward = (centre - mid).try_normalize(1e-9).unwrap_or_default();
+    let at = mid + inward * (0.06 * (hi.x - lo.x).max(hi.y - lo.y));
+    let (px, py) = chart.backend_coord(&(at.x, at.y));
+    root.draw(&Text::new(text, (px, py), centred_label()))
+        .map_err(de)
+}
+
+/// A feature on the floor or ceiling: its outline in its colour, labelled at its centre.
+fn draw_flat_feature<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    chart: &mut Chart<'_, DB>,
+    kind: SurfaceKind,
+    uv: &[(f64, f64)],
+    colour: RGBColor,
+    text: String,
+) -> Result<(), ReportError> {
+    let mut ring = uv.to_vec();
+    ring.push(uv[0]);
+    let (style, where_) = if kind == SurfaceKind::Ceiling {
+        (colour.stroke_width(2), " (ceiling)")
+    } else {
+        (colour.stroke_width(3), " (floor)")
+    };
+    chart
+        .draw_series(std::iter::once(PathElement::new(ring, style)))
+        .map_err(de)?;
+    let c = uv.iter().fold((0.0, 0.0), |a, p| {
+        (a.0 + p.0 / uv.len() as f64, a.1 + p.1 / uv.len() as f64)
+    });
+    let (px, py) = chart.backend_coord(&c);
+    root.draw(&Text::new(
+        format!("{text}{where_}"),
+        (px, py),
+        centred_label(),
+    ))
+    .map_err(de)
+}
+
+/// Labels of features and furniture, centred on their spot.
+fn centred_label() -> TextStyle<'static> {
+    (FONT_FAMILY, 12)
+        .into_font()
+        .color(&RGBColor(20, 20, 20))
+        .pos(Pos::new(HPos::Center, VPos::Center))
+}
+
+/// Features: on walls as bands along the wall, on floor and ceiling as outlines.
+fn draw_features<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    chart: &mut Chart<'_, DB>,
+    input: &MapInput<'_>,
+    scale: Scale,
+) -> Result<(), ReportError> {
+    let frame = &input.field.frame;
     for s in &input.scene.surfaces {
         for f in &s.features {
             let uv: Vec<(f64, f64)> = f
@@ -369,7 +538,7 @@ fn draw<DB: DrawingBackend>(
                 .map(|p| frame.uv(p))
                 .map(|q| (q.x, q.y))
                 .collect();
-            let colour = palette(norm(f.temperature.celsius()));
+            let colour = palette(scale.norm(f.temperature.celsius()));
             let name = if f.label.is_empty() {
                 f.id.clone()
             } else {
@@ -378,86 +547,29 @@ fn draw<DB: DrawingBackend>(
             let text = format!("{name} {:.1}°", f.temperature.celsius());
             match s.kind {
                 SurfaceKind::Wall | SurfaceKind::Other => {
-                    // The projection is a segment along the wall: its two extreme points.
-                    let c = uv.iter().fold((0.0, 0.0), |a, p| (a.0 + p.0, a.1 + p.1));
-                    let c = (c.0 / uv.len() as f64, c.1 / uv.len() as f64);
-                    let far = |from: (f64, f64)| {
-                        uv.iter().copied().max_by(|a, b| {
-                            let da = (a.0 - from.0).hypot(a.1 - from.1);
-                            let db = (b.0 - from.0).hypot(b.1 - from.1);
-                            da.total_cmp(&db)
-                        })
-                    };
-                    if let (Some(a), Some(b)) = (far(c), far(far(c).unwrap_or(c))) {
-                        chart
-                            .draw_series(std::iter::once(PathElement::new(
-                                vec![a, b],
-                                colour.stroke_width(7),
-                            )))
-                            .map_err(e)?;
-                        chart
-                            .draw_series(std::iter::once(PathElement::new(
-                                vec![a, b],
-                                BLACK.stroke_width(1),
-                            )))
-                            .map_err(e)?;
-                        // Label just inside the room from the band's middle.
-                        let mid = Point2::new((a.0 + b.0) / 2.0, (a.1 + b.1) / 2.0);
-                        let centre = frame.floor_uv.iter().fold(Point2::origin(), |acc, p| {
-                            acc + p.coords / frame.floor_uv.len() as f64
-                        });
-                        let inward = (centre - mid).try_normalize(1e-9).unwrap_or_default();
-                        let at = mid + inward * (0.06 * (hi.x - lo.x).max(hi.y - lo.y));
-                        let (px, py) = chart.backend_coord(&(at.x, at.y));
-                        root.draw(&Text::new(
-                            text,
-                            (px, py),
-                            label_font.clone().pos(Pos::new(HPos::Center, VPos::Center)),
-                        ))
-                        .map_err(e)?;
-                    }
+                    draw_wall_feature(root, chart, input.field, &uv, colour, text)?;
                 }
                 SurfaceKind::Ceiling | SurfaceKind::Floor => {
-                    let mut ring = uv.clone();
-                    ring.push(uv[0]);
-                    let style = if s.kind == SurfaceKind::Ceiling {
-                        colour.stroke_width(2)
-                    } else {
-                        colour.stroke_width(3)
-                    };
-                    chart
-                        .draw_series(std::iter::once(PathElement::new(ring, style)))
-                        .map_err(e)?;
-                    let c = uv.iter().fold((0.0, 0.0), |a, p| {
-                        (a.0 + p.0 / uv.len() as f64, a.1 + p.1 / uv.len() as f64)
-                    });
-                    let (px, py) = chart.backend_coord(&c);
-                    let where_ = if s.kind == SurfaceKind::Ceiling {
-                        " (ceiling)"
-                    } else {
-                        " (floor)"
-                    };
-                    root.draw(&Text::new(
-                        format!("{text}{where_}"),
-                        (px, py),
-                        label_font.clone().pos(Pos::new(HPos::Center, VPos::Center)),
-                    ))
-                    .map_err(e)?;
+                    draw_flat_feature(root, chart, s.kind, &uv, colour, text)?;
                 }
             }
         }
     }
+    Ok(())
+}
+
+/// Occluders (furniture): their footprint's bounding rectangle, named.
+fn draw_occluders<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    chart: &mut Chart<'_, DB>,
+    input: &MapInput<'_>,
+) -> Result<(), ReportError> {
+    let frame = &input.field.frame;
     for o in &input.scene.occluders {
         let corners: Vec<Point2<f64>> = match &o.shape {
-            OccluderShape::Box { min, max } => (0..8)
-                .map(|k| {
-                    let p = mrtmap_geometry::nalgebra::Point3::new(
-                        if k & 1 == 0 { min.x } else { max.x },
-                        if k & 2 == 0 { min.y } else { max.y },
-                        if k & 4 == 0 { min.z } else { max.z },
-                    );
-                    frame.uv(&p)
-                })
+            OccluderShape::Box { min, max } => mrtmap_geometry::box_corners(min, max)
+                .iter()
+                .map(|p| frame.uv(p))
                 .collect(),
             OccluderShape::Mesh { vertices, .. } => vertices.iter().map(|p| frame.uv(p)).collect(),
         };
@@ -473,34 +585,37 @@ fn draw<DB: DrawingBackend>(
                 [a, b],
                 RGBColor(90, 90, 90).mix(0.35).filled(),
             )))
-            .map_err(e)?;
+            .map_err(de)?;
         chart
             .draw_series(std::iter::once(Rectangle::new(
                 [a, b],
                 RGBColor(60, 60, 60).stroke_width(1),
             )))
-            .map_err(e)?;
+            .map_err(de)?;
         let (px, py) = chart.backend_coord(&((a.0 + b.0) / 2.0, (a.1 + b.1) / 2.0));
         let name = if o.label.is_empty() {
             o.id.clone()
         } else {
             o.label.clone()
         };
-        root.draw(&Text::new(
-            name,
-            (px, py),
-            label_font.clone().pos(Pos::new(HPos::Center, VPos::Center)),
-        ))
-        .map_err(e)?;
+        root.draw(&Text::new(name, (px, py), centred_label()))
+            .map_err(de)?;
     }
+    Ok(())
+}
 
-    // Marked points.
-    for m in input.marks {
+/// Marked points: a ringed dot and the name.
+fn draw_marks<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    chart: &Chart<'_, DB>,
+    marks: &[MapMark],
+) -> Result<(), ReportError> {
+    for m in marks {
         let (px, py) = chart.backend_coord(&(m.uv.x, m.uv.y));
         root.draw(&Circle::new((px, py), 6, WHITE.filled()))
-            .map_err(e)?;
+            .map_err(de)?;
         root.draw(&Circle::new((px, py), 6, BLACK.stroke_width(2)))
-            .map_err(e)?;
+            .map_err(de)?;
         root.draw(&Text::new(
             m.name.clone(),
             (px + 9, py - 9),
@@ -509,11 +624,17 @@ fn draw<DB: DrawingBackend>(
                 .color(&BLACK)
                 .pos(Pos::new(HPos::Left, VPos::Center)),
         ))
-        .map_err(e)?;
+        .map_err(de)?;
     }
+    Ok(())
+}
 
-    // Colour bar.
-    let (bw, bh) = bar_area.dim_in_pixel();
+/// The colour bar with its ticks in °C.
+fn draw_colour_bar<DB: DrawingBackend>(
+    bar_area: &DrawingArea<DB, Shift>,
+    scale: Scale,
+) -> Result<(), ReportError> {
+    let (_, bh) = bar_area.dim_in_pixel();
     let (x0, y0, bar_h) = (30i32, 40i32, (bh as i32 - 100).max(100));
     let steps = 200;
     for k in 0..steps {
@@ -525,33 +646,32 @@ fn draw<DB: DrawingBackend>(
                 [(x0, ya), (x0 + 24, yb + 1)],
                 palette(t).filled(),
             ))
-            .map_err(e)?;
+            .map_err(de)?;
     }
     bar_area
         .draw(&Rectangle::new(
             [(x0, y0), (x0 + 24, y0 + bar_h)],
             BLACK.stroke_width(1),
         ))
-        .map_err(e)?;
+        .map_err(de)?;
     bar_area
         .draw(&Text::new(
             "°C",
             (x0, y0 - 26),
             (FONT_FAMILY, 15).into_font().color(&BLACK),
         ))
-        .map_err(e)?;
-    let step = contour_step(vmax - vmin);
+        .map_err(de)?;
+    let step = contour_step(scale.vmax - scale.vmin);
     let dec = decimals(step).max(1);
-    let first = (vmin / step).ceil() * step;
-    let mut l = first;
-    while l <= vmax + 1e-9 {
-        let y = y0 + ((1.0 - norm(l)) * bar_h as f64).round() as i32;
+    let mut l = (scale.vmin / step).ceil() * step;
+    while l <= scale.vmax + 1e-9 {
+        let y = y0 + ((1.0 - scale.norm(l)) * bar_h as f64).round() as i32;
         bar_area
             .draw(&PathElement::new(
                 vec![(x0 + 24, y), (x0 + 30, y)],
                 BLACK.stroke_width(1),
             ))
-            .map_err(e)?;
+            .map_err(de)?;
         bar_area
             .draw(&Text::new(
                 format!("{l:.dec$}"),
@@ -561,11 +681,38 @@ fn draw<DB: DrawingBackend>(
                     .color(&BLACK)
                     .pos(Pos::new(HPos::Left, VPos::Center)),
             ))
-            .map_err(e)?;
+            .map_err(de)?;
         l += step;
     }
-    let _ = bw;
-    root.present().map_err(e)?;
+    Ok(())
+}
+
+/// Draws the whole map on `root`.
+fn draw<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    input: &MapInput<'_>,
+) -> Result<(), ReportError> {
+    if !register_font() {
+        return Err(ReportError::Draw(
+            "the embedded font could not be registered".into(),
+        ));
+    }
+    root.fill(&WHITE).map_err(de)?;
+    draw_titles(root, input)?;
+    let (w, _) = root.dim_in_pixel();
+    let body = root.margin(70, 10, 10, 10);
+    let (map_area, bar_area) = body.split_horizontally(w as i32 - 20 - 140);
+    let ok = computed_nodes(input.field);
+    let scale = Scale::of(&ok);
+    let mut chart = build_chart(&map_area, input.field)?;
+    draw_cells(&mut chart, input.field, &ok, scale)?;
+    draw_contours(root, &mut chart, input, &ok, scale)?;
+    draw_outline(&mut chart, input.field)?;
+    draw_features(root, &mut chart, input, scale)?;
+    draw_occluders(root, &mut chart, input)?;
+    draw_marks(root, &chart, input.marks)?;
+    draw_colour_bar(&bar_area, scale)?;
+    root.present().map_err(de)?;
     Ok(())
 }
 
@@ -575,7 +722,7 @@ pub fn render_png(input: &MapInput<'_>) -> Result<Vec<u8>, ReportError> {
     let mut buf = vec![255u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
-        draw(&root, input).map_err(ReportError::Draw)?;
+        draw(&root, input)?;
     }
     let img = image::RgbImage::from_raw(w, h, buf)
         .ok_or_else(|| ReportError::Draw("image buffer size".into()))?;
@@ -591,7 +738,7 @@ pub fn render_svg(input: &MapInput<'_>) -> Result<String, ReportError> {
     let mut s = String::new();
     {
         let root = SVGBackend::with_string(&mut s, (w, h)).into_drawing_area();
-        draw(&root, input).map_err(ReportError::Draw)?;
+        draw(&root, input)?;
     }
     Ok(s)
 }

@@ -64,10 +64,18 @@ pub fn parse_globe_csv(text: &str, file: &str) -> Result<Vec<GlobeRow>, ReportEr
     for record in reader.records() {
         let record = record.map_err(|e| {
             let line = e.position().map_or(0, |p| p.line());
-            ReportError::Input(format!("{file}:{line}: {e}"))
+            ReportError::Globe {
+                file: file.to_string(),
+                line,
+                problem: e.to_string(),
+            }
         })?;
         let line = record.position().map_or(0, |p| p.line());
-        let bad = |m: String| ReportError::Input(format!("{file}:{line}: {m}"));
+        let bad = |problem: String| ReportError::Globe {
+            file: file.to_string(),
+            line,
+            problem,
+        };
         if record.iter().all(str::is_empty) {
             continue;
         }
@@ -109,7 +117,9 @@ pub fn parse_globe_csv(text: &str, file: &str) -> Result<Vec<GlobeRow>, ReportEr
         rows.push(globe_row(&record, &cols, &bad)?);
     }
     if rows.is_empty() {
-        return Err(ReportError::Input(format!("{file}: no readings")));
+        return Err(ReportError::NoReadings {
+            file: file.to_string(),
+        });
     }
     Ok(rows)
 }
@@ -258,7 +268,7 @@ pub fn validate(rows: &[GlobeRow], ours: &MrtAt<'_>) -> Vec<ValidationRow> {
 }
 
 /// validation.csv (labels quoted where they need it).
-pub fn validation_csv(rows: &[ValidationRow]) -> String {
+pub fn validation_csv(rows: &[ValidationRow]) -> Result<String, ReportError> {
     let mut w = csv::Writer::from_writer(Vec::new());
     let header = [
         "label",
@@ -305,8 +315,12 @@ pub fn validation_csv(rows: &[ValidationRow]) -> String {
         ]);
     }
     for rec in &records {
-        // Writing to a Vec cannot fail.
-        let _ = w.write_record(rec);
+        w.write_record(rec)
+            .map_err(|e| ReportError::Csv(e.to_string()))?;
     }
-    String::from_utf8(w.into_inner().unwrap_or_default()).unwrap_or_default()
+    let bytes = w
+        .into_inner()
+        .map_err(|e| ReportError::Csv(e.error().to_string()))?;
+    // Every cell was a String: the bytes are UTF-8.
+    Ok(String::from_utf8_lossy(&bytes).into_owned())
 }

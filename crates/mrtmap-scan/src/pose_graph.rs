@@ -116,21 +116,38 @@ fn cost(initial: &HashMap<String, DVector<f64>>, factors: &[(Between, [String; 2
         .sum()
 }
 
-/// Optimises the graph. Of `initial`, the first node's pose is kept (the gauge) and the ids say
-/// which nodes exist: the others start along a spanning tree of the edges, whatever frame their
-/// odometry was in. Nodes the edges do not connect to the first node are left out of the result;
-/// edges naming unknown nodes are an error.
-pub fn optimise(
-    initial: &BTreeMap<i64, Isometry3<f64>>,
-    edges: &[Edge],
-) -> Result<Optimised, String> {
-    let Some((&first, first_pose)) = initial.iter().next() else {
-        return Err("no nodes".into());
-    };
+/// Why a pose graph could not be optimised.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum PoseGraphError {
+    /// The graph has no nodes.
+    #[error("no nodes")]
+    NoNodes,
+    /// An edge names a node without a pose.
+    #[error("a link names node {0}, which has no pose")]
+    UnknownNode(i64),
+    /// An edge's transform is not finite or not plausible.
+    #[error("the link {from} → {to} has a non-finite or implausible transform")]
+    BadTransform {
+        /// First node.
+        from: i64,
+        /// Second node.
+        to: i64,
+    },
+    /// Levenberg–Marquardt did not converge.
+    #[error("the pose graph optimisation did not converge")]
+    NotConverged,
+    /// The result holds non-finite poses.
+    #[error("the pose graph optimisation diverged (non-finite poses)")]
+    Diverged,
+}
+
+/// Refuses edges naming unknown nodes or carrying implausible transforms.
+fn check_edges(initial: &BTreeMap<i64, Isometry3<f64>>, edges: &[Edge]) -> Result<(), PoseGraphError> {
     for e in edges {
         for id in [e.from, e.to] {
             if !initial.contains_key(&id) {
-                return Err(format!("a link names node {id}, which has no pose"));
+                return Err(PoseGraphError::UnknownNode(id));
             }
         }
         let m = e.measured;
@@ -141,14 +158,23 @@ pub fn optimise(
             .all(|x| x.is_finite() && x.abs() < 1e6)
             || !m.rotation.coords.iter().all(|x| x.is_finite())
         {
-            return Err(format!(
-                "the link {} → {} has a non-finite or implausible transform",
-                e.from, e.to
-            ));
+            return Err(PoseGraphError::BadTransform {
+                from: e.from,
+                to: e.to,
+            });
         }
     }
-    // The start: the first node where it is, the others along a breadth-first spanning tree of the
-    // edges (as g2o and RTAB-Map start), so sessions whose odometry frames differ start together.
+    Ok(())
+}
+
+/// The start: the first node where it is, the others along a breadth-first spanning tree of the
+/// edges (as g2o and RTAB-Map start), so sessions whose odometry frames differ start together.
+/// Nodes the edges do not connect to the first are absent.
+fn spanning_start(
+    first: i64,
+    first_pose: &Isometry3<f64>,
+    edges: &[Edge],
+) -> HashMap<i64, Isometry3<f64>> {
     let mut start: HashMap<i64, Isometry3<f64>> = HashMap::from([(first, *first_pose)]);
     let mut by_node: HashMap<i64, Vec<(i64, Isometry3<f64>)>> = HashMap::new();
     for e in edges.iter().filter(|e| e.from != e.to) {
@@ -168,14 +194,20 @@ pub fn optimise(
             }
         }
     }
-    // The nodes connected to the first one are the ones the tree reached; only their edges count.
-    let reached: std::collections::BTreeSet<i64> = start.keys().copied().collect();
-    let name = |id: i64| format!("x{id}");
-    let values: HashMap<String, DVector<f64>> = reached
-        .iter()
-        .map(|&id| (name(id), to_vec(&start[&id])))
-        .collect();
-    let mut problem = tiny_solver::Problem::new();
+    start
+}
+
+/// The variable name of a node.
+fn name(id: i64) -> String {
+    format!("x{id}")
+}
+
+/// A Between factor per edge among the reached nodes, with the square root of its information
+/// (identity where the information is unusable), and how many were weighted as identity.
+fn between_factors(
+    edges: &[Edge],
+    reached: &std::collections::BTreeSet<i64>,
+) -> (Vec<(Between, [String; 2])>, usize) {
     let mut factors = Vec::new();
     let mut identity_weighted = 0;
     for e in edges
@@ -195,9 +227,34 @@ pub fn optimise(
             measured_inv: to_vec(&e.measured.inverse()),
             sqrt_info,
         };
-        let names = [name(e.from), name(e.to)];
+        factors.push((f, [name(e.from), name(e.to)]));
+    }
+    (factors, identity_weighted)
+}
+
+/// Optimises the graph. Of `initial`, the first node's pose is kept (the gauge) and the ids say
+/// which nodes exist: the others start along a spanning tree of the edges, whatever frame their
+/// odometry was in. Nodes the edges do not connect to the first node are left out of the result;
+/// edges naming unknown nodes are an error.
+pub fn optimise(
+    initial: &BTreeMap<i64, Isometry3<f64>>,
+    edges: &[Edge],
+) -> Result<Optimised, PoseGraphError> {
+    let Some((&first, first_pose)) = initial.iter().next() else {
+        return Err(PoseGraphError::NoNodes);
+    };
+    check_edges(initial, edges)?;
+    let start = spanning_start(first, first_pose, edges);
+    // The nodes connected to the first one are the ones the tree reached; only their edges count.
+    let reached: std::collections::BTreeSet<i64> = start.keys().copied().collect();
+    let values: HashMap<String, DVector<f64>> = reached
+        .iter()
+        .map(|&id| (name(id), to_vec(&start[&id])))
+        .collect();
+    let (factors, identity_weighted) = between_factors(edges, &reached);
+    let mut problem = tiny_solver::Problem::new();
+    for (f, names) in &factors {
         problem.add_residual_block(6, &[&names[0], &names[1]], Box::new(f.clone()), None);
-        factors.push((f, names));
     }
     problem.add_residual_block(
         7,
@@ -213,7 +270,7 @@ pub fn optimise(
     let cost_before = cost(&values, &factors);
     let result = tiny_solver::LevenbergMarquardtOptimizer::default()
         .optimize(&problem, &values, None)
-        .ok_or("the pose graph optimisation did not converge")?;
+        .ok_or(PoseGraphError::NotConverged)?;
     let cost_after = cost(&result, &factors);
     let poses: BTreeMap<i64, Isometry3<f64>> = reached
         .iter()
@@ -224,7 +281,7 @@ pub fn optimise(
             && p.rotation.coords.iter().all(|x| x.is_finite())
     };
     if poses.len() != reached.len() || !poses.values().all(finite) || !cost_after.is_finite() {
-        return Err("the pose graph optimisation diverged (non-finite poses)".into());
+        return Err(PoseGraphError::Diverged);
     }
     Ok(Optimised {
         poses,
@@ -412,7 +469,7 @@ mod tests {
             measured: Isometry3::identity(),
             information: Matrix6::identity(),
         };
-        assert!(optimise(&truth, &[e]).unwrap_err().contains("node 99"));
+        assert!(optimise(&truth, &[e]).unwrap_err().to_string().contains("node 99"));
         // Only nodes 1–3 are linked to the first: the rest, linked among themselves or not at
         // all, are left out.
         let edges: Vec<Edge> = [(1, 2), (2, 3), (5, 6), (6, 7)]
@@ -435,7 +492,7 @@ mod tests {
             measured: Isometry3::translation(1e30, 0.0, 0.0),
             information: Matrix6::identity(),
         };
-        assert!(optimise(&truth, &[wild]).unwrap_err().contains("1 → 2"));
+        assert!(optimise(&truth, &[wild]).unwrap_err().to_string().contains("1 → 2"));
         // An information matrix of 1e300 counts as identity.
         let huge = Edge {
             from: 1,

@@ -53,12 +53,12 @@ fn main() {
     });
     let mut sz = 0;
     time("png16 encode, no noise", &mut |k| {
-        sz += encode_png16(&imgs[k]).len();
+        sz += encode_png16(&imgs[k]).expect("encodes").len();
     });
     println!("   {} KB/frame", sz / n / 1000);
     let mut sz = 0;
     time("png16 encode, realistic", &mut |k| {
-        sz += encode_png16(&noisy[k]).len();
+        sz += encode_png16(&noisy[k]).expect("encodes").len();
     });
     println!("   {} KB/frame", sz / n / 1000);
     for (name, ct, ft) in [
@@ -119,7 +119,7 @@ fn main() {
             true,
             &mut rng,
         );
-        encode_png_rgb8(640, 480, &rgb);
-        encode_png16(&m);
+        encode_png_rgb8(640, 480, &rgb).expect("encodes");
+        encode_png16(&m).expect("encodes");
     });
 }

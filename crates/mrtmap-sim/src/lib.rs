@@ -41,9 +41,22 @@ pub use walk::{Walk, WalkParams, inset_polygon};
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum SimError {
-    /// Bad settings.
-    #[error("{0}")]
-    Config(String),
+    /// A setting out of its range.
+    #[error("{what} = {value} is outside {range}")]
+    OutOfRange {
+        /// The setting.
+        what: String,
+        /// Its value.
+        value: f64,
+        /// What is allowed.
+        range: &'static str,
+    },
+    /// The room could not be written as TOML.
+    #[error("cannot write room.toml: {0}")]
+    Toml(#[from] toml::ser::Error),
+    /// The truth could not be written as JSON.
+    #[error("cannot write truth.json: {0}")]
+    Json(#[from] serde_json::Error),
     /// The room is invalid.
     #[error(transparent)]
     Room(#[from] RoomError),

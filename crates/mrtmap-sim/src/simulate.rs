@@ -1,5 +1,5 @@
 //! The scan simulator: a walk through a room, sensors on their own clocks, a recording written in
-//! the layout of `shared/spec/recording.md`, and its truth.
+//! the recording layout (docs/recording.md), and its truth.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -8,8 +8,8 @@ use mrtmap_geometry::camera::{BrownConrady, PinholeCamera};
 use mrtmap_geometry::nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion, Vector3};
 use mrtmap_io::masks::{labels_path, mask_labels_json};
 use mrtmap_io::{
-    PartialDir, RgbCamera, Rig, ThermalEncoding, Trajectory, encode_png_rgb8, encode_png16,
-    stream_list_text,
+    EncodeError, FileError, PartialDir, RgbCamera, Rig, ThermalEncoding, Trajectory,
+    encode_png_rgb8, encode_png16, stream_list_text,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -175,12 +175,260 @@ fn stamps(seconds: f64, hz: f64, jitter_s: f64, rng: &mut ChaCha8Rng) -> Vec<f64
 /// Recording timestamps start here (a Unix time, like real recordings).
 pub const TIME_ORIGIN_S: f64 = 1_700_000_000.0;
 
-fn write(path: &Path, bytes: &[u8], total: &AtomicU64) -> Result<(), SimError> {
-    std::fs::write(path, bytes).map_err(|e| SimError::Write {
-        path: path.to_path_buf(),
-        source: e,
-    })?;
-    total.fetch_add(bytes.len() as u64, Ordering::Relaxed);
+/// The folder being written, and how many bytes went into it.
+struct Out {
+    root: PathBuf,
+    bytes: AtomicU64,
+}
+
+impl Out {
+    fn write(&self, rel: &str, bytes: &[u8]) -> Result<(), SimError> {
+        let path = self.root.join(rel);
+        std::fs::write(&path, bytes).map_err(|e| SimError::Write { path, source: e })?;
+        self.bytes.fetch_add(bytes.len() as u64, Ordering::Relaxed);
+        Ok(())
+    }
+
+    fn write_png(&self, rel: &str, png: Result<Vec<u8>, EncodeError>) -> Result<(), SimError> {
+        let png = png.map_err(|e| FileError::encode(&self.root.join(rel), e))?;
+        self.write(rel, &png)
+    }
+}
+
+/// Refuses settings out of range.
+fn check(cfg: &SimConfig) -> Result<(), SimError> {
+    if !(cfg.seconds > 0.5 && cfg.seconds <= 7200.0) {
+        return Err(SimError::OutOfRange {
+            what: "seconds".into(),
+            value: cfg.seconds,
+            range: "0.5…7200 s",
+        });
+    }
+    for (name, hz) in [
+        ("depth", cfg.depth_hz),
+        ("thermal", cfg.thermal_hz),
+        ("rgb", cfg.rgb_hz),
+        ("pose", cfg.pose_hz),
+    ] {
+        if !(hz > 0.0 && hz <= 1000.0) {
+            return Err(SimError::OutOfRange {
+                what: format!("{name} rate (Hz)"),
+                value: hz,
+                range: "0…1000 Hz",
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The SLAM estimate of `truth`: a random walk in position and heading about `up`.
+fn drifting(
+    truth: &[Isometry3<f64>],
+    up: &Unit<Vector3<f64>>,
+    cfg: &SimConfig,
+    rng: &mut ChaCha8Rng,
+) -> Vec<Isometry3<f64>> {
+    let std = Normal::new(0.0, 1.0).unwrap_or_else(|_| unreachable!("unit normal"));
+    let dt = 1.0 / cfg.pose_hz;
+    let (mut p, mut th) = (Vector3::zeros(), 0.0f64);
+    truth
+        .iter()
+        .enumerate()
+        .map(|(k, tp)| {
+            if k > 0 {
+                p += Vector3::new(std.sample(rng), std.sample(rng), std.sample(rng))
+                    * cfg.drift.position_m_per_sqrt_s
+                    * dt.sqrt();
+                th += std.sample(rng) * cfg.drift.heading_deg_per_sqrt_s.to_radians() * dt.sqrt();
+            }
+            Isometry3::from_parts(
+                Translation3::from(p),
+                UnitQuaternion::from_axis_angle(up, th),
+            ) * tp
+        })
+        .collect()
+}
+
+/// Writes groundtruth.txt and trajectory.txt (with the configured drift); returns the pose count.
+fn write_poses(
+    out: &Out,
+    walk: &Walk,
+    world_from_room: &Isometry3<f64>,
+    cfg: &SimConfig,
+    header: &str,
+    rng: &mut ChaCha8Rng,
+) -> Result<usize, SimError> {
+    let n_poses = (cfg.seconds * cfg.pose_hz).floor() as usize + 1;
+    let pose_t: Vec<f64> = (0..n_poses).map(|k| k as f64 / cfg.pose_hz).collect();
+    let truth_poses: Vec<Isometry3<f64>> = pose_t
+        .iter()
+        .map(|&t| world_from_room * walk.room_from_depth(t))
+        .collect();
+    let up = Unit::new_normalize(world_from_room * Vector3::z());
+    let slam_poses = drifting(&truth_poses, &up, cfg, rng);
+    let gt = Trajectory {
+        stamps: pose_t.iter().map(|&t| TIME_ORIGIN_S + t).collect(),
+        poses: truth_poses,
+    };
+    let slam = Trajectory {
+        stamps: gt.stamps.clone(),
+        poses: slam_poses,
+    };
+    out.write(
+        "groundtruth.txt",
+        gt.to_tum(&format!(
+            "{header}\ntrue poses: timestamp tx ty tz qx qy qz qw (world_from_depth)"
+        ))
+        .as_bytes(),
+    )?;
+    out.write(
+        "trajectory.txt",
+        slam.to_tum(&format!("{header}\nSLAM poses (drift {:?})", cfg.drift))
+            .as_bytes(),
+    )?;
+    Ok(n_poses)
+}
+
+/// The rig the simulated cameras form.
+fn rig(cfg: &SimConfig) -> Rig {
+    Rig {
+        depth: cfg.depth_camera,
+        depth_scale: cfg.depth_scale,
+        thermal: cfg.thermal_camera,
+        thermal_encoding: ThermalEncoding::Centikelvin,
+        depth_from_thermal: cfg.depth_from_thermal,
+        rgb: Some(RgbCamera {
+            camera: cfg.depth_camera,
+            depth_from_rgb: Isometry3::identity(),
+        }),
+    }
+}
+
+/// What every frame renderer needs.
+struct Frames<'a> {
+    room: &'a Room,
+    renderer: RoomRenderer,
+    walk: Walk,
+    cfg: &'a SimConfig,
+    realistic: bool,
+    out: &'a Out,
+    tick: &'a (dyn Fn() + Sync),
+}
+
+impl Frames<'_> {
+    /// Per-frame noise comes from a fast generator seeded from (seed, stream, frame), so frames
+    /// can be rendered in any order and on any number of threads with the same result.
+    fn rng(&self, stream: u64, k: usize) -> rand_xoshiro::Xoshiro256PlusPlus {
+        let mut r = ChaCha8Rng::seed_from_u64(self.cfg.seed);
+        r.set_stream((stream << 40) | k as u64);
+        rand_xoshiro::Xoshiro256PlusPlus::from_rng(&mut r)
+    }
+
+    fn depth(&self, times: &[f64]) -> Result<(), SimError> {
+        let cfg = self.cfg;
+        let rays = camera_rays(&cfg.depth_camera, 1);
+        let noise = self.realistic.then_some(&cfg.depth_noise);
+        times.par_iter().enumerate().try_for_each(|(k, &t)| {
+            let img = render_depth(
+                &self.renderer,
+                &cfg.depth_camera,
+                &rays,
+                &self.walk.room_from_depth(t),
+                cfg.depth_scale,
+                noise,
+                &mut self.rng(1, k),
+            );
+            self.out
+                .write_png(&format!("depth/{k:06}.png"), encode_png16(&img))?;
+            (self.tick)();
+            Ok(())
+        })
+    }
+
+    fn thermal(&self, times: &[f64]) -> Result<(), SimError> {
+        let cfg = self.cfg;
+        let noise = if self.realistic {
+            cfg.thermal_noise
+        } else {
+            ThermalNoise {
+                bias_k: cfg.thermal_noise.bias_k,
+                ..ThermalNoise::NONE
+            }
+        };
+        let rays = camera_rays(&cfg.thermal_camera, noise.supersample);
+        times.par_iter().enumerate().try_for_each(|(k, &t)| {
+            let pose = self.walk.room_from_depth(t) * cfg.depth_from_thermal;
+            let img = render_thermal(
+                self.room,
+                &self.renderer,
+                &cfg.thermal_camera,
+                &rays,
+                &pose,
+                ThermalEncoding::Centikelvin,
+                &noise,
+                &mut self.rng(2, k),
+            );
+            self.out
+                .write_png(&format!("thermal/{k:06}.png"), encode_png16(&img))?;
+            (self.tick)();
+            Ok(())
+        })
+    }
+
+    fn colour_and_masks(&self, times: &[f64]) -> Result<(), SimError> {
+        let cfg = self.cfg;
+        let rays = camera_rays(&cfg.depth_camera, 1);
+        let (w, h) = (cfg.depth_camera.width, cfg.depth_camera.height);
+        times.par_iter().enumerate().try_for_each(|(k, &t)| {
+            let (rgb, mask, labels) = render_rgb_and_mask(
+                self.room,
+                &self.renderer,
+                &cfg.depth_camera,
+                &rays,
+                &self.walk.room_from_depth(t),
+                self.realistic,
+                &mut self.rng(3, k),
+            );
+            self.out
+                .write_png(&format!("rgb/{k:06}.png"), encode_png_rgb8(w, h, &rgb))?;
+            let mask_rel = format!("masks/{k:06}.png");
+            self.out.write_png(&mask_rel, encode_png16(&mask))?;
+            let labels_rel = labels_path(Path::new(&mask_rel));
+            self.out.write(
+                &labels_rel.to_string_lossy(),
+                mask_labels_json(&labels).as_bytes(),
+            )?;
+            (self.tick)();
+            Ok(())
+        })
+    }
+}
+
+/// Writes the stream lists of the frames' times.
+fn write_lists(out: &Out, header: &str, depth_t: &[f64], thermal_t: &[f64], rgb_t: &[f64]) -> Result<(), SimError> {
+    let list = |ts: &[f64], dir: &str| -> Vec<(f64, String)> {
+        ts.iter()
+            .enumerate()
+            .map(|(k, &t)| (TIME_ORIGIN_S + t, format!("{dir}/{k:06}.png")))
+            .collect()
+    };
+    for (file, what, ts, dir) in [
+        ("depth.txt", "depth frames", depth_t, "depth"),
+        ("thermal.txt", "thermal frames", thermal_t, "thermal"),
+        ("rgb.txt", "colour frames", rgb_t, "rgb"),
+        (
+            "masks.txt",
+            "instance masks (16-bit ids, labels in the .json beside each)",
+            rgb_t,
+            "masks",
+        ),
+    ] {
+        let text = stream_list_text(
+            &format!("{header}\n{what}: timestamp path"),
+            &list(ts, dir),
+        );
+        out.write(file, text.as_bytes())?;
+    }
     Ok(())
 }
 
@@ -192,24 +440,7 @@ pub fn simulate(
     out: &Path,
     progress: Progress<'_>,
 ) -> Result<SimSummary, SimError> {
-    if !(cfg.seconds > 0.5 && cfg.seconds <= 7200.0) {
-        return Err(SimError::Config(format!(
-            "seconds = {} is outside 0.5…7200",
-            cfg.seconds
-        )));
-    }
-    for (name, hz) in [
-        ("depth", cfg.depth_hz),
-        ("thermal", cfg.thermal_hz),
-        ("rgb", cfg.rgb_hz),
-        ("pose", cfg.pose_hz),
-    ] {
-        if !(hz > 0.0 && hz <= 1000.0) {
-            return Err(SimError::Config(format!(
-                "{name} rate {hz} Hz is outside 0…1000"
-            )));
-        }
-    }
+    check(cfg)?;
     let dir = PartialDir::create(out)?;
     let root = dir.path().to_path_buf();
     for sub in ["depth", "thermal", "rgb", "masks"] {
@@ -218,231 +449,51 @@ pub fn simulate(
             source: e,
         })?;
     }
+    let files = Out {
+        root,
+        bytes: AtomicU64::new(0),
+    };
     let walk = Walk::new(room, cfg.walk, cfg.seed);
-    let renderer = RoomRenderer::new(room);
     let world_from_room = walk.room_from_depth(0.0).inverse();
     let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed);
-    let bytes = AtomicU64::new(0);
-
-    // Poses: truth, and the SLAM estimate with drift.
-    let n_poses = (cfg.seconds * cfg.pose_hz).floor() as usize + 1;
-    let pose_t: Vec<f64> = (0..n_poses).map(|k| k as f64 / cfg.pose_hz).collect();
-    let truth_poses: Vec<Isometry3<f64>> = pose_t
-        .iter()
-        .map(|&t| world_from_room * walk.room_from_depth(t))
-        .collect();
-    let up = Unit::new_normalize(world_from_room * Vector3::z());
-    let std = Normal::new(0.0, 1.0).unwrap_or_else(|_| unreachable!("unit normal"));
-    let dt = 1.0 / cfg.pose_hz;
-    let (mut p, mut th) = (Vector3::zeros(), 0.0f64);
-    let slam_poses: Vec<Isometry3<f64>> = truth_poses
-        .iter()
-        .enumerate()
-        .map(|(k, tp)| {
-            if k > 0 {
-                p += Vector3::new(
-                    std.sample(&mut rng),
-                    std.sample(&mut rng),
-                    std.sample(&mut rng),
-                ) * cfg.drift.position_m_per_sqrt_s
-                    * dt.sqrt();
-                th += std.sample(&mut rng)
-                    * cfg.drift.heading_deg_per_sqrt_s.to_radians()
-                    * dt.sqrt();
-            }
-            Isometry3::from_parts(
-                Translation3::from(p),
-                UnitQuaternion::from_axis_angle(&up, th),
-            ) * tp
-        })
-        .collect();
-    let stamp = |t: f64| TIME_ORIGIN_S + t;
     let header = format!(
         "mrtmap simulate: room {}, seed {}, noise {:?}",
         room.file.name, cfg.seed, cfg.noise
     );
-    let gt = Trajectory {
-        stamps: pose_t.iter().map(|&t| stamp(t)).collect(),
-        poses: truth_poses,
-    };
-    let slam = Trajectory {
-        stamps: gt.stamps.clone(),
-        poses: slam_poses,
-    };
-    write(
-        &root.join("groundtruth.txt"),
-        gt.to_tum(&format!(
-            "{header}\ntrue poses: timestamp tx ty tz qx qy qz qw (world_from_depth)"
-        ))
-        .as_bytes(),
-        &bytes,
-    )?;
-    write(
-        &root.join("trajectory.txt"),
-        slam.to_tum(&format!("{header}\nSLAM poses (drift {:?})", cfg.drift))
-            .as_bytes(),
-        &bytes,
-    )?;
-
+    let poses = write_poses(&files, &walk, &world_from_room, cfg, &header, &mut rng)?;
     let depth_t = stamps(cfg.seconds, cfg.depth_hz, 0.0003, &mut rng);
     let thermal_t = stamps(cfg.seconds, cfg.thermal_hz, 0.002, &mut rng);
     let rgb_t = stamps(cfg.seconds, cfg.rgb_hz, 0.0003, &mut rng);
     let total = (depth_t.len() + thermal_t.len() + rgb_t.len()) as u64;
     let done = AtomicU64::new(0);
     let tick = || progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
-
-    let realistic = cfg.noise == NoiseLevel::Realistic;
-    let rig = Rig {
-        depth: cfg.depth_camera,
-        depth_scale: cfg.depth_scale,
-        thermal: cfg.thermal_camera,
-        thermal_encoding: ThermalEncoding::Centikelvin,
-        depth_from_thermal: cfg.depth_from_thermal,
-        rgb: Some(RgbCamera {
-            camera: cfg.depth_camera,
-            depth_from_rgb: Isometry3::identity(),
-        }),
+    files.write("rig.toml", rig(cfg).to_toml().as_bytes())?;
+    let frames = Frames {
+        room,
+        renderer: RoomRenderer::new(room),
+        walk,
+        cfg,
+        realistic: cfg.noise == NoiseLevel::Realistic,
+        out: &files,
+        tick: &tick,
     };
-    write(&root.join("rig.toml"), rig.to_toml().as_bytes(), &bytes)?;
-    // Per-frame noise comes from a fast generator seeded from (seed, stream, frame), so frames can
-    // be rendered in any order and on any number of threads with the same result.
-    let frame_rng = |stream: u64, k: usize| {
-        let mut r = ChaCha8Rng::seed_from_u64(cfg.seed);
-        r.set_stream((stream << 40) | k as u64);
-        rand_xoshiro::Xoshiro256PlusPlus::from_rng(&mut r)
-    };
-
-    // Depth.
-    let depth_rays = camera_rays(&cfg.depth_camera, 1);
-    let depth_noise = realistic.then_some(&cfg.depth_noise);
-    depth_t.par_iter().enumerate().try_for_each(|(k, &t)| {
-        let img = render_depth(
-            &renderer,
-            &cfg.depth_camera,
-            &depth_rays,
-            &walk.room_from_depth(t),
-            cfg.depth_scale,
-            depth_noise,
-            &mut frame_rng(1, k),
-        );
-        write(
-            &root.join(format!("depth/{k:06}.png")),
-            &encode_png16(&img),
-            &bytes,
-        )?;
-        tick();
-        Ok::<(), SimError>(())
-    })?;
-    // Thermal.
-    let tnoise = if realistic {
-        cfg.thermal_noise
-    } else {
-        ThermalNoise {
-            bias_k: cfg.thermal_noise.bias_k,
-            ..ThermalNoise::NONE
-        }
-    };
-    let thermal_rays = camera_rays(&cfg.thermal_camera, tnoise.supersample);
-    thermal_t.par_iter().enumerate().try_for_each(|(k, &t)| {
-        let pose = walk.room_from_depth(t) * cfg.depth_from_thermal;
-        let img = render_thermal(
-            room,
-            &renderer,
-            &cfg.thermal_camera,
-            &thermal_rays,
-            &pose,
-            ThermalEncoding::Centikelvin,
-            &tnoise,
-            &mut frame_rng(2, k),
-        );
-        write(
-            &root.join(format!("thermal/{k:06}.png")),
-            &encode_png16(&img),
-            &bytes,
-        )?;
-        tick();
-        Ok::<(), SimError>(())
-    })?;
-    // Colour and masks.
-    rgb_t.par_iter().enumerate().try_for_each(|(k, &t)| {
-        let (rgb, mask, labels) = render_rgb_and_mask(
-            room,
-            &renderer,
-            &cfg.depth_camera,
-            &depth_rays,
-            &walk.room_from_depth(t),
-            realistic,
-            &mut frame_rng(3, k),
-        );
-        write(
-            &root.join(format!("rgb/{k:06}.png")),
-            &encode_png_rgb8(cfg.depth_camera.width, cfg.depth_camera.height, &rgb),
-            &bytes,
-        )?;
-        let mp = root.join(format!("masks/{k:06}.png"));
-        write(&mp, &encode_png16(&mask), &bytes)?;
-        write(
-            &labels_path(&mp),
-            mask_labels_json(&labels).as_bytes(),
-            &bytes,
-        )?;
-        tick();
-        Ok::<(), SimError>(())
-    })?;
-    let list = |ts: &[f64], dir: &str| -> Vec<(f64, String)> {
-        ts.iter()
-            .enumerate()
-            .map(|(k, &t)| (stamp(t), format!("{dir}/{k:06}.png")))
-            .collect()
-    };
-    write(
-        &root.join("depth.txt"),
-        stream_list_text(
-            &format!("{header}\ndepth frames: timestamp path"),
-            &list(&depth_t, "depth"),
-        )
-        .as_bytes(),
-        &bytes,
-    )?;
-    write(
-        &root.join("thermal.txt"),
-        stream_list_text(
-            &format!("{header}\nthermal frames: timestamp path"),
-            &list(&thermal_t, "thermal"),
-        )
-        .as_bytes(),
-        &bytes,
-    )?;
-    write(
-        &root.join("rgb.txt"),
-        stream_list_text(
-            &format!("{header}\ncolour frames: timestamp path"),
-            &list(&rgb_t, "rgb"),
-        )
-        .as_bytes(),
-        &bytes,
-    )?;
-    write(&root.join("masks.txt"), stream_list_text(&format!("{header}\ninstance masks (16-bit ids, labels in the .json beside each): timestamp path"), &list(&rgb_t, "masks")).as_bytes(), &bytes)?;
-    write(
-        &root.join("room.toml"),
-        toml::to_string(&room.file).unwrap_or_default().as_bytes(),
-        &bytes,
-    )?;
-
+    frames.depth(&depth_t)?;
+    frames.thermal(&thermal_t)?;
+    frames.colour_and_masks(&rgb_t)?;
+    write_lists(&files, &header, &depth_t, &thermal_t, &rgb_t)?;
+    let room_toml = toml::to_string(&room.file)?;
+    files.write("room.toml", room_toml.as_bytes())?;
     let truth = compute_truth(room, &world_from_room, cfg.truth_rays, cfg.seed)?;
-    write(
-        &root.join("truth.json"),
-        (serde_json::to_string_pretty(&truth).unwrap_or_default() + "\n").as_bytes(),
-        &bytes,
-    )?;
+    let truth_json = serde_json::to_string_pretty(&truth)?;
+    files.write("truth.json", (truth_json + "\n").as_bytes())?;
     let out = dir.finish()?;
     Ok(SimSummary {
         out,
         depth_frames: depth_t.len(),
         thermal_frames: thermal_t.len(),
         rgb_frames: rgb_t.len(),
-        poses: n_poses,
-        bytes: bytes.load(Ordering::Relaxed),
+        poses,
+        bytes: files.bytes.load(Ordering::Relaxed),
         truth_method: truth.method,
     })
 }

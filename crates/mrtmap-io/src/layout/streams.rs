@@ -1,7 +1,6 @@
 //! Stream lists (`depth.txt`, `thermal.txt`, `rgb.txt`, `masks.txt`): "timestamp path" per line,
 //! `#` starts a comment, timestamps in seconds.
 
-use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use crate::error::{FileError, FileErrorKind};
@@ -64,10 +63,10 @@ pub fn parse_stream_list(text: &str, list_path: &Path) -> Result<Vec<StreamEntry
 pub fn stream_list_text(header: &str, entries: &[(f64, String)]) -> String {
     let mut s = String::with_capacity(entries.len() * 40);
     for l in header.lines() {
-        let _ = writeln!(s, "# {l}");
+        s.push_str(&format!("# {l}\n"));
     }
     for (t, p) in entries {
-        let _ = writeln!(s, "{t:.6} {p}");
+        s.push_str(&format!("{t:.6} {p}\n"));
     }
     s
 }

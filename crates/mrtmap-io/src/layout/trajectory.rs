@@ -1,7 +1,6 @@
 //! TUM trajectories (`timestamp tx ty tz qx qy qz qw`, pose = world_from_camera, Hamilton
 //! quaternion in x y z w order) and pose interpolation (linear translation, slerp rotation).
 
-use std::fmt::Write as _;
 use std::path::Path;
 
 use mrtmap_geometry::nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
@@ -125,16 +124,15 @@ impl Trajectory {
     pub fn to_tum(&self, header: &str) -> String {
         let mut s = String::with_capacity(self.stamps.len() * 100);
         for l in header.lines() {
-            let _ = writeln!(s, "# {l}");
+            s.push_str(&format!("# {l}\n"));
         }
         for (t, p) in self.stamps.iter().zip(&self.poses) {
             let q = quaternion_xyzw(&p.rotation);
             let tr = p.translation.vector;
-            let _ = writeln!(
-                s,
-                "{t:.6} {:.9} {:.9} {:.9} {:.9} {:.9} {:.9} {:.9}",
+            s.push_str(&format!(
+                "{t:.6} {:.9} {:.9} {:.9} {:.9} {:.9} {:.9} {:.9}\n",
                 tr.x, tr.y, tr.z, q[0], q[1], q[2], q[3]
-            );
+            ));
         }
         s
     }

@@ -81,6 +81,45 @@ pub struct ThermalImage {
 }
 
 impl ThermalImage {
+    /// The temperatures (°C, 3 decimals) as CSV, one image row per line; pixels without a
+    /// temperature are empty cells.
+    pub fn csv(&self) -> String {
+        let mut s = String::with_capacity(self.celsius.len() * 7);
+        for row in self.celsius.chunks(self.width as usize) {
+            let cells: Vec<String> = row
+                .iter()
+                .map(|c| {
+                    if c.is_finite() {
+                        format!("{c:.3}")
+                    } else {
+                        String::new()
+                    }
+                })
+                .collect();
+            s.push_str(&cells.join(","));
+            s.push('\n');
+        }
+        s
+    }
+
+    /// The image in the iron palette from `lo_c` (black) to `hi_c` (white) as PNG; pixels without
+    /// a temperature are black.
+    pub fn iron_png(&self, lo_c: f64, hi_c: f64) -> Result<Vec<u8>, crate::EncodeError> {
+        let span = (hi_c - lo_c).max(1e-9);
+        let rgb: Vec<u8> = self
+            .celsius
+            .iter()
+            .flat_map(|&c| {
+                if c.is_finite() {
+                    crate::iron(((c - lo_c) / span) as f32)
+                } else {
+                    [0, 0, 0]
+                }
+            })
+            .collect();
+        crate::encode_png_rgb8(self.width, self.height, &rgb)
+    }
+
     /// Temperatures as 16-bit centikelvin (the recording layout's thermal encoding).
     pub fn centikelvin(&self) -> Image16 {
         Image16 {

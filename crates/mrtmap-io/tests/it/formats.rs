@@ -147,7 +147,7 @@ fn png16_round_trip_and_size_check() {
         *v = (k as u16) * 1000 + 3;
     }
     let p = dir.path().join("x.png");
-    std::fs::write(&p, encode_png16(&img)).unwrap();
+    std::fs::write(&p, encode_png16(&img).unwrap()).unwrap();
     let back = read_image16(&p).unwrap();
     assert_eq!(back, img);
     let e = back.check_size(&p, 8, 5).unwrap_err();

@@ -155,7 +155,7 @@ fn csv_and_json_forms_are_flat_and_quote_labels() {
         row("pp", 25.0, 22.0, 0.1, 0.038),
     ];
     let v = validate(&rows, &|_: &[f64; 3]| Ok((26.5, 0.02)));
-    let csv = validation_csv(&v);
+    let csv = validation_csv(&v).unwrap();
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines.len(), 3);
     assert_eq!(lines[0].split(',').count(), 17);

@@ -257,7 +257,6 @@ pub fn envelope(
             }
             let (mut best, mut cur_start, mut gap, mut cur_n) =
                 ((0usize, 0usize, 0usize), None::<usize>, 0usize, 0usize);
-            let mut last_occupied = 0usize;
             for (b, &c) in count.iter().enumerate() {
                 if c >= 3 {
                     if cur_start.is_none() {
@@ -266,7 +265,6 @@ pub fn envelope(
                     }
                     cur_n += c;
                     gap = 0;
-                    last_occupied = b;
                     if cur_n > best.2 {
                         best = (cur_start.unwrap_or(b), b, cur_n);
                     }
@@ -277,7 +275,6 @@ pub fn envelope(
                     }
                 }
             }
-            let _ = last_occupied;
             let (b0, b1, _) = best;
             planes[k].inliers = planes[k]
                 .inliers

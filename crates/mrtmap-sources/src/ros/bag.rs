@@ -498,6 +498,26 @@ pub struct BagWriter {
     chunk_index: Vec<(u32, f64, u32)>,
     chunk_conns_defined: Vec<u32>,
     chunk_infos: Vec<ChunkInfo>,
+    /// The first error compressing a chunk, reported by `finish`.
+    error: Option<std::io::Error>,
+}
+
+/// A chunk's bytes compressed as `c`, with the compression's name in the bag.
+fn compress_chunk(c: Compression, chunk: &[u8]) -> std::io::Result<(&'static str, Vec<u8>)> {
+    use std::io::Write;
+    Ok(match c {
+        Compression::None => ("none", chunk.to_vec()),
+        Compression::Bz2 => {
+            let mut e = bzip2::write::BzEncoder::new(Vec::new(), bzip2::Compression::default());
+            e.write_all(chunk)?;
+            ("bz2", e.finish()?)
+        }
+        Compression::Lz4 => {
+            let mut e = lz4_flex::frame::FrameEncoder::new(Vec::new());
+            e.write_all(chunk)?;
+            ("lz4", e.finish().map_err(std::io::Error::other)?)
+        }
+    })
 }
 
 fn field(out: &mut Vec<u8>, name: &str, value: &[u8]) {
@@ -542,6 +562,7 @@ impl BagWriter {
             chunk_index: Vec::new(),
             chunk_conns_defined: Vec::new(),
             chunk_infos: Vec::new(),
+            error: None,
         }
     }
 
@@ -595,18 +616,11 @@ impl BagWriter {
         if self.chunk_index.is_empty() {
             return;
         }
-        let (name, data): (&str, Vec<u8>) = match self.compression {
-            Compression::None => ("none", self.chunk.clone()),
-            Compression::Bz2 => {
-                let mut e = bzip2::write::BzEncoder::new(Vec::new(), bzip2::Compression::default());
-                // Writing into memory cannot fail.
-                let _ = std::io::Write::write_all(&mut e, &self.chunk);
-                ("bz2", e.finish().unwrap_or_default())
-            }
-            Compression::Lz4 => {
-                let mut e = lz4_flex::frame::FrameEncoder::new(Vec::new());
-                let _ = std::io::Write::write_all(&mut e, &self.chunk);
-                ("lz4", e.finish().unwrap_or_default())
+        let (name, data) = match compress_chunk(self.compression, &self.chunk) {
+            Ok(c) => c,
+            Err(e) => {
+                self.error.get_or_insert(e);
+                return;
             }
         };
         let chunk_pos = self.out.len() as u64;
@@ -664,9 +678,12 @@ impl BagWriter {
         self.chunk_conns_defined.clear();
     }
 
-    /// The bag's bytes.
-    pub fn finish(mut self) -> Vec<u8> {
+    /// The bag's bytes, or the first error compressing a chunk.
+    pub fn finish(mut self) -> std::io::Result<Vec<u8>> {
         self.flush_chunk();
+        if let Some(e) = self.error.take() {
+            return Err(e);
+        }
         let index_pos = self.out.len() as u64;
         let conns = std::mem::take(&mut self.conns);
         for (i, (topic, datatype)) in conns.iter().enumerate() {
@@ -711,7 +728,7 @@ impl BagWriter {
         header.extend_from_slice(&(pad as u32).to_le_bytes());
         header.resize(4096, b' ');
         self.out[MAGIC.len()..MAGIC.len() + 4096].copy_from_slice(&header);
-        self.out
+        Ok(self.out)
     }
 }
 
@@ -733,7 +750,7 @@ mod tests {
                 &[i as u8; 50],
             );
         }
-        w.finish()
+        w.finish().unwrap()
     }
 
     #[test]

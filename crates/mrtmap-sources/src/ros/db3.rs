@@ -24,22 +24,29 @@ fn sql(e: &rusqlite::Error) -> Corrupt {
 
 /// A message as stored, or inflated into `buf` when rosbag2 compressed it on its own
 /// (`compression_mode: message`, zstd; a CDR message never starts with zstd's magic).
-pub fn inflate<'a>(data: &'a [u8], buf: &'a mut Vec<u8>) -> Result<&'a [u8], String> {
+pub fn inflate<'a>(data: &'a [u8], buf: &'a mut Vec<u8>) -> Result<&'a [u8], InflateError> {
     if !data.starts_with(&ZSTD_MAGIC) {
         return Ok(data);
     }
     buf.clear();
-    let mut d = zstd::stream::read::Decoder::new(data)
-        .map_err(|e| format!("zstd-compressed message: {e}"))?;
+    let mut d = zstd::stream::read::Decoder::new(data)?;
     let mut lim = std::io::Read::take(&mut d, MAX_MESSAGE_BYTES as u64 + 1);
-    std::io::Read::read_to_end(&mut lim, buf)
-        .map_err(|e| format!("zstd-compressed message: {e}"))?;
+    std::io::Read::read_to_end(&mut lim, buf)?;
     if buf.len() > MAX_MESSAGE_BYTES {
-        return Err(format!(
-            "zstd-compressed message inflates past {MAX_MESSAGE_BYTES} bytes"
-        ));
+        return Err(InflateError::TooLarge);
     }
     Ok(&buf[..])
+}
+
+/// A zstd-compressed message that does not inflate.
+#[derive(Debug, thiserror::Error)]
+pub enum InflateError {
+    /// The zstd stream is broken.
+    #[error("zstd-compressed message: {0}")]
+    Zstd(#[from] std::io::Error),
+    /// It inflates past the size cap.
+    #[error("zstd-compressed message inflates past {MAX_MESSAGE_BYTES} bytes")]
+    TooLarge,
 }
 
 /// Whether an open SQLite database has rosbag2's `topics` and `messages` tables.
@@ -123,7 +130,7 @@ pub fn for_each_message(
         if !cdr {
             continue;
         }
-        let data = inflate(data, &mut buf).map_err(bad)?;
+        let data = inflate(data, &mut buf).map_err(|e| bad(e.to_string()))?;
         n += 1;
         f(Message {
             topic,
@@ -147,8 +154,8 @@ pub struct Db3Writer {
 
 impl Db3Writer {
     /// An empty bag.
-    pub fn new() -> Result<Self, String> {
-        let c = Connection::open_in_memory().map_err(|e| e.to_string())?;
+    pub fn new() -> Result<Self, rusqlite::Error> {
+        let c = Connection::open_in_memory()?;
         c.execute_batch(
             "BEGIN;
              CREATE TABLE schema(schema_version INTEGER PRIMARY KEY, ros_distro TEXT NOT NULL);
@@ -157,8 +164,7 @@ impl Db3Writer {
              CREATE TABLE topics(id INTEGER PRIMARY KEY, name TEXT NOT NULL, type TEXT NOT NULL, serialization_format TEXT NOT NULL, offered_qos_profiles TEXT NOT NULL);
              CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL, timestamp INTEGER NOT NULL, data BLOB NOT NULL);
              CREATE INDEX timestamp_idx ON messages (timestamp ASC);",
-        )
-        .map_err(|e| e.to_string())?;
+        )?;
         Ok(Self {
             c,
             topics: std::collections::HashMap::new(),
@@ -172,32 +178,29 @@ impl Db3Writer {
         datatype: &str,
         t: f64,
         data: &[u8],
-    ) -> Result<(), String> {
+    ) -> Result<(), rusqlite::Error> {
         let id = match self.topics.get(topic) {
             Some(&id) => id,
             None => {
                 let id = self.topics.len() as i64 + 1;
-                self.c
-                    .execute(
-                        "INSERT INTO topics VALUES(?1, ?2, ?3, 'cdr', '')",
-                        rusqlite::params![id, topic, datatype],
-                    )
-                    .map_err(|e| e.to_string())?;
+                self.c.execute(
+                    "INSERT INTO topics VALUES(?1, ?2, ?3, 'cdr', '')",
+                    rusqlite::params![id, topic, datatype],
+                )?;
                 self.topics.insert(topic.to_string(), id);
                 id
             }
         };
         self.c
             .prepare_cached("INSERT INTO messages(topic_id, timestamp, data) VALUES(?1, ?2, ?3)")
-            .and_then(|mut s| s.execute(rusqlite::params![id, (t * 1e9).round() as i64, data]))
-            .map_err(|e| e.to_string())?;
+            .and_then(|mut s| s.execute(rusqlite::params![id, (t * 1e9).round() as i64, data]))?;
         Ok(())
     }
 
     /// The file's bytes.
-    pub fn finish(mut self) -> Result<Vec<u8>, String> {
-        self.c.execute_batch("COMMIT;").map_err(|e| e.to_string())?;
-        let data = self.c.serialize(MAIN_DB).map_err(|e| e.to_string())?;
+    pub fn finish(mut self) -> Result<Vec<u8>, rusqlite::Error> {
+        self.c.execute_batch("COMMIT;")?;
+        let data = self.c.serialize(MAIN_DB)?;
         Ok(data.to_vec())
     }
 }

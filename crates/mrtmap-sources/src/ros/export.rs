@@ -134,7 +134,7 @@ fn rgb_image(i: &ros_msg::ImageMsg<'_>) -> Result<Vec<u8>, String> {
             rgb.extend(order.iter().map(|&k| px[k]));
         }
     }
-    Ok(encode_png_rgb8(i.width, i.height, &rgb))
+    encode_png_rgb8(i.width, i.height, &rgb).map_err(|e| e.to_string())
 }
 
 /// Why a message was not written: it is unusable (skipped and counted), or the output cannot be

@@ -9,6 +9,9 @@ use std::io::{Read, Seek, SeekFrom};
 
 use ::mcap::records::Record;
 
+/// Chunk compression of written MCAP files.
+pub use ::mcap::Compression as McapCompression;
+
 use super::bag::MAX_CHUNK_BYTES;
 use super::msg::{Message, Wire};
 use mrtmap_io::bytes::{Bytes, Corrupt, Endian};
@@ -256,20 +259,16 @@ pub struct McapWriter {
 }
 
 impl McapWriter {
-    /// A writer; `compression` is `None`, `Some("zstd")` or `Some("lz4")`.
-    pub fn new(compression: Option<&str>, chunk_size: u64) -> Result<Self, String> {
-        let c = match compression {
-            None => None,
-            Some("zstd") => Some(::mcap::Compression::Zstd),
-            Some("lz4") => Some(::mcap::Compression::Lz4),
-            Some(o) => return Err(format!("unknown MCAP compression {o}")),
-        };
+    /// A writer whose chunks are compressed by `compression` (zstd, LZ4) or stored.
+    pub fn new(
+        compression: Option<::mcap::Compression>,
+        chunk_size: u64,
+    ) -> Result<Self, ::mcap::McapError> {
         let w = ::mcap::WriteOptions::new()
-            .compression(c)
+            .compression(compression)
             .chunk_size(Some(chunk_size))
             .profile("ros2")
-            .create(std::io::Cursor::new(Vec::new()))
-            .map_err(|e| e.to_string())?;
+            .create(std::io::Cursor::new(Vec::new()))?;
         Ok(Self {
             w,
             channels: HashMap::new(),
@@ -283,18 +282,12 @@ impl McapWriter {
         datatype: &str,
         time: f64,
         data: &[u8],
-    ) -> Result<(), String> {
+    ) -> Result<(), ::mcap::McapError> {
         let id = match self.channels.get(topic) {
             Some(&id) => id,
             None => {
-                let s = self
-                    .w
-                    .add_schema(datatype, "ros2msg", b"")
-                    .map_err(|e| e.to_string())?;
-                let id = self
-                    .w
-                    .add_channel(s, topic, "cdr", &Default::default())
-                    .map_err(|e| e.to_string())?;
+                let s = self.w.add_schema(datatype, "ros2msg", b"")?;
+                let id = self.w.add_channel(s, topic, "cdr", &Default::default())?;
                 self.channels.insert(topic.to_string(), id);
                 id
             }
@@ -310,12 +303,11 @@ impl McapWriter {
                 },
                 data,
             )
-            .map_err(|e| e.to_string())
     }
 
     /// The file's bytes.
-    pub fn finish(mut self) -> Result<Vec<u8>, String> {
-        self.w.finish().map_err(|e| e.to_string())?;
+    pub fn finish(mut self) -> Result<Vec<u8>, ::mcap::McapError> {
+        self.w.finish()?;
         Ok(self.w.into_inner().into_inner())
     }
 }
@@ -326,7 +318,11 @@ mod tests {
 
     #[test]
     fn round_trips_compressed_and_not_and_cut_files_are_errors() {
-        for c in [None, Some("zstd"), Some("lz4")] {
+        for c in [
+            None,
+            Some(::mcap::Compression::Zstd),
+            Some(::mcap::Compression::Lz4),
+        ] {
             let mut w = McapWriter::new(c, 300).unwrap();
             for i in 0..30 {
                 let data = vec![0u8, 1, 0, 0, i as u8, 7, 7, 7];

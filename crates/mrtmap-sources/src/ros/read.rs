@@ -104,7 +104,8 @@ pub fn for_each<'a>(
                     return f(m);
                 }
                 let data =
-                    super::db3::inflate(m.data, &mut buf).map_err(|e| Corrupt::new(m.offset, e))?;
+                    super::db3::inflate(m.data, &mut buf)
+                    .map_err(|e| Corrupt::new(m.offset, e.to_string()))?;
                 f(Message { data, ..m })
             };
             super::mcap::for_each_message_in(&mut *input.open()?, &mut g).map(|s| s.unfinished)

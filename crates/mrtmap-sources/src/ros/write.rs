@@ -76,21 +76,23 @@ pub fn write_ros(rec: &Recording, o: &RosWriteOptions) -> Result<Vec<u8>, FileEr
         Mcap(Box<super::mcap::McapWriter>),
         Db3(super::db3::Db3Writer),
     }
-    let syntax = |e: String| FileError::new(&rec.dir, None, FileErrorKind::Syntax(e));
+    let syntax = |e: &dyn std::error::Error| {
+        FileError::new(&rec.dir, None, FileErrorKind::Syntax(e.to_string()))
+    };
     let mut w = match o.container {
         Container::Bag => W::Bag(BagWriter::new(o.compression, 768 * 1024)),
         Container::Mcap => W::Mcap(Box::new(
             super::mcap::McapWriter::new(
                 match o.compression {
                     Compression::None => None,
-                    Compression::Lz4 => Some("lz4"),
-                    Compression::Bz2 => Some("zstd"),
+                    Compression::Lz4 => Some(::mcap::Compression::Lz4),
+                    Compression::Bz2 => Some(::mcap::Compression::Zstd),
                 },
                 768 * 1024,
             )
-            .map_err(syntax)?,
+            .map_err(|e| syntax(&e))?,
         )),
-        Container::Db3 => W::Db3(super::db3::Db3Writer::new().map_err(syntax)?),
+        Container::Db3 => W::Db3(super::db3::Db3Writer::new().map_err(|e| syntax(&e))?),
     };
     let ty = |t: &str| -> String {
         match o.container {
@@ -107,8 +109,8 @@ pub fn write_ros(rec: &Recording, o: &RosWriteOptions) -> Result<Vec<u8>, FileEr
                 b.write(topic, &ty(datatype), t, data);
                 Ok(())
             }
-            W::Mcap(m) => m.write(topic, &ty(datatype), t, data).map_err(syntax),
-            W::Db3(d) => d.write(topic, &ty(datatype), t, data).map_err(syntax),
+            W::Mcap(m) => m.write(topic, &ty(datatype), t, data).map_err(|e| syntax(&e)),
+            W::Db3(d) => d.write(topic, &ty(datatype), t, data).map_err(|e| syntax(&e)),
         }
     };
     let rig = &rec.rig;
@@ -250,8 +252,8 @@ pub fn write_ros(rec: &Recording, o: &RosWriteOptions) -> Result<Vec<u8>, FileEr
         }
     }
     match w {
-        W::Bag(b) => Ok(b.finish()),
-        W::Mcap(m) => m.finish().map_err(syntax),
-        W::Db3(d) => d.finish().map_err(syntax),
+        W::Bag(b) => b.finish().map_err(|e| FileError::io(&rec.dir, e)),
+        W::Mcap(m) => m.finish().map_err(|e| syntax(&e)),
+        W::Db3(d) => d.finish().map_err(|e| syntax(&e)),
     }
 }

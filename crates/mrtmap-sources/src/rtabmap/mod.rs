@@ -724,14 +724,15 @@ pub fn calibration_blob(cam: &PinholeCamera, local: &Isometry3<f64>, version: [i
     b
 }
 
-fn compress(data: &[u8], rows: i32, cols: i32, ty: i32) -> Vec<u8> {
+fn compress(data: &[u8], rows: i32, cols: i32, ty: i32) -> std::io::Result<Vec<u8>> {
+    use std::io::Write;
     let mut e = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
-    let _ = std::io::Write::write_all(&mut e, data);
-    let mut b = e.finish().unwrap_or_default();
+    e.write_all(data)?;
+    let mut b = e.finish()?;
     for v in [rows, cols, ty] {
         b.extend_from_slice(&v.to_le_bytes());
     }
-    b
+    Ok(b)
 }
 
 /// Writes a database in RTAB-Map's layout (the tables and columns this reader uses, as RTAB-Map
@@ -774,7 +775,9 @@ pub fn write_database(
         .map_err(e)?;
         let depth = match schema {
             Schema::Current => rvl::encode_rtabmap(n.depth.width, n.depth.height, &n.depth.data),
-            Schema::Legacy => mrtmap_io::encode_png16(n.depth),
+            Schema::Legacy => {
+                mrtmap_io::encode_png16(n.depth).map_err(|er| FileError::encode(path, er))?
+            }
         };
         tx.execute(
             "INSERT INTO Data (id, image, depth, calibration) VALUES (?1, ?2, ?3, ?4)",
@@ -812,13 +815,12 @@ pub fn write_database(
                 .iter()
                 .flat_map(|n| pose_bytes(&n.optimised))
                 .collect();
+            let io = |er| FileError::io(path, er);
+            let ids = compress(&ids, 1, nodes.len() as i32, 4).map_err(io)?;
+            let poses = compress(&poses, nodes.len() as i32, 12, 5).map_err(io)?;
             tx.execute(
                 "INSERT INTO Admin (version, opt_ids, opt_poses) VALUES (?1, ?2, ?3)",
-                rusqlite::params![
-                    version,
-                    compress(&ids, 1, nodes.len() as i32, 4),
-                    compress(&poses, nodes.len() as i32, 12, 5)
-                ],
+                rusqlite::params![version, ids, poses],
             )
             .map_err(e)?;
         }
@@ -941,11 +943,11 @@ mod tests {
     #[test]
     fn compressed_blob_checks_its_trailer() {
         let data: Vec<u8> = (0..96u8).collect();
-        let b = compress(&data, 2, 12, 5);
+        let b = compress(&data, 2, 12, 5).unwrap();
         assert_eq!(uncompress(&b, "x").unwrap().0, data);
-        let lie = compress(&data, 3, 12, 5);
+        let lie = compress(&data, 3, 12, 5).unwrap();
         assert!(uncompress(&lie, "x").unwrap_err().contains("decompresses"));
-        let huge = compress(&data, i32::MAX, i32::MAX, 5);
+        let huge = compress(&data, i32::MAX, i32::MAX, 5).unwrap();
         assert!(uncompress(&huge, "x").unwrap_err().contains("too large"));
         assert!(pose_blob(&[0; 40], "p").is_err());
         // Determinant 1 but far from a rotation: refused (it used to loop forever).

@@ -66,7 +66,7 @@ fn recording(dir: &Path) -> Recording {
                 })
                 .collect(),
         };
-        std::fs::write(dir.join(format!("depth/{i}.png")), encode_png16(&d)).unwrap();
+        std::fs::write(dir.join(format!("depth/{i}.png")), encode_png16(&d).unwrap()).unwrap();
         lists[0] += &format!("{t:.6} depth/{i}.png\n");
         if i % 2 == 0 {
             let th = Image16 {
@@ -74,12 +74,12 @@ fn recording(dir: &Path) -> Recording {
                 height: 12,
                 data: (0..192).map(|k| 29_315 + k as u16 * 3 + i).collect(),
             };
-            std::fs::write(dir.join(format!("thermal/{i}.png")), encode_png16(&th)).unwrap();
+            std::fs::write(dir.join(format!("thermal/{i}.png")), encode_png16(&th).unwrap()).unwrap();
             lists[1] += &format!("{:.6} thermal/{i}.png\n", t + 0.01);
             let rgb: Vec<u8> = (0..300 * 3).map(|k| (k * 7 + i as usize) as u8).collect();
             std::fs::write(
                 dir.join(format!("rgb/{i}.png")),
-                encode_png_rgb8(20, 15, &rgb),
+                encode_png_rgb8(20, 15, &rgb).unwrap(),
             )
             .unwrap();
             lists[2] += &format!("{t:.6} rgb/{i}.png\n");
@@ -236,7 +236,7 @@ fn poses_from_tf_and_a_missing_thermal_calibration() {
         );
     }
     write_thermal(&mut w, &orig, "/lepton/image");
-    let bag = w.finish();
+    let bag = w.finish().unwrap();
     let s = ros::survey(Container::Bag, &bag).unwrap();
     // No thermal CameraInfo: the plan says so, and a rig supplies it.
     let p = ros::plan(
@@ -308,7 +308,7 @@ fn broken_bags_and_mcap_files_name_the_offset() {
     // A chunk header that claims 3 GB decompressed is refused before anything is allocated.
     let mut w = BagWriter::new(Compression::None, 1 << 20);
     w.write("/a", "std_msgs/String", 1.0, b"abc");
-    let mut big = w.finish();
+    let mut big = w.finish().unwrap();
     let pos = big.windows(5).position(|x| x == b"size=").unwrap() + 5;
     big[pos..pos + 4].copy_from_slice(&3_000_000_000u32.to_le_bytes());
     let e = ros::survey(Container::Bag, &big).unwrap_err();
@@ -335,7 +335,7 @@ fn broken_bags_and_mcap_files_name_the_offset() {
         1.0,
         &encode::image(Wire::Ros1, 1.0, "c", 20, 15, "16UC1", 40, &[0; 100]),
     );
-    let s = ros::survey(Container::Bag, &w.finish()).unwrap();
+    let s = ros::survey(Container::Bag, &w.finish().unwrap()).unwrap();
     assert_eq!(s.topics[names::DEPTH].undecodable, 1);
     let p = ros::plan(&s, &RosOptions::default());
     assert!(
@@ -480,7 +480,7 @@ fn compressed_depth_and_float_depth_topics() {
             let img = orig.read_depth(e).unwrap();
             if variant == "compressedDepth" {
                 let mut data = vec![0u8; 12];
-                data.extend(encode_png16(&img));
+                data.extend(encode_png16(&img).unwrap());
                 w.write(
                     "/d/image_raw/compressedDepth",
                     "sensor_msgs/CompressedImage",
@@ -508,7 +508,7 @@ fn compressed_depth_and_float_depth_topics() {
             }
         }
         write_thermal(&mut w, &orig, "/t/image");
-        let bag = w.finish();
+        let bag = w.finish().unwrap();
         let s = ros::survey(Container::Bag, &bag).unwrap();
         let p = ros::plan(
             &s,

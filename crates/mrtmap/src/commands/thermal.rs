@@ -2,7 +2,7 @@
 
 use anyhow::bail;
 use mrtmap_io::flir::FlirOverrides;
-use mrtmap_io::{ThermalImage, ThermalOptions, encode_png_rgb8, encode_png16, iron};
+use mrtmap_io::{FileError, ThermalOptions, encode_png16};
 use serde::Serialize;
 
 use crate::cli::ThermalArgs;
@@ -61,41 +61,6 @@ struct Out<'a> {
     notes: &'a [String],
 }
 
-fn csv(img: &ThermalImage) -> String {
-    let mut s = String::with_capacity(img.celsius.len() * 7);
-    for row in img.celsius.chunks(img.width as usize) {
-        let cells: Vec<String> = row
-            .iter()
-            .map(|c| {
-                if c.is_finite() {
-                    format!("{c:.3}")
-                } else {
-                    String::new()
-                }
-            })
-            .collect();
-        s.push_str(&cells.join(","));
-        s.push('\n');
-    }
-    s
-}
-
-fn colour_png(img: &ThermalImage, lo: f64, hi: f64) -> Vec<u8> {
-    let span = (hi - lo).max(1e-9);
-    let rgb: Vec<u8> = img
-        .celsius
-        .iter()
-        .flat_map(|&c| {
-            if c.is_finite() {
-                iron(((c - lo) / span) as f32)
-            } else {
-                [0, 0, 0]
-            }
-        })
-        .collect();
-    encode_png_rgb8(img.width, img.height, &rgb)
-}
-
 pub fn run(a: &ThermalArgs) -> anyhow::Result<()> {
     let opts = options(a)?;
     let img = mrtmap_io::read_thermal_file(&a.file, &opts)?;
@@ -121,13 +86,15 @@ pub fn run(a: &ThermalArgs) -> anyhow::Result<()> {
         notes: &img.notes,
     };
     if let Some(p) = &a.csv {
-        write_atomic(p, csv(&img).as_bytes())?;
+        write_atomic(p, img.csv().as_bytes())?;
     }
     if let Some(p) = &a.png {
-        write_atomic(p, &colour_png(&img, lo, hi))?;
+        let png = img.iron_png(lo, hi).map_err(|e| FileError::encode(p, e))?;
+        write_atomic(p, &png)?;
     }
     if let Some(p) = &a.centikelvin {
-        write_atomic(p, &encode_png16(&img.centikelvin()))?;
+        let png = encode_png16(&img.centikelvin()).map_err(|e| FileError::encode(p, e))?;
+        write_atomic(p, &png)?;
     }
     if a.json {
         print!("{}", json(&out)?);
