@@ -203,47 +203,50 @@ fn rotation_deg(p: &Isometry3<f64>) -> f64 {
     p.rotation.angle().to_degrees()
 }
 
-/// Fuses a recording. `progress(done, total)` is called after each frame.
-pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) + Sync)) -> Fused {
-    let t_start = Instant::now();
-    let limits = InterpolationLimits::default();
-    let pairs = pair_frames(rec, params.sync_tolerance_s, &limits);
-    let mut report = FusionReport {
-        recording: rec.dir.display().to_string(),
-        thermal_frames: rec.thermal.len(),
-        depth_frames: rec.depth.len(),
-        parameters: *params,
-        ..Default::default()
-    };
-    report.icp.enabled = params.icp.enabled;
-    let skip = |r: SkipReason, report: &mut FusionReport| {
-        *report.skipped.entry(r.describe().to_string()).or_default() += 1;
-    };
-    let usable: Vec<(usize, usize)> = pairs
-        .iter()
-        .filter_map(|p| match p.depth {
-            Ok(d) => Some((p.thermal, d)),
-            Err(r) => {
-                skip(r, &mut report);
-                None
-            }
-        })
-        .collect();
-    let total = rec.thermal.len() as u64;
-    let mut done = (rec.thermal.len() - usable.len()) as u64;
-    let rays = RayTable::new(&rec.rig.depth);
-    let mut map = VoxelMap::new(params.voxel_m);
-    let mut target: Option<IcpTarget> = None;
-    let mut since_rebuild = 0usize;
-    let mut correction = Isometry3::identity();
-    let (mut fit_sum, mut rmse_sum) = (0.0, 0.0);
-    let mut poses = Vec::new();
-    let mut timing = Timing::default();
+/// A prepared frame with its poses: world_from_depth and world_from_thermal-depth (before ICP),
+/// or after it world_from_depth and world_from_thermal.
+type Posed = (Prepared, Isometry3<f64>, Isometry3<f64>);
 
-    for chunk in usable.chunks(params.chunk.max(1)) {
-        // Read and back-project in parallel.
+/// The state carried through a fusion, chunk after chunk.
+struct Fuser<'a> {
+    rec: &'a Recording,
+    params: &'a FuseParams,
+    limits: InterpolationLimits,
+    rays: RayTable,
+    report: FusionReport,
+    map: VoxelMap,
+    target: Option<IcpTarget>,
+    since_rebuild: usize,
+    /// The ICP correction carried from frame to frame.
+    correction: Isometry3<f64>,
+    fit_sum: f64,
+    rmse_sum: f64,
+    poses: Vec<(f64, Isometry3<f64>)>,
+    timing: Timing,
+    done: u64,
+}
+
+impl Fuser<'_> {
+    /// Counts a frame skipped for `r`.
+    fn skip(&mut self, r: SkipReason) {
+        *self
+            .report
+            .skipped
+            .entry(r.describe().to_string())
+            .or_default() += 1;
+    }
+
+    /// Counts a frame skipped for `r` before it reaches the map: it is done.
+    fn drop_frame(&mut self, r: SkipReason) {
+        self.skip(r);
+        self.done += 1;
+    }
+
+    /// Reads and back-projects a chunk of (thermal, depth) frame pairs in parallel.
+    fn prepare(&mut self, chunk: &[(usize, usize)]) -> Vec<Result<Prepared, String>> {
         let t0 = Instant::now();
-        let prepared: Vec<Result<Prepared, String>> = chunk
+        let (rec, params) = (self.rec, self.params);
+        let prepared = chunk
             .par_iter()
             .map(|&(ti, di)| {
                 let th = &rec.thermal[ti];
@@ -253,115 +256,133 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
                 Ok(Prepared {
                     thermal_t: th.t,
                     depth_t: de.t,
-                    points: depth_points(&depth, &rays, rec.rig.depth_scale, &params.depth),
+                    points: depth_points(&depth, &self.rays, rec.rig.depth_scale, &params.depth),
                     thermal: ThermalImage::from_raw(&thermal, rec.rig.thermal_encoding),
                 })
             })
             .collect();
-        timing.read_cpu += t0.elapsed().as_secs_f64() * rayon::current_num_threads() as f64;
+        self.timing.read_cpu += t0.elapsed().as_secs_f64() * rayon::current_num_threads() as f64;
+        prepared
+    }
 
-        // ICP: every frame of the chunk is refined in parallel from the correction at the chunk's
-        // start; the carried correction is then updated in frame order.
-        let t1 = Instant::now();
-        let mut ready: Vec<(Prepared, Isometry3<f64>, Isometry3<f64>)> =
-            Vec::with_capacity(chunk.len());
+    /// The frames that can be used, with their poses; the others skipped and counted.
+    fn posed(&mut self, prepared: Vec<Result<Prepared, String>>) -> Vec<Posed> {
+        let mut ready = Vec::with_capacity(prepared.len());
         for pr in prepared {
             let pr = match pr {
                 Ok(p) => p,
                 Err(msg) => {
-                    skip(SkipReason::UnreadableImage, &mut report);
-                    if report.problems.len() < 10 {
-                        report.problems.push(msg);
+                    self.drop_frame(SkipReason::UnreadableImage);
+                    if self.report.problems.len() < 10 {
+                        self.report.problems.push(msg);
                     }
-                    done += 1;
                     continue;
                 }
             };
             if pr.points.points.len() < 100 {
-                skip(SkipReason::TooFewDepthPoints, &mut report);
-                done += 1;
+                self.drop_frame(SkipReason::TooFewDepthPoints);
                 continue;
             }
+            let traj = &self.rec.trajectory;
             let (Some(wd), Some(wt)) = (
-                rec.trajectory.interpolate(pr.depth_t, &limits),
-                rec.trajectory.interpolate(pr.thermal_t, &limits),
+                traj.interpolate(pr.depth_t, &self.limits),
+                traj.interpolate(pr.thermal_t, &self.limits),
             ) else {
-                skip(SkipReason::NoPose, &mut report);
-                done += 1;
+                self.drop_frame(SkipReason::NoPose);
                 continue;
             };
             ready.push((pr, wd, wt));
         }
-        let start = correction;
-        let refinements: Vec<Option<Result<Refinement, &'static str>>> = ready
-            .par_iter()
-            .map(|(pr, wd, _)| {
-                let tgt = target.as_ref().filter(|_| params.icp.enabled)?;
-                let init = start * wd;
-                let step = (pr.points.points.len() / params.icp.source_points.max(1)).max(1);
-                let src: Vec<Point3<f64>> = pr
-                    .points
-                    .points
-                    .iter()
-                    .step_by(step)
-                    .map(|p| init * p)
-                    .collect();
-                let reg = icp_point_to_plane(&src, tgt, &Isometry3::identity(), &params.icp.params);
-                let d = reg.target_from_source;
-                Some(if reg.fitness < params.icp.min_fitness {
-                    Err("fitness below the limit")
-                } else if reg.inlier_plane_rmse_m > params.icp.max_rmse_m {
-                    Err("residual above the limit")
-                } else if d.translation.vector.norm() > params.icp.max_step_m
-                    || rotation_deg(&d) > params.icp.max_step_deg
-                {
-                    Err("step larger than the limit")
-                } else {
-                    Ok(Refinement {
-                        delta: d,
-                        fitness: reg.fitness,
-                        rmse_m: reg.inlier_rmse_m,
-                        degenerate_dofs: reg.degenerate_dofs,
-                    })
-                })
-            })
+        ready
+    }
+
+    /// One frame's ICP against the map, from the correction `start`: `None` without a target.
+    fn refine(
+        &self,
+        pr: &Prepared,
+        wd: &Isometry3<f64>,
+        start: &Isometry3<f64>,
+    ) -> Option<Result<Refinement, &'static str>> {
+        let params = self.params;
+        let tgt = self.target.as_ref().filter(|_| params.icp.enabled)?;
+        let init = start * wd;
+        let step = (pr.points.points.len() / params.icp.source_points.max(1)).max(1);
+        let src: Vec<Point3<f64>> = pr
+            .points
+            .points
+            .iter()
+            .step_by(step)
+            .map(|p| init * p)
             .collect();
-        let mut work: Vec<(Prepared, Isometry3<f64>, Isometry3<f64>)> =
-            Vec::with_capacity(ready.len());
+        let reg = icp_point_to_plane(&src, tgt, &Isometry3::identity(), &params.icp.params);
+        let d = reg.target_from_source;
+        Some(if reg.fitness < params.icp.min_fitness {
+            Err("fitness below the limit")
+        } else if reg.inlier_plane_rmse_m > params.icp.max_rmse_m {
+            Err("residual above the limit")
+        } else if d.translation.vector.norm() > params.icp.max_step_m
+            || rotation_deg(&d) > params.icp.max_step_deg
+        {
+            Err("step larger than the limit")
+        } else {
+            Ok(Refinement {
+                delta: d,
+                fitness: reg.fitness,
+                rmse_m: reg.inlier_rmse_m,
+                degenerate_dofs: reg.degenerate_dofs,
+            })
+        })
+    }
+
+    /// ICP: every frame of the chunk is refined in parallel from the correction at the chunk's
+    /// start; the carried correction is then updated in frame order. Returns the frames with
+    /// their refined world_from_depth and world_from_thermal.
+    fn register(&mut self, ready: Vec<Posed>) -> Vec<Posed> {
+        let t1 = Instant::now();
+        let start = self.correction;
+        let refinements: Vec<_> = ready
+            .par_iter()
+            .map(|(pr, wd, _)| self.refine(pr, wd, &start))
+            .collect();
+        let mut work = Vec::with_capacity(ready.len());
         for ((pr, wd, wt), refinement) in ready.into_iter().zip(refinements) {
             let mut frame_correction = start;
             match refinement {
                 None => {}
                 Some(Err(why)) => {
-                    report.icp.attempted += 1;
-                    *report.icp.rejected.entry(why.to_string()).or_default() += 1;
+                    self.report.icp.attempted += 1;
+                    *self.report.icp.rejected.entry(why.to_string()).or_default() += 1;
                 }
                 Some(Ok(r)) => {
-                    report.icp.attempted += 1;
-                    report.icp.accepted += 1;
-                    fit_sum += r.fitness;
-                    rmse_sum += r.rmse_m;
-                    report.icp.degenerate_frames += (r.degenerate_dofs > 0) as usize;
+                    self.report.icp.attempted += 1;
+                    self.report.icp.accepted += 1;
+                    self.fit_sum += r.fitness;
+                    self.rmse_sum += r.rmse_m;
+                    self.report.icp.degenerate_frames += (r.degenerate_dofs > 0) as usize;
                     frame_correction = r.delta * start;
-                    correction =
-                        correction.lerp_slerp(&frame_correction, params.icp.correction_gain);
+                    self.correction = self
+                        .correction
+                        .lerp_slerp(&frame_correction, self.params.icp.correction_gain);
                 }
             }
             let world_from_depth = frame_correction * wd;
-            let world_from_thermal = frame_correction * wt * rec.rig.depth_from_thermal;
-            poses.push((pr.thermal_t, world_from_depth));
+            let world_from_thermal = frame_correction * wt * self.rec.rig.depth_from_thermal;
+            self.poses.push((pr.thermal_t, world_from_depth));
             work.push((pr, world_from_depth, world_from_thermal));
         }
-        timing.icp += t1.elapsed().as_secs_f64();
+        self.timing.icp += t1.elapsed().as_secs_f64();
+        work
+    }
 
-        // Observe in parallel.
+    /// Observes the frames' temperatures on their points, in parallel.
+    fn observe(&mut self, work: &[Posed]) -> Vec<(FrameVoxels, ObservationCounts)> {
         let t2 = Instant::now();
-        let results: Vec<(FrameVoxels, ObservationCounts)> = work
+        let (rec, params) = (self.rec, self.params);
+        let results = work
             .par_iter()
             .map(|(pr, wd, wt)| {
                 let pts: Vec<Point3<f64>> = pr.points.points.iter().map(|p| wd * p).collect();
-                let nrm: Vec<Vector3<f64>> =
-                    pr.points.normals.iter().map(|n| wd.rotation * n).collect();
+                let nrm: Vector3List = pr.points.normals.iter().map(|n| wd.rotation * n).collect();
                 let (obs, counts) = observe(
                     &pts,
                     &nrm,
@@ -380,47 +401,111 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
                 (fv, counts)
             })
             .collect();
-        timing.observe_cpu += t2.elapsed().as_secs_f64() * rayon::current_num_threads() as f64;
+        self.timing.observe_cpu += t2.elapsed().as_secs_f64() * rayon::current_num_threads() as f64;
+        results
+    }
 
-        // Merge in frame order.
+    /// Merges the frames into the map in frame order, and rebuilds the ICP target when due.
+    fn merge(
+        &mut self,
+        results: Vec<(FrameVoxels, ObservationCounts)>,
+        total: u64,
+        progress: &(dyn Fn(u64, u64) + Sync),
+    ) {
         let t3 = Instant::now();
         for (fv, counts) in results {
             if counts.kept == 0 {
-                skip(SkipReason::NothingVisible, &mut report);
+                self.skip(SkipReason::NothingVisible);
             } else {
-                report.used_frames += 1;
+                self.report.used_frames += 1;
             }
-            report.observations.add(&counts);
-            map.merge(fv);
-            since_rebuild += 1;
-            done += 1;
-            progress(done, total);
+            self.report.observations.add(&counts);
+            self.map.merge(fv);
+            self.since_rebuild += 1;
+            self.done += 1;
+            progress(self.done, total);
         }
-        if params.icp.enabled && (target.is_none() || since_rebuild >= params.icp.rebuild_every) {
-            let (p, n) = map.surface(3, params.icp.target_every);
-            if p.len() >= params.icp.min_map_voxels {
-                target = Some(IcpTarget::new(p, n));
-                since_rebuild = 0;
+        let icp = &self.params.icp;
+        if icp.enabled && (self.target.is_none() || self.since_rebuild >= icp.rebuild_every) {
+            let (p, n) = self.map.surface(3, icp.target_every);
+            if p.len() >= icp.min_map_voxels {
+                self.target = Some(IcpTarget::new(p, n));
+                self.since_rebuild = 0;
             }
         }
-        timing.merge += t3.elapsed().as_secs_f64();
+        self.timing.merge += t3.elapsed().as_secs_f64();
     }
-    let t4 = Instant::now();
-    let cloud = map.to_cloud();
-    timing.output = t4.elapsed().as_secs_f64();
-    timing.total = t_start.elapsed().as_secs_f64();
-    report.voxels = cloud.len();
-    if report.icp.accepted > 0 {
-        report.icp.mean_fitness = fit_sum / report.icp.accepted as f64;
-        report.icp.mean_inlier_rmse_m = rmse_sum / report.icp.accepted as f64;
+
+    /// The cloud, and the report completed.
+    fn finish(mut self, t_start: Instant) -> Fused {
+        let t4 = Instant::now();
+        let cloud = self.map.to_cloud();
+        self.timing.output = t4.elapsed().as_secs_f64();
+        self.timing.total = t_start.elapsed().as_secs_f64();
+        let report = &mut self.report;
+        report.voxels = cloud.len();
+        if report.icp.accepted > 0 {
+            report.icp.mean_fitness = self.fit_sum / report.icp.accepted as f64;
+            report.icp.mean_inlier_rmse_m = self.rmse_sum / report.icp.accepted as f64;
+        }
+        report.icp.final_correction_m = self.correction.translation.vector.norm();
+        report.icp.final_correction_deg = rotation_deg(&self.correction);
+        report.frames_per_second = report.thermal_frames as f64 / self.timing.total.max(1e-9);
+        report.timing_s = self.timing;
+        Fused {
+            cloud,
+            report: self.report,
+            poses: self.poses,
+        }
     }
-    report.icp.final_correction_m = correction.translation.vector.norm();
-    report.icp.final_correction_deg = rotation_deg(&correction);
-    report.frames_per_second = report.thermal_frames as f64 / timing.total.max(1e-9);
-    report.timing_s = timing;
-    Fused {
-        cloud,
+}
+
+/// Normals of a frame's points.
+type Vector3List = Vec<Vector3<f64>>;
+
+/// Fuses a recording. `progress(done, total)` is called after each frame.
+pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) + Sync)) -> Fused {
+    let t_start = Instant::now();
+    let limits = InterpolationLimits::default();
+    let pairs = pair_frames(rec, params.sync_tolerance_s, &limits);
+    let mut report = FusionReport {
+        recording: rec.dir.display().to_string(),
+        thermal_frames: rec.thermal.len(),
+        depth_frames: rec.depth.len(),
+        parameters: *params,
+        ..Default::default()
+    };
+    report.icp.enabled = params.icp.enabled;
+    let mut fuser = Fuser {
+        rec,
+        params,
+        limits,
+        rays: RayTable::new(&rec.rig.depth),
         report,
-        poses,
+        map: VoxelMap::new(params.voxel_m),
+        target: None,
+        since_rebuild: 0,
+        correction: Isometry3::identity(),
+        fit_sum: 0.0,
+        rmse_sum: 0.0,
+        poses: Vec::new(),
+        timing: Timing::default(),
+        done: 0,
+    };
+    let mut usable: Vec<(usize, usize)> = Vec::new();
+    for p in &pairs {
+        match p.depth {
+            Ok(d) => usable.push((p.thermal, d)),
+            Err(r) => fuser.drop_frame(r),
+        }
     }
+    let total = rec.thermal.len() as u64;
+    for chunk in usable.chunks(params.chunk.max(1)) {
+        let prepared = fuser.prepare(chunk);
+        let ready = fuser.posed(prepared);
+        let work = fuser.register(ready);
+        let results = fuser.observe(&work);
+        fuser.merge(results, total, progress);
+    }
+    fuser.finish(t_start)
 }

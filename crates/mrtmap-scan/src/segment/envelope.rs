@@ -151,18 +151,30 @@ pub fn find_planes(
         .collect()
 }
 
-/// Classifies planes against an up estimate, picks floor and ceiling, refines up from the floor,
-/// links the walls into a loop and computes the corners.
-pub fn envelope(
+/// Height of a point along `up`.
+fn height(pt: &Point3<f64>, up: &Vector3<f64>) -> f64 {
+    up.dot(&pt.coords)
+}
+
+/// Floor and ceiling, and up refined from the floor's normal.
+struct Caps {
+    floor: usize,
+    ceiling: usize,
+    up: Unit<Vector3<f64>>,
+    h_floor: f64,
+    h_ceiling: f64,
+}
+
+/// Floor and ceiling: the lowest and highest large horizontal planes; up from the floor's normal,
+/// oriented like the cameras' up. Classifies the horizontal planes and orients the floor's normal
+/// up and the ceiling's down.
+fn floor_and_ceiling(
     points: &[Point3<f64>],
-    mut planes: Vec<FoundPlane>,
+    planes: &mut [FoundPlane],
     up0: Unit<Vector3<f64>>,
     p: &SegmentParams,
-) -> Result<Envelope, SegmentError> {
+) -> Result<Caps, SegmentError> {
     let cos_h = p.horizontal_deg.to_radians().cos();
-    let sin_v = p.vertical_deg.to_radians().sin();
-    let height = |pt: &Point3<f64>, up: &Vector3<f64>| up.dot(&pt.coords);
-    // Floor and ceiling: the lowest and highest large horizontal planes.
     let horizontal: Vec<usize> = (0..planes.len())
         .filter(|&k| planes[k].plane.normal.dot(&up0).abs() > cos_h)
         .collect();
@@ -180,31 +192,24 @@ pub fn envelope(
         .iter()
         .map(|f| height(&mean_of(points, &f.inliers), &up0))
         .collect();
-    let plane_height = |k: usize| heights[k];
     let floor = *big
         .iter()
-        .min_by(|&&a, &&b| plane_height(a).total_cmp(&plane_height(b)))
+        .min_by(|&&a, &&b| heights[a].total_cmp(&heights[b]))
         .ok_or(SegmentError::NoFloor)?;
     let ceiling = *big
         .iter()
-        .max_by(|&&a, &&b| plane_height(a).total_cmp(&plane_height(b)))
+        .max_by(|&&a, &&b| heights[a].total_cmp(&heights[b]))
         .ok_or(SegmentError::NoCeiling)?;
-    if floor == ceiling || plane_height(ceiling) - plane_height(floor) < 1.5 {
+    if floor == ceiling || heights[ceiling] - heights[floor] < 1.5 {
         return Err(SegmentError::NoCeiling);
     }
-    // Up from the floor's normal, oriented like the cameras' up.
-    let mut fp = planes[floor].plane;
-    if fp.normal.dot(&up0) < 0.0 {
-        fp = fp.flipped();
+    if planes[floor].plane.normal.dot(&up0) < 0.0 {
+        planes[floor].plane = planes[floor].plane.flipped();
     }
-    planes[floor].plane = fp;
-    let up = fp.normal;
-    let mut cp = planes[ceiling].plane;
-    if cp.normal.dot(&up) > 0.0 {
-        cp = cp.flipped();
+    let up = planes[floor].plane.normal;
+    if planes[ceiling].plane.normal.dot(&up) > 0.0 {
+        planes[ceiling].plane = planes[ceiling].plane.flipped();
     }
-    planes[ceiling].plane = cp;
-    let (h_floor, h_ceiling) = (plane_height(floor), plane_height(ceiling));
     for &k in &horizontal {
         if k != floor && k != ceiling {
             planes[k].class = PlaneClass::OtherHorizontal;
@@ -212,132 +217,185 @@ pub fn envelope(
     }
     planes[floor].class = PlaneClass::Floor;
     planes[ceiling].class = PlaneClass::Ceiling;
-    // The room's interior: the mean of points between floor and ceiling.
+    Ok(Caps {
+        floor,
+        ceiling,
+        up,
+        h_floor: heights[floor],
+        h_ceiling: heights[ceiling],
+    })
+}
+
+/// The room's interior: the mean of points between floor and ceiling.
+fn room_centre(points: &[Point3<f64>], caps: &Caps) -> Point3<f64> {
     let inside: Vec<Point3<f64>> = points
         .iter()
         .filter(|q| {
-            let h = height(q, &up);
-            h > h_floor + 0.2 && h < h_ceiling - 0.2
+            let h = height(q, &caps.up);
+            h > caps.h_floor + 0.2 && h < caps.h_ceiling - 0.2
         })
         .copied()
         .collect();
-    let centre = centroid(&inside);
-    // Walls: vertical planes spanning enough of the room's height.
+    centroid(&inside)
+}
+
+/// The bins (start, end, count) of the contiguous run of occupied 10 cm bins (gaps up to 30 cm)
+/// holding the most points.
+fn main_run_bins(count: &[usize]) -> (usize, usize, usize) {
+    let (mut best, mut cur_start, mut gap, mut cur_n) =
+        ((0usize, 0usize, 0usize), None::<usize>, 0usize, 0usize);
+    for (b, &c) in count.iter().enumerate() {
+        if c >= 3 {
+            if cur_start.is_none() {
+                cur_start = Some(b);
+                cur_n = 0;
+            }
+            cur_n += c;
+            gap = 0;
+            if cur_n > best.2 {
+                best = (cur_start.unwrap_or(b), b, cur_n);
+            }
+        } else if cur_start.is_some() {
+            gap += 1;
+            if gap > 3 {
+                cur_start = None;
+            }
+        }
+    }
+    best
+}
+
+/// The wall's main run: 10 cm bins along it, the contiguous run (gaps up to 30 cm) holding the
+/// most inliers. Inliers elsewhere on the infinite plane belong to other surfaces and are dropped;
+/// returns the coverage, the occupied share of the run. A plane through the points of two corners
+/// (an artefact of mixed normals) covers little of its run.
+fn keep_main_run(plane: &mut FoundPlane, points: &[Point3<f64>], up: &Unit<Vector3<f64>>) -> f64 {
+    let d = up.cross(&plane.plane.normal);
+    let s: Vec<f64> = plane
+        .inliers
+        .iter()
+        .map(|&i| d.dot(&points[i].coords))
+        .collect();
+    let lo = s.iter().cloned().fold(f64::INFINITY, f64::min);
+    let hi = s.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+    let bins = (((hi - lo) / 0.1).ceil() as usize).clamp(1, 100_000);
+    let bin = |v: f64| (((v - lo) / 0.1) as usize).min(bins - 1);
+    let mut count = vec![0usize; bins];
+    for v in &s {
+        count[bin(*v)] += 1;
+    }
+    let (b0, b1, _) = main_run_bins(&count);
+    plane.inliers = plane
+        .inliers
+        .iter()
+        .zip(&s)
+        .filter(|(_, v)| (b0..=b1).contains(&bin(**v)))
+        .map(|(i, _)| *i)
+        .collect();
+    plane.points = plane.inliers.len();
+    count[b0..=b1].iter().filter(|&&c| c >= 3).count() as f64 / (b1 - b0 + 1) as f64
+}
+
+/// A vertical plane through `c` with `normal` made exactly horizontal, pointing into the room.
+fn vertical_plane(
+    normal: &Vector3<f64>,
+    c: &Point3<f64>,
+    up: &Unit<Vector3<f64>>,
+    centre: &Point3<f64>,
+) -> Plane {
+    let n = Unit::new_normalize(normal - up.as_ref() * normal.dot(up));
+    let pl = Plane::from_point_normal(c, n);
+    if pl.distance(centre) < 0.0 {
+        pl.flipped()
+    } else {
+        pl
+    }
+}
+
+/// Walls: vertical planes spanning much of the room's height, reaching the ceiling (furniture does
+/// not), seen along most of their length; made exactly vertical, facing into the room.
+fn find_walls(
+    points: &[Point3<f64>],
+    planes: &mut [FoundPlane],
+    caps: &Caps,
+    centre: &Point3<f64>,
+    p: &SegmentParams,
+) -> Vec<usize> {
+    let sin_v = p.vertical_deg.to_radians().sin();
+    let up = caps.up;
     let mut walls = Vec::new();
-    #[allow(clippy::needless_range_loop)] // planes[k] is read and rewritten in the body
-    for k in 0..planes.len() {
-        if planes[k].class != PlaneClass::Slanted || planes[k].plane.normal.dot(&up).abs() > sin_v {
+    for (k, plane) in planes.iter_mut().enumerate() {
+        if plane.class != PlaneClass::Slanted || plane.plane.normal.dot(&up).abs() > sin_v {
             continue; // horizontal (classified above) or slanted
         }
-        let mut hs: Vec<f64> = planes[k]
+        let mut hs: Vec<f64> = plane
             .inliers
             .iter()
             .map(|&i| height(&points[i], &up))
             .collect();
         let (bottom, top) = (percentile(&mut hs, 0.05), percentile(&mut hs, 0.98));
-        // The wall's main run: 10 cm bins along it, the contiguous run (gaps up to 30 cm) holding
-        // the most inliers. Inliers elsewhere on the infinite plane belong to other surfaces and
-        // are dropped; coverage is the occupied share of the run. A plane through the points of
-        // two corners (an artefact of mixed normals) covers little of its run.
-        let along = {
-            let n = planes[k].plane.normal;
-            let d = up.cross(&n);
-            let s: Vec<f64> = planes[k]
-                .inliers
-                .iter()
-                .map(|&i| d.dot(&points[i].coords))
-                .collect();
-            let lo = s.iter().cloned().fold(f64::INFINITY, f64::min);
-            let hi = s.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
-            let bins = (((hi - lo) / 0.1).ceil() as usize).clamp(1, 100_000);
-            let bin = |v: f64| (((v - lo) / 0.1) as usize).min(bins - 1);
-            let mut count = vec![0usize; bins];
-            for v in &s {
-                count[bin(*v)] += 1;
-            }
-            let (mut best, mut cur_start, mut gap, mut cur_n) =
-                ((0usize, 0usize, 0usize), None::<usize>, 0usize, 0usize);
-            for (b, &c) in count.iter().enumerate() {
-                if c >= 3 {
-                    if cur_start.is_none() {
-                        cur_start = Some(b);
-                        cur_n = 0;
-                    }
-                    cur_n += c;
-                    gap = 0;
-                    if cur_n > best.2 {
-                        best = (cur_start.unwrap_or(b), b, cur_n);
-                    }
-                } else if cur_start.is_some() {
-                    gap += 1;
-                    if gap > 3 {
-                        cur_start = None;
-                    }
-                }
-            }
-            let (b0, b1, _) = best;
-            planes[k].inliers = planes[k]
-                .inliers
-                .iter()
-                .zip(&s)
-                .filter(|(_, v)| (b0..=b1).contains(&bin(**v)))
-                .map(|(i, _)| *i)
-                .collect();
-            planes[k].points = planes[k].inliers.len();
-            count[b0..=b1].iter().filter(|&&c| c >= 3).count() as f64 / (b1 - b0 + 1) as f64
-        };
-        // A wall spans much of the room's height and reaches the ceiling (furniture does not), and
-        // is seen along most of its length.
-        if top - bottom >= p.wall_min_height_fraction * (h_ceiling - h_floor)
-            && top >= h_ceiling - p.wall_ceiling_gap_m
+        let along = keep_main_run(plane, points, &up);
+        if top - bottom >= p.wall_min_height_fraction * (caps.h_ceiling - caps.h_floor)
+            && top >= caps.h_ceiling - p.wall_ceiling_gap_m
             && along >= 0.5
         {
-            // Make vertical exactly (project the normal) and point it into the room.
-            let n = Unit::new_normalize(
-                planes[k].plane.normal.as_ref() - up.as_ref() * planes[k].plane.normal.dot(&up),
-            );
-            let c = mean_of(points, &planes[k].inliers);
-            let mut pl = Plane::from_point_normal(&c, n);
-            if pl.distance(&centre) < 0.0 {
-                pl = pl.flipped();
-            }
-            planes[k].plane = pl;
-            planes[k].class = PlaneClass::Wall;
+            let c = mean_of(points, &plane.inliers);
+            plane.plane = vertical_plane(&plane.plane.normal, &c, &up, centre);
+            plane.class = PlaneClass::Wall;
             walls.push(k);
         } else {
-            planes[k].class = PlaneClass::OtherVertical;
+            plane.class = PlaneClass::OtherVertical;
         }
     }
-    // One wall found twice (a doubled slab in a noisy cloud): merge walls whose horizontal
-    // directions agree within `merge_deg`, whose lines lie within `merge_distance_m` of each other
-    // and whose extents overlap; refit the merged wall.
-    let mut merged_any = true;
-    while merged_any {
-        merged_any = false;
-        'pairs: for a in 0..walls.len() {
+    walls
+}
+
+/// Whether walls `a` and `b` are one wall found twice: directions within `merge_deg`, lines within
+/// `merge_distance_m`, extents overlapping.
+fn same_wall(
+    points: &[Point3<f64>],
+    planes: &[FoundPlane],
+    (a, b): (usize, usize),
+    up: &Unit<Vector3<f64>>,
+    p: &SegmentParams,
+) -> bool {
+    let (pa, pb) = (planes[a].plane, planes[b].plane);
+    if pa.normal.dot(&pb.normal) < p.merge_deg.to_radians().cos() {
+        return false;
+    }
+    if pa.distance(&mean_of(points, &planes[b].inliers)).abs() > p.merge_distance_m {
+        return false;
+    }
+    let d = up.cross(&pa.normal);
+    let span = |k: usize| {
+        let mut s: Vec<f64> = planes[k]
+            .inliers
+            .iter()
+            .map(|&i| d.dot(&points[i].coords))
+            .collect();
+        (percentile(&mut s, 0.05), percentile(&mut s, 0.95))
+    };
+    let ((a0, a1), (b0, b1)) = (span(a), span(b));
+    a1.min(b1) - a0.max(b0) > 0.0
+}
+
+/// One wall found twice (a doubled slab in a noisy cloud): merges walls that are the same wall
+/// into the first and refits it.
+fn merge_doubled_walls(
+    points: &[Point3<f64>],
+    planes: &mut [FoundPlane],
+    walls: &mut Vec<usize>,
+    up: &Unit<Vector3<f64>>,
+    centre: &Point3<f64>,
+    p: &SegmentParams,
+) {
+    'again: loop {
+        for a in 0..walls.len() {
             for b in (a + 1)..walls.len() {
-                let (pa, pb) = (planes[walls[a]].plane, planes[walls[b]].plane);
-                if pa.normal.dot(&pb.normal) < p.merge_deg.to_radians().cos() {
-                    continue;
-                }
-                let d = up.cross(&pa.normal);
-                let cb = mean_of(points, &planes[walls[b]].inliers);
-                if pa.distance(&cb).abs() > p.merge_distance_m {
-                    continue;
-                }
-                let span = |k: usize| {
-                    let mut s: Vec<f64> = planes[k]
-                        .inliers
-                        .iter()
-                        .map(|&i| d.dot(&points[i].coords))
-                        .collect();
-                    (percentile(&mut s, 0.05), percentile(&mut s, 0.95))
-                };
-                let ((a0, a1), (b0, b1)) = (span(walls[a]), span(walls[b]));
-                if a1.min(b1) - a0.max(b0) <= 0.0 {
-                    continue;
-                }
                 let (ka, kb) = (walls[a], walls[b]);
+                if !same_wall(points, planes, (ka, kb), up, p) {
+                    continue;
+                }
                 let moved = std::mem::take(&mut planes[kb].inliers);
                 planes[ka].inliers.extend(moved);
                 planes[ka].points = planes[ka].inliers.len();
@@ -345,25 +403,27 @@ pub fn envelope(
                 planes[kb].class = PlaneClass::OtherVertical;
                 let pts: Vec<Point3<f64>> = planes[ka].inliers.iter().map(|&i| points[i]).collect();
                 if let Some(f) = Plane::fit(&pts) {
-                    let n =
-                        Unit::new_normalize(f.normal.as_ref() - up.as_ref() * f.normal.dot(&up));
-                    let mut pl = Plane::from_point_normal(&centroid(&pts), n);
-                    if pl.distance(&centre) < 0.0 {
-                        pl = pl.flipped();
-                    }
-                    planes[ka].plane = pl;
+                    planes[ka].plane = vertical_plane(&f.normal, &centroid(&pts), up, centre);
                 }
                 walls.remove(b);
-                merged_any = true;
-                break 'pairs;
+                continue 'again;
             }
         }
+        break;
     }
-    // A shadow of a wall: a weaker vertical plane, tilted a few degrees from a wall, whose points
-    // mostly lie within the wall's slab (RANSAC's leftovers of a thick fused wall plus whatever
-    // stands against it; long scans gather enough of them). It is not a wall of its own: drop
-    // walls within `SHADOW_DEG` of a wall with `SHADOW_RATIO` times their points when most of
-    // their points lie within two inlier distances of that wall's plane.
+}
+
+/// A shadow of a wall: a weaker vertical plane, tilted a few degrees from a wall, whose points
+/// mostly lie within the wall's slab (RANSAC's leftovers of a thick fused wall plus whatever
+/// stands against it; long scans gather enough of them). It is not a wall of its own: drops walls
+/// within `SHADOW_DEG` of a wall with `SHADOW_RATIO` times their points when most of their points
+/// lie within two inlier distances of that wall's plane.
+fn drop_shadow_walls(
+    points: &[Point3<f64>],
+    planes: &mut [FoundPlane],
+    walls: &mut Vec<usize>,
+    p: &SegmentParams,
+) {
     const SHADOW_DEG: f64 = 15.0;
     const SHADOW_RATIO: usize = 4;
     let shadows: Vec<usize> = walls
@@ -389,22 +449,36 @@ pub fn envelope(
         planes[w].class = PlaneClass::OtherVertical;
     }
     walls.retain(|w| !shadows.contains(w));
-    // The horizontal frame and the walls' lines and extents in it.
-    let origin = fp.project(&centre);
-    let frame = PlaneFrame::new(origin, up, &Vector3::x());
-    struct Line {
-        k: usize,
-        p: Point2<f64>,
-        d: Vector2<f64>,
-        ends: [Point2<f64>; 2],
+}
+
+/// A wall's line on the floor plan and the extent of its points along it.
+struct Line {
+    k: usize,
+    p: Point2<f64>,
+    d: Vector2<f64>,
+    ends: [Point2<f64>; 2],
+}
+
+impl Line {
+    fn length(&self) -> f64 {
+        (self.ends[1] - self.ends[0]).norm()
     }
-    let lines: Vec<Line> = walls
+}
+
+/// The walls' lines and extents in the horizontal frame.
+fn wall_lines(
+    points: &[Point3<f64>],
+    planes: &[FoundPlane],
+    walls: &[usize],
+    frame: &PlaneFrame,
+) -> Vec<Line> {
+    walls
         .iter()
         .map(|&k| {
             let pl = &planes[k].plane;
             let n2 = Vector2::new(frame.u.dot(&pl.normal), frame.v.dot(&pl.normal)).normalize();
             let d = Vector2::new(-n2.y, n2.x);
-            let on = frame.to_2d(&pl.project(&origin));
+            let on = frame.to_2d(&pl.project(&frame.origin));
             let mut s: Vec<f64> = planes[k]
                 .inliers
                 .iter()
@@ -418,9 +492,34 @@ pub fn envelope(
                 ends: [on + d * a, on + d * b],
             }
         })
-        .collect();
-    // Link wall ends: the corner of two walls is their lines' intersection; pair ends greedily by
-    // how far the corner lies from both ends.
+        .collect()
+}
+
+/// The wall lines, for an error message.
+fn describe_lines(lines: &[Line], planes: &[FoundPlane]) -> String {
+    lines
+        .iter()
+        .map(|l| {
+            let d = l.ends[1] - l.ends[0];
+            format!(
+                "{:.0}° {:.2} m long at ({:.2}, {:.2}), {} points",
+                d.y.atan2(d.x).to_degrees(),
+                d.norm(),
+                l.ends[0].x,
+                l.ends[0].y,
+                planes[l.k].points
+            )
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+/// At one end of a wall: the wall it meets there and the corner.
+type End = Option<(usize, Point2<f64>)>;
+
+/// Links wall ends: the corner of two walls is their lines' intersection; ends are paired
+/// greedily by how far the corner lies from both ends.
+fn link_ends(lines: &[Line], p: &SegmentParams) -> Vec<[End; 2]> {
     let mut pairs: Vec<(f64, usize, usize, usize, usize, Point2<f64>)> = Vec::new();
     for a in 0..lines.len() {
         for b in (a + 1)..lines.len() {
@@ -442,23 +541,6 @@ pub fn envelope(
         }
     }
     pairs.sort_by(|x, y| x.0.total_cmp(&y.0));
-    let found = lines
-        .iter()
-        .map(|l| {
-            let d = l.ends[1] - l.ends[0];
-            format!(
-                "{:.0}° {:.2} m long at ({:.2}, {:.2}), {} points",
-                d.y.atan2(d.x).to_degrees(),
-                d.norm(),
-                l.ends[0].x,
-                l.ends[0].y,
-                planes[l.k].points
-            )
-        })
-        .collect::<Vec<_>>()
-        .join("; ");
-    // For each wall's two ends: the wall it meets there and the corner.
-    type End = Option<(usize, Point2<f64>)>;
     let mut link: Vec<[End; 2]> = vec![[None, None]; lines.len()];
     for (_, a, ea, b, eb, c) in pairs {
         if link[a][ea].is_none() && link[b][eb].is_none() && link[a][1 - ea].map(|l| l.0) != Some(b)
@@ -467,33 +549,28 @@ pub fn envelope(
             link[b][eb] = Some((a, c));
         }
     }
-    // Walk the loop from the longest wall.
+    link
+}
+
+/// Walks the loop of linked walls from the longest: the lines in order and the corners, corner
+/// `k` joining walls `k` and `k + 1`; `None` with the walls linked when the loop does not close.
+fn walk_loop(lines: &[Line], link: &[[End; 2]]) -> Result<(Vec<usize>, Vec<Point2<f64>>), usize> {
     let start = (0..lines.len())
-        .max_by(|&a, &b| {
-            (lines[a].ends[1] - lines[a].ends[0])
-                .norm()
-                .total_cmp(&(lines[b].ends[1] - lines[b].ends[0]).norm())
-        })
-        .ok_or(SegmentError::NoWalls)?;
+        .max_by(|&a, &b| lines[a].length().total_cmp(&lines[b].length()))
+        .ok_or(0usize)?;
     let mut order = vec![start];
-    let mut corners2 = Vec::new();
+    let mut corners = Vec::new();
     let (mut cur, mut out_end) = (start, 1usize);
     loop {
         let Some((next, c)) = link[cur][out_end] else {
-            return Err(SegmentError::OpenOutline {
-                walls: order.len(),
-                found: found.clone(),
-            });
+            return Err(order.len());
         };
-        corners2.push(c);
+        corners.push(c);
         if next == start {
             break;
         }
         if order.contains(&next) || order.len() > lines.len() {
-            return Err(SegmentError::OpenOutline {
-                walls: order.len(),
-                found: found.clone(),
-            });
+            return Err(order.len());
         }
         let in_end = if link[next][0].map(|l| l.0) == Some(cur) {
             0
@@ -505,11 +582,39 @@ pub fn envelope(
         out_end = 1 - in_end;
     }
     if order.len() < 3 {
-        return Err(SegmentError::OpenOutline {
-            walls: order.len(),
-            found: found.clone(),
-        });
+        return Err(order.len());
     }
+    Ok((order, corners))
+}
+
+/// Classifies planes against an up estimate, picks floor and ceiling, refines up from the floor,
+/// links the walls into a loop and computes the corners.
+pub fn envelope(
+    points: &[Point3<f64>],
+    mut planes: Vec<FoundPlane>,
+    up0: Unit<Vector3<f64>>,
+    p: &SegmentParams,
+) -> Result<Envelope, SegmentError> {
+    let caps = floor_and_ceiling(points, &mut planes, up0, p)?;
+    let up = caps.up;
+    let centre = room_centre(points, &caps);
+    let mut walls = find_walls(points, &mut planes, &caps, &centre, p);
+    merge_doubled_walls(points, &mut planes, &mut walls, &up, &centre, p);
+    drop_shadow_walls(points, &mut planes, &mut walls, p);
+    // The horizontal frame and the walls' lines and extents in it.
+    let frame = PlaneFrame::new(planes[caps.floor].plane.project(&centre), up, &Vector3::x());
+    let lines = wall_lines(points, &planes, &walls, &frame);
+    let link = link_ends(&lines, p);
+    let found = describe_lines(&lines, &planes);
+    if lines.is_empty() {
+        return Err(SegmentError::NoWalls);
+    }
+    let (order, mut corners2) = walk_loop(&lines, &link).map_err(|walls| {
+        SegmentError::OpenOutline {
+            walls,
+            found: found.clone(),
+        }
+    })?;
     // corners2[k] joins order[k] and order[k+1]; rotate so corner k joins wall k−1 and wall k.
     corners2.rotate_right(1);
     let mut wall_order: Vec<usize> = order.iter().map(|&i| lines[i].k).collect();
@@ -532,16 +637,16 @@ pub fn envelope(
         intersect_three(a, b, cap)
     };
     let floor_corners: Option<Vec<Point3<f64>>> =
-        (0..n).map(|k| corner3(k, &planes[floor].plane)).collect();
+        (0..n).map(|k| corner3(k, &planes[caps.floor].plane)).collect();
     let ceiling_corners: Option<Vec<Point3<f64>>> =
-        (0..n).map(|k| corner3(k, &planes[ceiling].plane)).collect();
+        (0..n).map(|k| corner3(k, &planes[caps.ceiling].plane)).collect();
     let (Some(floor_corners), Some(ceiling_corners)) = (floor_corners, ceiling_corners) else {
         return Err(SegmentError::OpenOutline { walls: n, found });
     };
     Ok(Envelope {
         up,
-        floor,
-        ceiling,
+        floor: caps.floor,
+        ceiling: caps.ceiling,
         walls: wall_order,
         floor_corners,
         ceiling_corners,

@@ -66,20 +66,100 @@ pub struct Background {
     pub b: f64,
 }
 
+/// A surface's texels: which lie inside its outline, their radiant averages and their points.
 struct Grid {
     lo: Point2<f64>,
     t: f64,
+    nx: usize,
+    ny: usize,
     inside: Vec<bool>,
     temp: Vec<RadiantAverage>,
     points: Vec<Vec<usize>>,
 }
 
 impl Grid {
+    /// Rasterises the points `idx` of a surface (`host` its outline in `frame`) at texel `t`.
+    fn rasterise(
+        frame: &PlaneFrame,
+        host: &[Point2<f64>],
+        idx: &[usize],
+        pos: &[Point3<f64>],
+        temp_k: &[f64],
+        t: f64,
+    ) -> Self {
+        let (mut lo, mut hi) = (
+            Point2::new(f64::INFINITY, f64::INFINITY),
+            Point2::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+        );
+        for q in host {
+            lo = Point2::new(lo.x.min(q.x), lo.y.min(q.y));
+            hi = Point2::new(hi.x.max(q.x), hi.y.max(q.y));
+        }
+        let nx = ((hi.x - lo.x) / t).ceil().max(1.0) as usize;
+        let ny = ((hi.y - lo.y) / t).ceil().max(1.0) as usize;
+        let mut g = Grid {
+            lo,
+            t,
+            nx,
+            ny,
+            inside: vec![false; nx * ny],
+            temp: vec![RadiantAverage::new(); nx * ny],
+            points: vec![Vec::new(); nx * ny],
+        };
+        for j in 0..ny {
+            for i in 0..nx {
+                g.inside[j * nx + i] = point_in_polygon_fast(&g.centre(i, j), host);
+            }
+        }
+        for &k in idx {
+            let q = frame.to_2d(&pos[k]);
+            let (i, j) = (((q.x - lo.x) / t).floor(), ((q.y - lo.y) / t).floor());
+            if i >= 0.0 && j >= 0.0 && (i as usize) < nx && (j as usize) < ny {
+                let c = j as usize * nx + i as usize;
+                g.temp[c].add(Temperature::from_kelvin(temp_k[k]), 1.0);
+                g.points[c].push(k);
+            }
+        }
+        g
+    }
+
     fn centre(&self, i: usize, j: usize) -> Point2<f64> {
         Point2::new(
             self.lo.x + (i as f64 + 0.5) * self.t,
             self.lo.y + (j as f64 + 0.5) * self.t,
         )
+    }
+
+    /// The centre of texel `c`.
+    fn centre_of(&self, c: usize) -> Point2<f64> {
+        self.centre(c % self.nx, c / self.nx)
+    }
+
+    /// Whether texel `c` holds any point.
+    fn observed(&self, c: usize) -> bool {
+        self.temp[c].count() > 0
+    }
+
+    /// Texel `c`'s radiant temperature (K), NaN when unobserved.
+    fn kelvin(&self, c: usize) -> f64 {
+        self.temp[c].mean().map_or(f64::NAN, |x| x.kelvin())
+    }
+
+    /// The four neighbours of texel `c`: (exists, index).
+    fn neighbours(&self, c: usize) -> [(bool, usize); 4] {
+        let (nx, ny) = (self.nx, self.ny);
+        let (i, j) = (c % nx, c / nx);
+        [
+            (i > 0, c.wrapping_sub(1)),
+            (i + 1 < nx, c + 1),
+            (j > 0, c.wrapping_sub(nx)),
+            (j + 1 < ny, c + nx),
+        ]
+    }
+
+    /// Whether all four neighbours of texel `c` exist and are in `set`.
+    fn interior_of(&self, c: usize, set: &[bool]) -> bool {
+        self.neighbours(c).iter().all(|&(ok, d)| ok && set[d])
     }
 }
 
@@ -170,6 +250,208 @@ fn ccw(mut p: Vec<Point2<f64>>) -> Vec<Point2<f64>> {
     p
 }
 
+/// The texels beyond the threshold on one side of the background (`sign` +1 warm, −1 cold), with
+/// one-texel holes (unobserved or noisy) closed.
+fn threshold_mask(g: &Grid, resid: &dyn Fn(usize) -> f64, sign: f64, threshold_k: f64) -> Vec<bool> {
+    let n = g.nx * g.ny;
+    let raw: Vec<bool> = (0..n)
+        .map(|c| g.inside[c] && g.observed(c) && sign * resid(c) > threshold_k)
+        .collect();
+    let mut mask = raw.clone();
+    for c in 0..n {
+        if !mask[c]
+            && g.inside[c]
+            && g.neighbours(c)
+                .iter()
+                .filter(|&&(ok, d)| ok && raw[d])
+                .count()
+                >= 3
+        {
+            mask[c] = true;
+        }
+    }
+    mask
+}
+
+/// The connected components (4-connectivity) of `mask`, in order of their first texel.
+fn components(g: &Grid, mask: &[bool]) -> Vec<Vec<usize>> {
+    let mut label = vec![usize::MAX; mask.len()];
+    let mut out = Vec::new();
+    for seed in 0..mask.len() {
+        if !mask[seed] || label[seed] != usize::MAX {
+            continue;
+        }
+        let mut comp = vec![seed];
+        label[seed] = seed;
+        let mut k = 0;
+        while k < comp.len() {
+            let c = comp[k];
+            k += 1;
+            for (ok, d) in g.neighbours(c) {
+                if ok && mask[d] && label[d] == usize::MAX {
+                    label[d] = seed;
+                    comp.push(d);
+                }
+            }
+        }
+        out.push(comp);
+    }
+    out
+}
+
+/// Hysteresis: the region grown or shrunk to the texels beyond half its core contrast, connected
+/// to its texels that are; `None` when no texel of it was observed.
+fn hysteresis(g: &Grid, comp: &[usize], resid: &dyn Fn(usize) -> f64, sign: f64) -> Option<Vec<usize>> {
+    let mut core: Vec<f64> = comp
+        .iter()
+        .filter(|&&c| g.observed(c))
+        .map(|&c| sign * resid(c))
+        .collect();
+    if core.is_empty() {
+        return None;
+    }
+    core.sort_by(f64::total_cmp);
+    let half = 0.5 * core[core.len() / 2];
+    let mut member = vec![false; g.nx * g.ny];
+    let mut grown = Vec::new();
+    let mut queue: Vec<usize> = comp
+        .iter()
+        .copied()
+        .filter(|&c| g.observed(c) && sign * resid(c) > half)
+        .collect();
+    for &c in &queue {
+        member[c] = true;
+    }
+    while let Some(c) = queue.pop() {
+        grown.push(c);
+        for (ok, d) in g.neighbours(c) {
+            if ok && !member[d] && g.inside[d] && g.observed(d) && sign * resid(d) > half {
+                member[d] = true;
+                queue.push(d);
+            }
+        }
+    }
+    Some(grown)
+}
+
+/// A region's outline: its minimum-area rectangle when it fills at least 75 % of it, else its
+/// simplified convex outline, clipped to the host; why not when it does not fit.
+fn outline(g: &Grid, comp: &[usize], host: &[Point2<f64>], area: f64) -> Result<Vec<Point2<f64>>, String> {
+    use mrtmap_geometry::nalgebra::Vector2;
+    let t = g.t;
+    let corners: Vec<Point2<f64>> = comp
+        .iter()
+        .flat_map(|&c| {
+            let o = Point2::new(g.lo.x + (c % g.nx) as f64 * t, g.lo.y + (c / g.nx) as f64 * t);
+            [
+                o,
+                o + Vector2::new(t, 0.0),
+                o + Vector2::new(t, t),
+                o + Vector2::new(0.0, t),
+            ]
+        })
+        .collect();
+    let Some((rect, rect_area)) = min_area_rectangle(&corners) else {
+        return Err(String::new());
+    };
+    let mut poly = if area / rect_area >= 0.75 {
+        rect.to_vec()
+    } else {
+        simplify_closed(&convex_hull(&corners), 0.5 * t)
+    };
+    poly = ccw(poly);
+    if !polygon_inside(&poly, host, 1e-3) {
+        poly = ccw(clip_convex(&poly, &ccw(convex_hull(host))));
+        poly.dedup_by(|a, b| (*a - *b).norm() < 1e-6);
+    }
+    if poly.len() < 3 || !polygon_inside(&poly, host, 1e-3) {
+        return Err(format!(
+            "a {area:.2} m² region does not fit inside its surface"
+        ));
+    }
+    Ok(poly)
+}
+
+/// A feature of region `comp` with outline `poly`: its temperature from interior texels (all four
+/// neighbours in the feature; border texels mix in the background), or from all its texels when
+/// too few are interior.
+fn feature(
+    g: &Grid,
+    comp: &[usize],
+    poly: Vec<Point2<f64>>,
+    resid: &dyn Fn(usize) -> f64,
+    bg: &Background,
+) -> FoundFeature {
+    let mut in_comp = vec![false; g.nx * g.ny];
+    for &c in comp {
+        in_comp[c] = true;
+    }
+    let interior: Vec<usize> = comp
+        .iter()
+        .copied()
+        .filter(|&c| g.interior_of(c, &in_comp))
+        .collect();
+    let use_cells = if interior.iter().filter(|&&c| g.observed(c)).count() >= 4 {
+        &interior
+    } else {
+        comp
+    };
+    let mut avg = RadiantAverage::new();
+    let mut contrast = 0.0;
+    for &c in use_cells {
+        if g.observed(c) {
+            avg.add(Temperature::from_kelvin(g.kelvin(c)), 1.0);
+            contrast += resid(c);
+        }
+    }
+    let n_obs = avg.count().max(1) as f64;
+    FoundFeature {
+        temperature_k: avg.mean().map_or(bg.a, |x| x.kelvin()),
+        temperature_std_k: avg.std_dev_k().unwrap_or(0.0) / n_obs.sqrt(),
+        contrast_k: contrast / n_obs,
+        area_m2: signed_area(&poly).abs(),
+        points: comp
+            .iter()
+            .flat_map(|&c| g.points[c].iter().copied())
+            .collect(),
+        polygon_2d: poly,
+    }
+}
+
+/// The host's temperature and its uncertainty: its background texels only (the features' are
+/// subtracted, Algorithm 1), one texel clear of every feature (border texels mix both).
+fn host_temperature(
+    g: &Grid,
+    cells: &[usize],
+    in_feature: &[bool],
+    features: &[FoundFeature],
+    observed_fraction: f64,
+) -> Option<(f64, f64)> {
+    let (nx, ny) = (g.nx, g.ny);
+    let near_feature = |c: usize| {
+        let (i, j) = (c % nx, c / nx);
+        (j.saturating_sub(1)..=(j + 1).min(ny - 1)).any(|jj| {
+            (i.saturating_sub(1)..=(i + 1).min(nx - 1)).any(|ii| in_feature[jj * nx + ii])
+        })
+    };
+    let mut host_avg = RadiantAverage::new();
+    for &c in cells {
+        let centre = g.centre_of(c);
+        if !near_feature(c)
+            && !features
+                .iter()
+                .any(|f| point_in_polygon_fast(&centre, &f.polygon_2d))
+        {
+            host_avg.add(Temperature::from_kelvin(g.kelvin(c)), 1.0);
+        }
+    }
+    let m = host_avg.mean()?;
+    let sigma = host_avg.std_dev_k().unwrap_or(0.0);
+    let n = host_avg.count().max(1) as f64;
+    let std = ((sigma * sigma) / n + ((1.0 - observed_fraction) * sigma).powi(2)).sqrt();
+    Some((m.kelvin(), std))
+}
+
 /// Analyses one surface: `frame` and `host` (its polygon in the frame), the cloud's points on it
 /// (`idx` into `pos`/`temp_k`), whether the background may vary linearly along v (walls).
 pub fn analyse_surface(
@@ -181,40 +463,10 @@ pub fn analyse_surface(
     linear: bool,
     p: &SegmentParams,
 ) -> SurfaceAnalysis {
-    let t = p.texel_m;
-    let (mut lo, mut hi) = (
-        Point2::new(f64::INFINITY, f64::INFINITY),
-        Point2::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
-    );
-    for q in host {
-        lo = Point2::new(lo.x.min(q.x), lo.y.min(q.y));
-        hi = Point2::new(hi.x.max(q.x), hi.y.max(q.y));
-    }
-    let nx = ((hi.x - lo.x) / t).ceil().max(1.0) as usize;
-    let ny = ((hi.y - lo.y) / t).ceil().max(1.0) as usize;
-    let mut g = Grid {
-        lo,
-        t,
-        inside: vec![false; nx * ny],
-        temp: vec![RadiantAverage::new(); nx * ny],
-        points: vec![Vec::new(); nx * ny],
-    };
-    for j in 0..ny {
-        for i in 0..nx {
-            g.inside[j * nx + i] = point_in_polygon_fast(&g.centre(i, j), host);
-        }
-    }
-    for &k in idx {
-        let q = frame.to_2d(&pos[k]);
-        let (i, j) = (((q.x - lo.x) / t).floor(), ((q.y - lo.y) / t).floor());
-        if i >= 0.0 && j >= 0.0 && (i as usize) < nx && (j as usize) < ny {
-            let c = j as usize * nx + i as usize;
-            g.temp[c].add(Temperature::from_kelvin(temp_k[k]), 1.0);
-            g.points[c].push(k);
-        }
-    }
+    let g = Grid::rasterise(frame, host, idx, pos, temp_k, p.texel_m);
+    let (nx, ny) = (g.nx, g.ny);
     let cells: Vec<usize> = (0..nx * ny)
-        .filter(|&c| g.inside[c] && g.temp[c].count() > 0)
+        .filter(|&c| g.inside[c] && g.observed(c))
         .collect();
     let n_inside = g.inside.iter().filter(|x| **x).count();
     let observed_fraction = cells.len() as f64 / n_inside.max(1) as f64;
@@ -229,228 +481,52 @@ pub fn analyse_surface(
     if cells.len() < 3 {
         return out;
     }
-    let tk = |c: usize| g.temp[c].mean().map_or(f64::NAN, |x| x.kelvin());
     let samples: Vec<(f64, f64)> = cells
         .iter()
-        .map(|&c| (g.centre(c % nx, c / nx).y, tk(c)))
+        .map(|&c| (g.centre_of(c).y, g.kelvin(c)))
         .collect();
     let bg = robust_background(&samples, linear);
     out.background = bg;
-    let resid = |c: usize| tk(c) - bg.a - bg.b * g.centre(c % nx, c / nx).y;
-    // Warm and cold masks, with one-texel holes (unobserved or noisy) closed.
+    let resid = |c: usize| g.kelvin(c) - bg.a - bg.b * g.centre_of(c).y;
     let mut in_feature = vec![false; nx * ny];
     for sign in [1.0f64, -1.0] {
-        let raw: Vec<bool> = (0..nx * ny)
-            .map(|c| {
-                g.inside[c] && g.temp[c].count() > 0 && sign * resid(c) > p.feature_threshold_k
-            })
-            .collect();
-        let mut mask = raw.clone();
-        for j in 0..ny {
-            for i in 0..nx {
-                let c = j * nx + i;
-                if !mask[c] && g.inside[c] {
-                    let nb = [
-                        (i > 0, c.wrapping_sub(1)),
-                        (i + 1 < nx, c + 1),
-                        (j > 0, c.wrapping_sub(nx)),
-                        (j + 1 < ny, c + nx),
-                    ];
-                    if nb.iter().filter(|&&(ok, d)| ok && raw[d]).count() >= 3 {
-                        mask[c] = true;
-                    }
-                }
-            }
-        }
-        // Connected components (4-connectivity).
-        let mut label = vec![usize::MAX; nx * ny];
-        for seed in 0..nx * ny {
-            if !mask[seed] || label[seed] != usize::MAX {
+        let mask = threshold_mask(&g, &resid, sign, p.feature_threshold_k);
+        for region in components(&g, &mask) {
+            let Some(comp) = hysteresis(&g, &region, &resid, sign) else {
                 continue;
-            }
-            let mut comp = vec![seed];
-            label[seed] = seed;
-            let mut k = 0;
-            while k < comp.len() {
-                let c = comp[k];
-                k += 1;
-                let (i, j) = (c % nx, c / nx);
-                for (ok, d) in [
-                    (i > 0, c.wrapping_sub(1)),
-                    (i + 1 < nx, c + 1),
-                    (j > 0, c.wrapping_sub(nx)),
-                    (j + 1 < ny, c + nx),
-                ] {
-                    if ok && mask[d] && label[d] == usize::MAX {
-                        label[d] = seed;
-                        comp.push(d);
-                    }
-                }
-            }
-            // Hysteresis: grow or shrink the region to the texels beyond half its core contrast.
-            let mut core: Vec<f64> = comp
-                .iter()
-                .filter(|&&c| g.temp[c].count() > 0)
-                .map(|&c| sign * resid(c))
-                .collect();
-            if core.is_empty() {
-                continue;
-            }
-            core.sort_by(f64::total_cmp);
-            let half = 0.5 * core[core.len() / 2];
-            let mut member = vec![false; nx * ny];
-            let mut comp2 = Vec::new();
-            let mut queue: Vec<usize> = comp
-                .iter()
-                .copied()
-                .filter(|&c| g.temp[c].count() > 0 && sign * resid(c) > half)
-                .collect();
-            for &c in &queue {
-                member[c] = true;
-            }
-            while let Some(c) = queue.pop() {
-                comp2.push(c);
-                let (i, j) = (c % nx, c / nx);
-                for (ok, d) in [
-                    (i > 0, c.wrapping_sub(1)),
-                    (i + 1 < nx, c + 1),
-                    (j > 0, c.wrapping_sub(nx)),
-                    (j + 1 < ny, c + nx),
-                ] {
-                    if ok
-                        && !member[d]
-                        && g.inside[d]
-                        && g.temp[d].count() > 0
-                        && sign * resid(d) > half
-                    {
-                        member[d] = true;
-                        queue.push(d);
-                    }
-                }
-            }
-            let comp = comp2;
-            let area = comp.len() as f64 * t * t;
+            };
+            let area = comp.len() as f64 * g.t * g.t;
             if area < p.feature_min_area_m2 {
                 continue;
             }
-            let corners: Vec<Point2<f64>> = comp
-                .iter()
-                .flat_map(|&c| {
-                    let o = Point2::new(lo.x + (c % nx) as f64 * t, lo.y + (c / nx) as f64 * t);
-                    [
-                        o,
-                        o + mrtmap_geometry::nalgebra::Vector2::new(t, 0.0),
-                        o + mrtmap_geometry::nalgebra::Vector2::new(t, t),
-                        o + mrtmap_geometry::nalgebra::Vector2::new(0.0, t),
-                    ]
-                })
-                .collect();
-            let Some((rect, rect_area)) = min_area_rectangle(&corners) else {
-                continue;
+            let poly = match outline(&g, &comp, host, area) {
+                Ok(poly) => poly,
+                Err(why) => {
+                    if !why.is_empty() {
+                        out.dropped.push(why);
+                    }
+                    continue;
+                }
             };
-            let mut poly = if area / rect_area >= 0.75 {
-                rect.to_vec()
-            } else {
-                simplify_closed(&convex_hull(&corners), 0.5 * t)
-            };
-            poly = ccw(poly);
-            if !polygon_inside(&poly, host, 1e-3) {
-                poly = ccw(clip_convex(&poly, &ccw(convex_hull(host))));
-                poly.dedup_by(|a, b| (*a - *b).norm() < 1e-6);
-            }
-            if poly.len() < 3 || !polygon_inside(&poly, host, 1e-3) {
-                out.dropped.push(format!(
-                    "a {:.2} m² region does not fit inside its surface",
-                    area
-                ));
-                continue;
-            }
             if out
                 .features
                 .iter()
                 .any(|f| polygons_overlap(&f.polygon_2d, &poly, 1e-3))
             {
                 out.dropped
-                    .push(format!("a {:.2} m² region overlaps another feature", area));
+                    .push(format!("a {area:.2} m² region overlaps another feature"));
                 continue;
             }
-            // Temperature from interior texels (all four neighbours in the feature): border texels
-            // mix in the background. Fall back to all texels for small features.
-            let mut in_comp = vec![false; nx * ny];
-            for &c in &comp {
-                in_comp[c] = true;
-            }
-            let interior: Vec<usize> = comp
-                .iter()
-                .copied()
-                .filter(|&c| {
-                    let (i, j) = (c % nx, c / nx);
-                    i > 0
-                        && j > 0
-                        && i + 1 < nx
-                        && j + 1 < ny
-                        && in_comp[c - 1]
-                        && in_comp[c + 1]
-                        && in_comp[c - nx]
-                        && in_comp[c + nx]
-                })
-                .collect();
-            let use_cells = if interior.iter().filter(|&&c| g.temp[c].count() > 0).count() >= 4 {
-                &interior
-            } else {
-                &comp
-            };
-            let mut avg = RadiantAverage::new();
-            let mut contrast = 0.0;
-            for &c in use_cells {
-                if g.temp[c].count() > 0 {
-                    avg.add(Temperature::from_kelvin(tk(c)), 1.0);
-                    contrast += resid(c);
-                }
-            }
-            let n_obs = avg.count().max(1) as f64;
             for &c in &comp {
                 in_feature[c] = true;
             }
-            out.features.push(FoundFeature {
-                temperature_k: avg.mean().map_or(bg.a, |x| x.kelvin()),
-                temperature_std_k: avg.std_dev_k().unwrap_or(0.0) / n_obs.sqrt(),
-                contrast_k: contrast / n_obs,
-                area_m2: signed_area(&poly).abs(),
-                points: comp
-                    .iter()
-                    .flat_map(|&c| g.points[c].iter().copied())
-                    .collect(),
-                polygon_2d: poly,
-            });
+            out.features.push(feature(&g, &comp, poly, &resid, &bg));
         }
     }
-    // The host: its background texels only (the features' are subtracted, Algorithm 1), one texel
-    // clear of every feature (border texels mix both).
-    let near_feature = |c: usize| {
-        let (i, j) = (c % nx, c / nx);
-        (j.saturating_sub(1)..=(j + 1).min(ny - 1)).any(|jj| {
-            (i.saturating_sub(1)..=(i + 1).min(nx - 1)).any(|ii| in_feature[jj * nx + ii])
-        })
-    };
-    let mut host_avg = RadiantAverage::new();
-    for &c in &cells {
-        let centre = g.centre(c % nx, c / nx);
-        if !near_feature(c)
-            && !out
-                .features
-                .iter()
-                .any(|f| point_in_polygon_fast(&centre, &f.polygon_2d))
-        {
-            host_avg.add(Temperature::from_kelvin(tk(c)), 1.0);
-        }
-    }
-    if let Some(m) = host_avg.mean() {
-        let sigma = host_avg.std_dev_k().unwrap_or(0.0);
-        let n = host_avg.count().max(1) as f64;
-        out.temperature_k = Some(m.kelvin());
-        out.temperature_std_k =
-            ((sigma * sigma) / n + ((1.0 - observed_fraction) * sigma).powi(2)).sqrt();
+    if let Some((t, std)) = host_temperature(&g, &cells, &in_feature, &out.features, observed_fraction)
+    {
+        out.temperature_k = Some(t);
+        out.temperature_std_k = std;
     }
     out
 }

@@ -22,7 +22,8 @@ use super::SegmentParams;
 /// A piece of furniture: a box in the room's axes.
 #[derive(Clone, Debug)]
 pub struct FoundFurniture {
-    /// The eight corners (world); corner c has bit 0 = along, bit 1 = across, bit 2 = up.
+    /// The eight corners (world); corner c has bit 0 = along, bit 1 = across, bit 2 = up (the
+    /// order of [`mrtmap_geometry::box_corners`], so [`mrtmap_geometry::BOX_TRIANGLES`] apply).
     pub corners: [Point3<f64>; 8],
     /// Size along, across and up (m).
     pub size_m: [f64; 3],
@@ -31,22 +32,6 @@ pub struct FoundFurniture {
     /// Its cloud points.
     pub points: Vec<usize>,
 }
-
-/// The twelve triangles of a box from [`FoundFurniture::corners`].
-pub const BOX_TRIANGLES: [[usize; 3]; 12] = [
-    [0, 2, 6],
-    [0, 6, 4],
-    [1, 5, 7],
-    [1, 7, 3],
-    [0, 4, 5],
-    [0, 5, 1],
-    [2, 3, 7],
-    [2, 7, 6],
-    [0, 1, 3],
-    [0, 3, 2],
-    [4, 6, 7],
-    [4, 7, 5],
-];
 
 fn percentile(v: &mut [f64], q: f64) -> f64 {
     v.sort_by(f64::total_cmp);

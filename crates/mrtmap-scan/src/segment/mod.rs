@@ -13,8 +13,8 @@ pub mod labels;
 use std::collections::BTreeMap;
 
 use mrtmap_geometry::PlaneFrame;
-use mrtmap_geometry::nalgebra::{Isometry3, Point3, Unit, Vector3};
-use mrtmap_geometry::polygon::{Containment, point_in_polygon};
+use mrtmap_geometry::nalgebra::{Isometry3, Point2, Point3, Unit, Vector3};
+use mrtmap_geometry::polygon::{Containment, centroid, point_in_polygon};
 use mrtmap_io::{Recording, ThermalCloud};
 use mrtmap_physics::ZERO_CELSIUS_K;
 use mrtmap_radiation::{
@@ -253,64 +253,56 @@ struct SurfaceGeom {
     frame: PlaneFrame,
 }
 
-/// Segments a thermal cloud into a radiant scene.
-pub fn segment(
-    cloud: &ThermalCloud,
-    camera_poses: &[Isometry3<f64>],
-    masks: Option<&MaskInput<'_>>,
-    p: &SegmentParams,
-) -> Result<Segmentation, SegmentError> {
-    let pos: Vec<Point3<f64>> = cloud
-        .positions
-        .iter()
-        .map(|q| Point3::new(q[0] as f64, q[1] as f64, q[2] as f64))
-        .collect();
-    let nrm: Vec<Vector3<f64>> = cloud
-        .normals
-        .iter()
-        .map(|n| Vector3::new(n[0] as f64, n[1] as f64, n[2] as f64))
-        .collect();
-    let temp: Vec<f64> = cloud.temperature_k.iter().map(|t| *t as f64).collect();
-    let up0 = up_from_poses(camera_poses).ok_or(SegmentError::NoPoses)?;
-    let planes = envelope::find_planes(&pos, &nrm, p);
-    let env = envelope::envelope(&pos, planes, up0, p)?;
-    let up = env.up;
-    let n = env.walls.len();
-    let height_m = env.planes[env.floor]
-        .plane
-        .distance(&env.ceiling_corners[0])
-        .abs();
+/// The cloud as f64 arrays.
+struct Points {
+    pos: Vec<Point3<f64>>,
+    nrm: Vec<Vector3<f64>>,
+    temp: Vec<f64>,
+}
 
-    // Surface geometry: floor, ceiling, walls in loop order. Floor and ceiling texels run along the
-    // longest wall, so features aligned with the room align with the texel grid.
-    let mut geoms = Vec::with_capacity(n + 2);
-    let longest = (0..n)
+impl Points {
+    fn of(cloud: &ThermalCloud) -> Self {
+        Self {
+            pos: cloud
+                .positions
+                .iter()
+                .map(|q| Point3::new(q[0] as f64, q[1] as f64, q[2] as f64))
+                .collect(),
+            nrm: cloud
+                .normals
+                .iter()
+                .map(|n| Vector3::new(n[0] as f64, n[1] as f64, n[2] as f64))
+                .collect(),
+            temp: cloud.temperature_k.iter().map(|t| *t as f64).collect(),
+        }
+    }
+}
+
+/// The longest wall's direction along the floor.
+fn longest_wall(env: &Envelope) -> Vector3<f64> {
+    let n = env.walls.len();
+    (0..n)
         .map(|k| env.floor_corners[(k + 1) % n] - env.floor_corners[k])
         .max_by(|a, b| a.norm().total_cmp(&b.norm()))
-        .unwrap_or_else(Vector3::x);
-    let centroid = |ps: &[Point3<f64>]| {
-        Point3::from(ps.iter().fold(Vector3::zeros(), |a, q| a + q.coords) / ps.len() as f64)
-    };
-    geoms.push(SurfaceGeom {
-        id: "floor".into(),
-        kind: SurfaceKind::Floor,
-        frame: PlaneFrame::new(
-            centroid(&env.floor_corners),
-            env.planes[env.floor].plane.normal,
-            &longest,
-        ),
-        polygon: env.floor_corners.clone(),
-    });
-    geoms.push(SurfaceGeom {
-        id: "ceiling".into(),
-        kind: SurfaceKind::Ceiling,
-        frame: PlaneFrame::new(
-            centroid(&env.ceiling_corners),
-            env.planes[env.ceiling].plane.normal,
-            &longest,
-        ),
-        polygon: env.ceiling_corners.clone(),
-    });
+        .unwrap_or_else(Vector3::x)
+}
+
+/// Surface geometry: floor, ceiling, walls in loop order. Floor and ceiling texels run along the
+/// longest wall, so features aligned with the room align with the texel grid.
+fn surface_geometry(env: &Envelope, longest: &Vector3<f64>) -> Vec<SurfaceGeom> {
+    let n = env.walls.len();
+    let mut geoms = Vec::with_capacity(n + 2);
+    for (id, kind, plane, corners) in [
+        ("floor", SurfaceKind::Floor, env.floor, &env.floor_corners),
+        ("ceiling", SurfaceKind::Ceiling, env.ceiling, &env.ceiling_corners),
+    ] {
+        geoms.push(SurfaceGeom {
+            id: id.into(),
+            kind,
+            frame: PlaneFrame::new(centroid(corners), env.planes[plane].plane.normal, longest),
+            polygon: corners.clone(),
+        });
+    }
     for k in 0..n {
         let poly = vec![
             env.floor_corners[k],
@@ -321,7 +313,7 @@ pub fn segment(
         let wall = &env.planes[env.walls[k]].plane;
         let along = env.floor_corners[(k + 1) % n] - env.floor_corners[k];
         let mut frame = PlaneFrame::new(centroid(&poly), wall.normal, &along);
-        if frame.v.dot(&up) < 0.0 {
+        if frame.v.dot(&env.up) < 0.0 {
             // Keep v pointing up so the background's slope reads as a vertical gradient.
             frame = PlaneFrame {
                 u: -frame.u,
@@ -336,25 +328,26 @@ pub fn segment(
             frame,
         });
     }
-    let polys2: Vec<Vec<_>> = geoms
-        .iter()
-        .map(|g| g.polygon.iter().map(|q| g.frame.to_2d(q)).collect())
-        .collect();
+    geoms
+}
 
-    // Points to surfaces: the nearest surface plane within the band, with an agreeing normal, whose
-    // outline (grown by the band) contains the point's projection.
-    let mut surface_id = vec![-1i32; pos.len()];
-    let mut members: Vec<Vec<usize>> = vec![Vec::new(); geoms.len()];
+/// Each surface's band: three robust standard deviations of the distances of the points near it
+/// (the fused surface is as thick as the depth noise), at least `surface_band_m`.
+fn surface_bands(
+    geoms: &[SurfaceGeom],
+    polys2: &[Vec<Point2<f64>>],
+    pts: &Points,
+    p: &SegmentParams,
+) -> Vec<f64> {
     let cos_agree = p.plane_normal_deg.to_radians().cos();
-    // Each surface's band: three robust standard deviations of the distances of the points near
-    // it (the fused surface is as thick as the depth noise), at least `surface_band_m`.
-    let bands: Vec<f64> = geoms
+    geoms
         .iter()
         .enumerate()
         .map(|(s, g)| {
-            let mut d: Vec<f64> = pos
+            let mut d: Vec<f64> = pts
+                .pos
                 .iter()
-                .zip(&nrm)
+                .zip(&pts.nrm)
                 .filter(|(q, n)| {
                     n.dot(&g.frame.normal).abs() >= cos_agree
                         && g.frame.signed_distance(q).abs() < 0.4
@@ -372,15 +365,30 @@ pub fn segment(
             dev.sort_by(f64::total_cmp);
             (3.0 * 1.4826 * dev[dev.len() / 2]).clamp(p.surface_band_m, 0.35)
         })
-        .collect();
-    for (i, q) in pos.iter().enumerate() {
+        .collect()
+}
+
+/// Points to surfaces: the nearest surface plane within its band, with an agreeing normal, whose
+/// outline (grown by the band) contains the point's projection. Returns each point's surface (−1
+/// for none) and each surface's points.
+fn assign_points(
+    geoms: &[SurfaceGeom],
+    polys2: &[Vec<Point2<f64>>],
+    bands: &[f64],
+    pts: &Points,
+    p: &SegmentParams,
+) -> (Vec<i32>, Vec<Vec<usize>>) {
+    let cos_agree = p.plane_normal_deg.to_radians().cos();
+    let mut surface_id = vec![-1i32; pts.pos.len()];
+    let mut members: Vec<Vec<usize>> = vec![Vec::new(); geoms.len()];
+    for (i, q) in pts.pos.iter().enumerate() {
         let mut best: Option<(f64, usize)> = None;
         for (s, g) in geoms.iter().enumerate() {
             let d = g.frame.signed_distance(q).abs();
             // Normals must agree: the side of a box standing on the floor is not floor.
             if d <= bands[s]
                 && best.is_none_or(|b| d < b.0)
-                && nrm[i].dot(&g.frame.normal).abs() >= cos_agree
+                && pts.nrm[i].dot(&g.frame.normal).abs() >= cos_agree
                 && point_in_polygon(&g.frame.to_2d(q), &polys2[s], bands[s]) != Containment::Outside
             {
                 best = Some((d, s));
@@ -391,84 +399,115 @@ pub fn segment(
             members[s].push(i);
         }
     }
-    let unassigned = surface_id.iter().filter(|s| **s < 0).count();
+    (surface_id, members)
+}
 
-    // Thermal analysis per surface.
-    let analyses: Vec<features::SurfaceAnalysis> = geoms
-        .iter()
-        .enumerate()
-        .map(|(s, g)| {
-            features::analyse_surface(
-                &g.frame,
-                &polys2[s],
-                &members[s],
-                &pos,
-                &temp,
-                g.kind == SurfaceKind::Wall,
-                p,
-            )
-        })
-        .collect();
-    let mut all_features: Vec<(usize, &features::FoundFeature)> = Vec::new();
-    for (s, a) in analyses.iter().enumerate() {
-        for f in &a.features {
-            all_features.push((s, f));
-        }
-    }
-    // Furniture: what stands off the envelope.
+/// Furniture: what stands off the envelope, kept clear of the walls by their band and 5 cm.
+fn furniture_of(
+    env: &Envelope,
+    longest: &Vector3<f64>,
+    bands: &[f64],
+    pts: &Points,
+    surface_id: &[i32],
+    height_m: f64,
+    p: &SegmentParams,
+) -> Vec<furniture::FoundFurniture> {
+    let up = env.up;
     let floor_height = up.dot(&env.floor_corners[0].coords);
-    let floor_2d: Vec<mrtmap_geometry::nalgebra::Point2<f64>> = {
-        let u = (longest - up.as_ref() * longest.dot(&up)).normalize();
-        let v = up.cross(&u);
-        env.floor_corners
-            .iter()
-            .map(|q| mrtmap_geometry::nalgebra::Point2::new(u.dot(&q.coords), v.dot(&q.coords)))
-            .collect()
-    };
-    // Walls with the clearance furniture must keep from them: their band and 5 cm.
+    let u = (longest - up.as_ref() * longest.dot(&up)).normalize();
+    let v = up.cross(&u);
+    let floor_2d: Vec<Point2<f64>> = env
+        .floor_corners
+        .iter()
+        .map(|q| Point2::new(u.dot(&q.coords), v.dot(&q.coords)))
+        .collect();
     let wall_planes: Vec<(mrtmap_geometry::Plane, f64)> = env
         .walls
         .iter()
         .enumerate()
         .map(|(w, &k)| (env.planes[k].plane, bands[w + 2] + 0.05))
         .collect();
-    let furniture = furniture::find_furniture(
-        &pos,
-        &temp,
-        &surface_id,
+    furniture::find_furniture(
+        &pts.pos,
+        &pts.temp,
+        surface_id,
         &up,
-        &longest,
+        longest,
         floor_height,
         height_m,
         &floor_2d,
         &wall_planes,
         p,
-    );
-    // Labels: one pass over the masks for features and furniture.
-    let (voted, mask_summary) = match masks {
-        Some(m) => {
-            let pts: Vec<Vec<Point3<f64>>> = all_features
-                .iter()
-                .map(|(_, f)| f.points.iter().map(|&i| pos[i]).collect())
-                .chain(
-                    furniture
-                        .iter()
-                        .map(|f| f.points.iter().map(|&i| pos[i]).collect()),
-                )
-                .collect();
-            let (v, s) = labels::vote(m.recording, m.world_from_depth, &pts);
-            (v, Some(s))
-        }
-        None => (vec![None; all_features.len() + furniture.len()], None),
+    )
+}
+
+/// A label's vote, if masks gave one.
+type Vote = Option<(String, Votes)>;
+
+/// Labels: one pass over the masks for features and furniture; returns their votes (none without
+/// masks) and the masks' summary.
+fn vote_labels(
+    masks: Option<&MaskInput<'_>>,
+    features: &[(usize, &features::FoundFeature)],
+    furniture: &[furniture::FoundFurniture],
+    pos: &[Point3<f64>],
+) -> (Vec<Vote>, Vec<Vote>, Option<MaskSummary>) {
+    let Some(m) = masks else {
+        return (vec![None; features.len()], vec![None; furniture.len()], None);
     };
-    let mut voted = voted;
-    let furniture_votes = voted.split_off(all_features.len());
-    let mut feature_id = vec![-1i32; pos.len()];
-    let mut counts: BTreeMap<String, usize> = BTreeMap::new();
-    let mut feature_summaries = Vec::new();
-    let mut scene_features: Vec<Vec<FeatureFile>> = vec![Vec::new(); geoms.len()];
-    let mut warnings = Vec::new();
-    for (k, ((s, f), vote)) in all_features.iter().zip(voted).enumerate() {
+    let pts: Vec<Vec<Point3<f64>>> = features
+        .iter()
+        .map(|(_, f)| f.points.iter().map(|&i| pos[i]).collect())
+        .chain(
+            furniture
+                .iter()
+                .map(|f| f.points.iter().map(|&i| pos[i]).collect()),
+        )
+        .collect();
+    let (mut voted, summary) = labels::vote(m.recording, m.world_from_depth, &pts);
+    let furniture_votes = voted.split_off(features.len());
+    (voted, furniture_votes, Some(summary))
+}
+
+/// Ids from labels: "window-1", "window-2", "recessed-light-1"…
+#[derive(Default)]
+struct Ids(BTreeMap<String, usize>);
+
+impl Ids {
+    fn next(&mut self, label: &str) -> String {
+        let slug: String = label
+            .to_lowercase()
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join("-");
+        let c = self.0.entry(slug.clone()).or_default();
+        *c += 1;
+        format!("{slug}-{c}")
+    }
+}
+
+/// Features as written: per surface their scene entries, their summaries, each point's feature.
+struct Features {
+    per_surface: Vec<Vec<FeatureFile>>,
+    summaries: Vec<FeatureSummary>,
+    feature_id: Vec<i32>,
+}
+
+/// Labels, ids and scene entries of the features (`features` with their surface index).
+fn build_features(
+    geoms: &[SurfaceGeom],
+    features: &[(usize, &features::FoundFeature)],
+    votes: Vec<Vote>,
+    points: usize,
+    ids: &mut Ids,
+    warnings: &mut Vec<String>,
+) -> Features {
+    let mut out = Features {
+        per_surface: vec![Vec::new(); geoms.len()],
+        summaries: Vec::new(),
+        feature_id: vec![-1i32; points],
+    };
+    for (k, ((s, f), vote)) in features.iter().zip(votes).enumerate() {
         let (label, source, votes) = match vote {
             Some((l, v)) => (l, "masks", Some(v)),
             None => (
@@ -477,14 +516,7 @@ pub fn segment(
                 None,
             ),
         };
-        let slug: String = label
-            .to_lowercase()
-            .split_whitespace()
-            .collect::<Vec<_>>()
-            .join("-");
-        let c = counts.entry(slug.clone()).or_default();
-        *c += 1;
-        let id = format!("{slug}-{c}");
+        let id = ids.next(&label);
         if let Some(v) = &votes
             && (v.tie || v.weak)
         {
@@ -496,9 +528,9 @@ pub fn segment(
             ));
         }
         for &i in &f.points {
-            feature_id[i] = k as i32;
+            out.feature_id[i] = k as i32;
         }
-        scene_features[*s].push(FeatureFile {
+        out.per_surface[*s].push(FeatureFile {
             id: id.clone(),
             label: label.clone(),
             polygon: f
@@ -510,7 +542,7 @@ pub fn segment(
             emissivity: 1.0,
             temperature_std_k: Some(f.temperature_std_k),
         });
-        feature_summaries.push(FeatureSummary {
+        out.summaries.push(FeatureSummary {
             id,
             host: geoms[*s].id.clone(),
             label,
@@ -521,7 +553,18 @@ pub fn segment(
             area_m2: f.area_m2,
         });
     }
-    // Surfaces never observed get the mean of the observed ones, and say so.
+    out
+}
+
+/// The surfaces' scene entries (with their features) and summaries. Surfaces never observed get
+/// the mean of the observed ones, and say so.
+fn build_surfaces(
+    geoms: &[SurfaceGeom],
+    analyses: &[features::SurfaceAnalysis],
+    members: &[Vec<usize>],
+    mut per_surface: Vec<Vec<FeatureFile>>,
+    warnings: &mut Vec<String>,
+) -> (Vec<SurfaceFile>, Vec<SurfaceSummary>) {
     let observed: Vec<f64> = analyses.iter().filter_map(|a| a.temperature_k).collect();
     let fallback = observed.iter().sum::<f64>() / observed.len().max(1) as f64;
     let mut surfaces = Vec::new();
@@ -557,7 +600,7 @@ pub fn segment(
             emissivity: 1.0,
             temperature_std_k: Some(a.temperature_std_k),
             observed_fraction: Some(a.observed_fraction),
-            features: std::mem::take(&mut scene_features[s]),
+            features: std::mem::take(&mut per_surface[s]),
         });
         summaries.push(SurfaceSummary {
             id: g.id.clone(),
@@ -571,21 +614,23 @@ pub fn segment(
             gradient_k_per_m: a.background.b,
         });
     }
-    let mut furniture_summaries = Vec::new();
+    (surfaces, summaries)
+}
+
+/// The furniture's occluder entries (boxes as meshes) and summaries.
+fn build_furniture(
+    furniture: &[furniture::FoundFurniture],
+    votes: Vec<Vote>,
+    ids: &mut Ids,
+) -> (Vec<OccluderFile>, Vec<FurnitureSummary>) {
     let mut occluders = Vec::new();
-    for (f, vote) in furniture.iter().zip(furniture_votes) {
+    let mut summaries = Vec::new();
+    for (f, vote) in furniture.iter().zip(votes) {
         let (label, source, votes) = match vote {
             Some((l, v)) => (l, "masks", Some(v)),
             None => ("furniture".to_string(), "none", None),
         };
-        let slug: String = label
-            .to_lowercase()
-            .split_whitespace()
-            .collect::<Vec<_>>()
-            .join("-");
-        let c = counts.entry(slug.clone()).or_default();
-        *c += 1;
-        let id = format!("{slug}-{c}");
+        let id = ids.next(&label);
         occluders.push(OccluderFile {
             id: id.clone(),
             label: label.clone(),
@@ -593,14 +638,9 @@ pub fn segment(
             emissivity: 1.0,
             box_: None,
             vertices: Some(f.corners.iter().map(arr).collect()),
-            triangles: Some(
-                furniture::BOX_TRIANGLES
-                    .iter()
-                    .map(|t| [t[0], t[1], t[2]])
-                    .collect(),
-            ),
+            triangles: Some(mrtmap_geometry::BOX_TRIANGLES.to_vec()),
         });
-        furniture_summaries.push(FurnitureSummary {
+        summaries.push(FurnitureSummary {
             id,
             label,
             label_source: source.into(),
@@ -610,6 +650,86 @@ pub fn segment(
             points: f.points.len(),
         });
     }
+    (occluders, summaries)
+}
+
+/// The planes found, as the report lists them.
+fn plane_rows(env: &Envelope) -> Vec<(PlaneClass, [f64; 3], f64, usize)> {
+    env.planes
+        .iter()
+        .map(|f| {
+            (
+                f.class,
+                [f.plane.normal.x, f.plane.normal.y, f.plane.normal.z],
+                f.plane.d,
+                f.points,
+            )
+        })
+        .collect()
+}
+
+/// Segments a thermal cloud into a radiant scene: up, planes and the envelope; points to surfaces;
+/// each surface's background and features; furniture; labels; the scene and its report.
+pub fn segment(
+    cloud: &ThermalCloud,
+    camera_poses: &[Isometry3<f64>],
+    masks: Option<&MaskInput<'_>>,
+    p: &SegmentParams,
+) -> Result<Segmentation, SegmentError> {
+    let pts = Points::of(cloud);
+    let up0 = up_from_poses(camera_poses).ok_or(SegmentError::NoPoses)?;
+    let planes = envelope::find_planes(&pts.pos, &pts.nrm, p);
+    let env = envelope::envelope(&pts.pos, planes, up0, p)?;
+    let up = env.up;
+    let height_m = env.planes[env.floor]
+        .plane
+        .distance(&env.ceiling_corners[0])
+        .abs();
+    let longest = longest_wall(&env);
+    let geoms = surface_geometry(&env, &longest);
+    let polys2: Vec<Vec<_>> = geoms
+        .iter()
+        .map(|g| g.polygon.iter().map(|q| g.frame.to_2d(q)).collect())
+        .collect();
+    let bands = surface_bands(&geoms, &polys2, &pts, p);
+    let (surface_id, members) = assign_points(&geoms, &polys2, &bands, &pts, p);
+    let unassigned = surface_id.iter().filter(|s| **s < 0).count();
+    let analyses: Vec<features::SurfaceAnalysis> = geoms
+        .iter()
+        .enumerate()
+        .map(|(s, g)| {
+            features::analyse_surface(
+                &g.frame,
+                &polys2[s],
+                &members[s],
+                &pts.pos,
+                &pts.temp,
+                g.kind == SurfaceKind::Wall,
+                p,
+            )
+        })
+        .collect();
+    let all_features: Vec<(usize, &features::FoundFeature)> = analyses
+        .iter()
+        .enumerate()
+        .flat_map(|(s, a)| a.features.iter().map(move |f| (s, f)))
+        .collect();
+    let furniture = furniture_of(&env, &longest, &bands, &pts, &surface_id, height_m, p);
+    let (feature_votes, furniture_votes, mask_summary) =
+        vote_labels(masks, &all_features, &furniture, &pts.pos);
+    let mut ids = Ids::default();
+    let mut warnings = Vec::new();
+    let found = build_features(
+        &geoms,
+        &all_features,
+        feature_votes,
+        pts.pos.len(),
+        &mut ids,
+        &mut warnings,
+    );
+    let (surfaces, summaries) =
+        build_surfaces(&geoms, &analyses, &members, found.per_surface, &mut warnings);
+    let (occluders, furniture_summaries) = build_furniture(&furniture, furniture_votes, &mut ids);
     let scene = RadiantScene::new(&SceneFile {
         format: SCENE_FORMAT.into(),
         up: Some([up.x, up.y, up.z]),
@@ -618,24 +738,13 @@ pub fn segment(
     })?;
     let report = SegmentReport {
         up: [up.x, up.y, up.z],
-        planes: env
-            .planes
-            .iter()
-            .map(|f| {
-                (
-                    f.class,
-                    [f.plane.normal.x, f.plane.normal.y, f.plane.normal.z],
-                    f.plane.d,
-                    f.points,
-                )
-            })
-            .collect(),
+        planes: plane_rows(&env),
         floor_corners: env.floor_corners.iter().map(arr).collect(),
         height_m,
         surfaces: summaries,
-        features: feature_summaries,
+        features: found.summaries,
         furniture: furniture_summaries,
-        unassigned_fraction: unassigned as f64 / pos.len().max(1) as f64,
+        unassigned_fraction: unassigned as f64 / pts.pos.len().max(1) as f64,
         dropped: analyses
             .iter()
             .flat_map(|a| a.dropped.iter().cloned())
@@ -646,7 +755,7 @@ pub fn segment(
     Ok(Segmentation {
         scene,
         surface_id,
-        feature_id,
+        feature_id: found.feature_id,
         report,
     })
 }
