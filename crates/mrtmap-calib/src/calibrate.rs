@@ -192,6 +192,88 @@ fn keep_flags(rms: &[Option<f64>], floor_px: f64) -> Vec<bool> {
     rms.iter().map(|r| r.is_some_and(|x| x <= limit)).collect()
 }
 
+/// The corners of a detection (none when absent).
+fn corners_of(d: &Option<Detection>) -> &[Corner] {
+    d.as_ref().map(|d| d.corners.as_slice()).unwrap_or(&[])
+}
+
+/// Views that gave a pose: their index among the detections and their pose.
+type PosedViews = Vec<(usize, [f64; 6])>;
+
+/// Zhang's start: a homography per view, the focal lengths from them (the principal point at the
+/// centre), and each view's pose from its homography. Returns (fx, fy) and the views that gave a
+/// pose, with their index and pose.
+fn zhang_start(
+    board: &Board,
+    (width, height): (u32, u32),
+    dets: &[Option<Detection>],
+    usable: &[usize],
+) -> ((f64, f64), PosedViews) {
+    let (cx, cy) = ((width as f64 - 1.0) / 2.0, (height as f64 - 1.0) / 2.0);
+    let homs: Vec<Option<Matrix3<f64>>> = usable
+        .iter()
+        .map(|&k| {
+            let d = corners_of(&dets[k]);
+            let src: Vec<Point2<f64>> = d
+                .iter()
+                .map(|c| {
+                    let p = board.point(c.i, c.j);
+                    Point2::new(p.x, p.y)
+                })
+                .collect();
+            let dst: Vec<Point2<f64>> = d.iter().map(|c| Point2::new(c.x, c.y)).collect();
+            fit_homography(&src, &dst)
+        })
+        .collect();
+    let good: Vec<Matrix3<f64>> = homs.iter().flatten().copied().collect();
+    let (fx, fy) = init_focal(&good, cx, cy).unwrap_or((width as f64, width as f64));
+    let k = Matrix3::new(fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0);
+    let posed = homs
+        .iter()
+        .zip(usable)
+        .filter_map(|(h, &vi)| {
+            let p = h.as_ref().and_then(|h| pose_from_homography(h, &k))?;
+            Some((vi, vec6(&p)))
+        })
+        .collect();
+    ((fx, fy), posed)
+}
+
+/// Refits without the views whose error is far above the others', twice at most and keeping at
+/// least three; returns the fit and the views dropped (indices into `index`'s detections).
+fn drop_outlier_views(
+    prob: &Mono<'_>,
+    mut s: crate::lm::Solved,
+    model: DistortionModel,
+    active: &mut [bool],
+    index: &[usize],
+) -> (crate::lm::Solved, Vec<usize>) {
+    let mut rejected = Vec::new();
+    for _ in 0..2 {
+        let cam = camera_from(prob.size.0, prob.size.1, &s.global);
+        let rms: Vec<Option<f64>> = (0..index.len())
+            .map(|v| {
+                active[v]
+                    .then(|| view_error(&cam, &iso(&s.views[v]), prob.board, prob.views[v]).rms_px)
+            })
+            .collect();
+        let keep = keep_flags(&rms, 0.5);
+        let newly: Vec<usize> = (0..index.len())
+            .filter(|&v| active[v] && !keep[v])
+            .collect();
+        if newly.is_empty() || active.iter().filter(|a| **a).count() - newly.len() < 3 {
+            break;
+        }
+        for v in newly {
+            active[v] = false;
+            rejected.push(index[v]);
+        }
+        s = solve(prob, s.global, s.views, &model.free(), active, 100);
+    }
+    rejected.sort_unstable();
+    (s, rejected)
+}
+
 /// Calibrates one camera from its detections (`None` where the board was not found).
 pub fn calibrate_mono(
     board: &Board,
@@ -211,70 +293,19 @@ pub fn calibrate_mono(
         });
     }
     let (cx, cy) = ((width as f64 - 1.0) / 2.0, (height as f64 - 1.0) / 2.0);
-    let mut homs = Vec::new();
-    for &k in &usable {
-        let d = dets[k]
-            .as_ref()
-            .map(|d| d.corners.as_slice())
-            .unwrap_or(&[]);
-        let src: Vec<Point2<f64>> = d
-            .iter()
-            .map(|c| {
-                let p = board.point(c.i, c.j);
-                Point2::new(p.x, p.y)
-            })
-            .collect();
-        let dst: Vec<Point2<f64>> = d.iter().map(|c| Point2::new(c.x, c.y)).collect();
-        homs.push(fit_homography(&src, &dst));
-    }
-    let good: Vec<Matrix3<f64>> = homs.iter().flatten().copied().collect();
-    let (fx, fy) = init_focal(&good, cx, cy).unwrap_or((width as f64, width as f64));
-    let k = Matrix3::new(fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0);
-    let mut views: Vec<&[Corner]> = Vec::new();
-    let mut index = Vec::new();
-    let mut poses = Vec::new();
-    for (h, &vi) in homs.iter().zip(&usable) {
-        if let Some(p) = h.as_ref().and_then(|h| pose_from_homography(h, &k)) {
-            views.push(
-                dets[vi]
-                    .as_ref()
-                    .map(|d| d.corners.as_slice())
-                    .unwrap_or(&[]),
-            );
-            index.push(vi);
-            poses.push(vec6(&p));
-        }
-    }
+    let ((fx, fy), posed) = zhang_start(board, (width, height), dets, &usable);
+    let index: Vec<usize> = posed.iter().map(|p| p.0).collect();
     let prob = Mono {
         board,
         size: (width, height),
-        views,
+        views: index.iter().map(|&vi| corners_of(&dets[vi])).collect(),
     };
     let g0 = vec![fx, fy, cx, cy, 0.0, 0.0, 0.0, 0.0, 0.0];
     let mut active = vec![true; index.len()];
+    let poses = posed.iter().map(|p| p.1).collect();
     let s0 = solve(&prob, g0, poses, &DistortionModel::None.free(), &active, 50);
-    let mut s = solve(&prob, s0.global, s0.views, &model.free(), &active, 100);
-    let mut rejected = Vec::new();
-    for _ in 0..2 {
-        let cam = camera_from(width, height, &s.global);
-        let rms: Vec<Option<f64>> = (0..index.len())
-            .map(|v| {
-                active[v].then(|| view_error(&cam, &iso(&s.views[v]), board, prob.views[v]).rms_px)
-            })
-            .collect();
-        let keep = keep_flags(&rms, 0.5);
-        let newly: Vec<usize> = (0..index.len())
-            .filter(|&v| active[v] && !keep[v])
-            .collect();
-        if newly.is_empty() || active.iter().filter(|a| **a).count() - newly.len() < 3 {
-            break;
-        }
-        for v in newly {
-            active[v] = false;
-            rejected.push(index[v]);
-        }
-        s = solve(&prob, s.global, s.views, &model.free(), &active, 100);
-    }
+    let s1 = solve(&prob, s0.global, s0.views, &model.free(), &active, 100);
+    let (s, rejected) = drop_outlier_views(&prob, s1, model, &mut active, &index);
     let cam = camera_from(width, height, &s.global);
     let mut pose_out = vec![None; dets.len()];
     let mut errs = vec![None; dets.len()];
@@ -286,7 +317,6 @@ pub fn calibrate_mono(
         }
     }
     let error = pooled(&errs.iter().flatten().copied().collect::<Vec<_>>());
-    rejected.sort_unstable();
     Ok(MonoResult {
         camera: cam,
         std: s.global_std.map(|v| {
@@ -464,51 +494,59 @@ pub struct StereoOptions {
     pub common_corners: bool,
 }
 
-/// Calibrates both cameras and the extrinsic between them.
-pub fn calibrate_stereo(
+/// Each camera alone, from every image of it.
+fn both_alone(
     board: &Board,
     rgb_size: (u32, u32),
     thermal_size: (u32, u32),
-    pairs: &[PairInput<'_>],
+    dets: (&[Option<Detection>], &[Option<Detection>]),
     opts: &StereoOptions,
-) -> Result<StereoResult, CalibError> {
-    let (model_rgb, model_thermal) = (opts.model_rgb, opts.model_thermal);
-    let rgb_dets: Vec<Option<Detection>> = pairs.iter().map(|p| p.rgb.cloned()).collect();
-    let th_dets: Vec<Option<Detection>> = pairs.iter().map(|p| p.thermal.cloned()).collect();
-    let rgb_alone = calibrate_mono(board, rgb_size.0, rgb_size.1, &rgb_dets, model_rgb)
-        .map_err(|e| CalibError::Camera {
-            camera: "colour",
+) -> Result<(MonoResult, MonoResult), CalibError> {
+    let alone = |camera: &'static str, (w, h): (u32, u32), d, model| {
+        calibrate_mono(board, w, h, d, model).map_err(|e| CalibError::Camera {
+            camera,
             source: Box::new(e),
-        })?;
-    let thermal_alone = calibrate_mono(
-        board,
-        thermal_size.0,
-        thermal_size.1,
-        &th_dets,
-        model_thermal,
-    )
-    .map_err(|e| CalibError::Camera {
-        camera: "thermal",
-        source: Box::new(e),
-    })?;
-    let n = pairs.len();
-    let mut status: Vec<PairStatus> = (0..n)
-        .map(|k| {
-            PairStatus::Rejected(match (&rgb_dets[k], &th_dets[k]) {
+        })
+    };
+    Ok((
+        alone("colour", rgb_size, dets.0, opts.model_rgb)?,
+        alone("thermal", thermal_size, dets.1, opts.model_thermal)?,
+    ))
+}
+
+/// Why each pair is not used, until the joint fit uses it.
+fn initial_status(rgb: &[Option<Detection>], th: &[Option<Detection>]) -> Vec<PairStatus> {
+    rgb.iter()
+        .zip(th)
+        .map(|d| {
+            PairStatus::Rejected(match d {
                 (None, None) => "no board found in either image".into(),
                 (None, _) => "no board found in the colour image".into(),
                 (_, None) => "no board found in the thermal image".into(),
                 _ => "rejected as an outlier by the single-camera fit".into(),
             })
         })
-        .collect();
-    // Tie thermal labels to the colour labels: the quarter turn first.
-    struct Cand {
-        k: usize,
-        th: Vec<Corner>,
-        tc: Isometry3<f64>,
-        tt: Isometry3<f64>,
-    }
+        .collect()
+}
+
+/// A pair whose thermal corners were turned to the colour corners' orientation.
+struct Cand {
+    k: usize,
+    th: Vec<Corner>,
+    /// colour camera_from_board.
+    tc: Isometry3<f64>,
+    /// thermal camera_from_board, in the turned numbering.
+    tt: Isometry3<f64>,
+}
+
+/// Ties thermal labels to the colour labels, the quarter turn first: the turn that makes the
+/// thermal camera's rotation relative to the colour camera smallest.
+fn quarter_turns(
+    board: &Board,
+    th_dets: &[Option<Detection>],
+    rgb_alone: &MonoResult,
+    thermal_alone: &MonoResult,
+) -> Vec<Cand> {
     let mut cands = Vec::new();
     for (k, dt) in th_dets.iter().enumerate() {
         let (Some(tc), Some(tt), Some(dt)) =
@@ -533,6 +571,17 @@ pub fn calibrate_stereo(
             });
         }
     }
+    cands
+}
+
+/// The thermal camera's position relative to the colour camera: the median over the pairs that
+/// show the whole board in both images (their numbering is not ambiguous up to a shift).
+fn median_offset(
+    board: &Board,
+    cands: &[Cand],
+    rgb_dets: &[Option<Detection>],
+    th_dets: &[Option<Detection>],
+) -> Result<Vector3<f64>, CalibError> {
     let full = |d: &Option<Detection>| {
         d.as_ref().is_some_and(|d| {
             let (w, h) = d.extent();
@@ -541,32 +590,39 @@ pub fn calibrate_stereo(
                     || (w, h) == (board.rows as i32, board.cols as i32))
         })
     };
-    let complete: Vec<&Cand> = cands
+    let ts: Vec<Vector3<f64>> = cands
         .iter()
         .filter(|c| full(&rgb_dets[c.k]) && full(&th_dets[c.k]))
+        .map(|c| (c.tt * c.tc.inverse()).translation.vector)
         .collect();
-    if complete.is_empty() {
+    if ts.is_empty() {
         return Err(CalibError::NoCompletePair {
             cols: board.cols,
             rows: board.rows,
         });
     }
-    let t0 = {
-        let ts: Vec<Vector3<f64>> = complete
-            .iter()
-            .map(|c| (c.tt * c.tc.inverse()).translation.vector)
-            .collect();
-        Vector3::new(
-            median(ts.iter().map(|t| t.x).collect()),
-            median(ts.iter().map(|t| t.y).collect()),
-            median(ts.iter().map(|t| t.z).collect()),
-        )
-    };
+    Ok(Vector3::new(
+        median(ts.iter().map(|t| t.x).collect()),
+        median(ts.iter().map(|t| t.y).collect()),
+        median(ts.iter().map(|t| t.z).collect()),
+    ))
+}
+
+/// The pairs tied: index, colour camera_from_board, thermal_from_colour.
+type Tied = Vec<(usize, Isometry3<f64>, Isometry3<f64>)>;
+
+/// Ties each candidate's thermal numbering by the board shift that puts the thermal camera
+/// nearest `t0`; a pair for which no shift comes within 0.4 squares is rejected.
+fn tie_shifts(
+    board: &Board,
+    cands: &[Cand],
+    t0: &Vector3<f64>,
+    status: &mut [PairStatus],
+) -> (Tied, Vec<Option<Vec<Corner>>>) {
     let mut used = Vec::new();
-    let mut th_labels: Vec<Option<Vec<Corner>>> = vec![None; n];
-    let (c, r) = (board.cols as i32, board.rows as i32);
-    let reach = c.max(r);
-    for cand in &cands {
+    let mut th_labels: Vec<Option<Vec<Corner>>> = vec![None; status.len()];
+    let reach = (board.cols as i32).max(board.rows as i32);
+    for cand in cands {
         let mut best: Option<(f64, i32, i32)> = None;
         for di in -reach..=reach {
             for dj in -reach..=reach {
@@ -585,11 +641,90 @@ pub fn calibrate_stereo(
             ));
             continue;
         }
-        let th = shift(&cand.th, di, dj);
         let tt = cand.tt * board_shift(board, di, dj).inverse();
         used.push((cand.k, cand.tc, tt * cand.tc.inverse()));
-        th_labels[cand.k] = Some(th);
+        th_labels[cand.k] = Some(shift(&cand.th, di, dj));
     }
+    (used, th_labels)
+}
+
+/// The joint problem's global parameters, which are free, and each pair's errors.
+struct Joint<'a> {
+    prob: Stereo<'a>,
+    free: Vec<bool>,
+}
+
+impl Joint<'_> {
+    /// (colour, thermal) reprojection errors of view `v` under `s`.
+    fn errors(&self, s: &crate::lm::Solved, v: usize) -> (ViewError, ViewError) {
+        let (rgb_size, th_size) = (self.prob.rgb_size, self.prob.th_size);
+        let cr = camera_from(rgb_size.0, rgb_size.1, &s.global[0..9]);
+        let ct = camera_from(th_size.0, th_size.1, &s.global[9..18]);
+        let pose = iso(&s.views[v]);
+        let e = iso(&s.global[18..24]);
+        (
+            view_error(&cr, &pose, self.prob.board, self.prob.rgb[v]),
+            view_error(&ct, &(e * pose), self.prob.board, &self.prob.th[v]),
+        )
+    }
+
+    /// Refits without the pairs whose error is far above the others', twice at most and keeping
+    /// at least three; `status` says why a pair was dropped.
+    fn reject_outliers(
+        &self,
+        mut s: crate::lm::Solved,
+        active: &mut [bool],
+        idx: &[usize],
+        status: &mut [PairStatus],
+    ) -> crate::lm::Solved {
+        for _ in 0..2 {
+            let errs: Vec<Option<(ViewError, ViewError)>> = (0..idx.len())
+                .map(|v| active[v].then(|| self.errors(&s, v)))
+                .collect();
+            let rms = |pick: fn(&(ViewError, ViewError)) -> f64| {
+                errs.iter()
+                    .map(|e| e.as_ref().map(pick))
+                    .collect::<Vec<_>>()
+            };
+            let kr = keep_flags(&rms(|x| x.0.rms_px), 0.5);
+            let kt = keep_flags(&rms(|x| x.1.rms_px), 0.5);
+            let newly: Vec<usize> = (0..idx.len())
+                .filter(|&v| active[v] && !(kr[v] && kt[v]))
+                .collect();
+            if newly.is_empty() || active.iter().filter(|a| **a).count() - newly.len() < 3 {
+                break;
+            }
+            for v in newly {
+                active[v] = false;
+                let (er, et) = errs[v].unwrap_or_default();
+                status[idx[v]] = PairStatus::Rejected(format!(
+                    "outlier: RMS error {:.2} px colour, {:.2} px thermal, far above the other pairs'",
+                    er.rms_px, et.rms_px
+                ));
+            }
+            s = solve(&self.prob, s.global, s.views, &self.free, active, 100);
+        }
+        s
+    }
+}
+
+/// Calibrates both cameras and the extrinsic between them.
+pub fn calibrate_stereo(
+    board: &Board,
+    rgb_size: (u32, u32),
+    thermal_size: (u32, u32),
+    pairs: &[PairInput<'_>],
+    opts: &StereoOptions,
+) -> Result<StereoResult, CalibError> {
+    let rgb_dets: Vec<Option<Detection>> = pairs.iter().map(|p| p.rgb.cloned()).collect();
+    let th_dets: Vec<Option<Detection>> = pairs.iter().map(|p| p.thermal.cloned()).collect();
+    let (rgb_alone, thermal_alone) =
+        both_alone(board, rgb_size, thermal_size, (&rgb_dets, &th_dets), opts)?;
+    let n = pairs.len();
+    let mut status = initial_status(&rgb_dets, &th_dets);
+    let cands = quarter_turns(board, &th_dets, &rgb_alone, &thermal_alone);
+    let t0 = median_offset(board, &cands, &rgb_dets, &th_dets)?;
+    let (used, th_labels) = tie_shifts(board, &cands, &t0, &mut status);
     let e0 = Isometry3::from_parts(
         Translation3::from(t0),
         mean_rotation(&used.iter().map(|u| u.2.rotation).collect::<Vec<_>>()),
@@ -599,15 +734,7 @@ pub fn calibrate_stereo(
         board,
         rgb_size,
         th_size: thermal_size,
-        rgb: idx
-            .iter()
-            .map(|&k| {
-                rgb_dets[k]
-                    .as_ref()
-                    .map(|d| d.corners.as_slice())
-                    .unwrap_or(&[])
-            })
-            .collect(),
+        rgb: idx.iter().map(|&k| corners_of(&rgb_dets[k])).collect(),
         th: idx
             .iter()
             .map(|&k| th_labels[k].clone().unwrap_or_default())
@@ -616,56 +743,14 @@ pub fn calibrate_stereo(
     let mut g: Vec<f64> = intrinsics(&rgb_alone.camera).to_vec();
     g.extend(intrinsics(&thermal_alone.camera));
     g.extend(vec6(&e0));
-    let mut free: Vec<bool> = model_rgb.free().to_vec();
-    free.extend(model_thermal.free());
+    let mut free: Vec<bool> = opts.model_rgb.free().to_vec();
+    free.extend(opts.model_thermal.free());
     free.extend([true; 6]);
+    let joint = Joint { prob, free };
     let views: Vec<[f64; 6]> = used.iter().map(|u| vec6(&u.1)).collect();
     let mut active = vec![true; idx.len()];
-    let mut s = solve(&prob, g, views, &free, &active, 100);
-    let errors = |s: &crate::lm::Solved, v: usize| {
-        let cr = camera_from(rgb_size.0, rgb_size.1, &s.global[0..9]);
-        let ct = camera_from(thermal_size.0, thermal_size.1, &s.global[9..18]);
-        let pose = iso(&s.views[v]);
-        let e = iso(&s.global[18..24]);
-        (
-            view_error(&cr, &pose, board, prob.rgb[v]),
-            view_error(&ct, &(e * pose), board, &prob.th[v]),
-        )
-    };
-    for _ in 0..2 {
-        let errs: Vec<Option<(ViewError, ViewError)>> = (0..idx.len())
-            .map(|v| active[v].then(|| errors(&s, v)))
-            .collect();
-        let kr = keep_flags(
-            &errs
-                .iter()
-                .map(|e| e.map(|x| x.0.rms_px))
-                .collect::<Vec<_>>(),
-            0.5,
-        );
-        let kt = keep_flags(
-            &errs
-                .iter()
-                .map(|e| e.map(|x| x.1.rms_px))
-                .collect::<Vec<_>>(),
-            0.5,
-        );
-        let newly: Vec<usize> = (0..idx.len())
-            .filter(|&v| active[v] && !(kr[v] && kt[v]))
-            .collect();
-        if newly.is_empty() || active.iter().filter(|a| **a).count() - newly.len() < 3 {
-            break;
-        }
-        for v in newly {
-            active[v] = false;
-            let (er, et) = errs[v].unwrap_or_default();
-            status[idx[v]] = PairStatus::Rejected(format!(
-                "outlier: RMS error {:.2} px colour, {:.2} px thermal, far above the other pairs'",
-                er.rms_px, et.rms_px
-            ));
-        }
-        s = solve(&prob, s.global, s.views, &free, &active, 100);
-    }
+    let first = solve(&joint.prob, g, views, &joint.free, &active, 100);
+    let s = joint.reject_outliers(first, &mut active, &idx, &mut status);
     let mut results: Vec<PairResult> = (0..n)
         .map(|k| PairResult {
             status: status[k].clone(),
@@ -677,7 +762,7 @@ pub fn calibrate_stereo(
         .collect();
     let (mut er_all, mut et_all) = (Vec::new(), Vec::new());
     for v in 0..idx.len() {
-        let (er, et) = errors(&s, v);
+        let (er, et) = joint.errors(&s, v);
         let r = &mut results[idx[v]];
         r.rgb_error = Some(er);
         r.thermal_error = Some(et);

@@ -564,6 +564,191 @@ fn bounds(poly: &[Point2<f64>]) -> (Point2<f64>, Point2<f64>) {
     (lo, hi)
 }
 
+/// Ids seen so far: each must be present and unique across surfaces, features and occluders.
+#[derive(Default)]
+struct Ids(HashSet<String>);
+
+impl Ids {
+    fn claim(&mut self, id: &str, element: String) -> Result<(), SceneError> {
+        if id.is_empty() {
+            return Err(SceneError::EmptyId { element });
+        }
+        if !self.0.insert(id.to_string()) {
+            return Err(SceneError::DuplicateId { id: id.into() });
+        }
+        Ok(())
+    }
+}
+
+/// `up`, when given: a finite, non-zero vector.
+fn check_up(up: Option<[f64; 3]>) -> Result<Option<Unit<Vector3<f64>>>, SceneError> {
+    let Some(u) = up else {
+        return Ok(None);
+    };
+    let v = Vector3::new(u[0], u[1], u[2]);
+    if !v.iter().all(|c| c.is_finite()) {
+        return Err(SceneError::BadUp { value: u });
+    }
+    Ok(Some(
+        Unit::try_new(v, 1e-9).ok_or(SceneError::BadUp { value: u })?,
+    ))
+}
+
+/// A feature of the surface `host` (its frame and 2D outline), checked against the features
+/// already accepted on it.
+fn check_feature(
+    f: &FeatureFile,
+    host: &str,
+    frame: &PlaneFrame,
+    host_2d: &[Point2<f64>],
+    others: &[Feature],
+) -> Result<Feature, SceneError> {
+    let fpoly = check_polygon("feature", &f.id, &f.polygon)?;
+    let off = fpoly
+        .iter()
+        .map(|p| frame.signed_distance(p).abs())
+        .fold(0.0, f64::max);
+    if off > FEATURE_PLANE_TOLERANCE_M {
+        return Err(SceneError::FeatureOffPlane {
+            id: f.id.clone(),
+            host: host.into(),
+            distance_mm: off * 1e3,
+        });
+    }
+    let f2: Vec<Point2<f64>> = fpoly.iter().map(|p| frame.to_2d(p)).collect();
+    polygon::check_simple(&f2, 1e-6).map_err(|e| not_simple("feature", &f.id, e))?;
+    if !polygon::polygon_inside(&f2, host_2d, FEATURE_PLANE_TOLERANCE_M) {
+        return Err(SceneError::FeatureOutsideHost {
+            id: f.id.clone(),
+            host: host.into(),
+        });
+    }
+    if let Some(other) = others
+        .iter()
+        .find(|o| polygon::polygons_overlap(&o.polygon_2d, &f2, FEATURE_PLANE_TOLERANCE_M))
+    {
+        return Err(SceneError::FeaturesOverlap {
+            a: other.id.clone(),
+            b: f.id.clone(),
+            host: host.into(),
+        });
+    }
+    Ok(Feature {
+        id: f.id.clone(),
+        label: f.label.clone(),
+        polygon: fpoly,
+        temperature: check_temperature("feature", &f.id, f.temperature_c)?,
+        emissivity: check_emissivity("feature", &f.id, f.emissivity)?,
+        temperature_std_k: check_std("feature", &f.id, f.temperature_std_k)?,
+        bounds_2d: bounds(&f2),
+        polygon_2d: f2,
+    })
+}
+
+/// A surface (the `si`-th) with its features.
+fn check_surface(s: &SurfaceFile, si: usize, ids: &mut Ids) -> Result<Surface, SceneError> {
+    ids.claim(&s.id, format!("surface {}", si + 1))?;
+    let kind = SurfaceKind::parse(&s.kind).ok_or_else(|| SceneError::UnknownKind {
+        id: s.id.clone(),
+        kind: s.kind.clone(),
+    })?;
+    let poly = check_polygon("surface", &s.id, &s.polygon)?;
+    let dev = polygon::planarity_deviation(&poly);
+    if dev > PLANARITY_TOLERANCE_M {
+        return Err(SceneError::NonPlanar {
+            element: "surface",
+            id: s.id.clone(),
+            deviation_mm: dev * 1e3,
+        });
+    }
+    let frame = PlaneFrame::of_polygon(&poly)
+        .ok_or_else(|| not_simple("surface", &s.id, NotSimple::ZeroArea))?;
+    let poly2: Vec<Point2<f64>> = poly.iter().map(|p| frame.to_2d(p)).collect();
+    polygon::check_simple(&poly2, 1e-6).map_err(|e| not_simple("surface", &s.id, e))?;
+    let temperature = check_temperature("surface", &s.id, s.temperature_c)?;
+    let emissivity = check_emissivity("surface", &s.id, s.emissivity)?;
+    let temperature_std_k = check_std("surface", &s.id, s.temperature_std_k)?;
+    if let Some(f) = s.observed_fraction
+        && !(0.0..=1.0).contains(&f)
+    {
+        return Err(SceneError::BadValue {
+            element: "surface",
+            id: s.id.clone(),
+            what: "observed_fraction",
+            value: f,
+            rule: "between 0 and 1",
+        });
+    }
+    let mut features: Vec<Feature> = Vec::with_capacity(s.features.len());
+    for (fi, f) in s.features.iter().enumerate() {
+        ids.claim(&f.id, format!("feature {} of surface '{}'", fi + 1, s.id))?;
+        features.push(check_feature(f, &s.id, &frame, &poly2, &features)?);
+    }
+    Ok(Surface {
+        id: s.id.clone(),
+        kind,
+        label: s.label.clone(),
+        polygon: poly,
+        temperature,
+        emissivity,
+        temperature_std_k,
+        observed_fraction: s.observed_fraction,
+        features,
+        frame,
+        polygon_2d: poly2,
+    })
+}
+
+/// An occluder's shape: a box with min below max, or a mesh whose triangles name its vertices.
+fn check_shape(o: &OccluderFile) -> Result<OccluderShape, SceneError> {
+    let bad = |detail: String| SceneError::BadOccluder {
+        id: o.id.clone(),
+        detail,
+    };
+    match (&o.box_, &o.vertices, &o.triangles) {
+        (Some(b), None, None) => {
+            if b.min.iter().chain(b.max.iter()).any(|c| !c.is_finite()) {
+                return Err(bad("box corners must be finite".into()));
+            }
+            if (0..3).any(|i| b.min[i] >= b.max[i]) {
+                return Err(bad(format!(
+                    "box min {:?} is not below max {:?} on every axis",
+                    b.min, b.max
+                )));
+            }
+            Ok(OccluderShape::Box {
+                min: point(&b.min),
+                max: point(&b.max),
+            })
+        }
+        (None, Some(v), Some(t)) => {
+            if v.iter().flatten().any(|c| !c.is_finite()) {
+                return Err(bad("mesh vertices must be finite".into()));
+            }
+            if t.is_empty() {
+                return Err(bad("mesh has no triangles".into()));
+            }
+            if let Some((k, tri)) = t
+                .iter()
+                .enumerate()
+                .find(|(_, tri)| tri.iter().any(|&i| i >= v.len()))
+            {
+                return Err(bad(format!(
+                    "triangle {k} {tri:?} refers to a vertex beyond the {} given",
+                    v.len()
+                )));
+            }
+            Ok(OccluderShape::Mesh {
+                vertices: v.iter().map(point).collect(),
+                triangles: t.clone(),
+            })
+        }
+        _ => Err(bad(
+            "give either `box` or both `vertices` and `triangles`".into()
+        )),
+    }
+}
+
 impl RadiantScene {
     /// Validates a scene file against every rule of the spec.
     pub fn new(file: &SceneFile) -> Result<Self, SceneError> {
@@ -575,174 +760,23 @@ impl RadiantScene {
         if file.surfaces.is_empty() {
             return Err(SceneError::NoSurfaces);
         }
-        let up_given = match file.up {
-            None => None,
-            Some(u) => {
-                let v = Vector3::new(u[0], u[1], u[2]);
-                if !v.iter().all(|c| c.is_finite()) {
-                    return Err(SceneError::BadUp { value: u });
-                }
-                Some(Unit::try_new(v, 1e-9).ok_or(SceneError::BadUp { value: u })?)
-            }
-        };
-        let mut ids = HashSet::new();
-        let mut claim = |id: &str, element: String| -> Result<(), SceneError> {
-            if id.is_empty() {
-                return Err(SceneError::EmptyId { element });
-            }
-            if !ids.insert(id.to_string()) {
-                return Err(SceneError::DuplicateId { id: id.into() });
-            }
-            Ok(())
-        };
-        let mut surfaces = Vec::with_capacity(file.surfaces.len());
-        for (si, s) in file.surfaces.iter().enumerate() {
-            claim(&s.id, format!("surface {}", si + 1))?;
-            let kind = SurfaceKind::parse(&s.kind).ok_or_else(|| SceneError::UnknownKind {
-                id: s.id.clone(),
-                kind: s.kind.clone(),
-            })?;
-            let poly = check_polygon("surface", &s.id, &s.polygon)?;
-            let dev = polygon::planarity_deviation(&poly);
-            if dev > PLANARITY_TOLERANCE_M {
-                return Err(SceneError::NonPlanar {
-                    element: "surface",
-                    id: s.id.clone(),
-                    deviation_mm: dev * 1e3,
-                });
-            }
-            let frame = PlaneFrame::of_polygon(&poly)
-                .ok_or_else(|| not_simple("surface", &s.id, NotSimple::ZeroArea))?;
-            let poly2: Vec<Point2<f64>> = poly.iter().map(|p| frame.to_2d(p)).collect();
-            polygon::check_simple(&poly2, 1e-6).map_err(|e| not_simple("surface", &s.id, e))?;
-            let temperature = check_temperature("surface", &s.id, s.temperature_c)?;
-            let emissivity = check_emissivity("surface", &s.id, s.emissivity)?;
-            let temperature_std_k = check_std("surface", &s.id, s.temperature_std_k)?;
-            if let Some(f) = s.observed_fraction
-                && !(0.0..=1.0).contains(&f)
-            {
-                return Err(SceneError::BadValue {
-                    element: "surface",
-                    id: s.id.clone(),
-                    what: "observed_fraction",
-                    value: f,
-                    rule: "between 0 and 1",
-                });
-            }
-            let mut features: Vec<Feature> = Vec::with_capacity(s.features.len());
-            for (fi, f) in s.features.iter().enumerate() {
-                claim(&f.id, format!("feature {} of surface '{}'", fi + 1, s.id))?;
-                let fpoly = check_polygon("feature", &f.id, &f.polygon)?;
-                let off = fpoly
-                    .iter()
-                    .map(|p| frame.signed_distance(p).abs())
-                    .fold(0.0, f64::max);
-                if off > FEATURE_PLANE_TOLERANCE_M {
-                    return Err(SceneError::FeatureOffPlane {
-                        id: f.id.clone(),
-                        host: s.id.clone(),
-                        distance_mm: off * 1e3,
-                    });
-                }
-                let f2: Vec<Point2<f64>> = fpoly.iter().map(|p| frame.to_2d(p)).collect();
-                polygon::check_simple(&f2, 1e-6).map_err(|e| not_simple("feature", &f.id, e))?;
-                if !polygon::polygon_inside(&f2, &poly2, FEATURE_PLANE_TOLERANCE_M) {
-                    return Err(SceneError::FeatureOutsideHost {
-                        id: f.id.clone(),
-                        host: s.id.clone(),
-                    });
-                }
-                if let Some(other) = features.iter().find(|o| {
-                    polygon::polygons_overlap(&o.polygon_2d, &f2, FEATURE_PLANE_TOLERANCE_M)
-                }) {
-                    return Err(SceneError::FeaturesOverlap {
-                        a: other.id.clone(),
-                        b: f.id.clone(),
-                        host: s.id.clone(),
-                    });
-                }
-                features.push(Feature {
-                    id: f.id.clone(),
-                    label: f.label.clone(),
-                    polygon: fpoly,
-                    temperature: check_temperature("feature", &f.id, f.temperature_c)?,
-                    emissivity: check_emissivity("feature", &f.id, f.emissivity)?,
-                    temperature_std_k: check_std("feature", &f.id, f.temperature_std_k)?,
-                    bounds_2d: bounds(&f2),
-                    polygon_2d: f2,
-                });
-            }
-            surfaces.push(Surface {
-                id: s.id.clone(),
-                kind,
-                label: s.label.clone(),
-                polygon: poly,
-                temperature,
-                emissivity,
-                temperature_std_k,
-                observed_fraction: s.observed_fraction,
-                features,
-                frame,
-                polygon_2d: poly2,
-            });
-        }
+        let up_given = check_up(file.up)?;
+        let mut ids = Ids::default();
+        let surfaces = file
+            .surfaces
+            .iter()
+            .enumerate()
+            .map(|(si, s)| check_surface(s, si, &mut ids))
+            .collect::<Result<Vec<_>, _>>()?;
         let mut occluders = Vec::with_capacity(file.occluders.len());
         for (oi, o) in file.occluders.iter().enumerate() {
-            claim(&o.id, format!("occluder {}", oi + 1))?;
-            let bad = |detail: String| SceneError::BadOccluder {
-                id: o.id.clone(),
-                detail,
-            };
-            let shape = match (&o.box_, &o.vertices, &o.triangles) {
-                (Some(b), None, None) => {
-                    if b.min.iter().chain(b.max.iter()).any(|c| !c.is_finite()) {
-                        return Err(bad("box corners must be finite".into()));
-                    }
-                    if (0..3).any(|i| b.min[i] >= b.max[i]) {
-                        return Err(bad(format!(
-                            "box min {:?} is not below max {:?} on every axis",
-                            b.min, b.max
-                        )));
-                    }
-                    OccluderShape::Box {
-                        min: point(&b.min),
-                        max: point(&b.max),
-                    }
-                }
-                (None, Some(v), Some(t)) => {
-                    if v.iter().flatten().any(|c| !c.is_finite()) {
-                        return Err(bad("mesh vertices must be finite".into()));
-                    }
-                    if t.is_empty() {
-                        return Err(bad("mesh has no triangles".into()));
-                    }
-                    if let Some((k, tri)) = t
-                        .iter()
-                        .enumerate()
-                        .find(|(_, tri)| tri.iter().any(|&i| i >= v.len()))
-                    {
-                        return Err(bad(format!(
-                            "triangle {k} {tri:?} refers to a vertex beyond the {} given",
-                            v.len()
-                        )));
-                    }
-                    OccluderShape::Mesh {
-                        vertices: v.iter().map(point).collect(),
-                        triangles: t.clone(),
-                    }
-                }
-                _ => {
-                    return Err(bad(
-                        "give either `box` or both `vertices` and `triangles`".into()
-                    ));
-                }
-            };
+            ids.claim(&o.id, format!("occluder {}", oi + 1))?;
             occluders.push(Occluder {
                 id: o.id.clone(),
                 label: o.label.clone(),
+                shape: check_shape(o)?,
                 temperature: check_temperature("occluder", &o.id, o.temperature_c)?,
                 emissivity: check_emissivity("occluder", &o.id, o.emissivity)?,
-                shape,
             });
         }
         Ok(Self {

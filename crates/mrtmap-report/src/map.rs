@@ -155,6 +155,7 @@ fn runs_inside(
 type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// A drawing error, in words.
+#[allow(clippy::needless_pass_by_value)] // used as map_err(de)
 fn de<E: std::error::Error + Send + Sync>(x: DrawingAreaErrorKind<E>) -> ReportError {
     ReportError::Draw(x.to_string())
 }
@@ -490,7 +491,7 @@ fn draw_flat_feature<DB: DrawingBackend>(
     kind: SurfaceKind,
     uv: &[(f64, f64)],
     colour: RGBColor,
-    text: String,
+    text: &str,
 ) -> Result<(), ReportError> {
     let mut ring = uv.to_vec();
     ring.push(uv[0]);
@@ -550,7 +551,7 @@ fn draw_features<DB: DrawingBackend>(
                     draw_wall_feature(root, chart, input.field, &uv, colour, text)?;
                 }
                 SurfaceKind::Ceiling | SurfaceKind::Floor => {
-                    draw_flat_feature(root, chart, s.kind, &uv, colour, text)?;
+                    draw_flat_feature(root, chart, s.kind, &uv, colour, &text)?;
                 }
             }
         }

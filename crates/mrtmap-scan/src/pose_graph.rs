@@ -143,7 +143,10 @@ pub enum PoseGraphError {
 }
 
 /// Refuses edges naming unknown nodes or carrying implausible transforms.
-fn check_edges(initial: &BTreeMap<i64, Isometry3<f64>>, edges: &[Edge]) -> Result<(), PoseGraphError> {
+fn check_edges(
+    initial: &BTreeMap<i64, Isometry3<f64>>,
+    edges: &[Edge],
+) -> Result<(), PoseGraphError> {
     for e in edges {
         for id in [e.from, e.to] {
             if !initial.contains_key(&id) {
@@ -469,7 +472,12 @@ mod tests {
             measured: Isometry3::identity(),
             information: Matrix6::identity(),
         };
-        assert!(optimise(&truth, &[e]).unwrap_err().to_string().contains("node 99"));
+        assert!(
+            optimise(&truth, &[e])
+                .unwrap_err()
+                .to_string()
+                .contains("node 99")
+        );
         // Only nodes 1–3 are linked to the first: the rest, linked among themselves or not at
         // all, are left out.
         let edges: Vec<Edge> = [(1, 2), (2, 3), (5, 6), (6, 7)]
@@ -492,7 +500,12 @@ mod tests {
             measured: Isometry3::translation(1e30, 0.0, 0.0),
             information: Matrix6::identity(),
         };
-        assert!(optimise(&truth, &[wild]).unwrap_err().to_string().contains("1 → 2"));
+        assert!(
+            optimise(&truth, &[wild])
+                .unwrap_err()
+                .to_string()
+                .contains("1 → 2")
+        );
         // An information matrix of 1e300 counts as identity.
         let huge = Edge {
             from: 1,

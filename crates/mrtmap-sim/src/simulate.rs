@@ -405,7 +405,13 @@ impl Frames<'_> {
 }
 
 /// Writes the stream lists of the frames' times.
-fn write_lists(out: &Out, header: &str, depth_t: &[f64], thermal_t: &[f64], rgb_t: &[f64]) -> Result<(), SimError> {
+fn write_lists(
+    out: &Out,
+    header: &str,
+    depth_t: &[f64],
+    thermal_t: &[f64],
+    rgb_t: &[f64],
+) -> Result<(), SimError> {
     let list = |ts: &[f64], dir: &str| -> Vec<(f64, String)> {
         ts.iter()
             .enumerate()
@@ -423,10 +429,7 @@ fn write_lists(out: &Out, header: &str, depth_t: &[f64], thermal_t: &[f64], rgb_
             "masks",
         ),
     ] {
-        let text = stream_list_text(
-            &format!("{header}\n{what}: timestamp path"),
-            &list(ts, dir),
-        );
+        let text = stream_list_text(&format!("{header}\n{what}: timestamp path"), &list(ts, dir));
         out.write(file, text.as_bytes())?;
     }
     Ok(())

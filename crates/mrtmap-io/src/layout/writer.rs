@@ -47,7 +47,8 @@ impl LayoutWriter {
     /// Adds a 16-bit depth frame.
     pub fn depth(&mut self, t: f64, img: &Image16) -> Result<(), FileError> {
         let rel = format!("depth/{:06}.png", self.depth.len());
-        let png = encode_png16(img).map_err(|e| FileError::encode(&self.dir.path().join(&rel), e))?;
+        let png =
+            encode_png16(img).map_err(|e| FileError::encode(&self.dir.path().join(&rel), e))?;
         write(self.dir.path(), &rel, &png)?;
         self.depth.push((t, rel));
         Ok(())
@@ -56,7 +57,8 @@ impl LayoutWriter {
     /// Adds a 16-bit centikelvin thermal frame.
     pub fn thermal(&mut self, t: f64, img: &Image16) -> Result<(), FileError> {
         let rel = format!("thermal/{:06}.png", self.thermal.len());
-        let png = encode_png16(img).map_err(|e| FileError::encode(&self.dir.path().join(&rel), e))?;
+        let png =
+            encode_png16(img).map_err(|e| FileError::encode(&self.dir.path().join(&rel), e))?;
         write(self.dir.path(), &rel, &png)?;
         self.thermal.push((t, rel));
         Ok(())

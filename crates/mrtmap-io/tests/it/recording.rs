@@ -12,7 +12,8 @@ fn tiny(dir: &std::path::Path) {
             width: 4,
             height: 3,
             data: vec![1500; 12],
-        }).unwrap(),
+        })
+        .unwrap(),
     )
     .unwrap();
     std::fs::write(
@@ -21,7 +22,8 @@ fn tiny(dir: &std::path::Path) {
             width: 2,
             height: 2,
             data: vec![29415; 4],
-        }).unwrap(),
+        })
+        .unwrap(),
     )
     .unwrap();
     std::fs::write(dir.join("depth.txt"), "1.00 depth/0.png\n").unwrap();
@@ -80,7 +82,8 @@ fn missing_and_mismatched_files_are_named() {
             width: 5,
             height: 3,
             data: vec![1; 15],
-        }).unwrap(),
+        })
+        .unwrap(),
     )
     .unwrap();
     let r = Recording::open(dir.path()).unwrap();

@@ -184,7 +184,11 @@ fn lepton_raw_png_and_tiff_agree() {
         height: 120,
         data: data.clone(),
     };
-    std::fs::write(dir.path().join("f.png"), mrtmap_io::encode_png16(&img16).unwrap()).unwrap();
+    std::fs::write(
+        dir.path().join("f.png"),
+        mrtmap_io::encode_png16(&img16).unwrap(),
+    )
+    .unwrap();
     image::ImageBuffer::<image::Luma<u16>, _>::from_raw(160, 120, data.clone())
         .unwrap()
         .save(dir.path().join("f.tiff"))

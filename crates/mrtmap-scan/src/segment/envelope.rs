@@ -609,12 +609,11 @@ pub fn envelope(
     if lines.is_empty() {
         return Err(SegmentError::NoWalls);
     }
-    let (order, mut corners2) = walk_loop(&lines, &link).map_err(|walls| {
-        SegmentError::OpenOutline {
+    let (order, mut corners2) =
+        walk_loop(&lines, &link).map_err(|walls| SegmentError::OpenOutline {
             walls,
             found: found.clone(),
-        }
-    })?;
+        })?;
     // corners2[k] joins order[k] and order[k+1]; rotate so corner k joins wall k−1 and wall k.
     corners2.rotate_right(1);
     let mut wall_order: Vec<usize> = order.iter().map(|&i| lines[i].k).collect();
@@ -636,10 +635,12 @@ pub fn envelope(
         );
         intersect_three(a, b, cap)
     };
-    let floor_corners: Option<Vec<Point3<f64>>> =
-        (0..n).map(|k| corner3(k, &planes[caps.floor].plane)).collect();
-    let ceiling_corners: Option<Vec<Point3<f64>>> =
-        (0..n).map(|k| corner3(k, &planes[caps.ceiling].plane)).collect();
+    let floor_corners: Option<Vec<Point3<f64>>> = (0..n)
+        .map(|k| corner3(k, &planes[caps.floor].plane))
+        .collect();
+    let ceiling_corners: Option<Vec<Point3<f64>>> = (0..n)
+        .map(|k| corner3(k, &planes[caps.ceiling].plane))
+        .collect();
     let (Some(floor_corners), Some(ceiling_corners)) = (floor_corners, ceiling_corners) else {
         return Err(SegmentError::OpenOutline { walls: n, found });
     };

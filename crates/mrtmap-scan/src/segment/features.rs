@@ -252,14 +252,19 @@ fn ccw(mut p: Vec<Point2<f64>>) -> Vec<Point2<f64>> {
 
 /// The texels beyond the threshold on one side of the background (`sign` +1 warm, −1 cold), with
 /// one-texel holes (unobserved or noisy) closed.
-fn threshold_mask(g: &Grid, resid: &dyn Fn(usize) -> f64, sign: f64, threshold_k: f64) -> Vec<bool> {
+fn threshold_mask(
+    g: &Grid,
+    resid: &dyn Fn(usize) -> f64,
+    sign: f64,
+    threshold_k: f64,
+) -> Vec<bool> {
     let n = g.nx * g.ny;
     let raw: Vec<bool> = (0..n)
         .map(|c| g.inside[c] && g.observed(c) && sign * resid(c) > threshold_k)
         .collect();
     let mut mask = raw.clone();
-    for c in 0..n {
-        if !mask[c]
+    for (c, m) in mask.iter_mut().enumerate() {
+        if !*m
             && g.inside[c]
             && g.neighbours(c)
                 .iter()
@@ -267,7 +272,7 @@ fn threshold_mask(g: &Grid, resid: &dyn Fn(usize) -> f64, sign: f64, threshold_k
                 .count()
                 >= 3
         {
-            mask[c] = true;
+            *m = true;
         }
     }
     mask
@@ -301,7 +306,12 @@ fn components(g: &Grid, mask: &[bool]) -> Vec<Vec<usize>> {
 
 /// Hysteresis: the region grown or shrunk to the texels beyond half its core contrast, connected
 /// to its texels that are; `None` when no texel of it was observed.
-fn hysteresis(g: &Grid, comp: &[usize], resid: &dyn Fn(usize) -> f64, sign: f64) -> Option<Vec<usize>> {
+fn hysteresis(
+    g: &Grid,
+    comp: &[usize],
+    resid: &dyn Fn(usize) -> f64,
+    sign: f64,
+) -> Option<Vec<usize>> {
     let mut core: Vec<f64> = comp
         .iter()
         .filter(|&&c| g.observed(c))
@@ -336,13 +346,21 @@ fn hysteresis(g: &Grid, comp: &[usize], resid: &dyn Fn(usize) -> f64, sign: f64)
 
 /// A region's outline: its minimum-area rectangle when it fills at least 75 % of it, else its
 /// simplified convex outline, clipped to the host; why not when it does not fit.
-fn outline(g: &Grid, comp: &[usize], host: &[Point2<f64>], area: f64) -> Result<Vec<Point2<f64>>, String> {
+fn outline(
+    g: &Grid,
+    comp: &[usize],
+    host: &[Point2<f64>],
+    area: f64,
+) -> Result<Vec<Point2<f64>>, String> {
     use mrtmap_geometry::nalgebra::Vector2;
     let t = g.t;
     let corners: Vec<Point2<f64>> = comp
         .iter()
         .flat_map(|&c| {
-            let o = Point2::new(g.lo.x + (c % g.nx) as f64 * t, g.lo.y + (c / g.nx) as f64 * t);
+            let o = Point2::new(
+                g.lo.x + (c % g.nx) as f64 * t,
+                g.lo.y + (c / g.nx) as f64 * t,
+            );
             [
                 o,
                 o + Vector2::new(t, 0.0),
@@ -523,7 +541,8 @@ pub fn analyse_surface(
             out.features.push(feature(&g, &comp, poly, &resid, &bg));
         }
     }
-    if let Some((t, std)) = host_temperature(&g, &cells, &in_feature, &out.features, observed_fraction)
+    if let Some((t, std)) =
+        host_temperature(&g, &cells, &in_feature, &out.features, observed_fraction)
     {
         out.temperature_k = Some(t);
         out.temperature_std_k = std;

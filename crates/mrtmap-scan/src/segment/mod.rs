@@ -294,7 +294,12 @@ fn surface_geometry(env: &Envelope, longest: &Vector3<f64>) -> Vec<SurfaceGeom> 
     let mut geoms = Vec::with_capacity(n + 2);
     for (id, kind, plane, corners) in [
         ("floor", SurfaceKind::Floor, env.floor, &env.floor_corners),
-        ("ceiling", SurfaceKind::Ceiling, env.ceiling, &env.ceiling_corners),
+        (
+            "ceiling",
+            SurfaceKind::Ceiling,
+            env.ceiling,
+            &env.ceiling_corners,
+        ),
     ] {
         geoms.push(SurfaceGeom {
             id: id.into(),
@@ -453,7 +458,11 @@ fn vote_labels(
     pos: &[Point3<f64>],
 ) -> (Vec<Vote>, Vec<Vote>, Option<MaskSummary>) {
     let Some(m) = masks else {
-        return (vec![None; features.len()], vec![None; furniture.len()], None);
+        return (
+            vec![None; features.len()],
+            vec![None; furniture.len()],
+            None,
+        );
     };
     let pts: Vec<Vec<Point3<f64>>> = features
         .iter()
@@ -727,8 +736,13 @@ pub fn segment(
         &mut ids,
         &mut warnings,
     );
-    let (surfaces, summaries) =
-        build_surfaces(&geoms, &analyses, &members, found.per_surface, &mut warnings);
+    let (surfaces, summaries) = build_surfaces(
+        &geoms,
+        &analyses,
+        &members,
+        found.per_surface,
+        &mut warnings,
+    );
     let (occluders, furniture_summaries) = build_furniture(&furniture, furniture_votes, &mut ids);
     let scene = RadiantScene::new(&SceneFile {
         format: SCENE_FORMAT.into(),

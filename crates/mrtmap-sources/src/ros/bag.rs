@@ -312,12 +312,8 @@ pub fn for_each_message(
     for_each_message_in(&mut std::io::Cursor::new(file), f)
 }
 
-/// [`for_each_message`] reading from a file (or anything seekable), a record at a time: memory
-/// stays at one chunk, whatever the bag's size.
-pub fn for_each_message_in<R: Read + Seek + ?Sized>(
-    r: &mut R,
-    f: &mut dyn FnMut(Message<'_>) -> Result<(), Corrupt>,
-) -> Result<BagSummary, Corrupt> {
+/// The bag's length after checking its magic line.
+fn check_magic<R: Read + Seek + ?Sized>(r: &mut R) -> Result<u64, Corrupt> {
     let len = r.seek(SeekFrom::End(0)).map_err(|e| io_err(0, &e))?;
     let mut magic = [0u8; 13];
     r.seek(SeekFrom::Start(0)).map_err(|e| io_err(0, &e))?;
@@ -327,47 +323,149 @@ pub fn for_each_message_in<R: Read + Seek + ?Sized>(
             "not a ROS 1 bag (no \"#ROSBAG V2.0\" line)",
         ));
     }
+    Ok(len)
+}
+
+/// The record held in `buf`, read at file offset `at`.
+fn record_at(buf: &[u8], at: u64) -> Result<Record<'_>, Corrupt> {
+    let bytes = Bytes {
+        data: buf,
+        base: at,
+        endian: Endian::Little,
+    };
+    Ok(record(&bytes, 0)?.0)
+}
+
+/// A message's time field.
+fn message_time(r: &Record<'_>) -> Result<f64, Corrupt> {
+    match r.field("time") {
+        Some(v) if v.len() == 8 => Ok(u32::from_le_bytes([v[0], v[1], v[2], v[3]]) as f64
+            + u32::from_le_bytes([v[4], v[5], v[6], v[7]]) as f64 * 1e-9),
+        _ => Err(Corrupt::new(r.at, "message record without an 8-byte time")),
+    }
+}
+
+/// A connection record defines a connection; a message record is passed to `f` (its errors
+/// naming `offset`).
+fn handle_record(
+    r: &Record<'_>,
+    conns: &mut HashMap<u32, Connection>,
+    offset: u64,
+    f: &mut dyn FnMut(Message<'_>) -> Result<(), Corrupt>,
+) -> Result<(), Corrupt> {
+    match r.op {
+        OP_CONN => {
+            let (id, c) = connection(r)?;
+            conns.insert(id, c);
+        }
+        OP_MSG => {
+            let id = r.u32_field("conn")?;
+            let t = message_time(r)?;
+            let c = conns.get(&id).ok_or_else(|| {
+                Corrupt::new(
+                    r.at,
+                    format!("message on connection {id}, which no record defines"),
+                )
+            })?;
+            f(Message {
+                topic: &c.topic,
+                datatype: &c.datatype,
+                time: t,
+                data: r.data.data,
+                wire: Wire::Ros1,
+                offset,
+                record: None,
+            })?;
+        }
+        _ => {}
+    }
+    Ok(())
+}
+
+/// The header record: where the index section starts, and where the records after it start.
+fn read_header<R: Read + Seek + ?Sized>(
+    r: &mut R,
+    len: u64,
+    buf: &mut Vec<u8>,
+) -> Result<(u64, u64), Corrupt> {
+    let first = MAGIC.len() as u64;
+    let (op, pos) = read_record(r, len, first, buf, |_| false)?;
+    if op != OP_HEADER {
+        return Err(Corrupt::new(first, "the bag has no header record"));
+    }
+    let h = record_at(buf, first)?;
+    match h.field("index_pos") {
+        Some(v) if v.len() == 8 => Ok((
+            u64::from_le_bytes([v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]]),
+            pos,
+        )),
+        _ => Err(Corrupt::new(
+            first,
+            "bag header without an 8-byte index_pos",
+        )),
+    }
+}
+
+/// Connections from the index section, so that messages can be named even in chunks that do not
+/// repeat them.
+fn index_connections<R: Read + Seek + ?Sized>(
+    r: &mut R,
+    (index_pos, len): (u64, u64),
+    buf: &mut Vec<u8>,
+    conns: &mut HashMap<u32, Connection>,
+) -> Result<(), Corrupt> {
+    let mut p = index_pos;
+    while p < len {
+        let (op, next) = read_record(r, len, p, buf, |op| op == OP_CONN)?;
+        if op == OP_CONN {
+            let (id, c) = connection(&record_at(buf, p)?)?;
+            conns.insert(id, c);
+        }
+        p = next;
+    }
+    Ok(())
+}
+
+/// The records of a chunk, decompressed into `bufs`: offsets inside a compressed chunk do not
+/// exist in the file, so its messages name the chunk.
+fn chunk_records(
+    rec: &Record<'_>,
+    bufs: &mut Buffers,
+    conns: &mut HashMap<u32, Connection>,
+    f: &mut dyn FnMut(Message<'_>) -> Result<(), Corrupt>,
+) -> Result<(), Corrupt> {
+    decompress(rec, bufs)?;
+    let compressed = rec.field("compression") != Some(b"none".as_slice());
+    let inner = Bytes {
+        data: &bufs.out,
+        base: if compressed { rec.at } else { rec.data.base },
+        endian: Endian::Little,
+    };
+    let mut p = 0;
+    while p < inner.len() {
+        let (m, next) = record(&inner, p).map_err(|e| {
+            if compressed {
+                Corrupt::new(rec.at, format!("inside the compressed chunk: {}", e.what))
+            } else {
+                e
+            }
+        })?;
+        let off = if compressed { rec.at } else { m.data.base };
+        handle_record(&m, conns, off, f)?;
+        p = next;
+    }
+    Ok(())
+}
+
+/// [`for_each_message`] reading from a file (or anything seekable), a record at a time: memory
+/// stays at one chunk, whatever the bag's size.
+pub fn for_each_message_in<R: Read + Seek + ?Sized>(
+    r: &mut R,
+    f: &mut dyn FnMut(Message<'_>) -> Result<(), Corrupt>,
+) -> Result<BagSummary, Corrupt> {
+    let len = check_magic(r)?;
     let mut conns: HashMap<u32, Connection> = HashMap::new();
     let mut buf = Vec::new();
-    let handle = |r: &Record<'_>,
-                  conns: &mut HashMap<u32, Connection>,
-                  offset: u64,
-                  f: &mut dyn FnMut(Message<'_>) -> Result<(), Corrupt>|
-     -> Result<(), Corrupt> {
-        match r.op {
-            OP_CONN => {
-                let (id, c) = connection(r)?;
-                conns.insert(id, c);
-            }
-            OP_MSG => {
-                let id = r.u32_field("conn")?;
-                let t = match r.field("time") {
-                    Some(v) if v.len() == 8 => {
-                        u32::from_le_bytes([v[0], v[1], v[2], v[3]]) as f64
-                            + u32::from_le_bytes([v[4], v[5], v[6], v[7]]) as f64 * 1e-9
-                    }
-                    _ => return Err(Corrupt::new(r.at, "message record without an 8-byte time")),
-                };
-                let c = conns.get(&id).ok_or_else(|| {
-                    Corrupt::new(
-                        r.at,
-                        format!("message on connection {id}, which no record defines"),
-                    )
-                })?;
-                f(Message {
-                    topic: &c.topic,
-                    datatype: &c.datatype,
-                    time: t,
-                    data: r.data.data,
-                    wire: Wire::Ros1,
-                    offset,
-                    record: None,
-                })?;
-            }
-            _ => {}
-        }
-        Ok(())
-    };
     let mut summary = BagSummary::default();
     let mut bufs = Buffers::default();
     let mut count = |m: Message<'_>| {
@@ -375,101 +473,33 @@ pub fn for_each_message_in<R: Read + Seek + ?Sized>(
         f(m)
     };
     let f = &mut count;
-    // The header record first: it says where the index section (with every connection) starts.
-    let first = MAGIC.len() as u64;
-    let (op, mut pos) = read_record(r, len, first, &mut buf, |_| false)?;
-    if op != OP_HEADER {
-        return Err(Corrupt::new(first, "the bag has no header record"));
-    }
-    let (h, _) = record(
-        &Bytes {
-            data: &buf,
-            base: first,
-            endian: Endian::Little,
-        },
-        0,
-    )?;
-    let index_pos = match h.field("index_pos") {
-        Some(v) if v.len() == 8 => {
-            u64::from_le_bytes([v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]])
-        }
-        _ => {
-            return Err(Corrupt::new(
-                first,
-                "bag header without an 8-byte index_pos",
-            ));
-        }
-    };
-    let unindexed = index_pos <= first || index_pos >= len;
+    let (index_pos, mut pos) = read_header(r, len, &mut buf)?;
+    let unindexed = index_pos <= MAGIC.len() as u64 || index_pos >= len;
     if !unindexed {
-        // Connections from the index section, so that messages can be named even in chunks that
-        // do not repeat them.
-        let mut p = index_pos;
-        while p < len {
-            let (op, next) = read_record(r, len, p, &mut buf, |op| op == OP_CONN)?;
-            if op == OP_CONN {
-                let (rec, _) = record(
-                    &Bytes {
-                        data: &buf,
-                        base: p,
-                        endian: Endian::Little,
-                    },
-                    0,
-                )?;
-                let (id, c) = connection(&rec)?;
-                conns.insert(id, c);
-            }
-            p = next;
-        }
+        index_connections(r, (index_pos, len), &mut buf, &mut conns)?;
     }
     let end = if unindexed { len } else { index_pos };
+    let mut chunks = 0;
     while pos < end {
         let at = pos;
         let (op, next) = read_record(r, len, at, &mut buf, |op| {
             matches!(op, OP_CHUNK | OP_MSG | OP_CONN)
         })?;
         pos = next;
-        let (rec, _) = record(
-            &Bytes {
-                data: &buf,
-                base: at,
-                endian: Endian::Little,
-            },
-            0,
-        )?;
+        let rec = record_at(&buf, at)?;
         match op {
             OP_CHUNK => {
-                summary.chunks += 1;
-                decompress(&rec, &mut bufs)?;
-                let data = &bufs.out;
-                let compressed = rec.field("compression") != Some(b"none".as_slice());
-                // Offsets inside a compressed chunk do not exist in the file: name the chunk.
-                let inner = Bytes {
-                    data,
-                    base: if compressed { rec.at } else { rec.data.base },
-                    endian: Endian::Little,
-                };
-                let mut p = 0;
-                while p < inner.len() {
-                    let (m, next) = record(&inner, p).map_err(|e| {
-                        if compressed {
-                            Corrupt::new(rec.at, format!("inside the compressed chunk: {}", e.what))
-                        } else {
-                            e
-                        }
-                    })?;
-                    let off = if compressed { rec.at } else { m.data.base };
-                    handle(&m, &mut conns, off, f)?;
-                    p = next;
-                }
+                chunks += 1;
+                chunk_records(&rec, &mut bufs, &mut conns, f)?;
             }
-            OP_MSG | OP_CONN => handle(&rec, &mut conns, rec.data.base, f)?,
+            OP_MSG | OP_CONN => handle_record(&rec, &mut conns, rec.data.base, f)?,
             OP_INDEX | OP_CHUNK_INFO => {}
             op => {
                 return Err(Corrupt::new(at, format!("unknown record op 0x{op:02x}")));
             }
         }
     }
+    summary.chunks = chunks;
     summary.unindexed = unindexed;
     Ok(summary)
 }

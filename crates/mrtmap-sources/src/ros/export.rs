@@ -167,6 +167,79 @@ pub struct ExportReport {
     pub skipped_reasons: Vec<String>,
 }
 
+/// A colour message as PNG/JPEG bytes, its stamp and extension.
+fn colour_message(m: &Message<'_>, kind: MsgKind) -> Result<(f64, Vec<u8>, &'static str), String> {
+    if kind == MsgKind::CompressedImage {
+        let c = ros_msg::compressed_image(m.data, m.wire, m.offset).map_err(|e| e.to_string())?;
+        let ext = if c.data.starts_with(b"\x89PNG") {
+            "png"
+        } else {
+            "jpg"
+        };
+        return Ok((stamp_or(c.header.stamp, m.time), c.data.to_vec(), ext));
+    }
+    let i = ros_msg::image(m.data, m.wire, m.offset).map_err(|e| e.to_string())?;
+    Ok((stamp_or(i.header.stamp, m.time), rgb_image(&i)?, "png"))
+}
+
+/// A 16-bit image message of the size the camera has.
+fn sized_image(
+    m: &Message<'_>,
+    kind: MsgKind,
+    scale: f64,
+    thermal: bool,
+    cam: &mrtmap_geometry::camera::PinholeCamera,
+) -> Result<(f64, Image16), String> {
+    let (t, img) = image16_msg(m, kind, scale, thermal)?;
+    if (img.width, img.height) != (cam.width, cam.height) {
+        let what = if thermal { "thermal" } else { "depth" };
+        return Err(format!(
+            "{what} image is {}×{}, the {what} camera {}×{}",
+            img.width, img.height, cam.width, cam.height
+        ));
+    }
+    Ok((t, img))
+}
+
+/// Writes one message of the plan's streams into `w` (other topics are ignored).
+fn write_message(
+    m: &Message<'_>,
+    p: &Plan,
+    rig: &mrtmap_io::Rig,
+    w: &mut LayoutWriter,
+) -> Result<(), Step> {
+    let topic = Some(m.topic.to_string());
+    let kind = MsgKind::of(m.datatype);
+    if topic == p.depth {
+        let (t, img) = sized_image(m, kind, rig.depth_scale, false, &rig.depth)?;
+        w.depth(t, &img).map_err(Step::Write)?;
+    } else if topic == p.thermal {
+        let (t, img) = sized_image(m, kind, 1.0, true, &rig.thermal)?;
+        w.thermal(t, &img).map_err(Step::Write)?;
+    } else if topic == p.rgb {
+        let (t, bytes, ext) = colour_message(m, kind)?;
+        w.rgb(t, &bytes, ext).map_err(Step::Write)?;
+    } else if matches!(&p.poses, Some(PoseSource::Topic(pt)) if Some(pt) == topic.as_ref()) {
+        let x = if kind == MsgKind::Odometry {
+            ros_msg::odometry(m.data, m.wire, m.offset)
+        } else {
+            ros_msg::pose_stamped(m.data, m.wire, m.offset)
+        }
+        .map_err(|e| e.to_string())?;
+        w.pose(stamp_or(x.stamp, m.time), x.transform * p.child_from_depth);
+    } else if let Some(PoseSource::Tf(a, b)) = &p.poses
+        && kind == MsgKind::Tf
+        && !m.topic.ends_with("tf_static")
+    {
+        for x in ros_msg::tf_message(m.data, m.wire, m.offset).map_err(|e| e.to_string())? {
+            if &x.parent == a && &x.child == b {
+                w.pose(stamp_or(x.stamp, m.time), x.transform * p.child_from_depth);
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Writes the recording layout for a plan whose rig is complete.
 pub fn export<'a>(
     path: &Path,
@@ -176,103 +249,30 @@ pub fn export<'a>(
     out: &Path,
 ) -> Result<ExportReport, FileError> {
     let file = file.into();
-    let Some(rig) = p.rig else {
+    let (Some(rig), true) = (p.rig, p.missing.is_empty()) else {
         return Err(FileError::new(
             path,
             None,
             FileErrorKind::Missing(format!("what a scan needs: {}", p.missing.join("; "))),
         ));
     };
-    if !p.missing.is_empty() {
-        return Err(FileError::new(
-            path,
-            None,
-            FileErrorKind::Missing(format!("what a scan needs: {}", p.missing.join("; "))),
-        ));
-    }
     let mut w = LayoutWriter::create(out, &format!("converted by mrtmap from {}", path.display()))?;
     let mut rep = ExportReport::default();
     let mut err: Option<FileError> = None;
-    let skip = |rep: &mut ExportReport, topic: &str, place: String, why: String| {
-        rep.skipped += 1;
-        if rep.skipped_reasons.len() < 5 {
-            rep.skipped_reasons.push(format!("{topic} {place}: {why}"));
-        }
-    };
-    let tf_pose = match &p.poses {
-        Some(PoseSource::Tf(a, b)) => Some((a.clone(), b.clone())),
-        _ => None,
-    };
-    let pose_topic = match &p.poses {
-        Some(PoseSource::Topic(t)) => Some(t.clone()),
-        _ => None,
-    };
     let res = for_each(s.container, file, &mut |m| {
-        let topic = Some(m.topic.to_string());
-        let kind = MsgKind::of(m.datatype);
-        let r: Result<(), Step> = (|| {
-            if topic == p.depth {
-                let (t, img) = image16_msg(&m, kind, rig.depth_scale, false)?;
-                if (img.width, img.height) != (rig.depth.width, rig.depth.height) {
-                    return Err(Step::Skip(format!(
-                        "depth image is {}×{}, the depth camera {}×{}",
-                        img.width, img.height, rig.depth.width, rig.depth.height
-                    )));
-                }
-                w.depth(t, &img).map_err(Step::Write)?;
-            } else if topic == p.thermal {
-                let (t, img) = image16_msg(&m, kind, 1.0, true)?;
-                if (img.width, img.height) != (rig.thermal.width, rig.thermal.height) {
-                    return Err(Step::Skip(format!(
-                        "thermal image is {}×{}, the thermal camera {}×{}",
-                        img.width, img.height, rig.thermal.width, rig.thermal.height
-                    )));
-                }
-                w.thermal(t, &img).map_err(Step::Write)?;
-            } else if topic == p.rgb {
-                if kind == MsgKind::CompressedImage {
-                    let c = ros_msg::compressed_image(m.data, m.wire, m.offset)
-                        .map_err(|e| e.to_string())?;
-                    let ext = if c.data.starts_with(b"\x89PNG") {
-                        "png"
-                    } else {
-                        "jpg"
-                    };
-                    w.rgb(stamp_or(c.header.stamp, m.time), c.data, ext)
-                        .map_err(Step::Write)?;
-                } else {
-                    let i = ros_msg::image(m.data, m.wire, m.offset).map_err(|e| e.to_string())?;
-                    let png = rgb_image(&i)?;
-                    w.rgb(stamp_or(i.header.stamp, m.time), &png, "png")
-                        .map_err(Step::Write)?;
-                }
-            } else if topic == pose_topic {
-                let x = if kind == MsgKind::Odometry {
-                    ros_msg::odometry(m.data, m.wire, m.offset)
-                } else {
-                    ros_msg::pose_stamped(m.data, m.wire, m.offset)
-                }
-                .map_err(|e| e.to_string())?;
-                w.pose(stamp_or(x.stamp, m.time), x.transform * p.child_from_depth);
-            } else if let Some((a, b)) = &tf_pose
-                && kind == MsgKind::Tf
-                && !m.topic.ends_with("tf_static")
-            {
-                for x in ros_msg::tf_message(m.data, m.wire, m.offset).map_err(|e| e.to_string())? {
-                    if &x.parent == a && &x.child == b {
-                        w.pose(stamp_or(x.stamp, m.time), x.transform * p.child_from_depth);
-                    }
-                }
-            }
-            Ok(())
-        })();
-        match r {
+        match write_message(&m, p, &rig, &mut w) {
             Ok(()) => {}
             Err(Step::Write(e)) => {
                 err = Some(e);
                 return Err(Corrupt::new(m.offset, "stopped: cannot write the output"));
             }
-            Err(Step::Skip(why)) => skip(&mut rep, m.topic, m.place(), why),
+            Err(Step::Skip(why)) => {
+                rep.skipped += 1;
+                if rep.skipped_reasons.len() < 5 {
+                    rep.skipped_reasons
+                        .push(format!("{} {}: {why}", m.topic, m.place()));
+                }
+            }
         }
         Ok(())
     });
@@ -280,11 +280,7 @@ pub fn export<'a>(
         return Err(e);
     }
     res.map_err(|e| e.in_file(path))?;
-    let (d, t, c, n) = w.counts();
-    rep.depth = d;
-    rep.thermal = t;
-    rep.rgb = c;
-    rep.poses = n;
+    (rep.depth, rep.thermal, rep.rgb, rep.poses) = w.counts();
     let source = serde_json::json!({
         "format": "mrtmap-source/1",
         "source": path.display().to_string(),

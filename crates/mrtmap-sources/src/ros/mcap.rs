@@ -113,19 +113,142 @@ pub fn for_each_message(
     for_each_message_in(&mut std::io::Cursor::new(file), f)
 }
 
+fn io_error(at: u64, e: &std::io::Error) -> Corrupt {
+    Corrupt::new(at, format!("cannot read: {e}"))
+}
+
+/// The file's length after checking its magic.
+fn check_magic<R: Read + Seek + ?Sized>(r: &mut R) -> Result<u64, Corrupt> {
+    let len = r.seek(SeekFrom::End(0)).map_err(|e| io_error(0, &e))?;
+    r.seek(SeekFrom::Start(0)).map_err(|e| io_error(0, &e))?;
+    let mut magic = [0u8; 8];
+    if len < 8 || r.read_exact(&mut magic).is_err() || magic != MAGIC {
+        return Err(Corrupt::new(0, "not an MCAP file (no MCAP magic)"));
+    }
+    Ok(len)
+}
+
+/// The opcode and body length of the top-level record at `at`, checked against the `len` bytes of
+/// the file.
+fn record_header<R: Read + Seek + ?Sized>(
+    r: &mut R,
+    at: u64,
+    len: u64,
+) -> Result<(u8, u64), Corrupt> {
+    let left = len - at;
+    if left < 9 {
+        return Err(Corrupt::new(
+            at,
+            format!(
+                "a record opcode and length need 9 bytes but only {left} are left (file cut short?)"
+            ),
+        ));
+    }
+    let mut h = [0u8; 9];
+    r.seek(SeekFrom::Start(at)).map_err(|e| io_error(at, &e))?;
+    r.read_exact(&mut h).map_err(|e| io_error(at, &e))?;
+    let op = h[0];
+    let blen = u64::from_le_bytes([h[1], h[2], h[3], h[4], h[5], h[6], h[7], h[8]]);
+    if blen > left - 9 {
+        return Err(Corrupt::new(
+            at + 9,
+            format!(
+                "record (opcode 0x{op:02x}) needs {blen} bytes but only {} are left (file cut short?)",
+                left - 9
+            ),
+        ));
+    }
+    Ok((op, blen))
+}
+
+/// A chunk's records decompressed into `chunk` (decompressed here, not by mcap's ChunkReader:
+/// that one reserves whatever length a record inside the chunk claims, found by fuzzing: a 3 TB
+/// reservation, an abort).
+fn decompress_chunk(
+    header: &::mcap::records::ChunkHeader,
+    data: &[u8],
+    at: u64,
+    chunk: &mut Vec<u8>,
+) -> Result<(), Corrupt> {
+    if header.uncompressed_size > MAX_CHUNK_BYTES as u64 {
+        return Err(Corrupt::new(
+            at,
+            format!(
+                "chunk claims {} bytes decompressed (more than the {MAX_CHUNK_BYTES} accepted)",
+                header.uncompressed_size
+            ),
+        ));
+    }
+    let compression = header.compression.as_str();
+    let size = header.uncompressed_size as usize;
+    chunk.clear();
+    chunk.reserve(size.min(16 << 20));
+    let res = match compression {
+        "" => {
+            chunk.extend_from_slice(data);
+            Ok(data.len())
+        }
+        "zstd" => zstd::stream::read::Decoder::new(data)
+            .and_then(|d| d.take(size as u64 + 1).read_to_end(chunk)),
+        "lz4" => lz4_flex::frame::FrameDecoder::new(data)
+            .take(size as u64 + 1)
+            .read_to_end(chunk),
+        other => {
+            return Err(Corrupt::new(
+                at,
+                format!("chunk compression '{other}' is not one of none, zstd, lz4"),
+            ));
+        }
+    };
+    if let Err(e) = res {
+        return Err(Corrupt::new(at, format!("broken {compression} chunk: {e}")));
+    }
+    if chunk.len() != size {
+        return Err(Corrupt::new(
+            at,
+            format!(
+                "{compression} chunk decompresses to {} bytes but its header says {size}",
+                chunk.len()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The records of a decompressed chunk (found at `at`) that a scan needs.
+fn chunk_records(
+    chunk: &[u8],
+    at: u64,
+    state: &mut State,
+    summary: &mut McapSummary,
+    f: &mut dyn FnMut(Message<'_>) -> Result<(), Corrupt>,
+) -> Result<(), Corrupt> {
+    let inner = Bytes::new(chunk, Endian::Little);
+    let mut p = 0;
+    while p < inner.len() {
+        let (op, body, next) = record_at(&inner, p)
+            .map_err(|e| Corrupt::new(at, format!("inside the chunk: {}", e.what)))?;
+        if NEEDED.contains(&op) {
+            let r = ::mcap::parse_record(op, body).map_err(|e| {
+                Corrupt::new(
+                    at,
+                    format!("inside the chunk, record (opcode 0x{op:02x}): {e}"),
+                )
+            })?;
+            state.record(r, at, summary, f)?;
+        }
+        p = next;
+    }
+    Ok(())
+}
+
 /// [`for_each_message`] reading from a file (or anything seekable) a record at a time: memory
 /// stays at one chunk, whatever the file's size. Records a scan does not need are skipped unread.
 pub fn for_each_message_in<R: Read + Seek + ?Sized>(
     r: &mut R,
     f: &mut dyn FnMut(Message<'_>) -> Result<(), Corrupt>,
 ) -> Result<McapSummary, Corrupt> {
-    let io = |at: u64, e: std::io::Error| Corrupt::new(at, format!("cannot read: {e}"));
-    let len = r.seek(SeekFrom::End(0)).map_err(|e| io(0, e))?;
-    r.seek(SeekFrom::Start(0)).map_err(|e| io(0, e))?;
-    let mut magic = [0u8; 8];
-    if len < 8 || r.read_exact(&mut magic).is_err() || magic != MAGIC {
-        return Err(Corrupt::new(0, "not an MCAP file (no MCAP magic)"));
-    }
+    let len = check_magic(r)?;
     let mut state = State::default();
     let mut summary = McapSummary {
         unfinished: true,
@@ -133,32 +256,10 @@ pub fn for_each_message_in<R: Read + Seek + ?Sized>(
     };
     let mut pos = MAGIC.len() as u64;
     let mut chunk = Vec::new();
-    let mut body_buf = Vec::new();
+    let mut body = Vec::new();
     while pos < len {
         let at = pos;
-        let left = len - pos;
-        if left < 9 {
-            return Err(Corrupt::new(
-                at,
-                format!(
-                    "a record opcode and length need 9 bytes but only {left} are left (file cut short?)"
-                ),
-            ));
-        }
-        let mut h = [0u8; 9];
-        r.seek(SeekFrom::Start(pos)).map_err(|e| io(at, e))?;
-        r.read_exact(&mut h).map_err(|e| io(at, e))?;
-        let op = h[0];
-        let blen = u64::from_le_bytes([h[1], h[2], h[3], h[4], h[5], h[6], h[7], h[8]]);
-        if blen > left - 9 {
-            return Err(Corrupt::new(
-                at + 9,
-                format!(
-                    "record (opcode 0x{op:02x}) needs {blen} bytes but only {} are left (file cut short?)",
-                    left - 9
-                ),
-            ));
-        }
+        let (op, blen) = record_header(r, at, len)?;
         pos = at + 9 + blen;
         if op == 0x02 {
             summary.unfinished = false;
@@ -175,76 +276,15 @@ pub fn for_each_message_in<R: Read + Seek + ?Sized>(
                 ),
             ));
         }
-        body_buf.clear();
-        body_buf.resize(blen as usize, 0);
-        r.read_exact(&mut body_buf).map_err(|e| io(at + 9, e))?;
-        let body = &body_buf[..];
-        let rec = ::mcap::parse_record(op, body)
+        body.clear();
+        body.resize(blen as usize, 0);
+        r.read_exact(&mut body).map_err(|e| io_error(at + 9, &e))?;
+        let rec = ::mcap::parse_record(op, &body)
             .map_err(|e| Corrupt::new(at, format!("MCAP record (opcode 0x{op:02x}): {e}")))?;
         if let Record::Chunk { header, data } = rec {
             summary.chunks += 1;
-            if header.uncompressed_size > MAX_CHUNK_BYTES as u64 {
-                return Err(Corrupt::new(
-                    at,
-                    format!(
-                        "chunk claims {} bytes decompressed (more than the {MAX_CHUNK_BYTES} accepted)",
-                        header.uncompressed_size
-                    ),
-                ));
-            }
-            let compression = header.compression.as_str();
-            let size = header.uncompressed_size as usize;
-            // Decompressed here, not by mcap's ChunkReader: that one reserves whatever length a
-            // record inside the chunk claims (found by fuzzing: a 3 TB reservation, an abort).
-            chunk.clear();
-            chunk.reserve(size.min(16 << 20));
-            let res = match compression {
-                "" => {
-                    chunk.extend_from_slice(&data);
-                    Ok(data.len())
-                }
-                "zstd" => zstd::stream::read::Decoder::new(&data[..])
-                    .and_then(|d| d.take(size as u64 + 1).read_to_end(&mut chunk)),
-                "lz4" => lz4_flex::frame::FrameDecoder::new(&data[..])
-                    .take(size as u64 + 1)
-                    .read_to_end(&mut chunk),
-                other => {
-                    return Err(Corrupt::new(
-                        at,
-                        format!("chunk compression '{other}' is not one of none, zstd, lz4"),
-                    ));
-                }
-            };
-            if let Err(e) = res {
-                return Err(Corrupt::new(at, format!("broken {compression} chunk: {e}")));
-            }
-            if chunk.len() != size {
-                return Err(Corrupt::new(
-                    at,
-                    format!(
-                        "{compression} chunk decompresses to {} bytes but its header says {size}",
-                        chunk.len()
-                    ),
-                ));
-            }
-            let inner = Bytes::new(&chunk, Endian::Little);
-            let mut p = 0;
-            while p < inner.len() {
-                let (op, body, next) = record_at(&inner, p)
-                    .map_err(|e| Corrupt::new(at, format!("inside the chunk: {}", e.what)))?;
-                if !NEEDED.contains(&op) {
-                    p = next;
-                    continue;
-                }
-                let r = ::mcap::parse_record(op, body).map_err(|e| {
-                    Corrupt::new(
-                        at,
-                        format!("inside the chunk, record (opcode 0x{op:02x}): {e}"),
-                    )
-                })?;
-                state.record(r, at, &mut summary, f)?;
-                p = next;
-            }
+            decompress_chunk(&header, &data, at, &mut chunk)?;
+            chunk_records(&chunk, at, &mut state, &mut summary, f)?;
         } else {
             state.record(rec, at, &mut summary, f)?;
         }
@@ -293,16 +333,15 @@ impl McapWriter {
             }
         };
         let ns = (time * 1e9).round() as u64;
-        self.w
-            .write_to_known_channel(
-                &::mcap::records::MessageHeader {
-                    channel_id: id,
-                    sequence: 0,
-                    log_time: ns,
-                    publish_time: ns,
-                },
-                data,
-            )
+        self.w.write_to_known_channel(
+            &::mcap::records::MessageHeader {
+                channel_id: id,
+                sequence: 0,
+                log_time: ns,
+                publish_time: ns,
+            },
+            data,
+        )
     }
 
     /// The file's bytes.

@@ -165,16 +165,19 @@ fn pick(
         })
 }
 
-/// Chooses streams and assembles the rig.
-pub fn plan(s: &Survey, o: &RosOptions) -> Plan {
-    let mut missing = Vec::new();
-    let mut notes = Vec::new();
-    let is_image = |t: &TopicStats| {
-        matches!(
-            MsgKind::of(&t.datatype),
-            MsgKind::Image | MsgKind::CompressedImage
-        )
-    };
+fn is_image(t: &TopicStats) -> bool {
+    matches!(
+        MsgKind::of(&t.datatype),
+        MsgKind::Image | MsgKind::CompressedImage
+    )
+}
+
+/// The image topics of a scan: depth, thermal and colour.
+fn image_topics(
+    s: &Survey,
+    o: &RosOptions,
+    missing: &mut Vec<String>,
+) -> (Option<String>, Option<String>, Option<String>) {
     let depth = pick(
         s,
         &o.depth_topic,
@@ -189,7 +192,7 @@ pub fn plan(s: &Survey, o: &RosOptions) -> Plan {
                             .iter()
                             .any(|e| t.encoding.starts_with(e))))
         },
-        &mut missing,
+        missing,
     );
     let thermal = pick(
         s,
@@ -202,7 +205,7 @@ pub fn plan(s: &Survey, o: &RosOptions) -> Plan {
                 && !t.topic.to_ascii_lowercase().contains("depth")
                 && matches!(t.encoding.as_str(), "mono16" | "16UC1")
         },
-        &mut missing,
+        missing,
     );
     let rgb = pick(
         s,
@@ -215,9 +218,30 @@ pub fn plan(s: &Survey, o: &RosOptions) -> Plan {
                 && (matches!(t.encoding.as_str(), "rgb8" | "bgr8" | "rgba8" | "bgra8")
                     || t.encoding.contains("jpeg"))
         },
-        &mut missing,
+        missing,
     );
-    let mut poses = pick(
+    if depth.is_none() && o.depth_topic.is_none() {
+        missing.push(
+            "depth images: no 16UC1/32FC1 depth image topic (name one with --depth-topic)".into(),
+        );
+    }
+    if thermal.is_none() && o.thermal_topic.is_none() {
+        missing
+            .push("thermal images: no mono16 image topic (name one with --thermal-topic)".into());
+    }
+    (depth, thermal, rgb)
+}
+
+/// Where poses come from: an Odometry or PoseStamped topic, else a dynamic transform whose child
+/// reaches the depth camera through static ones.
+fn pose_source(
+    s: &Survey,
+    o: &RosOptions,
+    depth_frame: &str,
+    missing: &mut Vec<String>,
+    notes: &mut Vec<String>,
+) -> Option<PoseSource> {
+    let topic = pick(
         s,
         &o.pose_topic,
         &POSE_DEFAULTS,
@@ -228,73 +252,91 @@ pub fn plan(s: &Survey, o: &RosOptions) -> Plan {
                 MsgKind::Odometry | MsgKind::PoseStamped
             )
         },
-        &mut missing,
-    )
-    .map(PoseSource::Topic);
-    if depth.is_none() && o.depth_topic.is_none() {
-        missing.push(
-            "depth images: no 16UC1/32FC1 depth image topic (name one with --depth-topic)".into(),
-        );
+        missing,
+    );
+    if topic.is_some() || o.pose_topic.is_some() {
+        return topic.map(PoseSource::Topic);
     }
-    if thermal.is_none() && o.thermal_topic.is_none() {
-        missing
-            .push("thermal images: no mono16 image topic (name one with --thermal-topic)".into());
-    }
-    let depth_frame = depth
-        .as_ref()
-        .map(|d| s.topics[d].frame_id.clone())
-        .unwrap_or_default();
-    if poses.is_none() && o.pose_topic.is_none() {
-        // A dynamic transform whose child reaches the depth camera through static ones.
-        let best = s
-            .dynamic_tf
-            .iter()
-            .filter(|((_, c), _)| static_lookup(&s.static_tf, c, &depth_frame).is_some())
-            .max_by_key(|(_, n)| **n);
-        match best {
-            Some(((p, c), _)) => {
-                notes.push(format!("poses from /tf: {p} → {c}"));
-                poses = Some(PoseSource::Tf(p.clone(), c.clone()));
-            }
-            None => missing.push(
+    let best = s
+        .dynamic_tf
+        .iter()
+        .filter(|((_, c), _)| static_lookup(&s.static_tf, c, depth_frame).is_some())
+        .max_by_key(|(_, n)| **n);
+    match best {
+        Some(((p, c), _)) => {
+            notes.push(format!("poses from /tf: {p} → {c}"));
+            Some(PoseSource::Tf(p.clone(), c.clone()))
+        }
+        None => {
+            missing.push(
                 "poses: no Odometry or PoseStamped topic, and no /tf transform that reaches the depth camera (name one with --pose-topic)"
                     .into(),
-            ),
+            );
+            None
         }
     }
-    // Pose child → depth camera.
-    let mut child_from_depth = Isometry3::identity();
-    if let Some(PoseSource::Topic(t)) = &poses {
-        let child = pose_child(s, t);
-        match child.as_deref().and_then(|c| static_lookup(&s.static_tf, c, &depth_frame)) {
-            Some(x) => {
-                child_from_depth = x;
-                if x != Isometry3::identity() {
+}
+
+/// The pose frame's transform to the depth camera through /tf_static (identity when none).
+fn child_to_depth(
+    s: &Survey,
+    poses: &Option<PoseSource>,
+    depth_frame: &str,
+    notes: &mut Vec<String>,
+) -> Isometry3<f64> {
+    match poses {
+        Some(PoseSource::Topic(t)) => {
+            let child = pose_child(s, t);
+            match child
+                .as_deref()
+                .and_then(|c| static_lookup(&s.static_tf, c, depth_frame))
+            {
+                Some(x) => {
+                    if x != Isometry3::identity() {
+                        notes.push(format!(
+                            "poses of {} carried to the depth camera {depth_frame} through /tf_static",
+                            child.unwrap_or_default()
+                        ));
+                    }
+                    x
+                }
+                None => {
                     notes.push(format!(
-                        "poses of {} carried to the depth camera {depth_frame} through /tf_static",
-                        child.unwrap_or_default()
+                        "no static transform from the pose frame {} to the depth camera {depth_frame}: the poses are taken as the depth camera's own",
+                        child.unwrap_or_else(|| "(unnamed)".into())
                     ));
+                    Isometry3::identity()
                 }
             }
-            None => notes.push(format!(
-                "no static transform from the pose frame {} to the depth camera {depth_frame}: the poses are taken as the depth camera's own",
-                child.unwrap_or_else(|| "(unnamed)".into())
-            )),
         }
-    } else if let Some(PoseSource::Tf(_, c)) = &poses
-        && let Some(x) = static_lookup(&s.static_tf, c, &depth_frame)
-    {
-        child_from_depth = x;
+        Some(PoseSource::Tf(_, c)) => {
+            static_lookup(&s.static_tf, c, depth_frame).unwrap_or_else(Isometry3::identity)
+        }
+        None => Isometry3::identity(),
     }
-    // The rig.
+}
+
+/// The frame id of a topic's messages.
+fn frame_of(s: &Survey, topic: &Option<String>) -> Option<String> {
+    topic.as_ref().map(|t| s.topics[t].frame_id.clone())
+}
+
+/// The rig from CameraInfo and /tf_static, with what a rig.toml supplies; what is missing is said.
+fn assemble_rig(
+    s: &Survey,
+    o: &RosOptions,
+    (depth, thermal, rgb): (&Option<String>, &Option<String>, &Option<String>),
+    missing: &mut Vec<String>,
+) -> Option<Rig> {
     let info_of = |topic: &Option<String>| {
         topic
             .as_ref()
             .and_then(|t| s.infos.get(&info_topic_for(t)).and_then(camera_from_info))
     };
-    let depth_cam = info_of(&depth).or(o.rig.map(|r| r.depth));
-    let rgb_cam = info_of(&rgb).or(o.rig.and_then(|r| r.rgb.map(|c| c.camera)));
-    let thermal_cam = o.rig.map(|r| r.thermal).or_else(|| info_of(&thermal));
+    let depth_frame = frame_of(s, depth).unwrap_or_default();
+    let depth_cam = info_of(depth).or(o.rig.map(|r| r.depth));
+    let rgb_cam = info_of(rgb).or(o.rig.and_then(|r| r.rgb.map(|c| c.camera)));
+    let thermal_cam = o.rig.map(|r| r.thermal).or_else(|| info_of(thermal));
     if depth.is_some() && depth_cam.is_none() {
         missing.push(format!(
             "depth intrinsics: no CameraInfo on {} (or give --rig)",
@@ -307,10 +349,7 @@ pub fn plan(s: &Survey, o: &RosOptions) -> Plan {
             thermal.as_deref().map(info_topic_for).unwrap_or_default()
         ));
     }
-    let thermal_frame = thermal
-        .as_ref()
-        .map(|t| s.topics[t].frame_id.clone())
-        .unwrap_or_default();
+    let thermal_frame = frame_of(s, thermal).unwrap_or_default();
     let depth_from_thermal = match o.rig {
         Some(r) => Some(r.depth_from_thermal),
         None => static_lookup(&s.static_tf, &depth_frame, &thermal_frame),
@@ -324,30 +363,37 @@ pub fn plan(s: &Survey, o: &RosOptions) -> Plan {
         .depth_scale
         .or(o.rig.map(|r| r.depth_scale))
         .unwrap_or(1000.0);
-    let rig = match (depth_cam, thermal_cam, depth_from_thermal) {
-        (Some(d), Some(t), Some(x)) => {
-            let rgb_frame = rgb.as_ref().map(|t| s.topics[t].frame_id.clone());
-            let rgb_cam = rgb_cam.and_then(|c| {
-                let x = rgb_frame
-                    .as_deref()
-                    .and_then(|f| static_lookup(&s.static_tf, &depth_frame, f))
-                    .or(o.rig.and_then(|r| r.rgb.map(|c| c.depth_from_rgb)))?;
-                Some(RgbCamera {
-                    camera: c,
-                    depth_from_rgb: x,
-                })
-            });
-            Some(Rig {
-                depth: d,
-                depth_scale,
-                thermal: t,
-                thermal_encoding: ThermalEncoding::Centikelvin,
-                depth_from_thermal: x,
-                rgb: rgb_cam,
-            })
-        }
-        _ => None,
-    };
+    let (d, t, x) = (depth_cam?, thermal_cam?, depth_from_thermal?);
+    let rgb_frame = frame_of(s, rgb);
+    let rgb_cam = rgb_cam.and_then(|c| {
+        let x = rgb_frame
+            .as_deref()
+            .and_then(|f| static_lookup(&s.static_tf, &depth_frame, f))
+            .or(o.rig.and_then(|r| r.rgb.map(|c| c.depth_from_rgb)))?;
+        Some(RgbCamera {
+            camera: c,
+            depth_from_rgb: x,
+        })
+    });
+    Some(Rig {
+        depth: d,
+        depth_scale,
+        thermal: t,
+        thermal_encoding: ThermalEncoding::Centikelvin,
+        depth_from_thermal: x,
+        rgb: rgb_cam,
+    })
+}
+
+/// Chooses streams and assembles the rig.
+pub fn plan(s: &Survey, o: &RosOptions) -> Plan {
+    let mut missing = Vec::new();
+    let mut notes = Vec::new();
+    let (depth, thermal, rgb) = image_topics(s, o, &mut missing);
+    let depth_frame = frame_of(s, &depth).unwrap_or_default();
+    let poses = pose_source(s, o, &depth_frame, &mut missing, &mut notes);
+    let child_from_depth = child_to_depth(s, &poses, &depth_frame, &mut notes);
+    let rig = assemble_rig(s, o, (&depth, &thermal, &rgb), &mut missing);
     if s.unfinished {
         notes.push("the file was cut or never closed: what was read is all there is".into());
     }

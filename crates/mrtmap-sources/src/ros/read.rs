@@ -103,8 +103,7 @@ pub fn for_each<'a>(
                 if m.wire != Wire::Cdr {
                     return f(m);
                 }
-                let data =
-                    super::db3::inflate(m.data, &mut buf)
+                let data = super::db3::inflate(m.data, &mut buf)
                     .map_err(|e| Corrupt::new(m.offset, e.to_string()))?;
                 f(Message { data, ..m })
             };

@@ -61,66 +61,97 @@ impl RosWriteOptions {
     }
 }
 
-/// Writes a recording as a bag or MCAP file with RealSense-style topics ([`names`]): aligned
-/// depth (16UC1), colour (rgb8), thermal (mono16), their CameraInfo, T265-style odometry of a
-/// pose frame, and /tf_static tying the frames together.
-pub fn write_ros(rec: &Recording, o: &RosWriteOptions) -> Result<Vec<u8>, FileError> {
-    use super::bag::BagWriter;
-    use super::msg::encode;
-    let wire = match o.container {
-        Container::Bag => Wire::Ros1,
-        Container::Mcap | Container::Db3 => Wire::Cdr,
-    };
-    enum W {
-        Bag(BagWriter),
-        Mcap(Box<super::mcap::McapWriter>),
-        Db3(super::db3::Db3Writer),
-    }
-    let syntax = |e: &dyn std::error::Error| {
-        FileError::new(&rec.dir, None, FileErrorKind::Syntax(e.to_string()))
-    };
-    let mut w = match o.container {
-        Container::Bag => W::Bag(BagWriter::new(o.compression, 768 * 1024)),
-        Container::Mcap => W::Mcap(Box::new(
-            super::mcap::McapWriter::new(
-                match o.compression {
+/// Where messages go: a bag, MCAP or `.db3` writer, with type names in its ROS version.
+enum Sink {
+    Bag(super::bag::BagWriter),
+    Mcap(Box<super::mcap::McapWriter>),
+    Db3(super::db3::Db3Writer),
+}
+
+/// A writer's error as a file error of the recording.
+fn syntax(dir: &std::path::Path, e: &dyn std::error::Error) -> FileError {
+    FileError::new(dir, None, FileErrorKind::Syntax(e.to_string()))
+}
+
+impl Sink {
+    fn new(o: &RosWriteOptions, dir: &std::path::Path) -> Result<Self, FileError> {
+        Ok(match o.container {
+            Container::Bag => Self::Bag(super::bag::BagWriter::new(o.compression, 768 * 1024)),
+            Container::Mcap => {
+                let compression = match o.compression {
                     Compression::None => None,
                     Compression::Lz4 => Some(::mcap::Compression::Lz4),
                     Compression::Bz2 => Some(::mcap::Compression::Zstd),
-                },
-                768 * 1024,
-            )
-            .map_err(|e| syntax(&e))?,
-        )),
-        Container::Db3 => W::Db3(super::db3::Db3Writer::new().map_err(|e| syntax(&e))?),
-    };
-    let ty = |t: &str| -> String {
-        match o.container {
-            Container::Bag => t.to_string(),
-            Container::Mcap | Container::Db3 => {
-                let (pkg, name) = t.split_once('/').unwrap_or(("", t));
-                format!("{pkg}/msg/{name}")
+                };
+                let w = super::mcap::McapWriter::new(compression, 768 * 1024)
+                    .map_err(|e| syntax(dir, &e))?;
+                Self::Mcap(Box::new(w))
             }
+            Container::Db3 => Self::Db3(super::db3::Db3Writer::new().map_err(|e| syntax(dir, &e))?),
+        })
+    }
+
+    /// The wire format of the container.
+    fn wire(&self) -> Wire {
+        match self {
+            Self::Bag(_) => Wire::Ros1,
+            Self::Mcap(_) | Self::Db3(_) => Wire::Cdr,
         }
-    };
-    let mut put = |topic: &str, datatype: &str, t: f64, data: &[u8]| -> Result<(), FileError> {
-        match &mut w {
-            W::Bag(b) => {
-                b.write(topic, &ty(datatype), t, data);
+    }
+
+    /// Writes a message of `datatype` (ROS 1 spelling, `pkg/Name`).
+    fn put(
+        &mut self,
+        dir: &std::path::Path,
+        topic: &str,
+        datatype: &str,
+        t: f64,
+        data: &[u8],
+    ) -> Result<(), FileError> {
+        let ros2 = || {
+            let (pkg, name) = datatype.split_once('/').unwrap_or(("", datatype));
+            format!("{pkg}/msg/{name}")
+        };
+        match self {
+            Self::Bag(b) => {
+                b.write(topic, datatype, t, data);
                 Ok(())
             }
-            W::Mcap(m) => m.write(topic, &ty(datatype), t, data).map_err(|e| syntax(&e)),
-            W::Db3(d) => d.write(topic, &ty(datatype), t, data).map_err(|e| syntax(&e)),
+            Self::Mcap(m) => m
+                .write(topic, &ros2(), t, data)
+                .map_err(|e| syntax(dir, &e)),
+            Self::Db3(d) => d
+                .write(topic, &ros2(), t, data)
+                .map_err(|e| syntax(dir, &e)),
         }
-    };
-    let rig = &rec.rig;
-    let t0 = rec
-        .depth
-        .first()
-        .map(|e| e.t)
-        .unwrap_or(0.0)
-        .min(rec.trajectory.stamps.first().copied().unwrap_or(0.0));
-    // Static transforms first (latched in real bags).
+    }
+
+    fn finish(self, dir: &std::path::Path) -> Result<Vec<u8>, FileError> {
+        match self {
+            Self::Bag(b) => b.finish().map_err(|e| FileError::io(dir, e)),
+            Self::Mcap(m) => m.finish().map_err(|e| syntax(dir, &e)),
+            Self::Db3(d) => d.finish().map_err(|e| syntax(dir, &e)),
+        }
+    }
+}
+
+/// The colour camera's frame: its own when it sits apart from the depth camera.
+fn rgb_frame(rig: &mrtmap_io::Rig) -> &'static str {
+    match &rig.rgb {
+        Some(c) if c.depth_from_rgb != Isometry3::identity() => "camera_rgb_optical_frame",
+        _ => names::DEPTH_FRAME,
+    }
+}
+
+/// Static transforms (latched in real bags) and the cameras' CameraInfo, at `t0`.
+fn write_statics(
+    sink: &mut Sink,
+    rec: &Recording,
+    o: &RosWriteOptions,
+    t0: f64,
+) -> Result<(), FileError> {
+    use super::msg::encode;
+    let (rig, wire, dir) = (&rec.rig, sink.wire(), rec.dir.as_path());
     let mut statics = vec![
         (
             t0,
@@ -145,48 +176,36 @@ pub fn write_ros(rec: &Recording, o: &RosWriteOptions) -> Result<Vec<u8>, FileEr
             c.depth_from_rgb,
         ));
     }
-    put(
-        "/tf_static",
-        "tf2_msgs/TFMessage",
-        t0,
-        &encode::tf_message(wire, &statics),
-    )?;
-    put(
-        names::DEPTH_INFO,
-        "sensor_msgs/CameraInfo",
-        t0,
-        &encode::camera_info(wire, t0, names::DEPTH_FRAME, &rig.depth),
-    )?;
-    put(
-        names::THERMAL_INFO,
-        "sensor_msgs/CameraInfo",
-        t0,
-        &encode::camera_info(wire, t0, names::THERMAL_FRAME, &rig.thermal),
-    )?;
-    let rgb_frame = match &rig.rgb {
-        Some(c) if c.depth_from_rgb != Isometry3::identity() => "camera_rgb_optical_frame",
-        _ => names::DEPTH_FRAME,
-    };
+    let tf = encode::tf_message(wire, &statics);
+    sink.put(dir, "/tf_static", "tf2_msgs/TFMessage", t0, &tf)?;
+    let mut infos = vec![
+        (names::DEPTH_INFO, names::DEPTH_FRAME, &rig.depth),
+        (names::THERMAL_INFO, names::THERMAL_FRAME, &rig.thermal),
+    ];
     if let Some(c) = &rig.rgb {
-        let frame = rgb_frame;
-        put(
-            names::RGB_INFO,
-            "sensor_msgs/CameraInfo",
-            t0,
-            &encode::camera_info(wire, t0, frame, &c.camera),
-        )?;
+        infos.push((names::RGB_INFO, rgb_frame(rig), &c.camera));
     }
-    // Everything else in time order.
-    enum Item<'a> {
-        Depth(&'a StreamEntry),
-        Thermal(&'a StreamEntry),
-        Rgb(&'a StreamEntry),
-        Pose(usize),
+    for (topic, frame, cam) in infos {
+        let m = encode::camera_info(wire, t0, frame, cam);
+        sink.put(dir, topic, "sensor_msgs/CameraInfo", t0, &m)?;
     }
+    Ok(())
+}
+
+/// One timed item of a recording.
+enum Item<'a> {
+    Depth(&'a StreamEntry),
+    Thermal(&'a StreamEntry),
+    Rgb(&'a StreamEntry),
+    Pose(usize),
+}
+
+/// Every frame and pose of a recording, in time order.
+fn timeline(rec: &Recording) -> Vec<(f64, Item<'_>)> {
     let mut items: Vec<(f64, Item<'_>)> = Vec::new();
     items.extend(rec.depth.iter().map(|e| (e.t, Item::Depth(e))));
     items.extend(rec.thermal.iter().map(|e| (e.t, Item::Thermal(e))));
-    if rig.rgb.is_some() {
+    if rec.rig.rgb.is_some() {
         items.extend(rec.rgb.iter().map(|e| (e.t, Item::Rgb(e))));
     }
     items.extend(
@@ -197,63 +216,71 @@ pub fn write_ros(rec: &Recording, o: &RosWriteOptions) -> Result<Vec<u8>, FileEr
             .map(|(i, &t)| (t, Item::Pose(i))),
     );
     items.sort_by(|a, b| a.0.total_cmp(&b.0));
+    items
+}
+
+/// One item as its message.
+fn write_item(
+    sink: &mut Sink,
+    rec: &Recording,
+    o: &RosWriteOptions,
+    (t, item): (f64, Item<'_>),
+) -> Result<(), FileError> {
+    use super::msg::encode;
+    let (wire, dir) = (sink.wire(), rec.dir.as_path());
     let le16 =
         |img: &Image16| -> Vec<u8> { img.data.iter().flat_map(|v| v.to_le_bytes()).collect() };
-    for (t, item) in items {
-        match item {
-            Item::Depth(e) => {
-                let img = rec.read_depth(e)?;
-                let m = encode::image(
-                    wire,
-                    t,
-                    names::DEPTH_FRAME,
-                    img.width,
-                    img.height,
-                    "16UC1",
-                    2 * img.width,
-                    &le16(&img),
-                );
-                put(names::DEPTH, "sensor_msgs/Image", t, &m)?;
-            }
-            Item::Thermal(e) => {
-                let img = rec.read_thermal(e)?;
-                let m = encode::image(
-                    wire,
-                    t,
-                    names::THERMAL_FRAME,
-                    img.width,
-                    img.height,
-                    "mono16",
-                    2 * img.width,
-                    &le16(&img),
-                );
-                put(names::THERMAL, "sensor_msgs/Image", t, &m)?;
-            }
-            Item::Rgb(e) => {
-                let p = rec.path_of(e);
-                let img = image::open(&p)
-                    .map_err(|er| FileError::new(&p, None, FileErrorKind::Image(er.to_string())))?
-                    .to_rgb8();
-                let (iw, ih) = img.dimensions();
-                let m = encode::image(wire, t, rgb_frame, iw, ih, "rgb8", 3 * iw, img.as_raw());
-                put(names::RGB, "sensor_msgs/Image", t, &m)?;
-            }
-            Item::Pose(i) => {
-                let world_from_pose = rec.trajectory.poses[i] * o.pose_from_depth.inverse();
-                let m = encode::odometry(
-                    wire,
-                    t,
-                    names::ODOM_FRAME,
-                    names::POSE_FRAME,
-                    &world_from_pose,
-                );
-                put(names::ODOM, "nav_msgs/Odometry", t, &m)?;
-            }
+    let image16 = |img: &Image16, frame: &str, encoding: &str| {
+        let (w, h) = (img.width, img.height);
+        encode::image(wire, t, frame, w, h, encoding, 2 * w, &le16(img))
+    };
+    match item {
+        Item::Depth(e) => {
+            let m = image16(&rec.read_depth(e)?, names::DEPTH_FRAME, "16UC1");
+            sink.put(dir, names::DEPTH, "sensor_msgs/Image", t, &m)
+        }
+        Item::Thermal(e) => {
+            let m = image16(&rec.read_thermal(e)?, names::THERMAL_FRAME, "mono16");
+            sink.put(dir, names::THERMAL, "sensor_msgs/Image", t, &m)
+        }
+        Item::Rgb(e) => {
+            let p = rec.path_of(e);
+            let img = image::open(&p)
+                .map_err(|er| FileError::new(&p, None, FileErrorKind::Image(er.to_string())))?
+                .to_rgb8();
+            let (iw, ih) = img.dimensions();
+            let frame = rgb_frame(&rec.rig);
+            let m = encode::image(wire, t, frame, iw, ih, "rgb8", 3 * iw, img.as_raw());
+            sink.put(dir, names::RGB, "sensor_msgs/Image", t, &m)
+        }
+        Item::Pose(i) => {
+            let world_from_pose = rec.trajectory.poses[i] * o.pose_from_depth.inverse();
+            let m = encode::odometry(
+                wire,
+                t,
+                names::ODOM_FRAME,
+                names::POSE_FRAME,
+                &world_from_pose,
+            );
+            sink.put(dir, names::ODOM, "nav_msgs/Odometry", t, &m)
         }
     }
-    match w {
-        W::Bag(b) => b.finish().map_err(|e| FileError::io(&rec.dir, e)),
-        W::Mcap(m) => m.finish().map_err(|e| syntax(&e)),
-        W::Db3(d) => d.finish().map_err(|e| syntax(&e)),
+}
+
+/// Writes a recording as a bag or MCAP file with RealSense-style topics ([`names`]): aligned
+/// depth (16UC1), colour (rgb8), thermal (mono16), their CameraInfo, T265-style odometry of a
+/// pose frame, and /tf_static tying the frames together.
+pub fn write_ros(rec: &Recording, o: &RosWriteOptions) -> Result<Vec<u8>, FileError> {
+    let mut sink = Sink::new(o, &rec.dir)?;
+    let t0 = rec
+        .depth
+        .first()
+        .map(|e| e.t)
+        .unwrap_or(0.0)
+        .min(rec.trajectory.stamps.first().copied().unwrap_or(0.0));
+    write_statics(&mut sink, rec, o, t0)?;
+    for item in timeline(rec) {
+        write_item(&mut sink, rec, o, item)?;
     }
+    sink.finish(&rec.dir)
 }

@@ -66,7 +66,11 @@ fn recording(dir: &Path) -> Recording {
                 })
                 .collect(),
         };
-        std::fs::write(dir.join(format!("depth/{i}.png")), encode_png16(&d).unwrap()).unwrap();
+        std::fs::write(
+            dir.join(format!("depth/{i}.png")),
+            encode_png16(&d).unwrap(),
+        )
+        .unwrap();
         lists[0] += &format!("{t:.6} depth/{i}.png\n");
         if i % 2 == 0 {
             let th = Image16 {
@@ -74,7 +78,11 @@ fn recording(dir: &Path) -> Recording {
                 height: 12,
                 data: (0..192).map(|k| 29_315 + k as u16 * 3 + i).collect(),
             };
-            std::fs::write(dir.join(format!("thermal/{i}.png")), encode_png16(&th).unwrap()).unwrap();
+            std::fs::write(
+                dir.join(format!("thermal/{i}.png")),
+                encode_png16(&th).unwrap(),
+            )
+            .unwrap();
             lists[1] += &format!("{:.6} thermal/{i}.png\n", t + 0.01);
             let rgb: Vec<u8> = (0..300 * 3).map(|k| (k * 7 + i as usize) as u8).collect();
             std::fs::write(
