@@ -33,6 +33,7 @@ pub use scene::{
     BoxFile, FEATURE_PLANE_TOLERANCE_M, Feature, FeatureFile, Occluder, OccluderFile,
     OccluderShape, PLANARITY_TOLERANCE_M, RadiantScene, SCENE_FORMAT, SceneError, SceneFile,
     SceneLoadError, SceneLoadErrorKind, Surface, SurfaceFile, SurfaceKind, TEMPERATURE_RANGE_C,
+    slug,
 };
 
 use serde::{Deserialize, Serialize};

@@ -564,6 +564,15 @@ fn bounds(poly: &[Point2<f64>]) -> (Point2<f64>, Point2<f64>) {
     (lo, hi)
 }
 
+/// An id stem from a label: lower case, words joined by '-' ("Recessed light" → "recessed-light").
+pub fn slug(label: &str) -> String {
+    label
+        .to_lowercase()
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join("-")
+}
+
 /// Ids seen so far: each must be present and unique across surfaces, features and occluders.
 #[derive(Default)]
 struct Ids(HashSet<String>);

@@ -97,24 +97,19 @@ impl ObservationCounts {
     }
 }
 
-/// Observations of world points (with world normals) by a thermal camera at `world_from_thermal`.
-pub fn observe(
+/// A point's pixel and depth in the thermal image, if it falls in it.
+type Projected = Option<(Point2<f64>, f64)>;
+
+/// Each point's pixel and depth in the thermal image (`None` outside it or behind the camera),
+/// and the nearest depth per pixel.
+fn project(
     points: &[Point3<f64>],
-    normals: &[Vector3<f64>],
-    world_from_thermal: &Isometry3<f64>,
+    thermal_from_world: &Isometry3<f64>,
     cam: &PinholeCamera,
-    img: &ThermalImage,
-    params: &ObservationParams,
-) -> (Vec<Observation>, ObservationCounts) {
-    let thermal_from_world = world_from_thermal.inverse();
+) -> (Vec<Projected>, Vec<f64>) {
     let (w, h) = (cam.width as usize, cam.height as usize);
-    let mut counts = ObservationCounts {
-        points: points.len() as u64,
-        ..Default::default()
-    };
-    // Pass 1: project, fill the z-buffer.
     let mut zbuf = vec![f64::INFINITY; w * h];
-    let proj: Vec<Option<(Point2<f64>, f64)>> = points
+    let proj = points
         .iter()
         .map(|p| {
             let q = thermal_from_world * p;
@@ -128,7 +123,11 @@ pub fn observe(
             Some((px, q.z))
         })
         .collect();
-    // The 3×3 minimum of the z-buffer.
+    (proj, zbuf)
+}
+
+/// The 3×3 minimum of a `w`×`h` z-buffer.
+fn min_3x3(zbuf: &[f64], w: usize, h: usize) -> Vec<f64> {
     let mut zmin = vec![f64::INFINITY; w * h];
     for v in 0..h {
         for u in 0..w {
@@ -141,10 +140,57 @@ pub fn observe(
             zmin[v * w + u] = m;
         }
     }
-    let cam_pos = Point3::from(world_from_thermal.translation.vector);
+    zmin
+}
+
+/// An observation's weight: incidence (cosine, tapering to zero at the limit beyond 60°),
+/// distance (inverse square beyond the full-weight distance), place in the image (the edges
+/// half) and thermal contrast around the pixel (mixed pixels count less).
+fn weight(
+    cos: f64,
+    distance_m: f64,
+    px: &Point2<f64>,
+    contrast_k: f64,
+    cam: &PinholeCamera,
+    params: &ObservationParams,
+) -> f64 {
     let cos_limit = params.max_incidence_deg.to_radians().cos();
     let cos60 = 0.5;
     let rmax2 = ((cam.width as f64 / 2.0).powi(2) + (cam.height as f64 / 2.0).powi(2)).max(1.0);
+    let w_inc = if cos >= cos60 {
+        cos
+    } else {
+        cos * (cos - cos_limit) / (cos60 - cos_limit)
+    };
+    let w_dist = if distance_m <= params.full_weight_distance_m {
+        1.0
+    } else {
+        (params.full_weight_distance_m / distance_m).powi(2)
+    };
+    let r2 = ((px.x - cam.cx).powi(2) + (px.y - cam.cy).powi(2)) / rmax2;
+    let w_img = 1.0 - 0.5 * r2.min(1.0);
+    let w_edge = 1.0 / (1.0 + (contrast_k / params.edge_scale_k).powi(2));
+    w_inc * w_dist * w_img * w_edge
+}
+
+/// Observations of world points (with world normals) by a thermal camera at `world_from_thermal`.
+pub fn observe(
+    points: &[Point3<f64>],
+    normals: &[Vector3<f64>],
+    world_from_thermal: &Isometry3<f64>,
+    cam: &PinholeCamera,
+    img: &ThermalImage,
+    params: &ObservationParams,
+) -> (Vec<Observation>, ObservationCounts) {
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    let mut counts = ObservationCounts {
+        points: points.len() as u64,
+        ..Default::default()
+    };
+    let (proj, zbuf) = project(points, &world_from_thermal.inverse(), cam);
+    let zmin = min_3x3(&zbuf, w, h);
+    let cam_pos = Point3::from(world_from_thermal.translation.vector);
+    let cos_limit = params.max_incidence_deg.to_radians().cos();
     let mut out = Vec::with_capacity(points.len() / 2);
     for (i, pr) in proj.iter().enumerate() {
         let Some((px, z)) = *pr else {
@@ -179,25 +225,12 @@ pub fn observe(
             counts.edge += 1;
             continue;
         }
-        let w_inc = if cos >= cos60 {
-            cos
-        } else {
-            cos * (cos - cos_limit) / (cos60 - cos_limit)
-        };
-        let w_dist = if d <= params.full_weight_distance_m {
-            1.0
-        } else {
-            (params.full_weight_distance_m / d).powi(2)
-        };
-        let r2 = ((px.x - cam.cx).powi(2) + (px.y - cam.cy).powi(2)) / rmax2;
-        let w_img = 1.0 - 0.5 * r2.min(1.0);
-        let w_edge = 1.0 / (1.0 + (contrast / params.edge_scale_k).powi(2));
         counts.kept += 1;
         out.push(Observation {
             p,
             n,
             t_k: t,
-            w: w_inc * w_dist * w_img * w_edge,
+            w: weight(cos, d, &px, contrast, cam, params),
         });
     }
     (out, counts)

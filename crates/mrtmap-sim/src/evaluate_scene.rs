@@ -3,8 +3,8 @@
 
 use mrtmap_geometry::PlaneFrame;
 use mrtmap_geometry::nalgebra::{Point2, Point3};
-use mrtmap_geometry::polygon::signed_area;
-use mrtmap_radiation::{Method, MonteCarlo, MrtEngine, RadiantScene, SurfaceKind};
+use mrtmap_geometry::polygon::{self, signed_area};
+use mrtmap_radiation::{Method, MonteCarlo, MrtEngine, RadiantScene, Surface, SurfaceKind};
 use serde::{Deserialize, Serialize};
 
 use crate::truth::Truth;
@@ -79,43 +79,29 @@ fn ccw(mut p: Vec<Point2<f64>>) -> Vec<Point2<f64>> {
     p
 }
 
-/// Scores `found` against `truth` (both in the recording's world frame).
-pub fn score_scene(found: &RadiantScene, truth: &Truth) -> Result<SceneScore, crate::SimError> {
-    let t_scene = RadiantScene::new(&truth.scene)?;
-    let mut surfaces = Vec::new();
-    let mut features = Vec::new();
-    let mut matched_found = std::collections::HashSet::new();
-    for ts in &t_scene.surfaces {
-        // The found surface of the same kind whose plane is nearest the true centroid.
-        let c = Point3::from(
-            ts.polygon
-                .iter()
-                .fold(mrtmap_geometry::nalgebra::Vector3::zeros(), |a, p| {
-                    a + p.coords
-                })
-                / ts.polygon.len() as f64,
-        );
-        let best = found
-            .surfaces
-            .iter()
-            .filter(|s| s.kind == ts.kind && s.frame.normal.dot(&ts.frame.normal).abs() > 0.9)
-            .min_by(|a, b| {
-                a.frame
-                    .signed_distance(&c)
-                    .abs()
-                    .total_cmp(&b.frame.signed_distance(&c).abs())
-            });
-        let Some(fs) = best else {
-            surfaces.push(SurfaceScore {
-                truth_id: ts.id.clone(),
-                id: None,
-                angle_deg: f64::NAN,
-                offset_m: f64::NAN,
-                temperature_error_k: f64::NAN,
-            });
-            continue;
-        };
-        surfaces.push(SurfaceScore {
+/// The found surface of the same kind whose plane is nearest the true surface's centroid, and how
+/// far off it is.
+fn surface_score<'a>(ts: &Surface, found: &'a RadiantScene) -> (SurfaceScore, Option<&'a Surface>) {
+    let c = polygon::centroid(&ts.polygon);
+    let best = found
+        .surfaces
+        .iter()
+        .filter(|s| s.kind == ts.kind && s.frame.normal.dot(&ts.frame.normal).abs() > 0.9)
+        .min_by(|a, b| {
+            a.frame
+                .signed_distance(&c)
+                .abs()
+                .total_cmp(&b.frame.signed_distance(&c).abs())
+        });
+    let score = match best {
+        None => SurfaceScore {
+            truth_id: ts.id.clone(),
+            id: None,
+            angle_deg: f64::NAN,
+            offset_m: f64::NAN,
+            temperature_error_k: f64::NAN,
+        },
+        Some(fs) => SurfaceScore {
             truth_id: ts.id.clone(),
             id: Some(fs.id.clone()),
             angle_deg: fs
@@ -128,35 +114,50 @@ pub fn score_scene(found: &RadiantScene, truth: &Truth) -> Result<SceneScore, cr
                 .to_degrees(),
             offset_m: fs.frame.signed_distance(&c).abs(),
             temperature_error_k: fs.temperature.kelvin() - ts.temperature.kelvin(),
-        });
-        // Features of this host: IoU in the true host's plane.
-        let frame: &PlaneFrame = &ts.frame;
-        for tf in &ts.features {
-            let tpoly = ccw(tf.polygon.iter().map(|p| frame.to_2d(p)).collect());
-            let t_area = signed_area(&tpoly).abs();
-            let best = fs
-                .features
-                .iter()
-                .map(|ff| {
-                    let fpoly = ccw(ff.polygon.iter().map(|p| frame.to_2d(p)).collect());
-                    let inter = convex_intersection_area(&fpoly, &tpoly);
-                    (inter / (t_area + signed_area(&fpoly).abs() - inter), ff)
-                })
-                .max_by(|a, b| a.0.total_cmp(&b.0))
-                .filter(|(iou, _)| *iou > 0.0);
-            if let Some((_, ff)) = best {
-                matched_found.insert(ff.id.clone());
-            }
-            features.push(FeatureScore {
-                truth_id: tf.id.clone(),
-                truth_label: tf.label.clone(),
-                found: best.map(|(_, ff)| (ff.id.clone(), ff.label.clone())),
-                iou: best.map_or(0.0, |b| b.0),
-                temperature_error_k: best
-                    .map(|(_, ff)| ff.temperature.kelvin() - tf.temperature.kelvin()),
-            });
+        },
+    };
+    (score, best)
+}
+
+/// The true host's features against the found host's: the best IoU in the true host's plane;
+/// found features matched are added to `matched`.
+fn feature_scores(
+    ts: &Surface,
+    fs: &Surface,
+    matched: &mut std::collections::HashSet<String>,
+) -> Vec<FeatureScore> {
+    let frame: &PlaneFrame = &ts.frame;
+    let mut out = Vec::new();
+    for tf in &ts.features {
+        let tpoly = ccw(tf.polygon.iter().map(|p| frame.to_2d(p)).collect());
+        let t_area = signed_area(&tpoly).abs();
+        let best = fs
+            .features
+            .iter()
+            .map(|ff| {
+                let fpoly = ccw(ff.polygon.iter().map(|p| frame.to_2d(p)).collect());
+                let inter = convex_intersection_area(&fpoly, &tpoly);
+                (inter / (t_area + signed_area(&fpoly).abs() - inter), ff)
+            })
+            .max_by(|a, b| a.0.total_cmp(&b.0))
+            .filter(|(iou, _)| *iou > 0.0);
+        if let Some((_, ff)) = best {
+            matched.insert(ff.id.clone());
         }
+        out.push(FeatureScore {
+            truth_id: tf.id.clone(),
+            truth_label: tf.label.clone(),
+            found: best.map(|(_, ff)| (ff.id.clone(), ff.label.clone())),
+            iou: best.map_or(0.0, |b| b.0),
+            temperature_error_k: best
+                .map(|(_, ff)| ff.temperature.kelvin() - tf.temperature.kelvin()),
+        });
     }
+    out
+}
+
+/// The largest distance from a true floor or ceiling corner to the nearest found one.
+fn corner_error(found: &RadiantScene, truth: &RadiantScene) -> f64 {
     let corners = |s: &RadiantScene, k: SurfaceKind| -> Vec<Point3<f64>> {
         s.surfaces
             .iter()
@@ -167,7 +168,7 @@ pub fn score_scene(found: &RadiantScene, truth: &Truth) -> Result<SceneScore, cr
     let mut corner_max = 0.0f64;
     for k in [SurfaceKind::Floor, SurfaceKind::Ceiling] {
         let fc = corners(found, k);
-        for tc in corners(&t_scene, k) {
+        for tc in corners(truth, k) {
             let d = fc
                 .iter()
                 .map(|f| (f - tc).norm())
@@ -175,13 +176,11 @@ pub fn score_scene(found: &RadiantScene, truth: &Truth) -> Result<SceneScore, cr
             corner_max = corner_max.max(d);
         }
     }
-    let spurious = found
-        .surfaces
-        .iter()
-        .flat_map(|s| s.features.iter())
-        .filter(|f| !matched_found.contains(&f.id))
-        .map(|f| f.id.clone())
-        .collect();
+    corner_max
+}
+
+/// The found scene's MRT at the truth's validation points.
+fn point_scores(found: &RadiantScene, truth: &Truth) -> Result<Vec<PointScore>, crate::SimError> {
     let engine = MrtEngine::new(
         found,
         Method::Auto(MonteCarlo {
@@ -189,7 +188,7 @@ pub fn score_scene(found: &RadiantScene, truth: &Truth) -> Result<SceneScore, cr
             ..MonteCarlo::default()
         }),
     )?;
-    let points = truth
+    Ok(truth
         .points
         .iter()
         .enumerate()
@@ -202,12 +201,34 @@ pub fn score_scene(found: &RadiantScene, truth: &Truth) -> Result<SceneScore, cr
                 error_k: r.mrt.celsius() - p.mrt_c,
             })
         })
-        .collect::<Result<Vec<_>, mrtmap_radiation::MrtError>>()?;
+        .collect::<Result<Vec<_>, mrtmap_radiation::MrtError>>()?)
+}
+
+/// Scores `found` against `truth` (both in the recording's world frame).
+pub fn score_scene(found: &RadiantScene, truth: &Truth) -> Result<SceneScore, crate::SimError> {
+    let t_scene = RadiantScene::new(&truth.scene)?;
+    let mut surfaces = Vec::new();
+    let mut features = Vec::new();
+    let mut matched_found = std::collections::HashSet::new();
+    for ts in &t_scene.surfaces {
+        let (score, best) = surface_score(ts, found);
+        surfaces.push(score);
+        if let Some(fs) = best {
+            features.extend(feature_scores(ts, fs, &mut matched_found));
+        }
+    }
+    let spurious = found
+        .surfaces
+        .iter()
+        .flat_map(|s| s.features.iter())
+        .filter(|f| !matched_found.contains(&f.id))
+        .map(|f| f.id.clone())
+        .collect();
     Ok(SceneScore {
         surfaces,
-        corner_max_error_m: corner_max,
+        corner_max_error_m: corner_error(found, &t_scene),
         features,
         spurious_features: spurious,
-        points,
+        points: point_scores(found, truth)?,
     })
 }

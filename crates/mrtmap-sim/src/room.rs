@@ -186,6 +186,193 @@ fn finite(name: &str, v: f64) -> Result<f64, RoomError> {
     }
 }
 
+/// The floor plan, counter-clockwise seen from above, and whether the file's was reversed.
+fn floor_plan(file: &RoomFile) -> Result<(Vec<Point2<f64>>, bool), RoomError> {
+    let inv = RoomError::Invalid;
+    if file.floor_plan.len() < 3 {
+        return Err(inv("floor_plan needs at least 3 vertices".into()));
+    }
+    let mut plan: Vec<Point2<f64>> = file
+        .floor_plan
+        .iter()
+        .map(|p| Point2::new(p[0], p[1]))
+        .collect();
+    if plan.iter().any(|p| !p.x.is_finite() || !p.y.is_finite()) {
+        return Err(inv("floor_plan has a coordinate that is not finite".into()));
+    }
+    polygon::check_simple(&plan, 1e-6)
+        .map_err(|e| inv(format!("floor_plan is not a simple polygon ({e:?})")))?;
+    let reversed = polygon::signed_area(&plan) < 0.0;
+    if reversed {
+        plan.reverse();
+    }
+    Ok((plan, reversed))
+}
+
+/// The plan edge of the file's wall `i`: after reversing, file wall i is plan edge n−2−i.
+fn plan_wall(i: usize, n: usize, reversed: bool) -> usize {
+    if reversed { (2 * n - 2 - i) % n } else { i }
+}
+
+/// Each wall's temperature at mid-height, gradient and label, by plan edge.
+fn wall_settings(
+    file: &RoomFile,
+    n: usize,
+    reversed: bool,
+) -> Result<Vec<(f64, f64, String)>, RoomError> {
+    let t = &file.temperatures;
+    for (name, v) in [
+        ("floor_c", t.floor_c),
+        ("ceiling_c", t.ceiling_c),
+        ("walls_c", t.walls_c),
+        ("wall_gradient_k_per_m", t.wall_gradient_k_per_m),
+    ] {
+        finite(name, v)?;
+    }
+    let mut walls: Vec<(f64, f64, String)> =
+        vec![(t.walls_c, t.wall_gradient_k_per_m, "wall".to_string()); n];
+    for w in &file.walls {
+        if w.index >= n {
+            return Err(RoomError::Invalid(format!(
+                "[[walls]] index {} does not exist (the plan has {n} walls, 0…{})",
+                w.index,
+                n - 1
+            )));
+        }
+        let e = &mut walls[plan_wall(w.index, n, reversed)];
+        if let Some(v) = w.temperature_c {
+            e.0 = finite("wall temperature_c", v)?;
+        }
+        if let Some(g) = w.gradient_k_per_m {
+            e.1 = finite("wall gradient_k_per_m", g)?;
+        }
+        if let Some(l) = &w.label {
+            e.2 = l.clone();
+        }
+    }
+    Ok(walls)
+}
+
+/// The surface a feature is on (`k`-th feature, for messages).
+fn feature_surface(
+    f: &FeatureSpec,
+    k: usize,
+    n: usize,
+    reversed: bool,
+) -> Result<SurfaceRef, RoomError> {
+    Ok(match f.on.trim() {
+        "floor" => SurfaceRef::Floor,
+        "ceiling" => SurfaceRef::Ceiling,
+        s => {
+            let idx = s
+                .strip_prefix("wall")
+                .and_then(|x| x.trim().parse::<usize>().ok())
+                .filter(|i| *i < n)
+                .ok_or_else(|| {
+                    RoomError::Invalid(format!(
+                        "feature {} ('{}'): on = '{}' is not floor, ceiling or wall 0…{}",
+                        k + 1,
+                        f.label,
+                        f.on,
+                        n - 1
+                    ))
+                })?;
+            SurfaceRef::Wall(plan_wall(idx, n, reversed))
+        }
+    })
+}
+
+/// A feature's outline on its surface, from `rect` or `polygon`.
+fn feature_outline(f: &FeatureSpec, k: usize) -> Result<Vec<Point2<f64>>, RoomError> {
+    match (&f.rect, &f.polygon) {
+        (Some(r), None) => {
+            if r.iter().any(|x| !x.is_finite()) || r[2] <= 0.0 || r[3] <= 0.0 {
+                return Err(RoomError::Invalid(format!(
+                    "feature {} ('{}'): rect {:?} needs a positive width and height",
+                    k + 1,
+                    f.label,
+                    r
+                )));
+            }
+            Ok(vec![
+                Point2::new(r[0], r[1]),
+                Point2::new(r[0] + r[2], r[1]),
+                Point2::new(r[0] + r[2], r[1] + r[3]),
+                Point2::new(r[0], r[1] + r[3]),
+            ])
+        }
+        (None, Some(p)) => Ok(p.iter().map(|q| Point2::new(q[0], q[1])).collect()),
+        _ => Err(RoomError::Invalid(format!(
+            "feature {} ('{}'): give either rect or polygon",
+            k + 1,
+            f.label
+        ))),
+    }
+}
+
+/// The features placed on their surfaces, with ids from their labels.
+fn place_features(
+    file: &RoomFile,
+    plan: &[Point2<f64>],
+    reversed: bool,
+) -> Result<Vec<PlacedFeature>, RoomError> {
+    let n = plan.len();
+    let mut counts = std::collections::HashMap::<String, usize>::new();
+    let mut features = Vec::new();
+    for (k, f) in file.features.iter().enumerate() {
+        let on = feature_surface(f, k, n, reversed)?;
+        let poly = feature_outline(f, k)?;
+        // Walls with a reversed plan run the other way: mirror s.
+        let poly = match on {
+            SurfaceRef::Wall(i) if reversed => {
+                let len = (plan[(i + 1) % n] - plan[i]).norm();
+                poly.iter().map(|q| Point2::new(len - q.x, q.y)).collect()
+            }
+            _ => poly,
+        };
+        finite("feature temperature_c", f.temperature_c)?;
+        let slug = mrtmap_radiation::slug(&f.label);
+        let c = counts.entry(slug.clone()).or_default();
+        *c += 1;
+        features.push(PlacedFeature {
+            id: format!("{slug}-{c}"),
+            label: f.label.clone(),
+            on,
+            polygon_2d: poly,
+            temperature_c: f.temperature_c,
+        });
+    }
+    Ok(features)
+}
+
+/// Furniture boxes with min below max, and points inside the room.
+fn check_furniture_and_points(file: &RoomFile, plan: &[Point2<f64>]) -> Result<(), RoomError> {
+    for (k, b) in file.furniture.iter().enumerate() {
+        if (0..3).any(|i| !(b.min[i].is_finite() && b.max[i].is_finite() && b.min[i] < b.max[i])) {
+            return Err(RoomError::Invalid(format!(
+                "furniture {} ('{}'): min {:?} must be below max {:?}",
+                k + 1,
+                b.label,
+                b.min,
+                b.max
+            )));
+        }
+        finite("furniture temperature_c", b.temperature_c)?;
+    }
+    for p in &file.points {
+        let q = Point2::new(p.xy[0], p.xy[1]);
+        if polygon::point_in_polygon(&q, plan, 1e-3) != Containment::Inside
+            || !(0.0..file.height_m).contains(&p.height_m)
+        {
+            return Err(RoomError::Invalid(format!(
+                "point {} at {:?}, {} m is not inside the room",
+                p.name, p.xy, p.height_m
+            )));
+        }
+    }
+    Ok(())
+}
+
 impl Room {
     /// Parses and validates TOML text.
     pub fn from_toml(text: &str) -> Result<Self, RoomError> {
@@ -203,168 +390,23 @@ impl Room {
 
     /// Validates a room description.
     pub fn new(file: RoomFile) -> Result<Self, RoomError> {
-        let inv = |m: String| RoomError::Invalid(m);
         finite("height_m", file.height_m)?;
         if !(1.5..=20.0).contains(&file.height_m) {
-            return Err(inv(format!(
+            return Err(RoomError::Invalid(format!(
                 "height_m {} is outside 1.5…20 m",
                 file.height_m
             )));
         }
         finite("air_temperature_c", file.air_temperature_c)?;
-        if file.floor_plan.len() < 3 {
-            return Err(inv("floor_plan needs at least 3 vertices".into()));
-        }
-        let mut plan: Vec<Point2<f64>> = file
-            .floor_plan
-            .iter()
-            .map(|p| Point2::new(p[0], p[1]))
-            .collect();
-        if plan.iter().any(|p| !p.x.is_finite() || !p.y.is_finite()) {
-            return Err(inv("floor_plan has a coordinate that is not finite".into()));
-        }
-        polygon::check_simple(&plan, 1e-6)
-            .map_err(|e| inv(format!("floor_plan is not a simple polygon ({e:?})")))?;
-        let reversed = polygon::signed_area(&plan) < 0.0;
-        if reversed {
-            plan.reverse();
-        }
+        let (plan, reversed) = floor_plan(&file)?;
         let n = plan.len();
         let convex = (0..n).all(|i| {
             let (a, b, c) = (plan[i], plan[(i + 1) % n], plan[(i + 2) % n]);
             (b - a).perp(&(c - b)) >= -1e-12
         });
-        // Wall indices follow the file's order; after reversing, file wall i is plan edge n-2-i.
-        let plan_wall = |i: usize| if reversed { (2 * n - 2 - i) % n } else { i };
-        let t = &file.temperatures;
-        for (name, v) in [
-            ("floor_c", t.floor_c),
-            ("ceiling_c", t.ceiling_c),
-            ("walls_c", t.walls_c),
-            ("wall_gradient_k_per_m", t.wall_gradient_k_per_m),
-        ] {
-            finite(name, v)?;
-        }
-        let mut walls: Vec<(f64, f64, String)> =
-            vec![(t.walls_c, t.wall_gradient_k_per_m, "wall".to_string()); n];
-        for w in &file.walls {
-            if w.index >= n {
-                return Err(inv(format!(
-                    "[[walls]] index {} does not exist (the plan has {n} walls, 0…{})",
-                    w.index,
-                    n - 1
-                )));
-            }
-            let e = &mut walls[plan_wall(w.index)];
-            if let Some(v) = w.temperature_c {
-                e.0 = finite("wall temperature_c", v)?;
-            }
-            if let Some(g) = w.gradient_k_per_m {
-                e.1 = finite("wall gradient_k_per_m", g)?;
-            }
-            if let Some(l) = &w.label {
-                e.2 = l.clone();
-            }
-        }
-        let mut counts = std::collections::HashMap::<String, usize>::new();
-        let mut features = Vec::new();
-        for (k, f) in file.features.iter().enumerate() {
-            let on = match f.on.trim() {
-                "floor" => SurfaceRef::Floor,
-                "ceiling" => SurfaceRef::Ceiling,
-                s => {
-                    let idx = s
-                        .strip_prefix("wall")
-                        .and_then(|x| x.trim().parse::<usize>().ok())
-                        .filter(|i| *i < n)
-                        .ok_or_else(|| {
-                            inv(format!(
-                                "feature {} ('{}'): on = '{}' is not floor, ceiling or wall 0…{}",
-                                k + 1,
-                                f.label,
-                                f.on,
-                                n - 1
-                            ))
-                        })?;
-                    SurfaceRef::Wall(plan_wall(idx))
-                }
-            };
-            let poly: Vec<Point2<f64>> = match (&f.rect, &f.polygon) {
-                (Some(r), None) => {
-                    if r.iter().any(|x| !x.is_finite()) || r[2] <= 0.0 || r[3] <= 0.0 {
-                        return Err(inv(format!(
-                            "feature {} ('{}'): rect {:?} needs a positive width and height",
-                            k + 1,
-                            f.label,
-                            r
-                        )));
-                    }
-                    vec![
-                        Point2::new(r[0], r[1]),
-                        Point2::new(r[0] + r[2], r[1]),
-                        Point2::new(r[0] + r[2], r[1] + r[3]),
-                        Point2::new(r[0], r[1] + r[3]),
-                    ]
-                }
-                (None, Some(p)) => p.iter().map(|q| Point2::new(q[0], q[1])).collect(),
-                _ => {
-                    return Err(inv(format!(
-                        "feature {} ('{}'): give either rect or polygon",
-                        k + 1,
-                        f.label
-                    )));
-                }
-            };
-            // Walls with a reversed plan run the other way: mirror s.
-            let poly = match on {
-                SurfaceRef::Wall(i) if reversed => {
-                    let len = (plan[(i + 1) % n] - plan[i]).norm();
-                    poly.iter().map(|q| Point2::new(len - q.x, q.y)).collect()
-                }
-                _ => poly,
-            };
-            finite("feature temperature_c", f.temperature_c)?;
-            let slug: String = f
-                .label
-                .to_lowercase()
-                .split_whitespace()
-                .collect::<Vec<_>>()
-                .join("-");
-            let c = counts.entry(slug.clone()).or_default();
-            *c += 1;
-            features.push(PlacedFeature {
-                id: format!("{slug}-{c}"),
-                label: f.label.clone(),
-                on,
-                polygon_2d: poly,
-                temperature_c: f.temperature_c,
-            });
-        }
-        for (k, b) in file.furniture.iter().enumerate() {
-            if (0..3)
-                .any(|i| !(b.min[i].is_finite() && b.max[i].is_finite() && b.min[i] < b.max[i]))
-            {
-                return Err(inv(format!(
-                    "furniture {} ('{}'): min {:?} must be below max {:?}",
-                    k + 1,
-                    b.label,
-                    b.min,
-                    b.max
-                )));
-            }
-            finite("furniture temperature_c", b.temperature_c)?;
-        }
-        for p in &file.points {
-            let q = Point2::new(p.xy[0], p.xy[1]);
-            if polygon::point_in_polygon(&q, &plan, 1e-3) != Containment::Inside
-                || !(0.0..file.height_m).contains(&p.height_m)
-            {
-                return Err(inv(format!(
-                    "point {} at {:?}, {} m is not inside the room",
-                    p.name, p.xy, p.height_m
-                )));
-            }
-        }
+        let walls = wall_settings(&file, n, reversed)?;
+        let features = place_features(&file, &plan, reversed)?;
+        check_furniture_and_points(&file, &plan)?;
         let room = Self {
             file,
             plan,
@@ -486,96 +528,125 @@ impl Room {
         world_from_room: &Isometry3<f64>,
         strips: bool,
     ) -> Result<RadiantScene, SceneError> {
+        let mut surfaces = Vec::new();
+        for s in self.surfaces() {
+            surfaces.extend(self.surface_files(s, world_from_room, strips));
+        }
+        let up = world_from_room * Vector3::z();
+        RadiantScene::new(&SceneFile {
+            format: SCENE_FORMAT.into(),
+            up: Some([up.x, up.y, up.z]),
+            surfaces,
+            occluders: self.occluder_files(world_from_room),
+        })
+    }
+
+    /// Height bands a surface is cut into: one for the whole surface, or strips of
+    /// [`GRADIENT_STRIP_M`] on a stratified wall when `strips` is asked for.
+    fn bands(&self, s: SurfaceRef, strips: bool) -> Vec<(f64, f64)> {
+        let h = self.height();
+        let gradient = matches!(s, SurfaceRef::Wall(i) if self.walls[i].1 != 0.0);
+        if strips && gradient {
+            let k = (h / GRADIENT_STRIP_M).ceil() as usize;
+            (0..k)
+                .map(|j| (h * j as f64 / k as f64, h * (j + 1) as f64 / k as f64))
+                .collect()
+        } else {
+            vec![(f64::NEG_INFINITY, f64::INFINITY)]
+        }
+    }
+
+    /// A surface as scene entries in the world frame: whole, or one per height band.
+    fn surface_files(
+        &self,
+        s: SurfaceRef,
+        world_from_room: &Isometry3<f64>,
+        strips: bool,
+    ) -> Vec<SurfaceFile> {
         let w = |p: Point3<f64>| {
             let q = world_from_room * p;
             [q.x, q.y, q.z]
         };
-        let h = self.height();
-        let mut surfaces = Vec::new();
-        for s in self.surfaces() {
-            let id = self.surface_id(s);
-            let (kind, label) = match s {
-                SurfaceRef::Floor => ("floor", "floor".to_string()),
-                SurfaceRef::Ceiling => ("ceiling", "ceiling".to_string()),
-                SurfaceRef::Wall(i) => ("wall", self.walls[i].2.clone()),
-            };
-            let poly2 = self.surface_polygon_2d(s);
-            let feats: Vec<&PlacedFeature> = self.features.iter().filter(|f| f.on == s).collect();
-            let gradient = matches!(s, SurfaceRef::Wall(i) if self.walls[i].1 != 0.0);
-            let bands: Vec<(f64, f64)> = if strips && gradient {
-                let k = (h / GRADIENT_STRIP_M).ceil() as usize;
-                (0..k)
-                    .map(|j| (h * j as f64 / k as f64, h * (j + 1) as f64 / k as f64))
-                    .collect()
+        let id = self.surface_id(s);
+        let (kind, label) = match s {
+            SurfaceRef::Floor => ("floor", "floor".to_string()),
+            SurfaceRef::Ceiling => ("ceiling", "ceiling".to_string()),
+            SurfaceRef::Wall(i) => ("wall", self.walls[i].2.clone()),
+        };
+        let poly2 = self.surface_polygon_2d(s);
+        let feats: Vec<&PlacedFeature> = self.features.iter().filter(|f| f.on == s).collect();
+        let bands = self.bands(s, strips);
+        let whole = bands.len() == 1;
+        let clip = |p: &[Point2<f64>], z0, z1| {
+            if whole {
+                p.to_vec()
             } else {
-                vec![(f64::NEG_INFINITY, f64::INFINITY)]
+                clip_band(p, z0, z1)
+            }
+        };
+        let name = |base: &str, bi: usize| {
+            if whole {
+                base.to_string()
+            } else {
+                format!("{base}#{bi}")
+            }
+        };
+        let mut out = Vec::new();
+        for (bi, &(z0, z1)) in bands.iter().enumerate() {
+            let temperature_c = if whole {
+                self.surface_radiant_temperature_c(s)
+            } else {
+                self.background_temperature_c(s, (z0 + z1) / 2.0)
             };
-            for (bi, &(z0, z1)) in bands.iter().enumerate() {
-                let band_poly = if bands.len() == 1 {
-                    poly2.clone()
-                } else {
-                    clip_band(&poly2, z0, z1)
-                };
-                let temperature_c = if bands.len() == 1 {
-                    self.surface_radiant_temperature_c(s)
-                } else {
-                    self.background_temperature_c(s, (z0 + z1) / 2.0)
-                };
-                let mut features = Vec::new();
-                for f in &feats {
-                    let fp = if bands.len() == 1 {
-                        f.polygon_2d.clone()
-                    } else {
-                        clip_band(&f.polygon_2d, z0, z1)
-                    };
-                    if fp.len() < 3 || polygon::signed_area(&fp).abs() < 1e-9 {
-                        continue;
-                    }
-                    features.push(FeatureFile {
-                        id: if bands.len() == 1 {
-                            f.id.clone()
-                        } else {
-                            format!("{}#{bi}", f.id)
-                        },
-                        label: f.label.clone(),
-                        polygon: fp.iter().map(|q| w(self.on_surface(s, q))).collect(),
-                        temperature_c: f.temperature_c,
-                        emissivity: 1.0,
-                        temperature_std_k: None,
-                    });
+            let mut features = Vec::new();
+            for f in &feats {
+                let fp = clip(&f.polygon_2d, z0, z1);
+                if fp.len() < 3 || polygon::signed_area(&fp).abs() < 1e-9 {
+                    continue;
                 }
-                surfaces.push(SurfaceFile {
-                    id: if bands.len() == 1 {
-                        id.clone()
-                    } else {
-                        format!("{id}#{bi}")
-                    },
-                    kind: kind.into(),
-                    label: label.clone(),
-                    polygon: band_poly.iter().map(|q| w(self.on_surface(s, q))).collect(),
-                    temperature_c,
+                features.push(FeatureFile {
+                    id: name(&f.id, bi),
+                    label: f.label.clone(),
+                    polygon: fp.iter().map(|q| w(self.on_surface(s, q))).collect(),
+                    temperature_c: f.temperature_c,
                     emissivity: 1.0,
                     temperature_std_k: None,
-                    observed_fraction: None,
-                    features,
                 });
             }
+            out.push(SurfaceFile {
+                id: name(&id, bi),
+                kind: kind.into(),
+                label: label.clone(),
+                polygon: clip(&poly2, z0, z1)
+                    .iter()
+                    .map(|q| w(self.on_surface(s, q)))
+                    .collect(),
+                temperature_c,
+                emissivity: 1.0,
+                temperature_std_k: None,
+                observed_fraction: None,
+                features,
+            });
         }
+        out
+    }
+
+    /// The furniture as occluders in the world frame: boxes while the frame is axis-aligned with
+    /// the room's, else meshes.
+    fn occluder_files(&self, world_from_room: &Isometry3<f64>) -> Vec<OccluderFile> {
+        let w = |p: Point3<f64>| {
+            let q = world_from_room * p;
+            [q.x, q.y, q.z]
+        };
         let axis_aligned = world_from_room.rotation.angle() < 1e-12;
-        let occluders = self
-            .file
+        self.file
             .furniture
             .iter()
             .enumerate()
             .map(|(k, b)| {
                 let corners =
                     mrtmap_geometry::box_corners(&Point3::from(b.min), &Point3::from(b.max));
-                let slug: String = b
-                    .label
-                    .to_lowercase()
-                    .split_whitespace()
-                    .collect::<Vec<_>>()
-                    .join("-");
+                let slug = mrtmap_radiation::slug(&b.label);
                 let (box_, vertices, triangles) = if axis_aligned {
                     let (lo, hi) = (w(corners[0]), w(corners[7]));
                     (
@@ -600,14 +671,7 @@ impl Room {
                     triangles,
                 }
             })
-            .collect();
-        let up = world_from_room * Vector3::z();
-        RadiantScene::new(&SceneFile {
-            format: SCENE_FORMAT.into(),
-            up: Some([up.x, up.y, up.z]),
-            surfaces,
-            occluders,
-        })
+            .collect()
     }
 
     /// Radiant (T⁴ area-average) temperature of a surface's background (features excluded), °C.

@@ -263,6 +263,145 @@ pub fn read_thermal_file(path: &Path, opts: &ThermalOptions) -> Result<ThermalIm
     decode_thermal(path, &bytes, opts)
 }
 
+/// How a FLIR file's raw image was stored, in words.
+fn flir_notes(f: &super::flir::FlirFile) -> String {
+    format!(
+        "raw {}×{} stored as {}{}; {} byte order; {} records{}",
+        f.raw.width,
+        f.raw.height,
+        match f.raw_kind {
+            RawKind::Png => "PNG",
+            RawKind::Tiff => "TIFF",
+            RawKind::Packed => "packed counts",
+        },
+        if f.byte_swapped {
+            " (byte-swapped)"
+        } else {
+            ""
+        },
+        match f.endian {
+            crate::bytes::Endian::Little => "little-endian",
+            crate::bytes::Endian::Big => "big-endian",
+        },
+        f.records,
+        if f.segments > 0 {
+            format!(
+                " in {} APP1 segment{}",
+                f.segments,
+                if f.segments == 1 { "" } else { "s" }
+            )
+        } else {
+            String::new()
+        }
+    )
+}
+
+/// A FLIR R-JPEG or FFF file, converted with its own Planck constants and object parameters
+/// (those of `opts` replacing the file's).
+fn decode_flir(
+    path: &Path,
+    bytes: &[u8],
+    opts: &ThermalOptions,
+) -> Result<ThermalImage, FileError> {
+    let f = parse_flir(bytes).map_err(|e| e.in_file(path))?;
+    let p = f.params.with(&opts.flir);
+    let conv = p.converter();
+    let kind = if bytes.starts_with(b"\xFF\xD8") {
+        ThermalFileKind::FlirJpeg
+    } else {
+        ThermalFileKind::FlirFff
+    };
+    let mut notes = vec![flir_notes(&f)];
+    let mut metadata = f.metadata.clone();
+    if p != f.params {
+        notes.push("object parameters overridden from the command line".into());
+        for (name, v) in [
+            ("Used Emissivity", p.emissivity),
+            ("Used ObjectDistance", p.object_distance_m),
+            ("Used ReflectedApparentTemperature", p.reflected_c),
+            ("Used AtmosphericTemperature", p.atmospheric_c),
+            ("Used RelativeHumidity", p.relative_humidity),
+        ] {
+            metadata.push((name.into(), format!("{v}")));
+        }
+    }
+    Ok(ThermalImage {
+        width: f.raw.width,
+        height: f.raw.height,
+        celsius: f.raw.data.iter().map(|&r| conv.celsius(r as f64)).collect(),
+        raw: Some(f.raw),
+        kind,
+        metadata,
+        notes,
+    })
+}
+
+/// A 16-bit or float TIFF (float: °C, or kelvin when the median is above 150).
+fn decode_tiff_file(
+    path: &Path,
+    bytes: &[u8],
+    opts: &ThermalOptions,
+) -> Result<ThermalImage, FileError> {
+    match decode_tiff(bytes).map_err(|e| err(path, e))? {
+        TiffPixels::U16(img) => Ok(scaled(img, ThermalFileKind::Tiff16, opts)),
+        TiffPixels::F32 {
+            width,
+            height,
+            data,
+        } => {
+            let mut v: Vec<f32> = data.iter().copied().filter(|x| x.is_finite()).collect();
+            v.sort_by(f32::total_cmp);
+            let m = v.get(v.len() / 2).copied().unwrap_or(0.0);
+            let kelvin = m > 150.0;
+            let off = if kelvin { -273.15 } else { 0.0 };
+            Ok(ThermalImage {
+                width,
+                height,
+                celsius: data.iter().map(|&x| x as f64 + off).collect(),
+                raw: None,
+                kind: ThermalFileKind::TiffFloat,
+                metadata: Vec::new(),
+                notes: vec![if kelvin {
+                    format!("float values read as kelvin (median {m:.2})")
+                } else {
+                    format!("float values read as °C (median {m:.2})")
+                }],
+            })
+        }
+    }
+}
+
+/// A 16-bit grey PNG.
+fn decode_png_file(
+    path: &Path,
+    bytes: &[u8],
+    opts: &ThermalOptions,
+) -> Result<ThermalImage, FileError> {
+    let img = image::load_from_memory_with_format(bytes, image::ImageFormat::Png)
+        .map_err(|e| err(path, format!("cannot decode the PNG: {e}")))?;
+    match img {
+        image::DynamicImage::ImageLuma16(b) => {
+            let (w, h) = b.dimensions();
+            Ok(scaled(
+                Image16 {
+                    width: w,
+                    height: h,
+                    data: b.into_raw(),
+                },
+                ThermalFileKind::Png16,
+                opts,
+            ))
+        }
+        other => Err(err(
+            path,
+            format!(
+                "a {:?} PNG holds no temperatures (radiometric PNGs are 16-bit grey)",
+                other.color()
+            ),
+        )),
+    }
+}
+
 /// Decodes thermal image bytes (`path` names the file in errors and picks raw by extension).
 pub fn decode_thermal(
     path: &Path,
@@ -270,129 +409,13 @@ pub fn decode_thermal(
     opts: &ThermalOptions,
 ) -> Result<ThermalImage, FileError> {
     if is_flir(bytes) {
-        let f = parse_flir(bytes).map_err(|e| e.in_file(path))?;
-        let p = f.params.with(&opts.flir);
-        let conv = p.converter();
-        let kind = if bytes.starts_with(b"\xFF\xD8") {
-            ThermalFileKind::FlirJpeg
-        } else {
-            ThermalFileKind::FlirFff
-        };
-        let mut notes = vec![format!(
-            "raw {}×{} stored as {}{}; {} byte order; {} records{}",
-            f.raw.width,
-            f.raw.height,
-            match f.raw_kind {
-                RawKind::Png => "PNG",
-                RawKind::Tiff => "TIFF",
-                RawKind::Packed => "packed counts",
-            },
-            if f.byte_swapped {
-                " (byte-swapped)"
-            } else {
-                ""
-            },
-            match f.endian {
-                crate::bytes::Endian::Little => "little-endian",
-                crate::bytes::Endian::Big => "big-endian",
-            },
-            f.records,
-            if f.segments > 0 {
-                format!(
-                    " in {} APP1 segment{}",
-                    f.segments,
-                    if f.segments == 1 { "" } else { "s" }
-                )
-            } else {
-                String::new()
-            }
-        )];
-        if p != f.params {
-            notes.push("object parameters overridden from the command line".into());
-        }
-        let mut metadata = f.metadata.clone();
-        if p != f.params {
-            metadata.push(("Used Emissivity".into(), format!("{}", p.emissivity)));
-            metadata.push((
-                "Used ObjectDistance".into(),
-                format!("{}", p.object_distance_m),
-            ));
-            metadata.push((
-                "Used ReflectedApparentTemperature".into(),
-                format!("{}", p.reflected_c),
-            ));
-            metadata.push((
-                "Used AtmosphericTemperature".into(),
-                format!("{}", p.atmospheric_c),
-            ));
-            metadata.push((
-                "Used RelativeHumidity".into(),
-                format!("{}", p.relative_humidity),
-            ));
-        }
-        return Ok(ThermalImage {
-            width: f.raw.width,
-            height: f.raw.height,
-            celsius: f.raw.data.iter().map(|&r| conv.celsius(r as f64)).collect(),
-            raw: Some(f.raw),
-            kind,
-            metadata,
-            notes,
-        });
+        return decode_flir(path, bytes, opts);
     }
     if bytes.starts_with(b"II*\0") || bytes.starts_with(b"MM\0*") {
-        return match decode_tiff(bytes).map_err(|e| err(path, e))? {
-            TiffPixels::U16(img) => Ok(scaled(img, ThermalFileKind::Tiff16, opts)),
-            TiffPixels::F32 {
-                width,
-                height,
-                data,
-            } => {
-                let mut v: Vec<f32> = data.iter().copied().filter(|x| x.is_finite()).collect();
-                v.sort_by(f32::total_cmp);
-                let m = v.get(v.len() / 2).copied().unwrap_or(0.0);
-                let kelvin = m > 150.0;
-                let off = if kelvin { -273.15 } else { 0.0 };
-                Ok(ThermalImage {
-                    width,
-                    height,
-                    celsius: data.iter().map(|&x| x as f64 + off).collect(),
-                    raw: None,
-                    kind: ThermalFileKind::TiffFloat,
-                    metadata: Vec::new(),
-                    notes: vec![if kelvin {
-                        format!("float values read as kelvin (median {m:.2})")
-                    } else {
-                        format!("float values read as °C (median {m:.2})")
-                    }],
-                })
-            }
-        };
+        return decode_tiff_file(path, bytes, opts);
     }
     if bytes.starts_with(b"\x89PNG") {
-        let img = image::load_from_memory_with_format(bytes, image::ImageFormat::Png)
-            .map_err(|e| err(path, format!("cannot decode the PNG: {e}")))?;
-        return match img {
-            image::DynamicImage::ImageLuma16(b) => {
-                let (w, h) = b.dimensions();
-                Ok(scaled(
-                    Image16 {
-                        width: w,
-                        height: h,
-                        data: b.into_raw(),
-                    },
-                    ThermalFileKind::Png16,
-                    opts,
-                ))
-            }
-            other => Err(err(
-                path,
-                format!(
-                    "a {:?} PNG holds no temperatures (radiometric PNGs are 16-bit grey)",
-                    other.color()
-                ),
-            )),
-        };
+        return decode_png_file(path, bytes, opts);
     }
     let ext = path
         .extension()

@@ -38,52 +38,78 @@ fn percentile(v: &mut [f64], q: f64) -> f64 {
     v[((v.len() - 1) as f64 * q).round() as usize]
 }
 
-/// Finds furniture among the unassigned points.
-#[allow(clippy::too_many_arguments)]
-pub fn find_furniture(
+/// The room as furniture is sought in it.
+pub struct Room<'a> {
+    /// Up.
+    pub up: Unit<Vector3<f64>>,
+    /// A horizontal direction the boxes are aligned with (the longest wall).
+    pub along: Vector3<f64>,
+    /// Height of the floor along `up`.
+    pub floor_height: f64,
+    /// Floor to ceiling (m).
+    pub room_height: f64,
+    /// The floor outline in (along, across) coordinates.
+    pub floor_2d: &'a [Point2<f64>],
+    /// The walls' planes with the clearance furniture keeps from each.
+    pub wall_planes: &'a [(mrtmap_geometry::Plane, f64)],
+}
+
+/// The room's horizontal axes (along, across).
+fn axes(room: &Room<'_>) -> (Vector3<f64>, Vector3<f64>) {
+    let up = &room.up;
+    let u = (room.along - up.as_ref() * room.along.dot(up)).normalize();
+    (u, up.cross(&u))
+}
+
+/// A 3D cell of 5 cm.
+type Cell = [i32; 3];
+
+/// Unassigned points off the floor, below the ceiling, inside the outline and clear of the walls,
+/// in 5 cm cells of the room's axes.
+fn candidate_cells(
     pos: &[Point3<f64>],
-    temp_k: &[f64],
     surface_id: &[i32],
-    up: &Unit<Vector3<f64>>,
-    along: &Vector3<f64>,
-    floor_height: f64,
-    room_height: f64,
-    floor_2d: &[Point2<f64>],
-    wall_planes: &[(mrtmap_geometry::Plane, f64)],
+    room: &Room<'_>,
     p: &SegmentParams,
-) -> Vec<FoundFurniture> {
-    let u = (along - up.as_ref() * along.dot(up)).normalize();
-    let v = up.cross(&u);
-    let to2 = |q: &Point3<f64>| Point2::new(u.dot(&q.coords), v.dot(&q.coords));
-    let cell = 0.05;
-    let mut grid: HashMap<[i32; 3], Vec<usize>> = HashMap::new();
+) -> HashMap<Cell, Vec<usize>> {
+    const CELL: f64 = 0.05;
+    let (u, v) = axes(room);
+    let up = &room.up;
+    let mut grid: HashMap<Cell, Vec<usize>> = HashMap::new();
     for (i, q) in pos.iter().enumerate() {
         if surface_id[i] >= 0 {
             continue;
         }
-        let h = up.dot(&q.coords) - floor_height;
-        if h < 0.02 || h > room_height - 0.1 {
+        let h = up.dot(&q.coords) - room.floor_height;
+        if h < 0.02 || h > room.room_height - 0.1 {
             continue;
         }
-        if point_in_polygon(&to2(q), floor_2d, p.furniture_wall_clearance_m) != Containment::Inside
+        let q2 = Point2::new(u.dot(&q.coords), v.dot(&q.coords));
+        if point_in_polygon(&q2, room.floor_2d, p.furniture_wall_clearance_m) != Containment::Inside
         {
             continue;
         }
-        if wall_planes
+        if room
+            .wall_planes
             .iter()
             .any(|(w, clearance)| w.distance(q).abs() < clearance.max(p.furniture_wall_clearance_m))
         {
             continue;
         }
         let k = [
-            (u.dot(&q.coords) / cell).floor() as i32,
-            (v.dot(&q.coords) / cell).floor() as i32,
-            (h / cell).floor() as i32,
+            (u.dot(&q.coords) / CELL).floor() as i32,
+            (v.dot(&q.coords) / CELL).floor() as i32,
+            (h / CELL).floor() as i32,
         ];
         grid.entry(k).or_default().push(i);
     }
-    let mut seen: HashMap<[i32; 3], bool> = HashMap::new();
-    let mut keys: Vec<[i32; 3]> = grid.keys().copied().collect();
+    grid
+}
+
+/// The points of each group of touching cells (26-connectivity), groups in cell order.
+fn cell_components(grid: &HashMap<Cell, Vec<usize>>) -> Vec<Vec<usize>> {
+    let mut seen: HashMap<Cell, bool> = HashMap::new();
+    let mut keys: Vec<Cell> = grid.keys().copied().collect();
     keys.sort_unstable();
     let mut out = Vec::new();
     for start in keys {
@@ -107,57 +133,74 @@ pub fn find_furniture(
                 }
             }
         }
-        if comp.len() < p.furniture_min_points {
-            continue;
-        }
-        let mut a: Vec<f64> = comp.iter().map(|&i| u.dot(&pos[i].coords)).collect();
-        let mut b: Vec<f64> = comp.iter().map(|&i| v.dot(&pos[i].coords)).collect();
-        let mut h: Vec<f64> = comp
-            .iter()
-            .map(|&i| up.dot(&pos[i].coords) - floor_height)
-            .collect();
-        let (a0, a1) = (percentile(&mut a, 0.01), percentile(&mut a, 0.99));
-        let (b0, b1) = (percentile(&mut b, 0.01), percentile(&mut b, 0.99));
-        let (mut h0, h1) = (percentile(&mut h, 0.01), percentile(&mut h, 0.99));
-        if h0 < 0.15 {
-            h0 = 0.0;
-        }
-        // Reaching the ceiling, it is the noisy remainder of a wall; lower than 20 cm, the remainder
-        // of the floor (or a rug, which is floor): not furniture.
-        if h1 > room_height - 0.15 || h1 < 0.2 {
-            continue;
-        }
-        let size = [a1 - a0, b1 - b0, h1 - h0];
-        // Thinner than 15 cm across, it is the noisy remainder of a wall or a picture, not furniture.
-        if size[0].min(size[1]) < 0.15 || size[2] < 0.05 || size[0] * size[1] * size[2] < 0.02 {
-            continue;
-        }
-        let mut avg = RadiantAverage::new();
-        for &i in &comp {
-            avg.add(Temperature::from_kelvin(temp_k[i]), 1.0);
-        }
-        let Some(t) = avg.mean() else { continue };
-        let corner = |c: usize| {
-            let x = if c & 1 == 0 { a0 } else { a1 };
-            let y = if c & 2 == 0 { b0 } else { b1 };
-            let z = floor_height + if c & 4 == 0 { h0 } else { h1 };
-            Point3::from(u * x + v * y + up.as_ref() * z)
-        };
-        out.push(FoundFurniture {
-            corners: [
-                corner(0),
-                corner(1),
-                corner(2),
-                corner(3),
-                corner(4),
-                corner(5),
-                corner(6),
-                corner(7),
-            ],
-            size_m: size,
-            temperature_k: t.kelvin(),
-            points: comp,
-        });
+        out.push(comp);
     }
     out
+}
+
+/// A group's box in the room's axes (1–99 % of its points; standing on the floor when within
+/// 15 cm of it), unless it is the remainder of a wall, the floor or a picture.
+fn furniture_box(
+    comp: Vec<usize>,
+    pos: &[Point3<f64>],
+    temp_k: &[f64],
+    room: &Room<'_>,
+) -> Option<FoundFurniture> {
+    let (u, v) = axes(room);
+    let up = &room.up;
+    let mut a: Vec<f64> = comp.iter().map(|&i| u.dot(&pos[i].coords)).collect();
+    let mut b: Vec<f64> = comp.iter().map(|&i| v.dot(&pos[i].coords)).collect();
+    let mut h: Vec<f64> = comp
+        .iter()
+        .map(|&i| up.dot(&pos[i].coords) - room.floor_height)
+        .collect();
+    let (a0, a1) = (percentile(&mut a, 0.01), percentile(&mut a, 0.99));
+    let (b0, b1) = (percentile(&mut b, 0.01), percentile(&mut b, 0.99));
+    let (mut h0, h1) = (percentile(&mut h, 0.01), percentile(&mut h, 0.99));
+    if h0 < 0.15 {
+        h0 = 0.0;
+    }
+    // Reaching the ceiling, it is the noisy remainder of a wall; lower than 20 cm, the remainder
+    // of the floor (or a rug, which is floor): not furniture.
+    if h1 > room.room_height - 0.15 || h1 < 0.2 {
+        return None;
+    }
+    let size = [a1 - a0, b1 - b0, h1 - h0];
+    // Thinner than 15 cm across, it is the noisy remainder of a wall or a picture, not furniture.
+    if size[0].min(size[1]) < 0.15 || size[2] < 0.05 || size[0] * size[1] * size[2] < 0.02 {
+        return None;
+    }
+    let mut avg = RadiantAverage::new();
+    for &i in &comp {
+        avg.add(Temperature::from_kelvin(temp_k[i]), 1.0);
+    }
+    let t = avg.mean()?;
+    let corners = std::array::from_fn(|c| {
+        let x = if c & 1 == 0 { a0 } else { a1 };
+        let y = if c & 2 == 0 { b0 } else { b1 };
+        let z = room.floor_height + if c & 4 == 0 { h0 } else { h1 };
+        Point3::from(u * x + v * y + up.as_ref() * z)
+    });
+    Some(FoundFurniture {
+        corners,
+        size_m: size,
+        temperature_k: t.kelvin(),
+        points: comp,
+    })
+}
+
+/// Finds furniture among the points on no surface (`surface_id` −1).
+pub fn find_furniture(
+    pos: &[Point3<f64>],
+    temp_k: &[f64],
+    surface_id: &[i32],
+    room: &Room<'_>,
+    p: &SegmentParams,
+) -> Vec<FoundFurniture> {
+    let grid = candidate_cells(pos, surface_id, room, p);
+    cell_components(&grid)
+        .into_iter()
+        .filter(|comp| comp.len() >= p.furniture_min_points)
+        .filter_map(|comp| furniture_box(comp, pos, temp_k, room))
+        .collect()
 }

@@ -19,9 +19,10 @@
 
 use std::collections::BTreeMap;
 
+use mrtmap_geometry::camera::PinholeCamera;
 use mrtmap_geometry::nalgebra::{Isometry3, Point2, Point3};
 use mrtmap_io::masks::{labels_path, read_mask_labels};
-use mrtmap_io::{Recording, read_image16};
+use mrtmap_io::{Image16, Recording, read_image16};
 use mrtmap_radiation::SurfaceKind;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -91,6 +92,108 @@ pub struct MaskSummary {
     pub problems: Vec<String>,
 }
 
+/// One mask frame's view: the colour (mask) camera and where it was, the depth frame nearest in
+/// time and where that was.
+struct MaskView<'a> {
+    rec: &'a Recording,
+    cam: PinholeCamera,
+    cam_from_world: Isometry3<f64>,
+    depth: Image16,
+    depth_from_world: Isometry3<f64>,
+    mask: Image16,
+}
+
+impl MaskView<'_> {
+    /// The mask instance most of a feature's visible points fall on (half of them at least, of
+    /// ten visible at least); a point counts as visible when the depth frame sees it.
+    fn instance(&self, pts: &[Point3<f64>]) -> Option<u16> {
+        let depth_cam = &self.rec.rig.depth;
+        let mut counts: BTreeMap<u16, usize> = BTreeMap::new();
+        let mut visible = 0usize;
+        for p in pts {
+            let q = self.depth_from_world * p;
+            let Some(px) = depth_cam.project(&q).filter(|px| depth_cam.contains(px)) else {
+                continue;
+            };
+            let raw = self.depth.get(px.x.round() as u32, px.y.round() as u32);
+            let z = raw as f64 / self.rec.rig.depth_scale;
+            if raw == 0 || (z - q.z).abs() > 0.05 + 0.03 * q.z {
+                continue;
+            }
+            let Some(pc) = self
+                .cam
+                .project(&(self.cam_from_world * p))
+                .filter(|pc: &Point2<f64>| self.cam.contains(pc))
+            else {
+                continue;
+            };
+            visible += 1;
+            let id = self.mask.get(pc.x.round() as u32, pc.y.round() as u32);
+            if id > 0 {
+                *counts.entry(id).or_default() += 1;
+            }
+        }
+        let (id, n) = counts.iter().max_by_key(|(_, n)| **n)?;
+        (visible >= 10 && 2 * n >= visible).then_some(*id)
+    }
+}
+
+/// The depth frame within 50 ms of `t` nearest to it.
+fn nearest_depth(rec: &Recording, t: f64) -> Option<usize> {
+    let k = rec.depth.partition_point(|d| d.t < t);
+    [k.checked_sub(1), (k < rec.depth.len()).then_some(k)]
+        .into_iter()
+        .flatten()
+        .min_by(|&a, &b| {
+            (rec.depth[a].t - t)
+                .abs()
+                .total_cmp(&(rec.depth[b].t - t).abs())
+        })
+        .filter(|&d| (rec.depth[d].t - t).abs() <= 0.05)
+}
+
+/// One mask frame's votes: the label each feature's points fall on, if any; why not when the
+/// frame cannot be used.
+fn frame_votes(
+    rec: &Recording,
+    m: &mrtmap_io::StreamEntry,
+    world_from_depth: &(dyn Fn(f64) -> Option<Isometry3<f64>> + Sync),
+    features: &[Vec<Point3<f64>>],
+) -> Result<Vec<Option<String>>, String> {
+    let (cam, depth_from_cam) = match rec.rig.rgb {
+        Some(r) => (r.camera, r.depth_from_rgb),
+        None => (rec.rig.depth, Isometry3::identity()),
+    };
+    let wd = world_from_depth(m.t)
+        .ok_or_else(|| format!("{}: no pose at {:.3} s", m.path.display(), m.t))?;
+    let near = nearest_depth(rec, m.t)
+        .ok_or_else(|| format!("{}: no depth frame within 50 ms", m.path.display()))?;
+    let depth = rec
+        .read_depth(&rec.depth[near])
+        .map_err(|e| e.to_string())?;
+    let wd_depth = world_from_depth(rec.depth[near].t).unwrap_or(wd);
+    let png = rec.path_of(m);
+    let mask = read_image16(&png).map_err(|e| e.to_string())?;
+    mask.check_size(&png, cam.width, cam.height)
+        .map_err(|e| e.to_string())?;
+    let labels = read_mask_labels(&labels_path(&png)).map_err(|e| e.to_string())?;
+    let view = MaskView {
+        rec,
+        cam,
+        cam_from_world: (wd * depth_from_cam).inverse(),
+        depth,
+        depth_from_world: wd_depth.inverse(),
+        mask,
+    };
+    Ok(features
+        .iter()
+        .map(|pts| {
+            let id = view.instance(pts)?;
+            labels.get(&id).map(|l| l.label.clone())
+        })
+        .collect())
+}
+
 /// Votes for every feature (given as its cloud points) from the recording's masks, with
 /// `world_from_depth` giving the (refined) pose at any time.
 pub fn vote(
@@ -98,10 +201,6 @@ pub fn vote(
     world_from_depth: &(dyn Fn(f64) -> Option<Isometry3<f64>> + Sync),
     features: &[Vec<Point3<f64>>],
 ) -> (Vec<Option<(String, Votes)>>, MaskSummary) {
-    let (cam, depth_from_cam) = match rec.rig.rgb {
-        Some(r) => (r.camera, r.depth_from_rgb),
-        None => (rec.rig.depth, Isometry3::identity()),
-    };
     let mut summary = MaskSummary {
         frames: rec.masks.len(),
         ..Default::default()
@@ -109,70 +208,7 @@ pub fn vote(
     let per_frame: Vec<Result<Vec<Option<String>>, String>> = rec
         .masks
         .par_iter()
-        .map(|m| {
-            let wd = world_from_depth(m.t)
-                .ok_or_else(|| format!("{}: no pose at {:.3} s", m.path.display(), m.t))?;
-            let k = rec.depth.partition_point(|d| d.t < m.t);
-            let near = [k.checked_sub(1), (k < rec.depth.len()).then_some(k)]
-                .into_iter()
-                .flatten()
-                .min_by(|&a, &b| {
-                    (rec.depth[a].t - m.t)
-                        .abs()
-                        .total_cmp(&(rec.depth[b].t - m.t).abs())
-                })
-                .filter(|&d| (rec.depth[d].t - m.t).abs() <= 0.05)
-                .ok_or_else(|| format!("{}: no depth frame within 50 ms", m.path.display()))?;
-            let depth = rec
-                .read_depth(&rec.depth[near])
-                .map_err(|e| e.to_string())?;
-            let wd_depth = world_from_depth(rec.depth[near].t).unwrap_or(wd);
-            let png = rec.path_of(m);
-            let mask = read_image16(&png).map_err(|e| e.to_string())?;
-            mask.check_size(&png, cam.width, cam.height)
-                .map_err(|e| e.to_string())?;
-            let labels = read_mask_labels(&labels_path(&png)).map_err(|e| e.to_string())?;
-            let cam_from_world = (wd * depth_from_cam).inverse();
-            let depth_from_world = wd_depth.inverse();
-            Ok(features
-                .iter()
-                .map(|pts| {
-                    let mut counts: BTreeMap<u16, usize> = BTreeMap::new();
-                    let mut visible = 0usize;
-                    for p in pts {
-                        let q = depth_from_world * p;
-                        let Some(px) = rec
-                            .rig
-                            .depth
-                            .project(&q)
-                            .filter(|px| rec.rig.depth.contains(px))
-                        else {
-                            continue;
-                        };
-                        let raw = depth.get(px.x.round() as u32, px.y.round() as u32);
-                        let z = raw as f64 / rec.rig.depth_scale;
-                        if raw == 0 || (z - q.z).abs() > 0.05 + 0.03 * q.z {
-                            continue;
-                        }
-                        let Some(pc) = cam
-                            .project(&(cam_from_world * p))
-                            .filter(|pc: &Point2<f64>| cam.contains(pc))
-                        else {
-                            continue;
-                        };
-                        visible += 1;
-                        let id = mask.get(pc.x.round() as u32, pc.y.round() as u32);
-                        if id > 0 {
-                            *counts.entry(id).or_default() += 1;
-                        }
-                    }
-                    let (id, n) = counts.iter().max_by_key(|(_, n)| **n)?;
-                    (visible >= 10 && 2 * n >= visible)
-                        .then(|| labels.get(id).map(|l| l.label.clone()))
-                        .flatten()
-                })
-                .collect())
-        })
+        .map(|m| frame_votes(rec, m, world_from_depth, features))
         .collect();
     let mut tallies: Vec<BTreeMap<String, usize>> = vec![BTreeMap::new(); features.len()];
     for r in per_frame {

@@ -432,18 +432,15 @@ fn furniture_of(
         .enumerate()
         .map(|(w, &k)| (env.planes[k].plane, bands[w + 2] + 0.05))
         .collect();
-    furniture::find_furniture(
-        &pts.pos,
-        &pts.temp,
-        surface_id,
-        &up,
-        longest,
+    let room = furniture::Room {
+        up,
+        along: *longest,
         floor_height,
-        height_m,
-        &floor_2d,
-        &wall_planes,
-        p,
-    )
+        room_height: height_m,
+        floor_2d: &floor_2d,
+        wall_planes: &wall_planes,
+    };
+    furniture::find_furniture(&pts.pos, &pts.temp, surface_id, &room, p)
 }
 
 /// A label's vote, if masks gave one.
@@ -484,11 +481,7 @@ struct Ids(BTreeMap<String, usize>);
 
 impl Ids {
     fn next(&mut self, label: &str) -> String {
-        let slug: String = label
-            .to_lowercase()
-            .split_whitespace()
-            .collect::<Vec<_>>()
-            .join("-");
+        let slug = mrtmap_radiation::slug(label);
         let c = self.0.entry(slug.clone()).or_default();
         *c += 1;
         format!("{slug}-{c}")

@@ -302,21 +302,98 @@ fn optimised(c: &Connection, path: &Path) -> Result<Vec<(i64, Isometry3<f64>)>, 
         .collect()
 }
 
+/// RTAB-Map's link types by number.
+const LINK_TYPES: [&str; 10] = [
+    "neighbour",
+    "global loop closure",
+    "local-space closure",
+    "local-time closure",
+    "user",
+    "virtual",
+    "neighbour merged",
+    "pose prior",
+    "landmark",
+    "gravity",
+];
+
+/// Links by type, and how many are loop closures.
+fn link_counts(c: &Connection, path: &Path) -> Result<(Vec<(String, usize)>, usize), FileError> {
+    let mut links = Vec::new();
+    let mut closures = 0;
+    if !columns(c, "Link").iter().any(|x| x == "type") {
+        return Ok((links, closures));
+    }
+    let mut s = c
+        .prepare("SELECT type, COUNT(*) FROM Link GROUP BY type ORDER BY type")
+        .map_err(|e| sql_err(path, e))?;
+    let rows: Vec<(i64, i64)> = s
+        .query_map([], |r| Ok((r.get(0)?, r.get(1)?)))
+        .and_then(|m| m.collect())
+        .map_err(|e| sql_err(path, e))?;
+    for (t, n) in rows {
+        if is_loop_closure(t) {
+            closures += n as usize;
+        }
+        let name = LINK_TYPES
+            .get(t as usize)
+            .map_or(format!("type {t}"), |s| s.to_string());
+        links.push((name, n as usize));
+    }
+    Ok((links, closures))
+}
+
+/// The first calibration blob's camera, with a note when it cannot be read or holds several.
+fn first_calibration(c: &Connection, notes: &mut Vec<String>) -> Option<Calibration> {
+    let blob: Vec<u8> = c
+        .query_row(
+            "SELECT calibration FROM Data WHERE calibration IS NOT NULL AND length(calibration) > 0 LIMIT 1",
+            [],
+            |r| r.get(0),
+        )
+        .ok()?;
+    match calibration(&blob) {
+        Ok((cal, used)) => {
+            if used < blob.len() {
+                notes.push(
+                    "the calibration blob holds more than one camera: the first is used".into(),
+                );
+            }
+            Some(cal)
+        }
+        Err(e) => {
+            notes.push(format!("calibration blob: {e}"));
+            None
+        }
+    }
+}
+
+/// Which poses a database offers, in words.
+fn poses_said(optimised: usize, closures: usize) -> String {
+    if optimised > 0 {
+        "optimised (Admin.opt_poses)".into()
+    } else if closures > 0 {
+        format!(
+            "odometry (Node.pose; no optimised poses saved) — the Link graph has {closures} loop closure{}: convert optimises it",
+            if closures == 1 { "" } else { "s" }
+        )
+    } else {
+        "odometry (Node.pose; no optimised poses saved, no loop closures in Link)".into()
+    }
+}
+
 /// Summarises a database (no image is decoded).
 pub fn summarize(path: &Path) -> Result<DbSummary, FileError> {
     let (c, version) = open(path)?;
     let mut notes = Vec::new();
-    let q = |sql: &str| -> Result<i64, FileError> {
-        c.query_row(sql, [], |r| r.get(0))
+    let q = |sql: &str| -> Result<usize, FileError> {
+        c.query_row(sql, [], |r| r.get::<_, i64>(0))
+            .map(|n| n as usize)
             .map_err(|e| sql_err(path, e))
     };
-    let nodes = q("SELECT COUNT(*) FROM Node")? as usize;
-    let images =
-        q("SELECT COUNT(*) FROM Data WHERE image IS NOT NULL AND length(image) > 0")? as usize;
-    let depths =
-        q("SELECT COUNT(*) FROM Data WHERE depth IS NOT NULL AND length(depth) > 0")? as usize;
-    let rvl = q("SELECT COUNT(*) FROM Data WHERE substr(depth, 1, 8) = CAST('DEPTHRVL' AS BLOB)")?
-        as usize;
+    let nodes = q("SELECT COUNT(*) FROM Node")?;
+    let images = q("SELECT COUNT(*) FROM Data WHERE image IS NOT NULL AND length(image) > 0")?;
+    let depths = q("SELECT COUNT(*) FROM Data WHERE depth IS NOT NULL AND length(depth) > 0")?;
+    let rvl = q("SELECT COUNT(*) FROM Data WHERE substr(depth, 1, 8) = CAST('DEPTHRVL' AS BLOB)")?;
     let span: (f64, f64) = c
         .query_row("SELECT MIN(stamp), MAX(stamp) FROM Node", [], |r| {
             Ok((
@@ -325,83 +402,18 @@ pub fn summarize(path: &Path) -> Result<DbSummary, FileError> {
             ))
         })
         .map_err(|e| sql_err(path, e))?;
-    let mut links = Vec::new();
-    let mut closures = 0;
-    if columns(&c, "Link").iter().any(|x| x == "type") {
-        let names = [
-            "neighbour",
-            "global loop closure",
-            "local-space closure",
-            "local-time closure",
-            "user",
-            "virtual",
-            "neighbour merged",
-            "pose prior",
-            "landmark",
-            "gravity",
-        ];
-        let mut s = c
-            .prepare("SELECT type, COUNT(*) FROM Link GROUP BY type ORDER BY type")
-            .map_err(|e| sql_err(path, e))?;
-        let rows: Vec<(i64, i64)> = s
-            .query_map([], |r| Ok((r.get(0)?, r.get(1)?)))
-            .and_then(|m| m.collect())
-            .map_err(|e| sql_err(path, e))?;
-        for (t, n) in rows {
-            if is_loop_closure(t) {
-                closures += n as usize;
-            }
-            let name = names
-                .get(t as usize)
-                .map_or(format!("type {t}"), |s| s.to_string());
-            links.push((name, n as usize));
-        }
-    }
-    let opt = optimised(&c, path)?;
-    let calib_blob: Option<Vec<u8>> = c
-        .query_row(
-            "SELECT calibration FROM Data WHERE calibration IS NOT NULL AND length(calibration) > 0 LIMIT 1",
-            [],
-            |r| r.get(0),
-        )
-        .ok();
-    let calibration = match calib_blob {
-        Some(b) => match calibration(&b) {
-            Ok((cal, used)) => {
-                if used < b.len() {
-                    notes.push(
-                        "the calibration blob holds more than one camera: the first is used".into(),
-                    );
-                }
-                Some(cal)
-            }
-            Err(e) => {
-                notes.push(format!("calibration blob: {e}"));
-                None
-            }
-        },
-        None => None,
-    };
+    let (links, closures) = link_counts(&c, path)?;
+    let optimised = optimised(&c, path)?.len();
+    let calibration = first_calibration(&c, &mut notes);
     Ok(DbSummary {
-        poses: if opt.is_empty() {
-            if closures > 0 {
-                format!(
-                    "odometry (Node.pose; no optimised poses saved) — the Link graph has {closures} loop closure{}: convert optimises it",
-                    if closures == 1 { "" } else { "s" }
-                )
-            } else {
-                "odometry (Node.pose; no optimised poses saved, no loop closures in Link)".into()
-            }
-        } else {
-            "optimised (Admin.opt_poses)".into()
-        },
+        poses: poses_said(optimised, closures),
         version,
         nodes,
         images,
         depths,
         rvl,
         links,
-        optimised: opt.len(),
+        optimised,
         span,
         calibration,
         notes,
