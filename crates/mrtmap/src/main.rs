@@ -3,7 +3,6 @@
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    mrtmap::logging();
     match mrtmap::run() {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => mrtmap::report_error(&e),
