@@ -1,4 +1,4 @@
-//! Writing the result into rig.toml (`shared/spec/recording.md`): the `[thermal]` and `[rgb]`
+//! Writing the result into rig.toml (docs/recording.md): the `[thermal]` and `[rgb]`
 //! sections with `depth_from_thermal`, and a `[calibration]` table with the errors (readers of
 //! rig.toml ignore it).
 

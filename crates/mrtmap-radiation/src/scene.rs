@@ -1,7 +1,7 @@
 //! The radiant scene file (`scene.json`, format `mrtmap-scene/1`) and its validated model.
 //!
 //! [`SceneFile`] is the file as data (serde, every key of the spec plus the optional ones);
-//! [`RadiantScene`] is a scene that passed every rule of `shared/spec/scene.md`, with each
+//! [`RadiantScene`] is a scene that passed every rule of the scene format (docs/scene-format.md), with each
 //! surface's plane frame computed once. Conversion goes through [`RadiantScene::new`], whose
 //! errors name the surface, feature or occluder id and the rule broken.
 

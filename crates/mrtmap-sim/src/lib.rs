@@ -7,7 +7,7 @@
 //!  room.toml ──► Room ──► scene (exact MRT truth) ─────────────────────────► truth.json
 //!                  │
 //!                  └──► Walk ──► depth (30 Hz) / thermal (8.7 Hz) / colour + masks / poses (200 Hz)
-//!                                   └──► recording folder (shared/spec/recording.md)
+//!                                   └──► recording folder (docs/recording.md)
 //! ```
 //!
 //! The world frame of a recording is the depth camera's frame at the first pose (as with a SLAM

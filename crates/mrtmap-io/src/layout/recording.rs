@@ -1,5 +1,5 @@
 //! The recording layout (a folder, version 1): `rig.toml`, stream lists, TUM trajectories,
-//! images. See `shared/spec/recording.md`; what this reader accepts beyond it is in the crate docs.
+//! images. See docs/recording.md; what this reader accepts beyond it is in the crate docs.
 
 use std::path::{Path, PathBuf};
 

@@ -1,4 +1,4 @@
-//! Writes the recording layout (`shared/spec/recording.md`) frame by frame: what `convert` and
+//! Writes the recording layout (docs/recording.md) frame by frame: what `convert` and
 //! every reader of another format end in. The folder appears under its final name only when
 //! [`LayoutWriter::finish`] succeeds.
 

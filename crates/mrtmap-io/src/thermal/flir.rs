@@ -6,7 +6,7 @@
 //! and the CameraInfo record (Planck constants, emissivity, distances, temperatures, atmosphere),
 //! and convert raw counts to temperature with the formula of exiftool-based tools (Thermimage's
 //! `raw2temp`). Offsets follow exiftool's FLIR tables; every one is checked against exiftool's own
-//! output for the files in `shared/data`.
+//! output for the real FLIR files of the shared data folder (`MRTMAP_DATA_DIR`).
 
 use crate::bytes::{Bytes, Corrupt, Endian};
 use crate::image16::Image16;

@@ -4,6 +4,7 @@ use anyhow::bail;
 use mrtmap_io::Recording;
 use mrtmap_pipeline::run::segment_into;
 use mrtmap_pipeline::settings::SegmentSection;
+use mrtmap_scan::segment::{SegmentReport, Votes};
 
 use crate::cli::SegmentArgs;
 
@@ -30,7 +31,31 @@ pub fn run(a: &SegmentArgs) -> anyhow::Result<()> {
         masks: masks.is_some(),
     };
     let report = segment_into(&a.fused, masks.as_ref(), &section.params(), &a.out)?;
-    let r = &report;
+    print_report(&report);
+    for w in &report.warnings {
+        println!("  warning: {w}");
+    }
+    println!(
+        "wrote scene.json, segments.ply, segment.json in {}",
+        a.out.display()
+    );
+    Ok(())
+}
+
+/// A label's vote share, in words.
+fn votes_text(v: Option<&Votes>) -> String {
+    v.map(|v| {
+        format!(
+            ", {:.0} % of {} votes",
+            v.share * 100.0,
+            v.votes.values().sum::<usize>()
+        )
+    })
+    .unwrap_or_default()
+}
+
+/// The room, its surfaces, features and furniture.
+fn print_report(r: &SegmentReport) {
     println!(
         "room: {} walls, {:.2} m high; {:.0} % of the cloud on no surface (furniture, clutter)",
         r.surfaces.len() - 2,
@@ -51,45 +76,27 @@ pub fn run(a: &SegmentArgs) -> anyhow::Result<()> {
         );
     }
     for f in &r.features {
-        let votes = f
-            .votes
-            .as_ref()
-            .map(|v| {
-                format!(
-                    ", {:.0} % of {} votes",
-                    v.share * 100.0,
-                    v.votes.values().sum::<usize>()
-                )
-            })
-            .unwrap_or_default();
         println!(
-            "  {:<18} on {:<8} {:6.2} °C ({:+.1} K), {:.2} m², label by {}{votes}",
-            f.id, f.host, f.temperature_c, f.contrast_k, f.area_m2, f.label_source
+            "  {:<18} on {:<8} {:6.2} °C ({:+.1} K), {:.2} m², label by {}{}",
+            f.id,
+            f.host,
+            f.temperature_c,
+            f.contrast_k,
+            f.area_m2,
+            f.label_source,
+            votes_text(f.votes.as_ref())
         );
     }
     for f in &r.furniture {
-        let votes = f
-            .votes
-            .as_ref()
-            .map(|v| {
-                format!(
-                    ", {:.0} % of {} votes",
-                    v.share * 100.0,
-                    v.votes.values().sum::<usize>()
-                )
-            })
-            .unwrap_or_default();
         println!(
-            "  {:<18} furniture {:.2} × {:.2} × {:.2} m, {:6.2} °C, label by {}{votes}",
-            f.id, f.size_m[0], f.size_m[1], f.size_m[2], f.temperature_c, f.label_source
+            "  {:<18} furniture {:.2} × {:.2} × {:.2} m, {:6.2} °C, label by {}{}",
+            f.id,
+            f.size_m[0],
+            f.size_m[1],
+            f.size_m[2],
+            f.temperature_c,
+            f.label_source,
+            votes_text(f.votes.as_ref())
         );
     }
-    for w in &r.warnings {
-        println!("  warning: {w}");
-    }
-    println!(
-        "wrote scene.json, segments.ply, segment.json in {}",
-        a.out.display()
-    );
-    Ok(())
 }
