@@ -66,7 +66,7 @@ pub enum FileErrorKind {
     Image(String),
     /// An image that could not be encoded for writing.
     #[error(transparent)]
-    Encode(#[from] crate::image16::EncodeError),
+    Encode(#[from] EncodeError),
     /// A file listed in another that does not exist.
     #[error("listed file {0} does not exist")]
     Missing(String),
@@ -91,7 +91,7 @@ impl FileError {
     }
 
     /// An image that could not be encoded for this file.
-    pub fn encode(path: &Path, e: crate::image16::EncodeError) -> Self {
+    pub fn encode(path: &Path, e: EncodeError) -> Self {
         Self::new(path, None, FileErrorKind::Encode(e))
     }
 
@@ -116,4 +116,17 @@ impl FileError {
     pub fn io(path: &Path, e: std::io::Error) -> Self {
         Self::new(path, None, FileErrorKind::Io(e))
     }
+}
+
+/// An image that could not be encoded (its pixels do not fill its size, or it is empty).
+#[derive(Debug, thiserror::Error)]
+#[error("cannot encode a {width}×{height} PNG")]
+pub struct EncodeError {
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    /// Why.
+    #[source]
+    pub source: image::ImageError,
 }

@@ -5,7 +5,7 @@ use std::path::Path;
 use image::codecs::png::{CompressionType, FilterType, PngEncoder};
 use image::{ExtendedColorType, ImageEncoder, ImageReader};
 
-use crate::error::{FileError, FileErrorKind};
+use crate::error::{EncodeError, FileError, FileErrorKind};
 
 /// A 16-bit single-channel image, row-major.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -83,19 +83,6 @@ pub fn read_image16(path: &Path) -> Result<Image16, FileError> {
             )),
         )),
     }
-}
-
-/// An image that could not be encoded (its pixels do not fill its size, or it is empty).
-#[derive(Debug, thiserror::Error)]
-#[error("cannot encode a {width}×{height} PNG")]
-pub struct EncodeError {
-    /// Width.
-    pub width: u32,
-    /// Height.
-    pub height: u32,
-    /// Why.
-    #[source]
-    pub source: image::ImageError,
 }
 
 fn encode_png(

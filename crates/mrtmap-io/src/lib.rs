@@ -36,10 +36,8 @@ mod ply;
 pub mod thermal;
 
 pub use atomic::{PartialDir, write_atomic};
-pub use error::{FileError, FileErrorKind};
-pub use image16::{
-    EncodeError, Image16, encode_png_rgb8, encode_png16, gaussian_blur, read_image16,
-};
+pub use error::{EncodeError, FileError, FileErrorKind};
+pub use image16::{Image16, encode_png_rgb8, encode_png16, gaussian_blur, read_image16};
 pub use layout::masks;
 pub use layout::{
     InterpolationLimits, LayoutWriter, PoseFile, QUATERNION_NORM_TOLERANCE, Recording, RgbCamera,

@@ -37,6 +37,7 @@
 
 pub mod cache;
 pub mod calibration;
+mod conversion;
 pub mod demo;
 mod error;
 pub mod maps;

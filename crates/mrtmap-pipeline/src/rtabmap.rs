@@ -14,8 +14,8 @@ use mrtmap_sources::rtabmap::{self, Calibration, DbSummary};
 use mrtmap_sources::{SourceKind, resolve_source};
 
 use crate::cache::json_text;
+use crate::conversion::{Conversion, SourceOptions};
 use crate::error::{Error, Result};
-use crate::source::{Conversion, SourceOptions};
 
 /// What a scan needs besides the database.
 pub fn missing(s: &DbSummary, o: &SourceOptions) -> Vec<String> {

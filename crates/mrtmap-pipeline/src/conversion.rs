@@ -1,0 +1,79 @@
+//! What a source conversion is told and what it reports (shared by the ROS and RTAB-Map
+//! conversions).
+
+use std::path::PathBuf;
+
+use mrtmap_io::Rig;
+use mrtmap_sources::ros::RosOptions;
+use serde::Serialize;
+
+use crate::error::{Error, Result};
+
+/// How to read a bag, MCAP file or RTAB-Map database as a scan.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct SourceOptions {
+    /// A rig.toml: its thermal camera and extrinsic, and its depth/colour cameras where the
+    /// source has no CameraInfo.
+    pub rig: Option<PathBuf>,
+    /// Depth image topic.
+    pub depth_topic: Option<String>,
+    /// Thermal image topic.
+    pub thermal_topic: Option<String>,
+    /// Colour image topic.
+    pub rgb_topic: Option<String>,
+    /// Pose topic (Odometry or PoseStamped).
+    pub pose_topic: Option<String>,
+    /// Raw depth units per metre of 16-bit depth.
+    pub depth_scale: Option<f64>,
+    /// Thermal frames for a source without them (an RTAB-Map database).
+    pub thermal: Option<PathBuf>,
+}
+
+impl SourceOptions {
+    /// The ROS reader's options (reads the rig).
+    pub(crate) fn ros(&self) -> Result<RosOptions> {
+        if let Some(s) = self.depth_scale
+            && !(s > 0.0 && s.is_finite())
+        {
+            return Err(Error::setting(
+                format!("--depth-scale {s}"),
+                "must be a positive number of raw units per metre",
+            ));
+        }
+        Ok(RosOptions {
+            depth_topic: self.depth_topic.clone(),
+            thermal_topic: self.thermal_topic.clone(),
+            rgb_topic: self.rgb_topic.clone(),
+            pose_topic: self.pose_topic.clone(),
+            depth_scale: self.depth_scale,
+            rig: self.rig.as_deref().map(Rig::read).transpose()?,
+        })
+    }
+}
+
+/// What a conversion to the recording layout wrote.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Conversion {
+    /// The recording folder.
+    pub out: PathBuf,
+    /// Depth frames written.
+    pub depth: usize,
+    /// Thermal frames written.
+    pub thermal: usize,
+    /// Colour frames written.
+    pub rgb: usize,
+    /// Poses written.
+    pub poses: usize,
+    /// Where the thermal frames came from, when not from the source itself.
+    pub thermal_from: Option<String>,
+    /// Which poses were taken, when the source offers several kinds.
+    pub poses_from: Option<String>,
+    /// Messages (or database nodes) skipped.
+    pub skipped: usize,
+    /// "messages" or "nodes".
+    pub skipped_unit: &'static str,
+    /// The first reasons for skipping.
+    pub skipped_reasons: Vec<String>,
+    /// How things were decided.
+    pub notes: Vec<String>,
+}
