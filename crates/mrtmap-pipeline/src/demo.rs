@@ -17,11 +17,9 @@ use crate::error::Result;
 use crate::progress::Progress;
 use crate::report::report_data;
 use crate::run::{RunOutcome, run};
-use crate::settings::{PointEntry, Project};
+use crate::settings::{PointEntry, PointFrame, Project};
 use crate::simulation::{load_room, set_depth_size};
 
-/// Rays per validation point when comparing with the truth.
-const POINT_RAYS: usize = 100_000;
 /// Rays per grid node when comparing with the truth.
 const GRID_RAYS: usize = 20_000;
 /// First random stream of the grid nodes (the points use 0…).
@@ -122,6 +120,7 @@ fn demo_project(truth: &Truth, s: &DemoSettings) -> Project {
             .map(|p| PointEntry {
                 name: p.name.clone(),
                 xyz: p.xyz_world,
+                frame: PointFrame::Scan,
             })
             .collect(),
         ..Project::default()
@@ -145,22 +144,25 @@ fn engine(scene: &RadiantScene, rays: usize) -> Result<MrtEngine<'_>> {
     )?)
 }
 
-/// Ours against the truth at the validation points, with what a standard black globe would read:
-/// its equilibrium by the mixed-convection model, read back through the ISO 7726 formula, as the
-/// seed paper's reference globes were read.
-fn compare_points(
-    scene: &RadiantScene,
-    truth: &Truth,
-    air_speed: f64,
-) -> Result<Vec<ComparisonRow>> {
-    let engine = engine(scene, POINT_RAYS)?;
+/// Ours against the truth at the validation points (ours: the run's own values at its marks, one
+/// computation per number), with what a standard black globe would read: its equilibrium by the
+/// mixed-convection model, read back through the ISO 7726 formula, as the seed paper's reference
+/// globes were read.
+fn compare_points(run: &RunOutcome, truth: &Truth, air_speed: f64) -> Result<Vec<ComparisonRow>> {
     let air = Temperature::from_celsius(truth.air_temperature_c);
+    let marks = run
+        .maps
+        .first()
+        .map(|m| m.summary.marks.as_slice())
+        .unwrap_or(&[]);
     let mut rows = Vec::new();
-    for (k, p) in truth.points.iter().enumerate() {
-        let ours = engine
-            .at(&Point3::from(p.xyz_world), k as u64)?
-            .mrt
-            .celsius();
+    for p in &truth.points {
+        let Some(ours) = marks
+            .iter()
+            .find(|m| m.name.as_deref() == Some(p.name.as_str()))
+        else {
+            continue;
+        };
         let tg = globe_temperature(
             &Globe::STANDARD,
             Temperature::from_celsius(p.mrt_c),
@@ -180,16 +182,21 @@ fn compare_points(
             name: p.name.clone(),
             truth_c: p.mrt_c,
             globe_c,
-            ours_c: ours,
-            diff_k: ours - p.mrt_c,
+            ours_c: ours.mrt_c,
+            diff_k: ours.mrt_c - p.mrt_c,
         });
     }
     Ok(rows)
 }
 
-/// Ours against the truth on its grid (nodes where either has no value are left out).
+/// Ours against the truth on its grid (nodes where either has no value are left out); the truth's
+/// nodes are in the scan's frame, carried into the scene's room frame.
 fn compare_grid(scene: &RadiantScene, truth: &Truth) -> Result<GridError> {
     let engine = engine(scene, GRID_RAYS)?;
+    let room_from_world = scene
+        .world_from_room
+        .map(|w| w.inverse())
+        .unwrap_or_else(mrtmap_geometry::nalgebra::Isometry3::identity);
     let diffs: Vec<f64> = truth
         .grid
         .nodes
@@ -197,9 +204,8 @@ fn compare_grid(scene: &RadiantScene, truth: &Truth) -> Result<GridError> {
         .enumerate()
         .filter_map(|(k, n)| {
             let t = n.mrt_c?;
-            let o = engine
-                .at(&Point3::from(n.xyz_world), GRID_STREAM0 + k as u64)
-                .ok()?;
+            let at = room_from_world * Point3::from(n.xyz_world);
+            let o = engine.at(&at, GRID_STREAM0 + k as u64).ok()?;
             Some(o.mrt.celsius() - t)
         })
         .collect();
@@ -274,7 +280,7 @@ pub fn demo(out: &Path, s: &DemoSettings, progress: &dyn Progress) -> Result<Dem
     let run_dir = out.join("run");
     let outcome = run(&recording, &run_dir, &project, s.force, progress)?;
     progress.begin("comparing with the truth");
-    let rows = compare_points(&outcome.scene, &truth, s.air_speed_m_s)?;
+    let rows = compare_points(&outcome, &truth, s.air_speed_m_s)?;
     let grid = compare_grid(&outcome.scene, &truth)?;
     let d = DemoOutcome {
         room,

@@ -151,3 +151,24 @@ pub fn load_scene(path: Option<&Path>) -> Result<(RadiantScene, String)> {
         ),
     })
 }
+
+/// A point of `frame` in the scene's own frame: a scan-frame point is carried through the scene's
+/// `world_from_room` (`source` names the scene for the error when it has none).
+pub fn to_scene_frame(
+    xyz: [f64; 3],
+    frame: crate::settings::PointFrame,
+    scene: &RadiantScene,
+    source: &str,
+) -> Result<Point3<f64>> {
+    let p = Point3::from(xyz);
+    match frame {
+        crate::settings::PointFrame::Room => Ok(p),
+        crate::settings::PointFrame::Scan => match scene.world_from_room {
+            Some(w) => Ok(w.inverse() * p),
+            None => Err(Error::source(
+                Path::new(source),
+                "has no world_from_room (it was not written by segmentation), so points in the scan's frame cannot be placed in it: give them in its own frame",
+            )),
+        },
+    }
+}

@@ -12,6 +12,7 @@
 
 use std::path::Path;
 
+use mrtmap_geometry::nalgebra::Point3;
 use mrtmap_io::{Recording, Trajectory, read_cloud_ply, write_atomic, write_cloud_ply};
 use mrtmap_radiation::{GridSpec, RadiantScene};
 use mrtmap_scan::segment::{MaskInput, SegmentParams, SegmentReport, refined_poses, segment};
@@ -21,7 +22,7 @@ use crate::cache::{Fingerprint, Stage, StageOutcome, read_json, run_or_reuse, wr
 use crate::error::{Error, Result};
 use crate::maps::{Mark, MarkAt, Summary, make_map};
 use crate::progress::Progress;
-use crate::settings::Project;
+use crate::settings::{PointEntry, PointFrame, Project};
 
 /// Fuses `rec` into `out`: cloud.ply, fusion.json and poses.txt (the refined trajectory).
 pub fn fuse_into(
@@ -155,7 +156,8 @@ fn segment_stage(
         .file(&fused.join("cloud.ply"))
         .file(&fused.join("poses.txt"))
         .maybe_file(use_masks.then(|| rec.dir.join("masks.txt")).as_deref())
-        .setting("segment", &p.segment);
+        .setting("segment", &p.segment)
+        .setting("room", &p.room);
     let stage = Stage::in_dir(
         "segment",
         &dir,
@@ -165,9 +167,43 @@ fn segment_stage(
         progress.begin("segmenting surfaces and features");
         progress.advance(0, 1);
         let masks = use_masks.then_some(rec);
-        segment_into(&fused, masks, &p.segment.params(), &dir).map(|_| ())
+        segment_into(&fused, masks, &p.segment.params(&p.room), &dir).map(|_| ())
     })?;
     Ok((outcome, read_json(&dir.join("segment.json"))?))
+}
+
+/// The project's points in the scene's (room) frame: points given in the scan's frame are carried
+/// through the scene's `world_from_room`.
+pub fn points_in_room(
+    points: &[PointEntry],
+    scene: &RadiantScene,
+    scene_path: &Path,
+) -> Result<Vec<Mark>> {
+    points
+        .iter()
+        .map(|pt| {
+            let xyz = match pt.frame {
+                PointFrame::Room => pt.xyz,
+                PointFrame::Scan => {
+                    let Some(world_from_room) = scene.world_from_room else {
+                        return Err(Error::source(
+                            scene_path,
+                            format!(
+                                "point {} is given in the scan's frame, but the scene has no world_from_room to carry it into the room's frame",
+                                pt.name
+                            ),
+                        ));
+                    };
+                    let q = world_from_room.inverse() * Point3::from(pt.xyz);
+                    [q.x, q.y, q.z]
+                }
+            };
+            Ok(Mark {
+                name: pt.name.clone(),
+                at: MarkAt::Scene(xyz),
+            })
+        })
+        .collect()
 }
 
 /// The map stage at one height: `out/map-H.HHm`.
@@ -188,14 +224,7 @@ fn map_stage(
         height_m,
         margin_m: p.map.margin_m,
     };
-    let marks: Vec<Mark> = p
-        .points
-        .iter()
-        .map(|pt| Mark {
-            name: pt.name.clone(),
-            at: MarkAt::Scene(pt.xyz),
-        })
-        .collect();
+    let marks = points_in_room(&p.points, scene, &scene_path)?;
     // This map's own settings only: adding another height leaves it unchanged.
     let fingerprint = Fingerprint::new()
         .file(&scene_path)

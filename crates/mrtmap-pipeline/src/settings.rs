@@ -19,9 +19,14 @@ grid = [20, 20]           # nodes across and along the floor's bounding rectangl
 heights_m = [1.1]         # one map per height above the floor (1.1 m seated head, 1.7 m standing)
 margin_m = 0.1            # distance kept from the walls
 
-[[points]]                # named points (e.g. globe locations) in the scan's frame, metres
-name = "A"
-xyz = [1.0, 0.2, 2.0]
+[[points]]                # named points (e.g. globe locations), metres, in the room frame:
+name = "A"                # x, y along the floor from the origin corner, z above the floor
+xyz = [1.2, 0.8, 1.1]
+# frame = "scan"          # or in the scan's world frame (the frame of trajectory.txt)
+
+[room]
+# origin_corner = 1       # the floor corner at the origin (numbered on the report's map); by
+                          # default the start of the longest wall with the room in x, y >= 0
 
 [air]
 temperature_c = 21.0      # for the report's operative temperature and globe comparisons
@@ -68,14 +73,41 @@ impl Default for MapSection {
     }
 }
 
+/// The frame a point is given in: one choice for `--frame` and `[[points]] frame`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum PointFrame {
+    /// The room frame: x, y along the floor from the origin corner, z above the floor.
+    #[default]
+    Room,
+    /// The scan's world frame (the frame of trajectory.txt).
+    Scan,
+}
+
 /// `[[points]]`: a named point.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PointEntry {
     /// Name.
     pub name: String,
-    /// Position in the scan's frame (m).
+    /// Position (m).
     pub xyz: [f64; 3],
+    /// The frame of `xyz`.
+    #[serde(default, skip_serializing_if = "is_room")]
+    pub frame: PointFrame,
+}
+
+fn is_room(f: &PointFrame) -> bool {
+    *f == PointFrame::Room
+}
+
+/// `[room]`: the room frame.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RoomSection {
+    /// The floor corner at the origin (1-based, as numbered on the report's map); `None` for the
+    /// rule (the start of the longest wall with the room at x, y ≥ 0).
+    pub origin_corner: Option<usize>,
 }
 
 /// `[air]`.
@@ -174,11 +206,12 @@ impl Default for SegmentSection {
 }
 
 impl SegmentSection {
-    /// The segmentation's parameters.
-    pub fn params(&self) -> SegmentParams {
+    /// The segmentation's parameters, with the room frame's origin corner.
+    pub fn params(&self, room: &RoomSection) -> SegmentParams {
         SegmentParams {
             feature_threshold_k: self.feature_threshold_k,
             feature_min_area_m2: self.feature_min_area_m2,
+            origin_corner: room.origin_corner,
             ..SegmentParams::default()
         }
     }
@@ -292,6 +325,8 @@ pub struct Project {
     pub fuse: FuseSection,
     /// Segmentation.
     pub segment: SegmentSection,
+    /// The room frame.
+    pub room: RoomSection,
     /// View factors.
     pub mrt: MrtSection,
 }

@@ -8,6 +8,8 @@ use mrtmap_report::{ValidationRow, parse_globe_csv, validate, validation_csv};
 
 use crate::cache::write_json;
 use crate::error::{Error, Result};
+use crate::maps::to_scene_frame;
+use crate::settings::PointFrame;
 
 /// Rays per globe location: a standard error well below the globes' own.
 const RAYS: usize = 200_000;
@@ -35,11 +37,15 @@ fn scene_of(map: &Path) -> Result<PathBuf> {
 
 /// Compares the MRT of the scene in `map` with the globe readings of `globe`, writing
 /// validation.csv and validation.json into `out`.
-pub fn validate_map(map: &Path, globe: &Path, out: &Path) -> Result<Validation> {
+pub fn validate_map(map: &Path, globe: &Path, frame: PointFrame, out: &Path) -> Result<Validation> {
     let scene_path = scene_of(map)?;
     let scene = RadiantScene::load(&scene_path)?;
     let text = std::fs::read_to_string(globe).map_err(|e| mrtmap_io::FileError::io(globe, e))?;
-    let readings = parse_globe_csv(&text, &globe.display().to_string())?;
+    let mut readings = parse_globe_csv(&text, &globe.display().to_string())?;
+    for r in &mut readings {
+        let p = to_scene_frame(r.xyz, frame, &scene, &scene_path.display().to_string())?;
+        r.xyz = [p.x, p.y, p.z];
+    }
     let engine = MrtEngine::new(
         &scene,
         Method::Auto(MonteCarlo {

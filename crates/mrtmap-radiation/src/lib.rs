@@ -30,10 +30,10 @@ pub use engine::{
 };
 pub use field::{Extreme, FieldError, FieldSummary, GridNode, GridSpec, MapFrame, MrtField};
 pub use scene::{
-    BoxFile, FEATURE_PLANE_TOLERANCE_M, Feature, FeatureFile, Occluder, OccluderFile,
-    OccluderShape, PLANARITY_TOLERANCE_M, RadiantScene, SCENE_FORMAT, SceneError, SceneFile,
-    SceneLoadError, SceneLoadErrorKind, Surface, SurfaceFile, SurfaceKind, TEMPERATURE_RANGE_C,
-    slug,
+    BoxFile, FEATURE_PLANE_TOLERANCE_M, Feature, FeatureFile, FramePose, MAX_COORDINATE_M,
+    Occluder, OccluderFile, OccluderShape, PLANARITY_TOLERANCE_M, RadiantScene, SCENE_FORMAT,
+    SceneError, SceneFile, SceneLoadError, SceneLoadErrorKind, Surface, SurfaceFile, SurfaceKind,
+    TEMPERATURE_RANGE_C, slug,
 };
 
 use serde::{Deserialize, Serialize};

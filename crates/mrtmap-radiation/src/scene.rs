@@ -8,7 +8,9 @@
 use std::collections::HashSet;
 use std::path::Path;
 
-use mrtmap_geometry::nalgebra::{Point2, Point3, Unit, Vector3};
+use mrtmap_geometry::nalgebra::{
+    Isometry3, Point2, Point3, Quaternion, Translation3, Unit, UnitQuaternion, Vector3,
+};
 use mrtmap_geometry::polygon::{self, NotSimple, PlaneFrame};
 use mrtmap_geometry::{Tri, box_triangles};
 use mrtmap_physics::Temperature;
@@ -32,6 +34,49 @@ fn is_one(x: &f64) -> bool {
     *x == 1.0
 }
 
+/// A rigid transform as written in files: translation (m) and a unit quaternion (x, y, z, w).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FramePose {
+    /// Translation (m).
+    pub translation: [f64; 3],
+    /// Rotation quaternion (x, y, z, w).
+    pub rotation_xyzw: [f64; 4],
+}
+
+impl FramePose {
+    /// From an isometry.
+    pub fn from_isometry(p: &Isometry3<f64>) -> Self {
+        let t = p.translation.vector;
+        let q = p.rotation.coords;
+        Self {
+            translation: [t.x, t.y, t.z],
+            rotation_xyzw: [q.x, q.y, q.z, q.w],
+        }
+    }
+
+    /// The isometry, when the numbers are finite and the quaternion is unit length (within 1e-6).
+    pub fn to_isometry(&self) -> Option<Isometry3<f64>> {
+        let [x, y, z, w] = self.rotation_xyzw;
+        let q = Quaternion::new(w, x, y, z);
+        let finite = self
+            .translation
+            .iter()
+            .chain(&self.rotation_xyzw)
+            .all(|v| v.is_finite());
+        if !finite || (q.norm() - 1.0).abs() > 1e-6 {
+            return None;
+        }
+        Some(Isometry3::from_parts(
+            Translation3::new(
+                self.translation[0],
+                self.translation[1],
+                self.translation[2],
+            ),
+            UnitQuaternion::from_quaternion(q),
+        ))
+    }
+}
+
 /// `scene.json` as data.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SceneFile {
@@ -40,6 +85,11 @@ pub struct SceneFile {
     /// Optional up direction (unit vector); without it, the floor's normal into the room.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub up: Option<[f64; 3]>,
+    /// Where the room's frame (the frame of this file) sits in the scan's world frame:
+    /// p_in_world = world_from_room · p_in_room. Written by segmentation; absent in hand-written
+    /// scenes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub world_from_room: Option<FramePose>,
     /// The room's surfaces.
     pub surfaces: Vec<SurfaceFile>,
     /// Optional occluders (boxes or triangle meshes).
@@ -319,6 +369,36 @@ pub enum SceneError {
         /// What the file gives.
         value: [f64; 3],
     },
+    /// A coordinate too far from the origin to be part of a room.
+    #[error(
+        "{element} '{id}': a coordinate of {value:e} m is beyond ±{MAX_COORDINATE_M} m: no room is that large (is it in millimetres, or a typo?)"
+    )]
+    FarCoordinate {
+        /// Element kind.
+        element: &'static str,
+        /// Its id.
+        id: String,
+        /// The coordinate.
+        value: f64,
+    },
+    /// `up` points out of the room (the other surfaces lie below the floor along it).
+    #[error(
+        "`up` {value:?} points out of the room: the floor '{floor}' would be above the other surfaces (give the opposite direction, or leave `up` out)"
+    )]
+    UpOutOfRoom {
+        /// What the file gives.
+        value: [f64; 3],
+        /// The floor's id.
+        floor: String,
+    },
+    /// `world_from_room` is not finite or its quaternion is not unit length.
+    #[error(
+        "`world_from_room` {value:?} is not a rigid transform (finite translation, unit quaternion x, y, z, w)"
+    )]
+    BadWorldFromRoom {
+        /// What the file gives.
+        value: FramePose,
+    },
     /// A malformed occluder.
     #[error("occluder '{id}': {detail}")]
     BadOccluder {
@@ -462,6 +542,8 @@ impl Occluder {
 pub struct RadiantScene {
     /// Up as given in the file, if any.
     pub up_given: Option<Unit<Vector3<f64>>>,
+    /// p_in_world = world_from_room · p_in_room, when the scene came from a scan.
+    pub world_from_room: Option<Isometry3<f64>>,
     /// Surfaces.
     pub surfaces: Vec<Surface>,
     /// Occluders.
@@ -518,6 +600,9 @@ fn check_std(element: &'static str, id: &str, s: Option<f64>) -> Result<Option<f
     }
 }
 
+/// Coordinates beyond this (m) are refused: no room is that large.
+pub const MAX_COORDINATE_M: f64 = 10_000.0;
+
 fn check_polygon(
     element: &'static str,
     id: &str,
@@ -535,6 +620,13 @@ fn check_polygon(
             element,
             id: id.into(),
             what: "a polygon coordinate",
+        });
+    }
+    if let Some(&value) = poly.iter().flatten().find(|c| c.abs() > MAX_COORDINATE_M) {
+        return Err(SceneError::FarCoordinate {
+            element,
+            id: id.into(),
+            value,
         });
     }
     Ok(poly.iter().map(point).collect())
@@ -714,11 +806,24 @@ fn check_shape(o: &OccluderFile) -> Result<OccluderShape, SceneError> {
         id: o.id.clone(),
         detail,
     };
+    let far = |cs: &mut dyn Iterator<Item = &f64>| -> Result<(), SceneError> {
+        for &value in cs {
+            if value.abs() > MAX_COORDINATE_M {
+                return Err(SceneError::FarCoordinate {
+                    element: "occluder",
+                    id: o.id.clone(),
+                    value,
+                });
+            }
+        }
+        Ok(())
+    };
     match (&o.box_, &o.vertices, &o.triangles) {
         (Some(b), None, None) => {
             if b.min.iter().chain(b.max.iter()).any(|c| !c.is_finite()) {
                 return Err(bad("box corners must be finite".into()));
             }
+            far(&mut b.min.iter().chain(b.max.iter()))?;
             if (0..3).any(|i| b.min[i] >= b.max[i]) {
                 return Err(bad(format!(
                     "box min {:?} is not below max {:?} on every axis",
@@ -734,6 +839,7 @@ fn check_shape(o: &OccluderFile) -> Result<OccluderShape, SceneError> {
             if v.iter().flatten().any(|c| !c.is_finite()) {
                 return Err(bad("mesh vertices must be finite".into()));
             }
+            far(&mut v.iter().flatten())?;
             if t.is_empty() {
                 return Err(bad("mesh has no triangles".into()));
             }
@@ -758,6 +864,48 @@ fn check_shape(o: &OccluderFile) -> Result<OccluderShape, SceneError> {
     }
 }
 
+impl SceneFile {
+    /// The scene with every coordinate mapped by `to_from_this` (p_new = to_from_this · p) and `up`
+    /// turned with it; boxes become meshes when the map turns them. `world_from_room` is left as
+    /// it is: set it to what the new frame is.
+    pub fn transformed(&self, to_from_this: &Isometry3<f64>) -> SceneFile {
+        let map = |p: &[f64; 3]| {
+            let q = to_from_this * Point3::from(*p);
+            [q.x, q.y, q.z]
+        };
+        let poly = |v: &[[f64; 3]]| v.iter().map(map).collect::<Vec<_>>();
+        let turned = to_from_this.rotation.angle() > 1e-12;
+        let mut out = self.clone();
+        out.up = self.up.map(|u| {
+            let v = to_from_this.rotation * Vector3::from(u);
+            [v.x, v.y, v.z]
+        });
+        for s in &mut out.surfaces {
+            s.polygon = poly(&s.polygon);
+            for f in &mut s.features {
+                f.polygon = poly(&f.polygon);
+            }
+        }
+        for o in &mut out.occluders {
+            match o.box_.take() {
+                Some(b) if turned => {
+                    let corners = mrtmap_geometry::box_corners(&point(&b.min), &point(&b.max));
+                    o.vertices = Some(corners.iter().map(|c| map(&arr(c))).collect());
+                    o.triangles = Some(mrtmap_geometry::BOX_TRIANGLES.to_vec());
+                }
+                Some(b) => {
+                    o.box_ = Some(BoxFile {
+                        min: map(&b.min),
+                        max: map(&b.max),
+                    });
+                }
+                None => o.vertices = o.vertices.as_deref().map(poly),
+            }
+        }
+        out
+    }
+}
+
 impl RadiantScene {
     /// Validates a scene file against every rule of the spec.
     pub fn new(file: &SceneFile) -> Result<Self, SceneError> {
@@ -770,6 +918,13 @@ impl RadiantScene {
             return Err(SceneError::NoSurfaces);
         }
         let up_given = check_up(file.up)?;
+        let world_from_room = match file.world_from_room {
+            None => None,
+            Some(p) => Some(
+                p.to_isometry()
+                    .ok_or(SceneError::BadWorldFromRoom { value: p })?,
+            ),
+        };
         let mut ids = Ids::default();
         let surfaces = file
             .surfaces
@@ -788,11 +943,38 @@ impl RadiantScene {
                 emissivity: check_emissivity("occluder", &o.id, o.emissivity)?,
             });
         }
-        Ok(Self {
+        let scene = Self {
             up_given,
+            world_from_room,
             surfaces,
             occluders,
-        })
+        };
+        scene.check_up_direction()?;
+        Ok(scene)
+    }
+
+    /// A given `up` must point from the floor towards the rest of the room.
+    fn check_up_direction(&self) -> Result<(), SceneError> {
+        let (Some(up), Some(floor)) = (self.up_given, self.floor()) else {
+            return Ok(());
+        };
+        let others: Vec<Point3<f64>> = self
+            .surfaces
+            .iter()
+            .filter(|s| !std::ptr::eq(*s, floor))
+            .flat_map(|s| s.polygon.iter().copied())
+            .collect();
+        if others.is_empty() {
+            return Ok(());
+        }
+        let rise = up.dot(&(polygon::centroid(&others) - polygon::centroid(&floor.polygon)));
+        if rise < 0.0 {
+            return Err(SceneError::UpOutOfRoom {
+                value: [up.x, up.y, up.z],
+                floor: floor.id.clone(),
+            });
+        }
+        Ok(())
     }
 
     /// Parses and validates JSON text.
@@ -825,6 +1007,7 @@ impl RadiantScene {
         SceneFile {
             format: SCENE_FORMAT.into(),
             up: self.up_given.map(|u| [u.x, u.y, u.z]),
+            world_from_room: self.world_from_room.as_ref().map(FramePose::from_isometry),
             surfaces: self
                 .surfaces
                 .iter()

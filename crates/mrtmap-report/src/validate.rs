@@ -21,7 +21,7 @@ pub const ISO_DESIRED_K: f64 = 0.2;
 pub struct GlobeRow {
     /// Location label.
     pub label: String,
-    /// Position in the scan's frame (m).
+    /// Position (m), in the frame of the scene it is compared with.
     pub xyz: [f64; 3],
     /// Globe temperature (°C).
     pub tg_c: f64,

@@ -204,8 +204,19 @@ fn point_scores(found: &RadiantScene, truth: &Truth) -> Result<Vec<PointScore>, 
         .collect::<Result<Vec<_>, mrtmap_radiation::MrtError>>()?)
 }
 
-/// Scores `found` against `truth` (both in the recording's world frame).
+/// Scores `found` against `truth`: in the recording's world frame, `found` carried there by its
+/// `world_from_room` when it has one.
 pub fn score_scene(found: &RadiantScene, truth: &Truth) -> Result<SceneScore, crate::SimError> {
+    let in_world;
+    let found = match found.world_from_room {
+        Some(w) => {
+            let mut f = found.to_file().transformed(&w);
+            f.world_from_room = None;
+            in_world = RadiantScene::new(&f)?;
+            &in_world
+        }
+        None => found,
+    };
     let t_scene = RadiantScene::new(&truth.scene)?;
     let mut surfaces = Vec::new();
     let mut features = Vec::new();

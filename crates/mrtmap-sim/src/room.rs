@@ -536,6 +536,7 @@ impl Room {
         RadiantScene::new(&SceneFile {
             format: SCENE_FORMAT.into(),
             up: Some([up.x, up.y, up.z]),
+            world_from_room: None,
             surfaces,
             occluders: self.occluder_files(world_from_room),
         })

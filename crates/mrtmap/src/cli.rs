@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use mrtmap_pipeline::settings::PointFrame;
 use mrtmap_pipeline::{DirectionChoice, MethodChoice, MrtSection};
 
 /// Map the mean radiant temperature (MRT) of a room.
@@ -340,9 +341,17 @@ pub struct RunArgs {
     /// Margin from the walls (m) ([map] margin_m).
     #[arg(long = "margin-m")]
     pub margin_m: Option<f64>,
-    /// A named point NAME=X,Y,Z in the scan's frame, repeatable ([[points]]).
+    /// A named point NAME=X,Y,Z, repeatable ([[points]]): in the room frame (x, y along the floor
+    /// from the origin corner, z above the floor), or in the scan's frame with --frame scan.
     #[arg(long = "mark", value_name = "NAME=X,Y,Z", value_parser = parse_mark)]
     pub marks: Vec<(String, Vec<f64>)>,
+    /// The frame of --mark: room (default) or scan (the frame of trajectory.txt).
+    #[arg(long, value_enum, default_value_t = PointFrame::Room)]
+    pub frame: PointFrame,
+    /// The floor corner at the room frame's origin, as numbered on the report's map ([room]
+    /// origin_corner); by default the start of the longest wall with the room at x, y ≥ 0.
+    #[arg(long, value_name = "N")]
+    pub origin_corner: Option<usize>,
     /// Voxel size (m) ([fuse] voxel_m).
     #[arg(long = "voxel-m")]
     pub voxel_m: Option<f64>,
@@ -396,10 +405,14 @@ pub struct ValidateArgs {
     #[arg(long, value_name = "DIR")]
     pub map: PathBuf,
     /// Globe readings: CSV with the columns label,x,y,z,tg_c,ta_c,va_m_s,diameter_m,emissivity (°C,
-    /// m/s, m; x, y, z in the scan's frame, the frame of scene.json). With a header the columns may
-    /// come in any order and others (time, notes) are ignored; `#` starts a comment line.
+    /// m/s, m; x, y, z in the room frame of scene.json, or the scan's with --frame scan). With a
+    /// header the columns may come in any order and others (time, notes) are ignored; `#` starts a
+    /// comment line.
     #[arg(long, value_name = "FILE")]
     pub globe: PathBuf,
+    /// The frame of the globes' x, y, z: room (scene.json's, default) or scan.
+    #[arg(long, value_enum, default_value_t = PointFrame::Room)]
+    pub frame: PointFrame,
     /// Where to write validation.csv and validation.json (default: the map folder).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
@@ -423,6 +436,10 @@ pub struct SegmentArgs {
     /// Smallest feature (m²).
     #[arg(long = "feature-min-area-m2", default_value_t = 0.04)]
     pub feature_min_area_m2: f64,
+    /// The floor corner at the room frame's origin, as numbered in segment.json's floor_corners;
+    /// by default the start of the longest wall with the room at x, y ≥ 0.
+    #[arg(long, value_name = "N")]
+    pub origin_corner: Option<usize>,
 }
 
 /// On or off.
@@ -607,9 +624,14 @@ pub struct MapArgs {
 pub struct MrtArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
-    /// A point X,Y,Z in the scene file's frame (m). Repeatable.
+    /// A point X,Y,Z (m) in the scene file's frame: for a scanned room, its room frame (x, y along
+    /// the floor from the origin corner, z above the floor). Repeatable.
     #[arg(long = "at", value_name = "X,Y,Z", required = true, value_parser = parse_point)]
     pub at: Vec<[f64; 3]>,
+    /// The frame of --at: room (the scene file's, default) or scan (the scan's world frame; needs
+    /// a scene written by segmentation, which records where the room sits in the scan).
+    #[arg(long, value_enum, default_value_t = PointFrame::Room)]
+    pub frame: PointFrame,
     #[command(flatten)]
     pub method: MethodArgs,
     /// Print JSON instead of a table.

@@ -2,7 +2,7 @@ use std::path::Path;
 use std::sync::Mutex;
 
 use mrtmap_pipeline::run::run;
-use mrtmap_pipeline::settings::PointEntry;
+use mrtmap_pipeline::settings::{PointEntry, PointFrame};
 use mrtmap_pipeline::{Progress, Project};
 use mrtmap_sim::{NoiseLevel, SimConfig, preset, simulate};
 
@@ -44,6 +44,7 @@ fn a_run_reports_progress_and_reuses_unchanged_stages() {
     p.points.push(PointEntry {
         name: "P".into(),
         xyz: [0.0, 0.0, 0.0],
+        frame: PointFrame::Scan,
     });
     let log = Log::default();
     let first = run(&rec, &out, &p, false, &log).unwrap();

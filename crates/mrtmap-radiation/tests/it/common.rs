@@ -59,6 +59,7 @@ pub fn box_room(sx: f64, sy: f64, sz: f64, t: [f64; 6]) -> SceneFile {
     SceneFile {
         format: SCENE_FORMAT.into(),
         up: None,
+        world_from_room: None,
         surfaces: vec![
             surface(
                 "floor",
@@ -136,6 +137,7 @@ pub fn l_room() -> SceneFile {
     SceneFile {
         format: SCENE_FORMAT.into(),
         up: None,
+        world_from_room: None,
         surfaces,
         occluders: Vec::new(),
     }

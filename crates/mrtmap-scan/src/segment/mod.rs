@@ -9,6 +9,7 @@ mod envelope;
 mod features;
 mod furniture;
 pub mod labels;
+pub mod room;
 
 use std::collections::BTreeMap;
 
@@ -18,8 +19,8 @@ use mrtmap_geometry::polygon::{Containment, centroid, point_in_polygon};
 use mrtmap_io::{Recording, ThermalCloud};
 use mrtmap_physics::ZERO_CELSIUS_K;
 use mrtmap_radiation::{
-    FeatureFile, OccluderFile, RadiantScene, SCENE_FORMAT, SceneError, SceneFile, SurfaceFile,
-    SurfaceKind,
+    FeatureFile, FramePose, OccluderFile, RadiantScene, SCENE_FORMAT, SceneError, SceneFile,
+    SurfaceFile, SurfaceKind,
 };
 use serde::{Deserialize, Serialize};
 
@@ -68,6 +69,9 @@ pub struct SegmentParams {
     pub furniture_min_points: usize,
     /// Seed of RANSAC.
     pub seed: u64,
+    /// The floor corner (1-based, in the automatic numbering) at the room frame's origin; `None`
+    /// for the rule of [`room`].
+    pub origin_corner: Option<usize>,
 }
 
 impl Default for SegmentParams {
@@ -92,6 +96,7 @@ impl Default for SegmentParams {
             furniture_wall_clearance_m: 0.15,
             furniture_min_points: 200,
             seed: 1,
+            origin_corner: None,
         }
     }
 }
@@ -123,6 +128,16 @@ pub enum SegmentError {
         walls: usize,
         /// The wall planes found (direction on the floor, extent, points).
         found: String,
+    },
+    /// The origin corner asked for does not exist.
+    #[error(
+        "origin corner {given} does not exist: the room has {corners} corners, numbered 1…{corners}"
+    )]
+    OriginCorner {
+        /// The corner asked for.
+        given: usize,
+        /// Corners the room has.
+        corners: usize,
     },
     /// The scene built breaks a scene rule.
     #[error("the scene built from the cloud is invalid: {0}")]
@@ -199,9 +214,14 @@ pub struct FurnitureSummary {
 pub struct SegmentReport {
     /// Up in the world frame.
     pub up: [f64; 3],
+    /// The room frame: p_in_world = world_from_room · p_in_room (scene.json is in the room frame).
+    pub world_from_room: FramePose,
+    /// How the room frame was chosen.
+    pub room: room::RoomFrame,
     /// Planes found: class, normal, offset, points.
     pub planes: Vec<(PlaneClass, [f64; 3], f64, usize)>,
-    /// Room corners at the floor, in order (counter-clockwise from above).
+    /// Room corners at the floor in the room frame, numbered from 1 (the first listed):
+    /// counter-clockwise from above, corner k starting wall k.
     pub floor_corners: Vec<[f64; 3]>,
     /// Floor-to-ceiling height (m).
     pub height_m: f64,
@@ -655,6 +675,43 @@ fn build_furniture(
     (occluders, summaries)
 }
 
+/// The room frame (see [`room`]): the walls described by their length, the features found on
+/// them and their temperature.
+fn choose_room_frame(
+    env: &Envelope,
+    analyses: &[features::SurfaceAnalysis],
+    p: &SegmentParams,
+) -> Result<room::RoomFrame, SegmentError> {
+    let n = env.walls.len();
+    let observed: Vec<f64> = analyses.iter().filter_map(|a| a.temperature_k).collect();
+    let mean = observed.iter().sum::<f64>() / observed.len().max(1) as f64;
+    let walls: Vec<room::WallFacts> = (0..n)
+        .map(|k| {
+            let a = &analyses[k + 2];
+            room::WallFacts {
+                length_m: (env.floor_corners[(k + 1) % n] - env.floor_corners[k]).norm(),
+                feature_area_m2: a.features.iter().map(|f| f.area_m2).sum(),
+                temperature_k: a.temperature_k.unwrap_or(mean),
+            }
+        })
+        .collect();
+    room::room_frame(&env.floor_corners, &walls, &env.up, p.origin_corner).map_err(|corners| {
+        SegmentError::OriginCorner {
+            given: p.origin_corner.unwrap_or(0),
+            corners,
+        }
+    })
+}
+
+/// Walls get the room frame's numbers: wall k runs from corner k to corner k + 1, corner 1 being
+/// the rule's origin.
+fn number_walls(geoms: &mut [SurfaceGeom], frame: &room::RoomFrame) {
+    let n = geoms.len() - 2;
+    for (k, g) in geoms[2..].iter_mut().enumerate() {
+        g.id = format!("wall-{}", (k + n - frame.first_index) % n + 1);
+    }
+}
+
 /// The planes found, as the report lists them.
 fn plane_rows(env: &Envelope) -> Vec<(PlaneClass, [f64; 3], f64, usize)> {
     env.planes
@@ -717,6 +774,9 @@ pub fn segment(
         .flat_map(|(s, a)| a.features.iter().map(move |f| (s, f)))
         .collect();
     let furniture = furniture_of(&env, &longest, &bands, &pts, &surface_id, height_m, p);
+    let frame = choose_room_frame(&env, &analyses, p)?;
+    let mut geoms = geoms;
+    number_walls(&mut geoms, &frame);
     let (feature_votes, furniture_votes, mask_summary) =
         vote_labels(masks, &all_features, &furniture, &pts.pos);
     let mut ids = Ids::default();
@@ -737,16 +797,35 @@ pub fn segment(
         &mut warnings,
     );
     let (occluders, furniture_summaries) = build_furniture(&furniture, furniture_votes, &mut ids);
-    let scene = RadiantScene::new(&SceneFile {
+    let in_world = SceneFile {
         format: SCENE_FORMAT.into(),
         up: Some([up.x, up.y, up.z]),
+        world_from_room: None,
         surfaces,
         occluders,
-    })?;
+    };
+    let world_from_room = frame.world_from_room;
+    let mut in_room = in_world.transformed(&world_from_room.inverse());
+    in_room.up = Some([0.0, 0.0, 1.0]);
+    in_room.world_from_room = Some(FramePose::from_isometry(&world_from_room));
+    let scene = RadiantScene::new(&in_room)?;
+    if frame.outside_quadrant > 0 {
+        warnings.push(format!(
+            "with the origin at corner {}, {} corner(s) of the room lie at x < 0 or y < 0",
+            frame.origin_corner, frame.outside_quadrant
+        ));
+    }
+    let n = env.floor_corners.len();
     let report = SegmentReport {
         up: [up.x, up.y, up.z],
+        world_from_room: FramePose::from_isometry(&world_from_room),
         planes: plane_rows(&env),
-        floor_corners: env.floor_corners.iter().map(arr).collect(),
+        floor_corners: (0..n)
+            .map(|k| {
+                arr(&(world_from_room.inverse() * env.floor_corners[(frame.first_index + k) % n]))
+            })
+            .collect(),
+        room: frame,
         height_m,
         surfaces: summaries,
         features: found.summaries,

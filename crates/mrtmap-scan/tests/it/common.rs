@@ -21,10 +21,24 @@ pub fn scan_scaled(
     depth_scale: f64,
     out: &Path,
 ) -> Room {
+    scan_seeded(room, noise, drift, seconds, depth_scale, 1, out)
+}
+
+/// [`scan_scaled`] with the walk of `seed`.
+pub fn scan_seeded(
+    room: &str,
+    noise: NoiseLevel,
+    drift: Drift,
+    seconds: f64,
+    depth_scale: f64,
+    seed: u64,
+    out: &Path,
+) -> Room {
     let mut cfg = SimConfig {
         seconds,
         noise,
         drift,
+        seed,
         truth_rays: 1_000,
         ..SimConfig::default()
     };
@@ -46,13 +60,17 @@ pub fn fuse_dir(dir: &Path, p: &FuseParams) -> Fused {
     fuse(&Recording::open(dir).unwrap(), p, &|_, _| {})
 }
 
-pub fn score(room: &Room, dir: &Path, fused: &Fused) -> CloudScore {
+/// The simulated room's frame in the scan's world frame (from truth.json).
+pub fn truth_world_from_room(dir: &Path) -> Isometry3<f64> {
     let truth: Truth =
         serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
     let t = truth.world_from_room;
-    let wfr = Isometry3::from_parts(
+    Isometry3::from_parts(
         Translation3::new(t.translation[0], t.translation[1], t.translation[2]),
         mrtmap_io::unit_quaternion(t.rotation_xyzw).unwrap(),
-    );
-    score_cloud(room, &wfr, &fused.cloud, 0.03)
+    )
+}
+
+pub fn score(room: &Room, dir: &Path, fused: &Fused) -> CloudScore {
+    score_cloud(room, &truth_world_from_room(dir), &fused.cloud, 0.03)
 }

@@ -11,9 +11,25 @@ fn run(
     noise: NoiseLevel,
     seconds: f64,
 ) -> (SceneScore, mrtmap_scan::segment::SegmentReport) {
+    let (s, r, _) = run_seeded(room, noise, seconds, 1);
+    (s, r)
+}
+
+/// [`run`] with the walk of `seed`; also the segmented room's frame in the simulated room's
+/// (sim_room_from_room).
+fn run_seeded(
+    room: &str,
+    noise: NoiseLevel,
+    seconds: f64,
+    seed: u64,
+) -> (
+    SceneScore,
+    mrtmap_scan::segment::SegmentReport,
+    Isometry3<f64>,
+) {
     let dir = tempfile::tempdir().unwrap();
     let rec_dir = dir.path().join("scan");
-    scan_scaled(room, noise, Drift::NONE, seconds, 0.5, &rec_dir);
+    scan_seeded(room, noise, Drift::NONE, seconds, 0.5, seed, &rec_dir);
     let rec = Recording::open(&rec_dir).unwrap();
     let mut p = params(true);
     p.depth.stride = 1;
@@ -32,7 +48,13 @@ fn run(
     let truth: Truth =
         serde_json::from_str(&std::fs::read_to_string(rec_dir.join("truth.json")).unwrap())
             .unwrap();
-    (score_scene(&seg.scene, &truth).unwrap(), seg.report)
+    let sim_room_from_room =
+        truth_world_from_room(&rec_dir).inverse() * seg.scene.world_from_room.unwrap();
+    (
+        score_scene(&seg.scene, &truth).unwrap(),
+        seg.report,
+        sim_room_from_room,
+    )
 }
 
 fn check_noise_free(room: &str, s: &SceneScore) {
@@ -136,4 +158,24 @@ fn realistic_office_mrt_within_tolerance() {
         );
     }
     println!("realistic office points: {:?}", s.points);
+}
+
+/// Two walks through the office that start in different places give the same room frame (as
+/// placed in the simulated room), and in it every corner lies at x, y ≥ 0 on the floor (z = 0).
+#[test]
+fn the_room_frame_does_not_depend_on_where_the_walk_started() {
+    let (_, r1, a) = run_seeded("office", NoiseLevel::None, 20.0, 1);
+    let (_, r5, b) = run_seeded("office", NoiseLevel::None, 20.0, 5);
+    let d = a.inverse() * b;
+    assert!(
+        d.translation.vector.norm() < 0.03 && d.rotation.angle().to_degrees() < 1.0,
+        "seed 1 {a:?}, seed 5 {b:?}"
+    );
+    for r in [&r1, &r5] {
+        assert_eq!(r.floor_corners[0], [0.0, 0.0, 0.0]);
+        for c in &r.floor_corners {
+            assert!(c[0] > -0.03 && c[1] > -0.03 && c[2].abs() < 1e-6, "{c:?}");
+        }
+        assert!(!r.room.chosen && r.room.origin_corner == 1);
+    }
 }

@@ -1,10 +1,9 @@
 //! `mrtmap mrt`: MRT at points with view-factor tables.
 
-use mrtmap_geometry::nalgebra::Point3;
 use mrtmap_radiation::{MrtEngine, PointRecord};
 use serde::Serialize;
 
-use mrtmap_pipeline::maps::load_scene;
+use mrtmap_pipeline::maps::{load_scene, to_scene_frame};
 
 use crate::cli::MrtArgs;
 use crate::output::json;
@@ -22,7 +21,8 @@ pub fn run(a: &MrtArgs) -> anyhow::Result<()> {
     let engine = MrtEngine::new(&scene, method)?;
     let mut points = Vec::with_capacity(a.at.len());
     for (k, p) in a.at.iter().enumerate() {
-        let r = engine.at(&Point3::new(p[0], p[1], p[2]), k as u64)?;
+        let at = to_scene_frame(*p, a.frame, &scene, &source)?;
+        let r = engine.at(&at, k as u64)?;
         points.push(PointRecord::new(None, &r, engine.patches()));
     }
     if a.json {

@@ -28,12 +28,15 @@ fn settings(a: &RunArgs) -> anyhow::Result<Project> {
     }
     for (name, c) in &a.marks {
         let &[x, y, z] = c.as_slice() else {
-            bail!("--mark {name}: give X,Y,Z in the scan's frame");
+            bail!(
+                "--mark {name}: give X,Y,Z (metres; the room frame, or the scan's with --frame scan)"
+            );
         };
         p.points.retain(|q| &q.name != name);
         p.points.push(PointEntry {
             name: name.clone(),
             xyz: [x, y, z],
+            frame: a.frame,
         });
     }
     if let Some(v) = a.voxel_m {
@@ -44,6 +47,9 @@ fn settings(a: &RunArgs) -> anyhow::Result<Project> {
     }
     if a.no_masks {
         p.segment.masks = false;
+    }
+    if let Some(c) = a.origin_corner {
+        p.room.origin_corner = Some(c);
     }
     if let Some(t) = a.air_c {
         p.air.temperature_c = Some(t);

@@ -3,7 +3,7 @@
 use anyhow::bail;
 use mrtmap_io::Recording;
 use mrtmap_pipeline::run::segment_into;
-use mrtmap_pipeline::settings::SegmentSection;
+use mrtmap_pipeline::settings::{RoomSection, SegmentSection};
 use mrtmap_scan::segment::{SegmentReport, Votes};
 
 use crate::cli::SegmentArgs;
@@ -30,7 +30,10 @@ pub fn run(a: &SegmentArgs) -> anyhow::Result<()> {
         feature_min_area_m2: a.feature_min_area_m2,
         masks: masks.is_some(),
     };
-    let report = segment_into(&a.fused, masks.as_ref(), &section.params(), &a.out)?;
+    let room = RoomSection {
+        origin_corner: a.origin_corner,
+    };
+    let report = segment_into(&a.fused, masks.as_ref(), &section.params(&room), &a.out)?;
     print_report(&report);
     for w in &report.warnings {
         println!("  warning: {w}");

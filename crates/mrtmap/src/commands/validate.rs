@@ -7,7 +7,7 @@ use crate::cli::ValidateArgs;
 
 pub fn run(a: &ValidateArgs) -> anyhow::Result<()> {
     let out = a.out.clone().unwrap_or_else(|| a.map.clone());
-    let v = validate_map(&a.map, &a.globe, &out)?;
+    let v = validate_map(&a.map, &a.globe, a.frame, &out)?;
     let (scene_path, result) = (&v.scene, &v.rows);
     println!("scene: {}", scene_path.display());
     println!(
