@@ -27,8 +27,8 @@ impl fmt::Display for FileError {
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum FileErrorKind {
-    /// The file could not be read or written.
-    #[error("{0}")]
+    /// The file could not be read or written (said in words, without the OS's error number).
+    #[error("{}", io_words(.0))]
     Io(#[from] std::io::Error),
     /// A line or value that does not parse.
     #[error("{0}")]
@@ -78,6 +78,29 @@ pub enum FileErrorKind {
         /// What is wrong there.
         what: String,
     },
+}
+
+/// An OS error in words for a person, with what to do where that is clear.
+pub fn io_words(e: &std::io::Error) -> String {
+    use std::io::ErrorKind as K;
+    match e.kind() {
+        K::NotFound => "does not exist: check the path".into(),
+        K::PermissionDenied => "permission denied: choose a place you may read and write".into(),
+        K::AlreadyExists => "already exists: remove it or choose another name".into(),
+        K::IsADirectory => "is a folder where a file is needed".into(),
+        K::NotADirectory => "a part of this path is a file where a folder is needed".into(),
+        K::StorageFull => "the disk is full: free some space".into(),
+        K::InvalidData => "is not text in UTF-8 (is it the right file?)".into(),
+        K::ReadOnlyFilesystem => "is on a read-only file system: choose another place".into(),
+        K::UnexpectedEof => "ends too early (cut short?)".into(),
+        _ => {
+            let s = e.to_string();
+            match s.find(" (os error") {
+                Some(k) => s[..k].to_lowercase(),
+                None => s,
+            }
+        }
+    }
 }
 
 impl FileError {

@@ -36,7 +36,7 @@ mod ply;
 pub mod thermal;
 
 pub use atomic::{PartialDir, write_atomic};
-pub use error::{EncodeError, FileError, FileErrorKind};
+pub use error::{EncodeError, FileError, FileErrorKind, io_words};
 pub use image16::{Image16, encode_png_rgb8, encode_png16, gaussian_blur, read_image16};
 pub use layout::masks;
 pub use layout::{

@@ -7,13 +7,14 @@ use std::time::Instant;
 use mrtmap_geometry::nalgebra::{Point2, Point3};
 use mrtmap_io::write_atomic;
 use mrtmap_radiation::{
-    GridSpec, MapFrame, Method, MrtEngine, MrtField, PointRecord, RadiantScene,
+    GridSpec, MapFrame, Method, MrtEngine, MrtError, MrtField, PointRecord, RadiantScene,
 };
 use mrtmap_report::{MapAxes, MapInput, MapMark, MapSummary, grid_csv, render_png, render_svg};
 use serde::{Deserialize, Serialize};
 
 use crate::cache::write_json;
 use crate::error::{Error, Result};
+use crate::settings::MrtSection;
 
 /// A point to mark on a map: map coordinates U,V at the map's height, or scene coordinates X,Y,Z.
 #[derive(Clone, Debug, PartialEq)]
@@ -55,22 +56,42 @@ pub struct MapOutput {
     pub png: Vec<u8>,
 }
 
+/// Where each mark is in the scene, refused when outside the room (before any MRT is computed).
+fn mark_points(
+    engine: &MrtEngine<'_>,
+    frame: &MapFrame,
+    spec: &GridSpec,
+    marks: &[Mark],
+) -> Result<Vec<Point3<f64>>> {
+    marks
+        .iter()
+        .map(|m| {
+            let p = match m.at {
+                MarkAt::Map([u, v]) => frame.point(&Point2::new(u, v), spec.height_m),
+                MarkAt::Scene([x, y, z]) => Point3::new(x, y, z),
+            };
+            engine.check_inside(&p).map_err(|source| Error::Point {
+                name: m.name.clone(),
+                source,
+            })?;
+            Ok(p)
+        })
+        .collect()
+}
+
 /// The MRT at each mark, with where it falls on the map.
 fn mark_records(
     engine: &MrtEngine<'_>,
     field: &MrtField,
     spec: &GridSpec,
     marks: &[Mark],
+    points: &[Point3<f64>],
 ) -> Result<(Vec<PointRecord>, Vec<MapMark>)> {
     let mut records = Vec::new();
     let mut map_marks = Vec::new();
-    for (k, m) in marks.iter().enumerate() {
-        let p = match m.at {
-            MarkAt::Map([u, v]) => field.frame.point(&Point2::new(u, v), spec.height_m),
-            MarkAt::Scene([x, y, z]) => Point3::new(x, y, z),
-        };
+    for (k, (m, p)) in marks.iter().zip(points).enumerate() {
         let r = engine
-            .at(&p, (spec.nx * spec.ny + k) as u64)
+            .at(p, (spec.nx * spec.ny + k) as u64)
             .map_err(|source| Error::Point {
                 name: m.name.clone(),
                 source,
@@ -78,37 +99,50 @@ fn mark_records(
         records.push(PointRecord::new(Some(m.name.clone()), &r, engine.patches()));
         map_marks.push(MapMark {
             name: m.name.clone(),
-            uv: field.frame.uv(&p),
+            uv: field.frame.uv(p),
         });
     }
     Ok((records, map_marks))
 }
 
 /// Computes the MRT map of `scene` (from `source`, for people) on `spec` with `marks`, and writes
-/// mrt_grid.csv, mrt_map.png, mrt_map.svg and summary.json into `out`.
+/// mrt_grid.csv, mrt_map.png, mrt_map.svg and summary.json into `out`. The height and the marks
+/// are checked against the room before anything is computed.
 pub fn make_map(
     scene: &RadiantScene,
     source: &str,
-    method: Method,
+    mrt: &MrtSection,
     spec: GridSpec,
     marks: &[Mark],
     out: &Path,
 ) -> Result<MapOutput> {
-    let engine = MrtEngine::new(scene, method)?;
+    let method = mrt.method(scene)?;
+    let engine = mrt.engine(scene)?;
     let frame = MapFrame::of_scene(scene).map_err(|source_err| Error::Map {
         scene: source.to_string(),
         source: source_err,
     })?;
+    if let Some(b) = engine.bounds() {
+        b.check_height(spec.height_m)?;
+    }
+    let points = mark_points(&engine, &frame, &spec, marks)?;
     let t0 = Instant::now();
     let field = MrtField::compute(&engine, frame, spec)?;
     let secs = t0.elapsed().as_secs_f64();
-    let (records, map_marks) = mark_records(&engine, &field, &spec, marks)?;
+    // An open scene is refused as a whole, not drawn as a map with holes.
+    if let Some(e) = field.nodes.iter().find_map(|n| match &n.result {
+        Err(e @ MrtError::NotEnclosed { .. }) => Some(e.clone()),
+        _ => None,
+    }) {
+        return Err(e.into());
+    }
+    let (records, map_marks) = mark_records(&engine, &field, &spec, marks, &points)?;
     let how = method.describe(engine.ray_engine());
     let input = MapInput {
         field: &field,
         scene,
         marks: &map_marks,
-        subtitle: format!("{source}; {}×{} grid, {how}", spec.nx, spec.ny),
+        subtitle: format!("{source}; {}×{} grid; {}", spec.nx, spec.ny, method.brief()),
     };
     let (rays, seed) = match method {
         Method::MonteCarlo(mc) | Method::Auto(mc) => (Some(mc.rays), Some(mc.seed)),

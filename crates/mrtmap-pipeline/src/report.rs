@@ -2,6 +2,7 @@
 
 use std::path::Path;
 
+use mrtmap_report::numbers::{fixed, uncertainty};
 use mrtmap_report::{ReportData, ReportMap};
 use mrtmap_scan::FusionReport;
 use mrtmap_scan::segment::SegmentReport;
@@ -104,10 +105,93 @@ fn coverage_rows(o: &RunOutcome) -> Vec<(String, String)> {
             o.maps
                 .first()
                 .and_then(|m| m.summary.map.field.as_ref())
-                .map_or("—".into(), |f| format!("{:.3} K", f.max_std_error_k)),
+                .map_or("—".into(), |f| {
+                    format!("{} K", uncertainty(f.max_std_error_k, 3))
+                }),
         ),
         ("what ± covers".into(), WHAT_PLUS_MINUS_COVERS.into()),
     ]
+}
+
+/// The room frame in words, its corners and its walls (room frame, corner 1 first).
+#[allow(clippy::type_complexity)]
+fn room_rows(s: &SegmentReport) -> (String, Vec<[String; 3]>, Vec<[String; 4]>) {
+    let c = &s.floor_corners;
+    let n = c.len();
+    if n < 3 {
+        return (String::new(), Vec::new(), Vec::new());
+    }
+    let k = s.room.origin_corner;
+    let how = if s.room.chosen {
+        "chosen in the settings"
+    } else {
+        "the longest wall with the room on its left, seen from above"
+    };
+    let text = format!(
+        "All coordinates (maps, points, grid CSV, scene.json) are in the room's own frame: the origin is floor corner {k} (marked on the maps), x runs along wall-{k} ({how}), y across the room, z up from the floor. Measure them with a tape from that corner. The room is {:.2} m high; the scan's own frame is kept in scene.json (world_from_room) for scan-frame input (--frame scan).",
+        s.height_m
+    );
+    let corners = c
+        .iter()
+        .enumerate()
+        .map(|(i, p)| [(i + 1).to_string(), fixed(p[0], 2), fixed(p[1], 2)])
+        .collect();
+    let walls = (0..n)
+        .map(|i| {
+            let (a, b) = (c[i], c[(i + 1) % n]);
+            let len = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt();
+            [
+                format!("wall-{}", i + 1),
+                (i + 1).to_string(),
+                ((i + 1) % n + 1).to_string(),
+                format!("{len:.2}"),
+            ]
+        })
+        .collect();
+    (text, corners, walls)
+}
+
+/// When (UTC), by which mrtmap version and by which command: "on 2026-12-01 15:50 UTC by
+/// mrtmap 0.1.0: mrtmap run scan --out out".
+pub fn provenance() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let (y, m, d) = civil_from_days((secs / 86_400) as i64);
+    let (hh, mm) = ((secs % 86_400) / 3600, (secs % 3600) / 60);
+    let mut command: Vec<String> = std::env::args_os()
+        .map(|a| {
+            let a = a.to_string_lossy().into_owned();
+            if a.contains(char::is_whitespace) {
+                format!("'{a}'")
+            } else {
+                a
+            }
+        })
+        .collect();
+    if let Some(first) = command.first_mut()
+        && let Some(name) = Path::new(first.as_str()).file_name()
+    {
+        *first = name.to_string_lossy().into_owned();
+    }
+    format!(
+        "on {y:04}-{m:02}-{d:02} {hh:02}:{mm:02} UTC by mrtmap {}: {}",
+        env!("CARGO_PKG_VERSION"),
+        command.join(" ")
+    )
+}
+
+/// The proleptic Gregorian date of a day count since 1970-01-01 (H. Hinnant's `civil_from_days`).
+fn civil_from_days(z: i64) -> (i64, u32, u32) {
+    let z = z + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = (doy - (153 * mp + 2) / 5 + 1) as u32;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
+    (yoe + era * 400 + i64::from(m <= 2), m, d)
 }
 
 /// Seconds per stage, saying which were reused.
@@ -127,6 +211,7 @@ pub fn timing_rows(stages: &[StageOutcome]) -> Vec<(String, String)> {
 
 /// The report's tables from a run.
 pub fn report_data(o: &RunOutcome, title: &str, source: &str, p: &Project) -> ReportData {
+    let (room_frame, corners, walls) = room_rows(&o.segment);
     ReportData {
         title: title.into(),
         source: source.into(),
@@ -151,6 +236,10 @@ pub fn report_data(o: &RunOutcome, title: &str, source: &str, p: &Project) -> Re
         warnings: o.warnings.clone(),
         timing: timing_rows(&o.stages),
         parameters: p.to_toml(),
+        made: provenance(),
+        room_frame,
+        corners,
+        walls,
         ..Default::default()
     }
 }
@@ -188,4 +277,25 @@ pub fn write_run_outputs(
             project: p,
         },
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn civil_dates_from_day_counts() {
+        assert_eq!(civil_from_days(0), (1970, 1, 1));
+        assert_eq!(civil_from_days(59), (1970, 3, 1));
+        assert_eq!(civil_from_days(11_016), (2000, 2, 29));
+        assert_eq!(civil_from_days(20_788), (2026, 12, 1));
+        assert_eq!(civil_from_days(-1), (1969, 12, 31));
+    }
+
+    #[test]
+    fn provenance_names_the_version_and_date() {
+        let p = provenance();
+        assert!(p.starts_with("on 20"), "{p}");
+        assert!(p.contains(" UTC by mrtmap "), "{p}");
+    }
 }

@@ -238,7 +238,6 @@ fn map_stage(
         &dir,
         &["summary.json", "mrt_map.png", "mrt_grid.csv"],
     );
-    let method = p.mrt.method(scene)?;
     let mut made = None;
     let outcome = run_or_reuse(&stage, fingerprint, force, || {
         progress.begin(&format!("mapping MRT at {height_m:.2} m"));
@@ -246,7 +245,7 @@ fn map_stage(
         made = Some(make_map(
             scene,
             "the scanned room",
-            method,
+            &p.mrt,
             spec,
             &marks,
             &dir,
@@ -265,6 +264,40 @@ fn map_stage(
     Ok((outcome, MapResult { summary, png, csv }))
 }
 
+/// Refuses what makes no sense in the scanned room before any map is computed: a map height
+/// outside it, a point outside it, settings the MRT engine refuses.
+fn check_requests(scene: &RadiantScene, scene_path: &Path, p: &Project) -> Result<()> {
+    let engine = p.mrt.engine(scene)?;
+    let Some(bounds) = engine.bounds() else {
+        return Ok(());
+    };
+    for &h in &p.map.heights_m {
+        bounds.check_height(h)?;
+    }
+    for m in points_in_room(&p.points, scene, scene_path)? {
+        if let MarkAt::Scene(xyz) = m.at {
+            engine
+                .check_inside(&Point3::from(xyz))
+                .map_err(|source| Error::Point {
+                    name: m.name.clone(),
+                    source,
+                })?;
+        }
+    }
+    Ok(())
+}
+
+/// Refuses an output path that is a file, before anything runs (it is created when missing).
+pub fn check_out_dir(out: &Path) -> Result<()> {
+    if out.exists() && !out.is_dir() {
+        return Err(Error::source(
+            out,
+            "is a file, but the output must be a folder (created when missing): choose another --out",
+        ));
+    }
+    Ok(())
+}
+
 /// Runs fuse → segment → maps on the recording folder `recording` into `out`.
 pub fn run(
     recording: &Path,
@@ -274,6 +307,7 @@ pub fn run(
     progress: &dyn Progress,
 ) -> Result<RunOutcome> {
     p.check()?;
+    check_out_dir(out)?;
     let rec = Recording::open(recording)?;
     let mut warnings: Vec<String> = rec
         .warnings
@@ -291,7 +325,9 @@ pub fn run(
             .iter()
             .map(|w| format!("segmentation: {w}")),
     );
-    let scene = RadiantScene::load(&out.join("segment").join("scene.json"))?;
+    let scene_path = out.join("segment").join("scene.json");
+    let scene = RadiantScene::load(&scene_path)?;
+    check_requests(&scene, &scene_path, p)?;
     let mut stages = vec![fused, segmented];
     let mut maps = Vec::new();
     for &h in &p.map.heights_m {

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use mrtmap_geometry::sampling::DirectionSet;
-use mrtmap_radiation::{Method, MonteCarlo, RadiantScene};
+use mrtmap_radiation::{Method, MonteCarlo, MrtEngine, RadiantScene};
 use mrtmap_scan::FuseParams;
 use mrtmap_scan::segment::SegmentParams;
 use serde::{Deserialize, Serialize};
@@ -265,6 +265,9 @@ pub struct MrtSection {
     pub directions: DirectionChoice,
     /// Independent Monte Carlo replicates the standard errors come from.
     pub replicates: usize,
+    /// Answer at points the scene does not enclose (ΣF short of 1: a missing wall, floor or
+    /// ceiling) instead of refusing them; the result says how much of the view is missing.
+    pub allow_open: bool,
 }
 
 impl Default for MrtSection {
@@ -276,6 +279,7 @@ impl Default for MrtSection {
             seed: mc.seed,
             directions: DirectionChoice::Fibonacci,
             replicates: mc.replicates,
+            allow_open: false,
         }
     }
 }
@@ -308,6 +312,12 @@ impl MrtSection {
             MethodChoice::Auto if scene.occluders.is_empty() => Method::Auto(mc),
             MethodChoice::Auto => Method::MonteCarlo(mc),
         })
+    }
+
+    /// The engine for `scene` with these settings (its method, and whether open scenes are
+    /// answered).
+    pub fn engine<'a>(&self, scene: &'a RadiantScene) -> Result<MrtEngine<'a>> {
+        Ok(MrtEngine::new(scene, self.method(scene)?)?.allow_open(self.allow_open))
     }
 }
 

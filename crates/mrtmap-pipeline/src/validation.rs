@@ -42,10 +42,6 @@ pub fn validate_map(map: &Path, globe: &Path, frame: PointFrame, out: &Path) -> 
     let scene = RadiantScene::load(&scene_path)?;
     let text = std::fs::read_to_string(globe).map_err(|e| mrtmap_io::FileError::io(globe, e))?;
     let mut readings = parse_globe_csv(&text, &globe.display().to_string())?;
-    for r in &mut readings {
-        let p = to_scene_frame(r.xyz, frame, &scene, &scene_path.display().to_string())?;
-        r.xyz = [p.x, p.y, p.z];
-    }
     let engine = MrtEngine::new(
         &scene,
         Method::Auto(MonteCarlo {
@@ -53,6 +49,22 @@ pub fn validate_map(map: &Path, globe: &Path, frame: PointFrame, out: &Path) -> 
             ..MonteCarlo::default()
         }),
     )?;
+    for r in &mut readings {
+        let p = to_scene_frame(r.xyz, frame, &scene, &scene_path.display().to_string())?;
+        engine.check_inside(&p).map_err(|e| Error::Config {
+            path: globe.to_path_buf(),
+            line: r.line as usize,
+            message: format!(
+                "reading '{}': {e}; give x, y, z in metres from the room's origin corner (the report's room coordinates){}",
+                r.label,
+                match frame {
+                    PointFrame::Room => ", or in the scan's frame with --frame scan",
+                    PointFrame::Scan => "",
+                }
+            ),
+        })?;
+        r.xyz = [p.x, p.y, p.z];
+    }
     let ours = |x: &[f64; 3]| {
         engine
             .at(&Point3::from(*x), 0)

@@ -20,6 +20,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
+use crate::bounds::RoomBounds;
 use crate::scene::{RadiantScene, SurfaceKind};
 
 /// Tolerance on Σ F above 1 before the exact engine declares that surfaces hide each other.
@@ -151,6 +152,17 @@ impl Method {
         }
     }
 
+    /// The method in a few words, for a map's subtitle.
+    pub fn brief(&self) -> String {
+        match self {
+            Method::Exact => "exact view factors".to_string(),
+            Method::Auto(_) => {
+                "exact view factors (Monte Carlo where surfaces hide each other)".to_string()
+            }
+            Method::MonteCarlo(mc) => format!("Monte Carlo view factors ({} rays)", mc.rays),
+        }
+    }
+
     /// The method for people; `engine` names the ray caster of a Monte Carlo method.
     pub fn describe(&self, engine: Option<&str>) -> String {
         match self {
@@ -171,13 +183,16 @@ impl Method {
     }
 }
 
+/// ΣF may differ from 1 by this much before a point counts as not enclosed (1 % of the view).
+pub const ENCLOSURE_TOLERANCE: f64 = 0.01;
+
 /// Why an MRT could not be computed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum MrtError {
     /// Exact view factors asked for a scene with occluders.
     #[error(
-        "the scene has {count} occluder(s) (first: '{first}'), which exact solid angles cannot handle: use the Monte Carlo method"
+        "the scene has furniture ({count} piece(s) as occluders; first: '{first}'), which exact solid angles cannot see: use the Monte Carlo method (--method montecarlo, or auto)"
     )]
     OccludersNeedRayTracing {
         /// How many.
@@ -195,8 +210,29 @@ pub enum MrtError {
         /// Σ F.
         sum: f64,
     },
+    /// The point is not in the room.
+    #[error("point ({:.2}, {:.2}, {:.2}) is {where_}: the room spans {room}", point[0], point[1], point[2])]
+    OutsideRoom {
+        /// The point.
+        point: [f64; 3],
+        /// Where it is.
+        where_: String,
+        /// Where the room is.
+        room: String,
+    },
+    /// The scene does not enclose the point: part of the sphere around it sees nothing.
+    #[error(
+        "point ({:.2}, {:.2}, {:.2}): the scene's surfaces cover only {:.1} % of the view around it (ΣF = {sum:.4}); a room must be closed (is a wall, the ceiling or the floor missing?). To compute it anyway, allow open scenes (--allow-open)",
+        point[0], point[1], point[2], sum * 100.0
+    )]
+    NotEnclosed {
+        /// The point.
+        point: [f64; 3],
+        /// Σ F.
+        sum: f64,
+    },
     /// The point lies inside an occluder.
-    #[error("point {point:?} lies inside occluder '{id}'")]
+    #[error("point ({:.2}, {:.2}, {:.2}) lies inside the furniture '{id}'", point[0], point[1], point[2])]
     InsideOccluder {
         /// The point.
         point: [f64; 3],
@@ -259,6 +295,9 @@ struct Tracer {
 /// A scene made ready for MRT queries with one method: patch list, and for Monte Carlo the BVH.
 pub struct MrtEngine<'a> {
     scene: &'a RadiantScene,
+    bounds: Option<RoomBounds>,
+    /// Answer at points the scene does not enclose (ΣF short of 1) instead of refusing.
+    open: bool,
     patches: Vec<Patch>,
     /// Index of each surface's own patch; its features follow it.
     surface_patch: Vec<usize>,
@@ -331,6 +370,8 @@ impl<'a> MrtEngine<'a> {
         };
         Ok(Self {
             scene,
+            bounds: RoomBounds::of_scene(scene),
+            open: false,
             patches,
             surface_patch,
             occluder_patch0: k,
@@ -359,8 +400,36 @@ impl<'a> MrtEngine<'a> {
         self.tracer.as_ref().map(|t| t.caster.engine())
     }
 
+    /// Answers at points the scene does not enclose (an open scene: ΣF short of 1) instead of
+    /// refusing them; the result's `view_factor_sum` says how much is missing.
+    pub fn allow_open(mut self, yes: bool) -> Self {
+        self.open = yes;
+        self
+    }
+
+    /// The room's extent, when the scene has a floor.
+    pub fn bounds(&self) -> Option<&RoomBounds> {
+        self.bounds.as_ref()
+    }
+
+    /// Refuses a point outside the room (below the floor, above the ceiling, beyond the walls).
+    pub fn check_inside(&self, p: &Point3<f64>) -> Result<(), MrtError> {
+        let Some(b) = &self.bounds else {
+            return Ok(());
+        };
+        match b.locate(p) {
+            None => Ok(()),
+            Some(w) => Err(MrtError::OutsideRoom {
+                point: arr(p),
+                where_: w.to_string(),
+                room: b.describe(),
+            }),
+        }
+    }
+
     /// MRT at `p`. `stream` selects the point's random stream (use the point's index).
     pub fn at(&self, p: &Point3<f64>, stream: u64) -> Result<PointMrt, MrtError> {
+        self.check_inside(p)?;
         if let Some(o) = self.scene.occluders.iter().find(|o| o.contains(p)) {
             return Err(MrtError::InsideOccluder {
                 point: arr(p),
@@ -402,6 +471,10 @@ impl<'a> MrtEngine<'a> {
                 .collect();
             mean_radiant_temperature(&src)
         };
+        let sum: f64 = f.iter().sum();
+        if !self.open && (sum - 1.0).abs() > ENCLOSURE_TOLERANCE {
+            return Err(MrtError::NotEnclosed { point: arr(p), sum });
+        }
         let m = mrt_of(&f).map_err(|source| MrtError::Physics {
             point: arr(p),
             source,

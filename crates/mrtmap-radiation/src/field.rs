@@ -33,6 +33,16 @@ pub enum FieldError {
     /// A grid that makes no sense.
     #[error("invalid grid: {0}")]
     BadGrid(String),
+    /// A map height outside the room.
+    #[error(
+        "a map {height_m:.2} m above the floor is not in the room: give a height between 0 and the ceiling, {ceiling_m:.2} m above the floor (1.1 m is seated head height, 1.7 m standing)"
+    )]
+    HeightOutsideRoom {
+        /// The height asked for (m).
+        height_m: f64,
+        /// The ceiling's height above the floor (m).
+        ceiling_m: f64,
+    },
 }
 
 /// The horizontal frame maps are drawn in.
@@ -228,6 +238,9 @@ impl MrtField {
                 "height {} m, margin {} m",
                 spec.height_m, spec.margin_m
             )));
+        }
+        if let Some(b) = engine.bounds() {
+            b.check_height(spec.height_m)?;
         }
         let (lo, hi) = frame.floor_bounds();
         let m = spec.margin_m;

@@ -20,13 +20,15 @@
 //! assert!(at.mrt.celsius() > 19.0 && at.mrt.celsius() < 22.0);
 //! ```
 
+mod bounds;
 mod engine;
 mod field;
 mod scene;
 
+pub use bounds::{Outside, ROOM_TOLERANCE_M, RoomBounds};
 pub use engine::{
-    EXACT_OVERLAP_TOLERANCE, Method, MonteCarlo, MrtEngine, MrtError, Patch, PatchKind, PointMrt,
-    patches,
+    ENCLOSURE_TOLERANCE, EXACT_OVERLAP_TOLERANCE, Method, MonteCarlo, MrtEngine, MrtError, Patch,
+    PatchKind, PointMrt, patches,
 };
 pub use field::{Extreme, FieldError, FieldSummary, GridNode, GridSpec, MapFrame, MrtField};
 pub use scene::{

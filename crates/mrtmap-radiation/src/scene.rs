@@ -423,8 +423,12 @@ pub struct SceneLoadError {
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum SceneLoadErrorKind {
-    /// Reading failed.
-    #[error("cannot read the file: {0}")]
+    /// Reading failed (said by the kind of failure, without the OS's error number).
+    #[error("cannot read the file: {}", match .0.kind() {
+        std::io::ErrorKind::NotFound => "it does not exist (check the path)".to_string(),
+        std::io::ErrorKind::InvalidData => "it is not UTF-8 text (is it the right file?)".to_string(),
+        k => k.to_string(),
+    })]
     Io(#[from] std::io::Error),
     /// The content is invalid.
     #[error("{0}")]
@@ -906,6 +910,33 @@ impl SceneFile {
     }
 }
 
+/// The element at `path` in scene JSON `text`, for people: "surfaces[3] (id 'wall-east')"; `None`
+/// at the top level.
+fn element_named(text: &str, path: &serde_path_to_error::Path) -> Option<String> {
+    use serde_path_to_error::Segment;
+    let segments: Vec<&Segment> = path.iter().collect();
+    if segments.is_empty() || path.to_string() == "." {
+        return None;
+    }
+    let root: Option<serde_json::Value> = serde_json::from_str(text).ok();
+    let mut at = root.as_ref();
+    let mut id = None;
+    for seg in &segments {
+        at = match seg {
+            Segment::Seq { index } => at.and_then(|v| v.get(*index)),
+            Segment::Map { key } => at.and_then(|v| v.get(key.as_str())),
+            _ => None,
+        };
+        if let Some(i) = at.and_then(|v| v.get("id")).and_then(|v| v.as_str()) {
+            id = Some(i.to_string());
+        }
+    }
+    Some(match id {
+        Some(id) => format!("{path} (id '{id}')"),
+        None => path.to_string(),
+    })
+}
+
 impl RadiantScene {
     /// Validates a scene file against every rule of the spec.
     pub fn new(file: &SceneFile) -> Result<Self, SceneError> {
@@ -979,15 +1010,24 @@ impl RadiantScene {
 
     /// Parses and validates JSON text.
     pub fn from_json(text: &str) -> Result<Self, SceneError> {
-        let file: SceneFile = serde_json::from_str(text).map_err(|e| SceneError::Json {
-            message: e
+        let mut de = serde_json::Deserializer::from_str(text);
+        let file: SceneFile = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+            let element = element_named(text, e.path());
+            let e = e.into_inner();
+            let message = e
                 .to_string()
                 .split(" at line ")
                 .next()
                 .unwrap_or_default()
-                .to_string(),
-            line: e.line(),
-            column: e.column(),
+                .to_string();
+            SceneError::Json {
+                message: match element {
+                    Some(el) => format!("{el}: {message}"),
+                    None => message,
+                },
+                line: e.line(),
+                column: e.column(),
+            }
         })?;
         Self::new(&file)
     }

@@ -4,6 +4,7 @@ use base64::Engine;
 use mrtmap_radiation::PointRecord;
 use serde::Serialize;
 
+use crate::numbers::{uncertainty, xyz};
 use crate::tables::MapSummary;
 use crate::validate::ValidationRow;
 
@@ -66,6 +67,14 @@ pub struct ReportData {
     pub timing: KeyValues,
     /// Parameters (pretty text).
     pub parameters: String,
+    /// When, by which version and by which command the report was made.
+    pub made: String,
+    /// The room frame in words (where the origin is, which way x points).
+    pub room_frame: String,
+    /// The room's corners: number, x, y (m, room frame).
+    pub corners: Vec<[String; 3]>,
+    /// The room's walls: id, from corner, to corner, length (m).
+    pub walls: Vec<[String; 4]>,
 }
 
 /// HTML-escapes text.
@@ -115,20 +124,16 @@ fn map_section(o: &mut String, m: &ReportMap) {
         return;
     };
     o.push_str(&format!(
-        "<p>{} nodes ({}×{} grid, {} m margin, {} view factors): min {} °C at ({:.2}, {:.2}, {:.2}), max {} °C at ({:.2}, {:.2}, {:.2}), mean {} °C; largest standard error {} K. Grid values: <code>{}</code>.</p>",
+        "<p>{} nodes ({}×{} grid, {} m margin, {} view factors): min {} °C at {}, max {} °C at {}, mean {} °C; largest standard error {} K. Grid values: <code>{}</code>.</p>",
         f.nodes,
         m.summary.grid[0],
         m.summary.grid[1],
         m.summary.margin_m,
         esc(&m.summary.method),
         num(&format!("map-{key}-min"), f.min.mrt_c, 2),
-        f.min.xyz[0],
-        f.min.xyz[1],
-        f.min.xyz[2],
+        xyz(&f.min.xyz),
         num(&format!("map-{key}-max"), f.max.mrt_c, 2),
-        f.max.xyz[0],
-        f.max.xyz[1],
-        f.max.xyz[2],
+        xyz(&f.max.xyz),
         num(&format!("map-{key}-mean"), f.mean_c, 2),
         num(&format!("map-{key}-maxse"), f.max_std_error_k, 3),
         esc(&m.csv)
@@ -198,7 +203,7 @@ fn validation_row(r: &ValidationRow) -> Vec<String> {
         f(&r.mrt_mixed_c),
         r.ours_c
             .as_ref()
-            .map(|(o, s)| format!("{o:.2} ± {s:.2}"))
+            .map(|(o, s)| format!("{o:.2} ± {}", uncertainty(*s, 2)))
             .unwrap_or_else(|e| esc(e)),
         r.diff_iso_k.map_or("—".into(), |v| format!("{v:+.2}")),
         r.diff_mixed_k.map_or("—".into(), |v| format!("{v:+.2}")),
@@ -240,13 +245,11 @@ fn points_section(o: &mut String, d: &ReportData) {
     for p in &d.points {
         let name = p.name.clone().unwrap_or_default();
         o.push_str(&format!(
-            "<h3>{} at ({:.2}, {:.2}, {:.2}): {} °C ± {:.2} K</h3>",
+            "<h3>{} at {}: {} °C ± {} K</h3>",
             esc(&name),
-            p.xyz[0],
-            p.xyz[1],
-            p.xyz[2],
+            xyz(&p.xyz),
             num(&format!("point-{name}"), p.mrt_c, 2),
-            p.std_error_k
+            uncertainty(p.std_error_k, 2)
         ));
         let rows: Vec<Vec<String>> = p
             .view_factors
@@ -271,15 +274,43 @@ fn plain_table<R: AsRef<[String]>>(o: &mut String, heading: &str, headers: &[&st
         return;
     }
     o.push_str(&format!("<h2>{heading}</h2>"));
-    let cells: Vec<Vec<String>> = rows
-        .iter()
-        .map(|r| r.as_ref().iter().map(|c| esc(c)).collect())
-        .collect();
-    table(o, headers, &cells);
+    let rows: Vec<Vec<String>> = rows.iter().map(|r| r.as_ref().to_vec()).collect();
+    plain_rows(o, headers, &rows);
 }
 
 fn key_value_rows(kv: &KeyValues) -> Vec<Vec<String>> {
     kv.iter().map(|(k, v)| vec![k.clone(), v.clone()]).collect()
+}
+
+/// Where the coordinates are measured from: the room frame, its corners and walls.
+fn room_section(o: &mut String, d: &ReportData) {
+    if d.room_frame.is_empty() {
+        return;
+    }
+    o.push_str(&format!(
+        "<h2>Room coordinates</h2><p>{}</p>",
+        esc(&d.room_frame)
+    ));
+    let corners: Vec<Vec<String>> = d.corners.iter().map(|r| r.to_vec()).collect();
+    plain_rows(o, &["corner", "x (m)", "y (m)"], &corners);
+    let walls: Vec<Vec<String>> = d.walls.iter().map(|r| r.to_vec()).collect();
+    plain_rows(
+        o,
+        &["wall", "from corner", "to corner", "length (m)"],
+        &walls,
+    );
+}
+
+/// A table of plain text cells (escaped here), unless it has no rows.
+fn plain_rows(o: &mut String, headers: &[&str], rows: &[Vec<String>]) {
+    if rows.is_empty() {
+        return;
+    }
+    let cells: Vec<Vec<String>> = rows
+        .iter()
+        .map(|r| r.iter().map(|c| esc(c)).collect())
+        .collect();
+    table(o, headers, &cells);
 }
 
 /// The report as one HTML document.
@@ -291,12 +322,16 @@ pub fn render_html(d: &ReportData) -> String {
         esc(&d.title),
         esc(&d.source)
     ));
+    if !d.made.is_empty() {
+        o.push_str(&format!("<p class=\"made\">Made {}</p>", esc(&d.made)));
+    }
     if !d.warnings.is_empty() {
         o.push_str("<h2>Warnings</h2>");
         for w in &d.warnings {
             o.push_str(&format!("<p class=\"warn\">{}</p>", esc(w)));
         }
     }
+    room_section(&mut o, d);
     for m in &d.maps {
         map_section(&mut o, m);
     }
@@ -317,14 +352,14 @@ pub fn render_html(d: &ReportData) -> String {
     );
     plain_table(
         &mut o,
-        "Furniture (occluders)",
+        "Furniture (blocks part of the view)",
         &["id", "label", "size (m)", "T (°C)"],
         &d.furniture,
     );
     plain_table(
         &mut o,
         "Coverage and uncertainty",
-        &["", ""],
+        &["what", "value"],
         &key_value_rows(&d.coverage),
     );
     plain_table(
@@ -339,6 +374,9 @@ pub fn render_html(d: &ReportData) -> String {
             esc(&d.parameters)
         ));
     }
-    o.push_str("<p><small>Generated by mrtmap.</small></p></body></html>\n");
+    o.push_str(&format!(
+        "<p><small>Generated by mrtmap {}.</small></p></body></html>\n",
+        env!("CARGO_PKG_VERSION")
+    ));
     o
 }

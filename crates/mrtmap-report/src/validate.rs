@@ -3,7 +3,7 @@
 //! the same point, with ISO 7726's accuracy classes (required ±2 K, desired ±0.2 K).
 //!
 //! `globe.csv` has a header and the columns `label,x,y,z,tg_c,ta_c,va_m_s,diameter_m,emissivity`;
-//! x, y, z are in the scan's frame (the frame of scene.json); blank lines and lines starting with
+//! x, y, z are in the frame of scene.json (the room's own frame for a scanned room); blank lines and lines starting with
 //! `#` are skipped.
 
 use mrtmap_physics::{Globe, GlobeMethod, GlobeReading, Temperature, mrt_from_globe};
@@ -33,6 +33,9 @@ pub struct GlobeRow {
     pub diameter_m: f64,
     /// Globe emissivity.
     pub emissivity: f64,
+    /// The 1-based line of globe.csv it was read from (0 when not read from a file).
+    #[serde(default)]
+    pub line: u64,
 }
 
 /// The columns of globe.csv, in the order of a file without a header.
@@ -70,7 +73,9 @@ pub fn parse_globe_csv(text: &str, file: &str) -> Result<Vec<GlobeRow>, ReportEr
                 problem: e.to_string(),
             }
         })?;
-        let line = record.position().map_or(0, |p| p.line());
+        let line = record
+            .position()
+            .map_or(0, |p| line_of(text, p.byte() as usize));
         let bad = |problem: String| ReportError::Globe {
             file: file.to_string(),
             line,
@@ -111,10 +116,15 @@ pub fn parse_globe_csv(text: &str, file: &str) -> Result<Vec<GlobeRow>, ReportEr
                     record.len()
                 )));
             }
-            rows.push(globe_row(&record, &[0, 1, 2, 3, 4, 5, 6, 7, 8], &bad)?);
+            rows.push(globe_row(
+                &record,
+                &[0, 1, 2, 3, 4, 5, 6, 7, 8],
+                line,
+                &bad,
+            )?);
             continue;
         };
-        rows.push(globe_row(&record, &cols, &bad)?);
+        rows.push(globe_row(&record, &cols, line, &bad)?);
     }
     if rows.is_empty() {
         return Err(ReportError::NoReadings {
@@ -124,10 +134,21 @@ pub fn parse_globe_csv(text: &str, file: &str) -> Result<Vec<GlobeRow>, ReportEr
     Ok(rows)
 }
 
+/// The 1-based line of the first non-blank character at or after byte `at` of `text` (the csv
+/// reader counts a record from the blank lines before it).
+fn line_of(text: &str, at: usize) -> u64 {
+    let at = at.min(text.len());
+    let start = text[at..]
+        .find(|c: char| !c.is_whitespace())
+        .map_or(text.len(), |k| at + k);
+    text[..start].matches('\n').count() as u64 + 1
+}
+
 /// One reading from a record whose column k holds [`GLOBE_COLUMNS`]`[k]` at `cols[k]`.
 fn globe_row(
     record: &csv::StringRecord,
     cols: &[usize; 9],
+    line: u64,
     bad: &dyn Fn(String) -> ReportError,
 ) -> Result<GlobeRow, ReportError> {
     let field = |k: usize| record.get(cols[k]).unwrap_or("");
@@ -149,6 +170,7 @@ fn globe_row(
         va_m_s: num(6)?,
         diameter_m: num(7)?,
         emissivity: num(8)?,
+        line,
     })
 }
 

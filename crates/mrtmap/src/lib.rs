@@ -4,9 +4,10 @@
 //! resolved from flags, printing. Everything below this crate returns data; only this crate prints.
 #![allow(clippy::print_stdout, clippy::print_stderr)]
 
+#[macro_use]
+mod output;
 mod cli;
 mod commands;
-mod output;
 
 use std::process::ExitCode;
 

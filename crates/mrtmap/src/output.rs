@@ -1,8 +1,44 @@
 //! What the commands share for output: JSON text, progress bars, and the printed forms of maps
 //! and stages.
 
+use std::io::Write;
+
 use mrtmap_pipeline::StageOutcome;
 use mrtmap_pipeline::maps::Summary;
+use mrtmap_report::numbers::{fixed, uncertainty, xyz};
+
+/// Like `println!`, but a closed pipe (`mrtmap rooms | head -1`) ends the program quietly.
+macro_rules! outln {
+    () => {
+        $crate::output::write_stdout(format_args!("\n"))
+    };
+    ($($arg:tt)*) => {
+        $crate::output::write_stdout(format_args!("{}\n", format_args!($($arg)*)))
+    };
+}
+
+/// Like `print!`, but a closed pipe ends the program quietly.
+macro_rules! out {
+    ($($arg:tt)*) => {
+        $crate::output::write_stdout(format_args!($($arg)*))
+    };
+}
+
+/// Writes to standard output. When the reader has gone (a closed pipe) the program ends quietly
+/// with success, as Unix tools do; any other failure to write ends it with a message.
+pub fn write_stdout(args: std::fmt::Arguments<'_>) {
+    let mut stdout = std::io::stdout().lock();
+    if let Err(e) = stdout.write_fmt(args).and_then(|()| stdout.flush()) {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(0);
+        }
+        eprintln!(
+            "error: cannot write to standard output: {}",
+            mrtmap_io::io_words(&e)
+        );
+        std::process::exit(1);
+    }
+}
 
 /// JSON text with a trailing newline.
 pub fn json<T: serde::Serialize>(value: &T) -> anyhow::Result<String> {
@@ -46,37 +82,35 @@ impl mrtmap_pipeline::Progress for Bar {
 pub fn print_map(s: &Summary) {
     match &s.map.field {
         Some(f) => {
-            println!(
-                "MRT at {:.2} m over {} nodes: min {:.2} °C at ({:.2}, {:.2}), max {:.2} °C at ({:.2}, {:.2}), mean {:.2} °C; largest standard error {:.3} K",
+            outln!(
+                "MRT at {:.2} m over {} nodes: min {:.2} °C at ({}, {}), max {:.2} °C at ({}, {}), mean {:.2} °C; largest standard error {} K",
                 s.map.height_m,
                 f.nodes,
                 f.min.mrt_c,
-                f.min.uv[0],
-                f.min.uv[1],
+                fixed(f.min.uv[0], 2),
+                fixed(f.min.uv[1], 2),
                 f.max.mrt_c,
-                f.max.uv[0],
-                f.max.uv[1],
+                fixed(f.max.uv[0], 2),
+                fixed(f.max.uv[1], 2),
                 f.mean_c,
-                f.max_std_error_k
+                uncertainty(f.max_std_error_k, 3)
             );
             if f.skipped > 0 {
-                println!(
-                    "{} nodes skipped (inside occluders or failed): see the note column of mrt_grid.csv",
+                outln!(
+                    "{} nodes skipped (inside furniture, or refused): see the note column of mrt_grid.csv",
                     f.skipped
                 );
             }
         }
-        None => println!("no grid node could be computed"),
+        None => outln!("no grid node could be computed"),
     }
     for m in &s.marks {
-        println!(
-            "  {}: MRT {:.2} °C ± {:.2} K at ({:.2}, {:.2}, {:.2})",
+        outln!(
+            "  {}: MRT {:.2} °C ± {} K at {}",
             m.name.as_deref().unwrap_or("?"),
             m.mrt_c,
-            m.std_error_k,
-            m.xyz[0],
-            m.xyz[1],
-            m.xyz[2]
+            uncertainty(m.std_error_k, 2),
+            xyz(&m.xyz)
         );
     }
 }
@@ -84,7 +118,7 @@ pub fn print_map(s: &Summary) {
 /// Prints one line per stage: its time, and whether it was reused.
 pub fn print_stages(stages: &[StageOutcome]) {
     for st in stages {
-        println!(
+        outln!(
             "  {:<14} {:>7.1} s{}",
             st.stage,
             st.secs,
@@ -104,9 +138,9 @@ pub fn print_run(o: &mrtmap_pipeline::run::RunOutcome, out: &std::path::Path, se
         print_map(&m.summary);
     }
     for w in &o.warnings {
-        println!("warning: {w}");
+        outln!("warning: {w}");
     }
-    println!(
+    outln!(
         "done in {secs:.1} s; report: {}",
         out.join("report.html").display()
     );
@@ -115,7 +149,7 @@ pub fn print_run(o: &mrtmap_pipeline::run::RunOutcome, out: &std::path::Path, se
 /// Prints what a conversion wrote.
 pub fn print_conversion(c: &mrtmap_pipeline::source::Conversion) {
     let from = |s: &Option<String>| s.as_ref().map(|s| format!(" ({s})")).unwrap_or_default();
-    println!(
+    outln!(
         "wrote {}: {} depth, {} thermal{}, {} colour frames, {} poses{}{}",
         c.out.display(),
         c.depth,
@@ -131,10 +165,10 @@ pub fn print_conversion(c: &mrtmap_pipeline::source::Conversion) {
         }
     );
     for r in &c.skipped_reasons {
-        println!("  skipped: {r}");
+        outln!("  skipped: {r}");
     }
     for n in &c.notes {
-        println!("  note: {n}");
+        outln!("  note: {n}");
     }
 }
 
@@ -142,11 +176,11 @@ pub fn print_conversion(c: &mrtmap_pipeline::source::Conversion) {
 pub fn print_plan(p: &mrtmap_sources::ros::Plan) {
     use mrtmap_sources::ros::PoseSource;
     let show = |o: &Option<String>| o.clone().unwrap_or_else(|| "—".into());
-    println!("for a scan:");
-    println!("  depth    {}", show(&p.depth));
-    println!("  thermal  {}", show(&p.thermal));
-    println!("  colour   {}", show(&p.rgb));
-    println!(
+    outln!("for a scan:");
+    outln!("  depth    {}", show(&p.depth));
+    outln!("  thermal  {}", show(&p.thermal));
+    outln!("  colour   {}", show(&p.rgb));
+    outln!(
         "  poses    {}",
         match &p.poses {
             Some(PoseSource::Topic(t)) => t.clone(),
@@ -155,7 +189,7 @@ pub fn print_plan(p: &mrtmap_sources::ros::Plan) {
         }
     );
     for n in &p.notes {
-        println!("  note: {n}");
+        outln!("  note: {n}");
     }
     print_missing(&p.missing);
 }
@@ -163,11 +197,11 @@ pub fn print_plan(p: &mrtmap_sources::ros::Plan) {
 /// Prints whether a source is ready for a scan, or what it lacks.
 pub fn print_missing(missing: &[String]) {
     if missing.is_empty() {
-        println!("ready: mrtmap convert / fuse / run can use it");
+        outln!("ready: mrtmap convert / fuse / run can use it");
     } else {
-        println!("missing for a scan:");
+        outln!("missing for a scan:");
         for m in missing {
-            println!("  - {m}");
+            outln!("  - {m}");
         }
     }
 }

@@ -105,7 +105,7 @@ fn exact_refuses_occluders_with_a_clear_message() {
     let e = MrtEngine::new(&s, Method::Exact).err().unwrap();
     assert_eq!(
         e.to_string(),
-        "the scene has 1 occluder(s) (first: 'desk-1'), which exact solid angles cannot handle: use the Monte Carlo method"
+        "the scene has furniture (1 piece(s) as occluders; first: 'desk-1'), which exact solid angles cannot see: use the Monte Carlo method (--method montecarlo, or auto)"
     );
     let engine = MrtEngine::new(&s, mc(2000, 1, DirectionSet::Fibonacci, 8)).unwrap();
     assert!(matches!(

@@ -30,6 +30,7 @@ fn header_columns_are_found_by_name_in_any_order() {
                 va_m_s: 0.1,
                 diameter_m: 0.15,
                 emissivity: 0.95,
+                line: 4,
             },
             GlobeRow {
                 label: "door".into(),
@@ -39,6 +40,7 @@ fn header_columns_are_found_by_name_in_any_order() {
                 va_m_s: 0.2,
                 diameter_m: 0.05,
                 emissivity: 0.95,
+                line: 5,
             },
         ]
     );
@@ -90,6 +92,7 @@ fn row(label: &str, tg: f64, ta: f64, v: f64, d: f64) -> GlobeRow {
         va_m_s: v,
         diameter_m: d,
         emissivity: 0.95,
+        line: 0,
     }
 }
 

@@ -704,11 +704,14 @@ fn choose_room_frame(
 }
 
 /// Walls get the room frame's numbers: wall k runs from corner k to corner k + 1, corner 1 being
-/// the rule's origin.
+/// the rule's origin; the floor's outline starts at corner 1, so that its k-th vertex is corner k.
 fn number_walls(geoms: &mut [SurfaceGeom], frame: &room::RoomFrame) {
     let n = geoms.len() - 2;
     for (k, g) in geoms[2..].iter_mut().enumerate() {
         g.id = format!("wall-{}", (k + n - frame.first_index) % n + 1);
+    }
+    if geoms[0].polygon.len() == n {
+        geoms[0].polygon.rotate_left(frame.first_index);
     }
 }
 

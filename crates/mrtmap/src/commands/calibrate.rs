@@ -73,7 +73,7 @@ fn file_name(p: &Path) -> String {
 }
 
 fn print_mono(d: &ImageDetections, r: &MonoResult) {
-    println!(
+    outln!(
         "{}",
         describe("camera", &r.camera, r, r.std.as_ref().map(|s| &s[..]))
     );
@@ -86,7 +86,7 @@ fn print_mono(d: &ImageDetections, r: &MonoResult) {
             .collect::<Vec<_>>()
             .join(", ")
     };
-    println!(
+    outln!(
         "mean reprojection error {:.3} px (RMS {:.3} px) over {} views, {} corners; rejected: {rejected}",
         r.error.mean_px,
         r.error.rms_px,
@@ -103,7 +103,7 @@ fn mono(a: &CalibrateArgs, board: &Board, dir: &Path) -> anyhow::Result<()> {
     }
     let d = detect_images(dir, board)?;
     print_problems(d.seen.iter());
-    println!(
+    outln!(
         "board {}x{} of {} mm squares found in {} of {} images ({}×{})",
         board.cols,
         board.rows,
@@ -117,7 +117,7 @@ fn mono(a: &CalibrateArgs, board: &Board, dir: &Path) -> anyhow::Result<()> {
     print_mono(&d, &r);
     if let Some(rep) = &a.report {
         write_mono_report(rep, board, &d, &r)?;
-        println!("report: {}", rep.display());
+        outln!("report: {}", rep.display());
     }
     Ok(())
 }
@@ -125,14 +125,14 @@ fn mono(a: &CalibrateArgs, board: &Board, dir: &Path) -> anyhow::Result<()> {
 fn stereo(a: &CalibrateArgs, board: &Board, dir: &Path) -> anyhow::Result<()> {
     let d = detect_pairs(dir, board, a.max_dt)?;
     if let Some(first) = d.unmatched.first() {
-        println!(
+        outln!(
             "{} image(s) without a partner were left out (first: {})",
             d.unmatched.len(),
             first.display()
         );
     }
     print_problems(d.rgb_seen.iter().chain(&d.thermal_seen));
-    println!(
+    outln!(
         "{} pairs; board {}x{} ({} mm squares) found in {} colour ({}×{}) and {} thermal ({}×{}) images",
         d.pairs.len(),
         board.cols,
@@ -154,7 +154,7 @@ fn stereo(a: &CalibrateArgs, board: &Board, dir: &Path) -> anyhow::Result<()> {
     print_stereo(&r, d.pairs.iter().map(|p| p.name.as_str()));
     if let Some(out) = &a.out {
         let updated = write_rig(out, board, &d, &r)?;
-        println!(
+        outln!(
             "wrote {} ({})",
             out.display(),
             if updated {
@@ -166,7 +166,7 @@ fn stereo(a: &CalibrateArgs, board: &Board, dir: &Path) -> anyhow::Result<()> {
     }
     if let Some(rep) = &a.report {
         write_stereo_report(rep, board, &d, &r)?;
-        println!("report: {}", rep.join("index.html").display());
+        outln!("report: {}", rep.join("index.html").display());
     }
     Ok(())
 }
@@ -196,7 +196,7 @@ fn print_extrinsic(r: &StereoResult) {
                 .to_degrees()
         )
     });
-    println!(
+    outln!(
         "thermal camera in the colour frame: translation ({:.2}, {:.2}, {:.2}) mm{tstd}, rotation {:.3}°{rstd} about ({:.3}, {:.3}, {:.3})",
         t.x,
         t.y,
@@ -210,11 +210,11 @@ fn print_extrinsic(r: &StereoResult) {
 
 fn print_stereo<'a>(r: &StereoResult, names: impl Iterator<Item = &'a str>) {
     let std = r.std.as_deref();
-    println!(
+    outln!(
         "{}",
         describe("colour", &r.rgb, &r.rgb_alone, std.map(|s| &s[0..9]))
     );
-    println!(
+    outln!(
         "{}",
         describe(
             "thermal",
@@ -229,7 +229,7 @@ fn print_stereo<'a>(r: &StereoResult, names: impl Iterator<Item = &'a str>) {
         .iter()
         .filter(|p| p.status == PairStatus::Used)
         .count();
-    println!(
+    outln!(
         "joint fit over {used} of {} pairs: mean reprojection error colour {:.3} px (RMS {:.3}), thermal {:.3} px (RMS {:.3})",
         r.pairs.len(),
         r.rgb_error.mean_px,
@@ -237,12 +237,16 @@ fn print_stereo<'a>(r: &StereoResult, names: impl Iterator<Item = &'a str>) {
         r.thermal_error.mean_px,
         r.thermal_error.rms_px
     );
-    println!(
+    outln!(
         "{:<24} {:>7} {:>8} {:>10} {:>11}  status",
-        "pair", "colour", "thermal", "MRE col", "MRE therm"
+        "pair",
+        "colour",
+        "thermal",
+        "MRE col",
+        "MRE therm"
     );
     for (p, name) in r.pairs.iter().zip(names) {
-        println!(
+        outln!(
             "{name:<24} {:>7} {:>8} {:>10} {:>11}  {}",
             p.rgb_corners,
             p.thermal_corners,

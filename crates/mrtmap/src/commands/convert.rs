@@ -41,9 +41,9 @@ pub fn run(a: &ConvertArgs) -> anyhow::Result<()> {
         let [d, t, c, p] = w.counts;
         match (w.nodes, what) {
             (Some(n), ContainerOut::RtabMap(schema)) => {
-                println!("wrote {} ({n} nodes, {schema:?} schema)", a.out.display());
+                outln!("wrote {} ({n} nodes, {schema:?} schema)", a.out.display());
             }
-            _ => println!(
+            _ => outln!(
                 "wrote {} ({} bytes): {d} depth, {t} thermal, {c} colour frames, {p} poses",
                 a.out.display(),
                 w.bytes.unwrap_or(0)

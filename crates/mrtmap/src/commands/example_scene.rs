@@ -9,9 +9,9 @@ pub fn run(args: &ExampleSceneArgs) -> anyhow::Result<()> {
     match &args.out {
         Some(p) => {
             write_atomic(p, EXAMPLE_OFFICE_JSON.as_bytes())?;
-            println!("wrote {}", p.display());
+            outln!("wrote {}", p.display());
         }
-        None => print!("{EXAMPLE_OFFICE_JSON}"),
+        None => out!("{EXAMPLE_OFFICE_JSON}"),
     }
     Ok(())
 }

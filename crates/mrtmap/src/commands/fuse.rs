@@ -20,7 +20,7 @@ pub fn run(a: &FuseArgs) -> anyhow::Result<()> {
     if let Some(c) = &prepared.conversion {
         print_conversion(c);
     } else if prepared.reused {
-        println!(
+        outln!(
             "using {} (converted earlier from {})",
             prepared.dir.display(),
             a.recording.display()
@@ -33,23 +33,32 @@ pub fn run(a: &FuseArgs) -> anyhow::Result<()> {
     let bar = Bar::new("");
     let r = fuse_into(&rec, &params, &a.out, &bar)?;
     bar.finish();
-    println!(
+    outln!(
         "fused {} of {} thermal frames into {} voxels of {} m in {:.1} s ({:.0} frames/s)",
-        r.used_frames, r.thermal_frames, r.voxels, a.voxel_m, r.timing_s.total, r.frames_per_second
+        r.used_frames,
+        r.thermal_frames,
+        r.voxels,
+        a.voxel_m,
+        r.timing_s.total,
+        r.frames_per_second
     );
     for (why, n) in &r.skipped {
-        println!("  skipped {n} frames: {why}");
+        outln!("  skipped {n} frames: {why}");
     }
     for p in &r.problems {
-        println!("  problem: {p}");
+        outln!("  problem: {p}");
     }
     let o = &r.observations;
-    println!(
+    outln!(
         "  depth points: {} kept, {} outside the thermal view, {} hidden from it, {} grazing, {} on strong thermal edges",
-        o.kept, o.outside, o.occluded, o.grazing, o.edge
+        o.kept,
+        o.outside,
+        o.occluded,
+        o.grazing,
+        o.edge
     );
     if r.icp.enabled {
-        println!(
+        outln!(
             "  ICP: {} of {} refinements accepted (mean fitness {:.2}, inlier RMSE {:.1} mm); final correction {:.1} cm, {:.2}°",
             r.icp.accepted,
             r.icp.attempted,
@@ -59,10 +68,10 @@ pub fn run(a: &FuseArgs) -> anyhow::Result<()> {
             r.icp.final_correction_deg
         );
         for (why, n) in &r.icp.rejected {
-            println!("    rejected {n}: {why}");
+            outln!("    rejected {n}: {why}");
         }
     }
-    println!(
+    outln!(
         "wrote cloud.ply, fusion.json, poses.txt in {}",
         a.out.display()
     );

@@ -71,26 +71,36 @@ pub fn run(a: &GlobeArgs) -> anyhow::Result<()> {
         direction,
     };
     if a.json {
-        print!("{}", json(&out)?);
+        out!("{}", json(&out)?);
     } else if direction == "mrt_from_globe" {
-        println!("MRT {:.2} °C", out.mrt_c);
-        println!(
+        outln!("MRT {:.2} °C", out.mrt_c);
+        outln!(
             "  from globe {:.2} °C, air {:.2} °C, air speed {} m/s, globe {} m, ε {}",
-            out.globe_c, a.ta, a.va, a.diameter, a.emissivity
+            out.globe_c,
+            a.ta,
+            a.va,
+            a.diameter,
+            a.emissivity
         );
-        println!(
+        outln!(
             "  formula: {} (h = {:.2} W/m²K)",
-            out.formula_description, out.h_w_m2k
+            out.formula_description,
+            out.h_w_m2k
         );
     } else {
-        println!("globe temperature {:.2} °C", out.globe_c);
-        println!(
+        outln!("globe temperature {:.2} °C", out.globe_c);
+        outln!(
             "  at MRT {:.2} °C, air {:.2} °C, air speed {} m/s, globe {} m, ε {}",
-            out.mrt_c, a.ta, a.va, a.diameter, a.emissivity
+            out.mrt_c,
+            a.ta,
+            a.va,
+            a.diameter,
+            a.emissivity
         );
-        println!(
+        outln!(
             "  formula: {} (h = {:.2} W/m²K), solved numerically",
-            out.formula_description, out.h_w_m2k
+            out.formula_description,
+            out.h_w_m2k
         );
     }
     Ok(())

@@ -19,7 +19,7 @@ fn fmt_span(t0: f64, t1: f64) -> String {
 pub fn run(a: &InspectArgs) -> anyhow::Result<()> {
     let what = inspect(&a.source, &a.src.options())?;
     if a.json {
-        print!("{}", json(&inspection_json(a, &what))?);
+        out!("{}", json(&inspection_json(a, &what))?);
         return Ok(());
     }
     match &what {
@@ -66,9 +66,9 @@ fn inspection_json(a: &InspectArgs, what: &Inspection) -> serde_json::Value {
 }
 
 fn print_folder(a: &InspectArgs, f: &FolderSummary) {
-    println!("{}: recording folder", a.source.display());
+    outln!("{}: recording folder", a.source.display());
     for s in &f.streams {
-        println!(
+        outln!(
             "  {:<10} {:>6} {:>8.2} Hz  {}",
             s.name,
             s.count,
@@ -76,7 +76,7 @@ fn print_folder(a: &InspectArgs, f: &FolderSummary) {
             fmt_span(s.t0, s.t1)
         );
     }
-    println!(
+    outln!(
         "  rig: depth {}×{}, thermal {}×{}{}",
         f.rig.depth.width,
         f.rig.depth.height,
@@ -85,13 +85,13 @@ fn print_folder(a: &InspectArgs, f: &FolderSummary) {
         if f.rig.rgb.is_some() { ", colour" } else { "" }
     );
     for w in &f.warnings {
-        println!("  warning: {w}");
+        outln!("  warning: {w}");
     }
 }
 
 fn print_ros(a: &InspectArgs, r: &RosSummary) {
     let s = &r.survey;
-    println!(
+    outln!(
         "{}: {} ({} bytes){}",
         a.source.display(),
         r.describe(),
@@ -103,12 +103,16 @@ fn print_ros(a: &InspectArgs, r: &RosSummary) {
         }
     );
     let w = s.topics.keys().map(|k| k.len()).max().unwrap_or(5).max(5);
-    println!(
+    outln!(
         "{:<w$}  {:<28} {:>6} {:>8}  {:<14} span",
-        "topic", "type", "count", "rate Hz", "encoding"
+        "topic",
+        "type",
+        "count",
+        "rate Hz",
+        "encoding"
     );
     for t in s.topics.values() {
-        println!(
+        outln!(
             "{:<w$}  {:<28} {:>6} {:>8.2}  {:<14} {}{}",
             t.topic,
             t.datatype,
@@ -127,18 +131,18 @@ fn print_ros(a: &InspectArgs, r: &RosSummary) {
         );
     }
     for tf in &s.static_tf {
-        println!("static transform {} → {}", tf.parent, tf.child);
+        outln!("static transform {} → {}", tf.parent, tf.child);
     }
     print_plan(&r.plan);
 }
 
 fn print_database(path: &std::path::Path, s: &DbSummary) {
-    println!(
+    outln!(
         "{}: RTAB-Map database, schema {}",
         path.display(),
         s.version
     );
-    println!(
+    outln!(
         "  nodes {}  colour {}  depth {} ({} RVL)  span {:.3} … {:.3} s ({:.2} s)",
         s.nodes,
         s.images,
@@ -149,17 +153,17 @@ fn print_database(path: &std::path::Path, s: &DbSummary) {
         s.span.1 - s.span.0
     );
     if s.nodes > 1 && s.span.1 > s.span.0 {
-        println!(
+        outln!(
             "  node rate {:.2} Hz",
             (s.nodes - 1) as f64 / (s.span.1 - s.span.0)
         );
     }
-    println!("  poses: {}", s.poses);
+    outln!("  poses: {}", s.poses);
     for (name, n) in &s.links {
-        println!("  links: {n} {name}");
+        outln!("  links: {n} {name}");
     }
     match &s.calibration {
-        Some(c) => println!(
+        Some(c) => outln!(
             "  camera {}×{} fx {:.2} fy {:.2} cx {:.2} cy {:.2} (written by RTAB-Map {}.{}.{})",
             c.camera.width,
             c.camera.height,
@@ -171,9 +175,9 @@ fn print_database(path: &std::path::Path, s: &DbSummary) {
             c.version[1],
             c.version[2]
         ),
-        None => println!("  camera: no calibration"),
+        None => outln!("  camera: no calibration"),
     }
     for n in &s.notes {
-        println!("  note: {n}");
+        outln!("  note: {n}");
     }
 }

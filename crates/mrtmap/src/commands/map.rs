@@ -8,7 +8,6 @@ use crate::output::print_map;
 
 pub fn run(a: &MapArgs) -> anyhow::Result<()> {
     let (scene, source) = load_scene(a.scene.scene.as_deref())?;
-    let method = a.method.section().method(&scene)?;
     let spec = GridSpec {
         nx: a.grid.0,
         ny: a.grid.1,
@@ -26,11 +25,11 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
             },
         })
         .collect();
-    let m = make_map(&scene, &source, method, spec, &marks, &a.out)?;
-    println!("scene: {source}");
-    println!("method: {}", m.method);
+    let m = make_map(&scene, &source, &a.method.section(), spec, &marks, &a.out)?;
+    outln!("scene: {source}");
+    outln!("method: {}", m.method);
     print_map(&m.summary);
-    println!(
+    outln!(
         "computed in {:.3} s; wrote mrt_grid.csv, mrt_map.png, mrt_map.svg, summary.json in {}",
         m.summary.map.compute_secs,
         a.out.display()

@@ -8,13 +8,13 @@ use crate::cli::RoomsArgs;
 pub fn run(a: &RoomsArgs) -> anyhow::Result<()> {
     match &a.name {
         Some(n) => match PRESETS.iter().find(|p| p.0 == n) {
-            Some((_, text)) => print!("{text}"),
+            Some((_, text)) => out!("{text}"),
             None => bail!("no preset room '{n}' (see `mrtmap rooms`)"),
         },
         None => {
             for (name, text) in PRESETS {
                 let room = Room::from_toml(text)?;
-                println!("{name:<16} {}", room.file.description);
+                outln!("{name:<16} {}", room.file.description);
             }
         }
     }

@@ -60,12 +60,13 @@ fn settings(a: &RunArgs) -> anyhow::Result<Project> {
 
 pub fn run(a: &RunArgs) -> anyhow::Result<()> {
     let p = settings(a)?;
+    mrtmap_pipeline::run::check_out_dir(&a.out)?;
     let t0 = Instant::now();
     let prepared = prepare(&a.recording, &a.out, &a.src.options())?;
     if let Some(c) = &prepared.conversion {
         print_conversion(c);
     } else if prepared.reused {
-        println!(
+        outln!(
             "using {} (converted earlier from {})",
             prepared.dir.display(),
             a.recording.display()
@@ -82,7 +83,7 @@ pub fn run(a: &RunArgs) -> anyhow::Result<()> {
     );
     let secs = t0.elapsed().as_secs_f64();
     write_run_outputs(&a.out, &data, &outcome, &a.recording, &p, secs)?;
-    println!("ran {} into {}", a.recording.display(), a.out.display());
+    outln!("ran {} into {}", a.recording.display(), a.out.display());
     print_run(&outcome, &a.out, secs);
     Ok(())
 }

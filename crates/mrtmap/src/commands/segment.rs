@@ -36,9 +36,9 @@ pub fn run(a: &SegmentArgs) -> anyhow::Result<()> {
     let report = segment_into(&a.fused, masks.as_ref(), &section.params(&room), &a.out)?;
     print_report(&report);
     for w in &report.warnings {
-        println!("  warning: {w}");
+        outln!("  warning: {w}");
     }
-    println!(
+    outln!(
         "wrote scene.json, segments.ply, segment.json in {}",
         a.out.display()
     );
@@ -59,27 +59,27 @@ fn votes_text(v: Option<&Votes>) -> String {
 
 /// The room, its surfaces, features and furniture.
 fn print_report(r: &SegmentReport) {
-    println!(
+    outln!(
         "room: {} walls, {:.2} m high; {:.0} % of the cloud on no surface (furniture, clutter)",
         r.surfaces.len() - 2,
         r.height_m,
         r.unassigned_fraction * 100.0
     );
     for s in &r.surfaces {
-        println!(
+        outln!(
             "  {:<8} {:>6.2} m²  {}  ({:.0} % observed)",
             s.id,
             s.area_m2,
             s.temperature_c
                 .map_or("not observed".to_string(), |t| format!(
-                    "{t:6.2} °C ± {:.2} K",
-                    s.temperature_std_k
+                    "{t:6.2} °C ± {} K",
+                    mrtmap_report::numbers::uncertainty(s.temperature_std_k, 2)
                 )),
             s.observed_fraction * 100.0
         );
     }
     for f in &r.features {
-        println!(
+        outln!(
             "  {:<18} on {:<8} {:6.2} °C ({:+.1} K), {:.2} m², label by {}{}",
             f.id,
             f.host,
@@ -91,7 +91,7 @@ fn print_report(r: &SegmentReport) {
         );
     }
     for f in &r.furniture {
-        println!(
+        outln!(
             "  {:<18} furniture {:.2} × {:.2} × {:.2} m, {:6.2} °C, label by {}{}",
             f.id,
             f.size_m[0],

@@ -40,7 +40,7 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<()> {
     let t0 = Instant::now();
     let summary = simulate(&room, &cfg, &a.out, &|done, total| bar.advance(done, total))?;
     bar.finish();
-    println!(
+    outln!(
         "simulated {:.0} s of scanning the {} room in {:.1} s: {} depth, {} thermal, {} colour + mask frames, {} poses; {:.1} MB in {}",
         a.seconds,
         room.file.name,
@@ -52,7 +52,7 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<()> {
         summary.bytes as f64 / 1e6,
         summary.out.display()
     );
-    println!(
+    outln!(
         "truth.json: MRT at the validation points and on the 20×20 grid at 1.1 m ({} view factors)",
         summary.truth_method
     );

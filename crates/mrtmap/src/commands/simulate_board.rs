@@ -15,7 +15,7 @@ pub fn run(a: &SimulateBoardArgs) -> anyhow::Result<()> {
         ..SynthOptions::default()
     };
     let n = simulate_boards(&a.out, &o)?;
-    println!(
+    outln!(
         "wrote {n} pairs to {} (board {}x{}, {} mm squares; truth.json)",
         a.out.display(),
         o.board.cols,

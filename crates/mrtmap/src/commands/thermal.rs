@@ -97,28 +97,31 @@ pub fn run(a: &ThermalArgs) -> anyhow::Result<()> {
         write_atomic(p, &png)?;
     }
     if a.json {
-        print!("{}", json(&out)?);
+        out!("{}", json(&out)?);
         return Ok(());
     }
-    println!(
+    outln!(
         "{}: {}, {}×{} pixels",
-        out.file, out.format, out.width, out.height
+        out.file,
+        out.format,
+        out.width,
+        out.height
     );
     for n in &img.notes {
-        println!("  {n}");
+        outln!("  {n}");
     }
     if !img.metadata.is_empty() {
-        println!("metadata:");
+        outln!("metadata:");
         let w = img.metadata.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
         for (k, v) in &img.metadata {
-            println!("  {k:<w$}  {v}");
+            outln!("  {k:<w$}  {v}");
         }
     }
-    println!(
+    outln!(
         "temperature °C: min {lo:.2}  max {hi:.2}  mean {mean:.2}  median {median:.2}  centre {centre:.2}"
     );
     if out.invalid_pixels > 0 {
-        println!(
+        outln!(
             "{} pixels have no temperature (raw value outside the calibration)",
             out.invalid_pixels
         );
@@ -129,7 +132,7 @@ pub fn run(a: &ThermalArgs) -> anyhow::Result<()> {
         ("centikelvin", &a.centikelvin),
     ] {
         if let Some(p) = p {
-            println!("wrote {} ({flag})", p.display());
+            outln!("wrote {} ({flag})", p.display());
         }
     }
     Ok(())

@@ -157,7 +157,7 @@ fn occluders_need_montecarlo_and_auto_picks_it() {
         &[
             "mrt", "--scene", &scene, "--at", "2,2,1.1", "--method", "exact",
         ],
-        "occluder(s) (first: 'desk-1')",
+        "furniture (1 piece(s) as occluders; first: 'desk-1')",
     );
     let v = ok_json(&[
         "mrt",
@@ -189,7 +189,7 @@ fn occluders_need_montecarlo_and_auto_picks_it() {
             "--rays",
             "1000",
         ],
-        "inside occluder 'desk-1'",
+        "inside the furniture 'desk-1'",
     );
 }
 
@@ -284,7 +284,7 @@ fn map_writes_csv_png_svg_and_a_summary_that_agree() {
         svg.contains("<svg") && svg.contains("Mean radiant temperature at 1.10 m above the floor")
     );
     assert!(
-        svg.contains("\nwindow 11.5°\n") && svg.contains("\nA\n"),
+        svg.contains("\nwindow 11.5 °C\n") && svg.contains("\nA\n"),
         "features and marks are named"
     );
     // No temporary files are left behind.
@@ -325,5 +325,210 @@ fn example_scene_round_trips_through_map() {
     assert_eq!(
         std::fs::read_to_string(a.join("mrt_grid.csv")).unwrap(),
         std::fs::read_to_string(b.join("mrt_grid.csv")).unwrap()
+    );
+}
+
+/// The example office as JSON, changed by `edit`, written to `dir/name`.
+fn edited_example(dir: &Path, name: &str, edit: impl FnOnce(&mut Value)) -> String {
+    let mut v: Value = serde_json::from_str(mrtmap_radiation::EXAMPLE_OFFICE_JSON).unwrap();
+    edit(&mut v);
+    let p = dir.join(name);
+    std::fs::write(&p, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+    p.display().to_string()
+}
+
+#[test]
+fn points_and_heights_outside_the_room_are_refused_with_where_the_room_is() {
+    let room = "the room spans x 0.00…4.20 m, y 0.00…3.60 m, and 0…2.70 m above the floor";
+    fails_with(
+        &["mrt", "--at", "10,10,10"],
+        &format!("point (10.00, 10.00, 10.00) is 7.30 m above the ceiling: {room}"),
+    );
+    fails_with(&["mrt", "--at", "2,2,-1"], "is 1.00 m below the floor");
+    fails_with(&["mrt", "--at", "5,1,1.1"], "is outside the walls");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("m");
+    for h in ["5", "-5", "0"] {
+        fails_with(
+            &[
+                "map",
+                &format!("--height={h}"),
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            "above the floor is not in the room: give a height between 0 and the ceiling, 2.70 m",
+        );
+    }
+    fails_with(
+        &["map", "--mark", "far=50,50", "--out", out.to_str().unwrap()],
+        "cannot compute the MRT at far",
+    );
+    assert!(!out.exists(), "a refused map writes nothing");
+    // A point on a wall is still in the room.
+    let v = ok_json(&["mrt", "--at", "0,1.8,1.1", "--json"]);
+    assert!(v["points"][0]["mrt_c"].as_f64().unwrap() > 15.0);
+}
+
+#[test]
+fn open_scenes_are_refused_unless_asked_for() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = edited_example(dir.path(), "open.json", |v| {
+        let s = v["surfaces"].as_array_mut().unwrap();
+        s.retain(|x| x["kind"] != "ceiling");
+    });
+    fails_with(
+        &["mrt", "--scene", &scene, "--at", "2,1.8,1.1"],
+        "the scene's surfaces cover only",
+    );
+    fails_with(
+        &[
+            "map",
+            "--scene",
+            &scene,
+            "--out",
+            dir.path().join("m").to_str().unwrap(),
+        ],
+        "a room must be closed (is a wall, the ceiling or the floor missing?)",
+    );
+    let v = ok_json(&[
+        "mrt",
+        "--scene",
+        &scene,
+        "--at",
+        "2,1.8,1.1",
+        "--allow-open",
+        "--json",
+    ]);
+    let sum = v["points"][0]["view_factor_sum"].as_f64().unwrap();
+    assert!(sum < 0.9, "ΣF {sum}");
+    let text = crate::ok(&[
+        "mrt",
+        "--scene",
+        &scene,
+        "--at",
+        "2,1.8,1.1",
+        "--allow-open",
+    ]);
+    assert!(text.contains("warning: the scene covers only"), "{text}");
+}
+
+#[test]
+fn impossible_scenes_are_refused_and_name_the_element() {
+    let dir = tempfile::tempdir().unwrap();
+    let down = edited_example(dir.path(), "down.json", |v| {
+        v["up"] = serde_json::json!([0.0, 0.0, -1.0]);
+    });
+    fails_with(
+        &["mrt", "--scene", &down, "--at", "2,2,1.1"],
+        "`up` [0.0, 0.0, -1.0] points out of the room",
+    );
+    let far = edited_example(dir.path(), "far.json", |v| {
+        v["surfaces"][2]["polygon"][0][0] = serde_json::json!(1e300);
+    });
+    fails_with(
+        &["mrt", "--scene", &far, "--at", "2,2,1.1"],
+        "a coordinate of 1e300 m is beyond ±10000 m",
+    );
+    let missing = edited_example(dir.path(), "missing.json", |v| {
+        v["surfaces"][3]
+            .as_object_mut()
+            .unwrap()
+            .remove("temperature_c");
+    });
+    fails_with(
+        &["mrt", "--scene", &missing, "--at", "2,2,1.1"],
+        "surfaces[3] (id 'wall-west'): missing field `temperature_c`",
+    );
+    let feature = edited_example(dir.path(), "feature.json", |v| {
+        v["surfaces"][1]["features"][0]
+            .as_object_mut()
+            .unwrap()
+            .remove("polygon");
+    });
+    fails_with(
+        &["mrt", "--scene", &feature, "--at", "2,2,1.1"],
+        "surfaces[1].features[0] (id 'light-1'): missing field `polygon`",
+    );
+    fails_with(
+        &["mrt", "--at", "2,2,1.1", "--replicates", "0"],
+        "--replicates 0 ([mrt] replicates) is too few: the standard error needs at least 2 independent replicates",
+    );
+}
+
+#[test]
+fn a_closed_pipe_ends_the_program_quietly() {
+    for args in [
+        &["rooms"][..],
+        &["mrt", "--at", "2,1.8,1.1"],
+        &["example-scene"],
+    ] {
+        let (reader, writer) = std::io::pipe().unwrap();
+        drop(reader);
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_mrtmap"))
+            .args(args)
+            .stdout(writer)
+            .stderr(std::process::Stdio::piped())
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{args:?}: {:?} {err}", out.status);
+        assert!(err.is_empty(), "{args:?}: {err}");
+    }
+}
+
+#[test]
+fn run_refuses_an_output_that_is_a_file_before_reading_anything() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("out.txt");
+    std::fs::write(&file, "x").unwrap();
+    fails_with(
+        &[
+            "run",
+            "/nonexistent-recording",
+            "--out",
+            file.to_str().unwrap(),
+        ],
+        "is a file, but the output must be a folder",
+    );
+    fails_with(
+        &[
+            "mrt",
+            "--scene",
+            dir.path().to_str().unwrap(),
+            "--at",
+            "1,1,1",
+        ],
+        "cannot read the file: is a directory",
+    );
+}
+
+#[test]
+fn validate_refuses_globes_outside_the_room_and_says_why_a_value_is_missing() {
+    let dir = tempfile::tempdir().unwrap();
+    edited_example(dir.path(), "scene.json", |_| {});
+    let globe = dir.path().join("globe.csv");
+    std::fs::write(
+        &globe,
+        "label,x,y,z,tg_c,ta_c,va_m_s,diameter_m,emissivity\n\
+         desk,2.0,1.8,1.1,20.5,21.0,0.1,0.15,0.95\n\
+         far,50,50,50,20.5,21.0,0.1,0.15,0.95\n",
+    )
+    .unwrap();
+    let (d, g) = (dir.path().to_str().unwrap(), globe.to_str().unwrap());
+    fails_with(
+        &["validate", "--map", d, "--globe", g],
+        &format!("{g}:3: reading 'far': point (50.00, 50.00, 50.00) is 47.30 m above the ceiling"),
+    );
+    std::fs::write(
+        &globe,
+        "label,x,y,z,tg_c,ta_c,va_m_s,diameter_m,emissivity\n\
+         big,2.0,1.8,1.1,20.5,21.0,0.1,0.30,0.95\n",
+    )
+    .unwrap();
+    let text = crate::ok(&["validate", "--map", d, "--globe", g]);
+    assert!(text.contains("— (1)"), "{text}");
+    assert!(
+        text.contains("(1) big: no mixed-convection MRT: "),
+        "{text}"
     );
 }

@@ -185,6 +185,16 @@ fn report_numbers_match_the_csv_and_it_renders() {
         html.contains("data:image/png;base64,") && !html.contains("src=\"map-"),
         "images are embedded"
     );
+    // Provenance and the room frame a person measures from.
+    assert!(
+        html.contains(&format!(
+            " UTC by mrtmap {}: mrtmap run ",
+            env!("CARGO_PKG_VERSION")
+        )),
+        "date, version and command"
+    );
+    assert!(html.contains("<h2>Room coordinates</h2>") && html.contains("<td>wall-1</td>"));
+    assert!(!html.contains("<th></th>"), "no empty header cells");
     let value = |id: &str| -> f64 {
         let key = format!("id=\"{id}\">");
         let i = html

@@ -1,10 +1,13 @@
-//! The MRT heatmap: cells coloured by MRT, labelled contour lines, the room outline, features and
-//! occluders drawn and named, marked points, a colour bar in °C and a title with the height.
-//! One drawing routine serves both the PNG and the SVG backend.
+//! The MRT heatmap: cells coloured by MRT, labelled contour lines, the room outline with its
+//! corners numbered and the origin's axes, features and furniture drawn and named, marked points,
+//! a colour bar in °C and a title with the height. Labels are placed without overlap
+//! ([`labels`]). One drawing routine serves both the PNG and the SVG backend.
+
+mod labels;
 
 use std::sync::OnceLock;
 
-use mrtmap_geometry::nalgebra::{Point2, Vector3};
+use mrtmap_geometry::nalgebra::{Point2, Vector2, Vector3};
 use mrtmap_geometry::polygon::point_in_polygon_fast;
 use mrtmap_radiation::{MrtField, OccluderShape, RadiantScene, SurfaceKind};
 use plotters::coord::Shift;
@@ -13,6 +16,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use crate::ReportError;
+use labels::{LABEL_H, Label, PixelBox, Placer, centred_box, draw_label};
 
 static FONT: OnceLock<bool> = OnceLock::new();
 const FONT_FAMILY: &str = "sans-serif";
@@ -23,7 +27,7 @@ fn register_font() -> bool {
         plotters::style::register_font(
             FONT_FAMILY,
             FontStyle::Normal,
-            include_bytes!("../assets/DejaVuSans.ttf"),
+            include_bytes!("../../assets/DejaVuSans.ttf"),
         )
         .is_ok()
     })
@@ -324,9 +328,6 @@ fn contour_levels(scale: Scale) -> Vec<f64> {
         .collect()
 }
 
-/// A pixel box (x0, y0, x1, y1) taken by a label or a mark.
-type PixelBox = (i32, i32, i32, i32);
-
 /// Labels a contour along its longer runs first, at the first spot clear of earlier labels and
 /// marks (`placed`, which the label joins).
 fn label_contour<DB: DrawingBackend>(
@@ -334,7 +335,7 @@ fn label_contour<DB: DrawingBackend>(
     chart: &Chart<'_, DB>,
     runs: &[Vec<(f64, f64)>],
     label: String,
-    placed: &mut Vec<PixelBox>,
+    placer: &mut Placer,
 ) -> Result<(), ReportError> {
     let tw = 7 * label.len() as i32 + 6;
     let mut sorted: Vec<&Vec<(f64, f64)>> = runs.iter().collect();
@@ -344,16 +345,13 @@ fn label_contour<DB: DrawingBackend>(
         .flat_map(|r| [0.5, 0.3, 0.7, 0.15, 0.85].map(|t| r[((r.len() - 1) as f64 * t) as usize]))
         .find_map(|at| {
             let (px, py) = chart.backend_coord(&at);
-            let rect = (px - tw / 2 - 2, py - 10, px + tw / 2 + 2, py + 10);
-            let clear = placed
-                .iter()
-                .all(|b| rect.2 < b.0 || rect.0 > b.2 || rect.3 < b.1 || rect.1 > b.3);
-            clear.then_some((px, py, rect))
+            let rect: PixelBox = (px - tw / 2 - 2, py - 10, px + tw / 2 + 2, py + 10);
+            placer.is_clear(rect).then_some((px, py, rect))
         });
     let Some((px, py, rect)) = spot else {
         return Ok(());
     };
-    placed.push(rect);
+    placer.reserve(rect);
     root.draw(&Rectangle::new(
         [(px - tw / 2, py - 8), (px + tw / 2, py + 8)],
         WHITE.mix(0.85).filled(),
@@ -370,18 +368,21 @@ fn label_contour<DB: DrawingBackend>(
     .map_err(de)
 }
 
-/// Labelled contours on the node grid; segments outside the floor are not drawn.
+/// A contour's runs inside the room and its label text.
+type ContourRuns = (Vec<Vec<(f64, f64)>>, String);
+
+/// Contour lines on the node grid (segments outside the floor are not drawn); their labels are
+/// placed last, around everything else.
 fn draw_contours<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
     chart: &mut Chart<'_, DB>,
     input: &MapInput<'_>,
     ok: &[Node],
     scale: Scale,
-) -> Result<(), ReportError> {
+) -> Result<Vec<ContourRuns>, ReportError> {
     let field = input.field;
     let (nx, ny) = (field.u.len(), field.v.len());
     if ok.len() < 4 || nx < 2 || ny < 2 {
-        return Ok(());
+        return Ok(Vec::new());
     }
     let filled = filled_grid(field, ok, scale.vmin);
     let dec = decimals(contour_step(scale.vmax - scale.vmin));
@@ -396,17 +397,10 @@ fn draw_contours<DB: DrawingBackend>(
         .y_origin(gy)
         .x_step(du)
         .y_step(dv);
-    let mut placed: Vec<PixelBox> = input
-        .marks
-        .iter()
-        .map(|m| {
-            let (px, py) = chart.backend_coord(&(m.uv.x, m.uv.y));
-            (px - 10, py - 22, px + 30, py + 10)
-        })
-        .collect();
     let Ok(lines) = builder.lines(&filled, &levels) else {
-        return Ok(());
+        return Ok(Vec::new());
     };
+    let mut out = Vec::new();
     for line in lines {
         let level = line.threshold();
         let runs: Vec<Vec<(f64, f64)>> = line
@@ -421,9 +415,9 @@ fn draw_contours<DB: DrawingBackend>(
                     .map(|r| PathElement::new(r.clone(), BLACK.mix(0.75).stroke_width(1))),
             )
             .map_err(de)?;
-        label_contour(root, chart, &runs, format!("{level:.dec$}"), &mut placed)?;
+        out.push((runs, format!("{level:.dec$}")));
     }
-    Ok(())
+    Ok(out)
 }
 
 /// The room's outline.
@@ -444,15 +438,14 @@ fn draw_outline<DB: DrawingBackend>(
     Ok(())
 }
 
-/// A feature on a wall: a band along the wall in its colour, labelled just inside the room.
+/// A feature on a wall: a band along the wall in its colour; its label goes just inside the room.
 fn draw_wall_feature<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
     chart: &mut Chart<'_, DB>,
     field: &MrtField,
     uv: &[(f64, f64)],
     colour: RGBColor,
     text: String,
-) -> Result<(), ReportError> {
+) -> Result<Option<Label>, ReportError> {
     let frame = &field.frame;
     let (lo, hi) = frame.floor_bounds();
     // The projection is a segment along the wall: its two extreme points.
@@ -466,7 +459,7 @@ fn draw_wall_feature<DB: DrawingBackend>(
         })
     };
     let (Some(a), Some(b)) = (far(c), far(far(c).unwrap_or(c))) else {
-        return Ok(());
+        return Ok(None);
     };
     for style in [colour.stroke_width(7), BLACK.stroke_width(1)] {
         chart
@@ -479,20 +472,20 @@ fn draw_wall_feature<DB: DrawingBackend>(
     });
     let inward = (centre - mid).try_normalize(1e-9).unwrap_or_default();
     let at = mid + inward * (0.06 * (hi.x - lo.x).max(hi.y - lo.y));
-    let (px, py) = chart.backend_coord(&(at.x, at.y));
-    root.draw(&Text::new(text, (px, py), centred_label()))
-        .map_err(de)
+    Ok(Some(Label {
+        anchor: chart.backend_coord(&(at.x, at.y)),
+        text,
+    }))
 }
 
-/// A feature on the floor or ceiling: its outline in its colour, labelled at its centre.
+/// A feature on the floor or ceiling: its outline in its colour; its label goes at its centre.
 fn draw_flat_feature<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
     chart: &mut Chart<'_, DB>,
     kind: SurfaceKind,
     uv: &[(f64, f64)],
     colour: RGBColor,
     text: &str,
-) -> Result<(), ReportError> {
+) -> Result<Label, ReportError> {
     let mut ring = uv.to_vec();
     ring.push(uv[0]);
     let (style, where_) = if kind == SurfaceKind::Ceiling {
@@ -506,31 +499,20 @@ fn draw_flat_feature<DB: DrawingBackend>(
     let c = uv.iter().fold((0.0, 0.0), |a, p| {
         (a.0 + p.0 / uv.len() as f64, a.1 + p.1 / uv.len() as f64)
     });
-    let (px, py) = chart.backend_coord(&c);
-    root.draw(&Text::new(
-        format!("{text}{where_}"),
-        (px, py),
-        centred_label(),
-    ))
-    .map_err(de)
+    Ok(Label {
+        anchor: chart.backend_coord(&c),
+        text: format!("{text}{where_}"),
+    })
 }
 
-/// Labels of features and furniture, centred on their spot.
-fn centred_label() -> TextStyle<'static> {
-    (FONT_FAMILY, 12)
-        .into_font()
-        .color(&RGBColor(20, 20, 20))
-        .pos(Pos::new(HPos::Center, VPos::Center))
-}
-
-/// Features: on walls as bands along the wall, on floor and ceiling as outlines.
+/// Features: on walls as bands along the wall, on floor and ceiling as outlines; their labels.
 fn draw_features<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
     chart: &mut Chart<'_, DB>,
     input: &MapInput<'_>,
     scale: Scale,
-) -> Result<(), ReportError> {
+) -> Result<Vec<Label>, ReportError> {
     let frame = &input.field.frame;
+    let mut labels = Vec::new();
     for s in &input.scene.surfaces {
         for f in &s.features {
             let uv: Vec<(f64, f64)> = f
@@ -545,27 +527,27 @@ fn draw_features<DB: DrawingBackend>(
             } else {
                 f.label.clone()
             };
-            let text = format!("{name} {:.1}°", f.temperature.celsius());
+            let text = format!("{name} {:.1} °C", f.temperature.celsius());
             match s.kind {
                 SurfaceKind::Wall | SurfaceKind::Other => {
-                    draw_wall_feature(root, chart, input.field, &uv, colour, text)?;
+                    labels.extend(draw_wall_feature(chart, input.field, &uv, colour, text)?);
                 }
                 SurfaceKind::Ceiling | SurfaceKind::Floor => {
-                    draw_flat_feature(root, chart, s.kind, &uv, colour, &text)?;
+                    labels.push(draw_flat_feature(chart, s.kind, &uv, colour, &text)?);
                 }
             }
         }
     }
-    Ok(())
+    Ok(labels)
 }
 
-/// Occluders (furniture): their footprint's bounding rectangle, named.
-fn draw_occluders<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
+/// Furniture: its footprint's bounding rectangle; its label.
+fn draw_furniture<DB: DrawingBackend>(
     chart: &mut Chart<'_, DB>,
     input: &MapInput<'_>,
-) -> Result<(), ReportError> {
+) -> Result<Vec<Label>, ReportError> {
     let frame = &input.field.frame;
+    let mut labels = Vec::new();
     for o in &input.scene.occluders {
         let corners: Vec<Point2<f64>> = match &o.shape {
             OccluderShape::Box { min, max } => mrtmap_geometry::box_corners(min, max)
@@ -593,39 +575,167 @@ fn draw_occluders<DB: DrawingBackend>(
                 RGBColor(60, 60, 60).stroke_width(1),
             )))
             .map_err(de)?;
-        let (px, py) = chart.backend_coord(&((a.0 + b.0) / 2.0, (a.1 + b.1) / 2.0));
         let name = if o.label.is_empty() {
             o.id.clone()
         } else {
             o.label.clone()
         };
-        root.draw(&Text::new(name, (px, py), centred_label()))
-            .map_err(de)?;
+        labels.push(Label {
+            anchor: chart.backend_coord(&((a.0 + b.0) / 2.0, (a.1 + b.1) / 2.0)),
+            text: name,
+        });
     }
-    Ok(())
+    Ok(labels)
 }
 
-/// Marked points: a ringed dot and the name.
+/// Marked points: a ringed dot and the name beside it, in the first free spot.
 fn draw_marks<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     chart: &Chart<'_, DB>,
     marks: &[MapMark],
+    placer: &mut Placer,
 ) -> Result<(), ReportError> {
-    for m in marks {
-        let (px, py) = chart.backend_coord(&(m.uv.x, m.uv.y));
+    let dots: Vec<(i32, i32)> = marks
+        .iter()
+        .map(|m| chart.backend_coord(&(m.uv.x, m.uv.y)))
+        .collect();
+    for &(px, py) in &dots {
         root.draw(&Circle::new((px, py), 6, WHITE.filled()))
             .map_err(de)?;
         root.draw(&Circle::new((px, py), 6, BLACK.stroke_width(2)))
             .map_err(de)?;
+        placer.reserve((px - 8, py - 8, px + 8, py + 8));
+    }
+    for (m, &(px, py)) in marks.iter().zip(&dots) {
+        let w = 10 * m.name.chars().count() as i32 + 4;
+        let spots = [(px + 10 + w / 2, py - 10), (px - 10 - w / 2, py - 10)];
+        let at = spots
+            .into_iter()
+            .chain(placer.find((px, py), w, 18))
+            .find(|&c| placer.is_clear(centred_box(c, w, 18)))
+            .unwrap_or(spots[0]);
+        placer.reserve(centred_box(at, w, 18));
         root.draw(&Text::new(
             m.name.clone(),
-            (px + 9, py - 9),
+            at,
             (FONT_FAMILY, 15)
                 .into_font()
                 .color(&BLACK)
-                .pos(Pos::new(HPos::Left, VPos::Center)),
+                .pos(Pos::new(HPos::Center, VPos::Center)),
         ))
         .map_err(de)?;
+    }
+    Ok(())
+}
+
+/// The direction into the room at floor corner `k` (the bisector of its two walls, turned inward).
+fn inward(floor: &[Point2<f64>], k: usize) -> Vector2<f64> {
+    let n = floor.len();
+    let p = floor[k];
+    let e1 = (floor[(k + 1) % n] - p)
+        .try_normalize(1e-12)
+        .unwrap_or_default();
+    let e0 = (floor[(k + n - 1) % n] - p)
+        .try_normalize(1e-12)
+        .unwrap_or_default();
+    let twice_area: f64 = (0..n)
+        .map(|i| {
+            let (a, b) = (floor[i], floor[(i + 1) % n]);
+            a.x * b.y - b.x * a.y
+        })
+        .sum();
+    // The side of the first wall the room is on: left for a counter-clockwise outline.
+    let side = Vector2::new(-e1.y, e1.x) * twice_area.signum();
+    let b = e0 + e1;
+    match b.try_normalize(1e-6) {
+        Some(b) if b.dot(&side) >= 0.0 => b,
+        Some(b) => -b,
+        None => side,
+    }
+}
+
+/// Floor corners numbered (corner k starts wall k) and, when the map is in the room's frame and
+/// its origin is a corner, that corner in red with the x and y axes drawn from it.
+fn draw_corners<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    chart: &Chart<'_, DB>,
+    field: &MrtField,
+    placer: &mut Placer,
+) -> Result<(), ReportError> {
+    let frame = &field.frame;
+    let floor = &frame.floor_uv;
+    let room_frame = axis_name(&frame.plane.u, "u") == "x" && axis_name(&frame.plane.v, "v") == "y";
+    let origin = floor
+        .iter()
+        .position(|p| room_frame && p.coords.norm() < 0.02);
+    let red = RGBColor(180, 20, 20);
+    let px = |p: &Point2<f64>| chart.backend_coord(&(p.x, p.y));
+    if let Some(k) = origin {
+        let o = px(&floor[k]);
+        for (axis, name) in [(Vector2::x(), "x"), (Vector2::y(), "y")] {
+            let tip = px(&(floor[k] + axis));
+            let d = Vector2::new(f64::from(tip.0 - o.0), f64::from(tip.1 - o.1))
+                .try_normalize(1e-12)
+                .unwrap_or_default();
+            let at = |l: f64| {
+                (
+                    o.0 + (d.x * l).round() as i32,
+                    o.1 + (d.y * l).round() as i32,
+                )
+            };
+            let (end, l1, l2) = (at(56.0), (d.y, -d.x), (-d.y, d.x));
+            root.draw(&PathElement::new(vec![o, end], red.stroke_width(3)))
+                .map_err(de)?;
+            let wing = |n: (f64, f64)| {
+                let b = at(46.0);
+                (
+                    b.0 + (n.0 * 6.0).round() as i32,
+                    b.1 + (n.1 * 6.0).round() as i32,
+                )
+            };
+            root.draw(&Polygon::new(vec![end, wing(l1), wing(l2)], red.filled()))
+                .map_err(de)?;
+            let text_at = at(68.0);
+            placer.reserve(centred_box(text_at, 14, LABEL_H));
+            root.draw(&Text::new(
+                name,
+                text_at,
+                (FONT_FAMILY, 15)
+                    .into_font()
+                    .color(&red)
+                    .pos(Pos::new(HPos::Center, VPos::Center)),
+            ))
+            .map_err(de)?;
+        }
+    }
+    for (k, p) in floor.iter().enumerate() {
+        let c = px(p);
+        let tip = px(&(p + inward(floor, k)));
+        let d = Vector2::new(f64::from(tip.0 - c.0), f64::from(tip.1 - c.1))
+            .try_normalize(1e-12)
+            .unwrap_or_default();
+        let at = (
+            c.0 + (d.x * 16.0).round() as i32,
+            c.1 + (d.y * 16.0).round() as i32,
+        );
+        let (fill, ink) = if Some(k) == origin {
+            (red, WHITE)
+        } else {
+            (WHITE, BLACK)
+        };
+        root.draw(&Circle::new(at, 9, fill.filled())).map_err(de)?;
+        root.draw(&Circle::new(at, 9, ink.mix(0.9).stroke_width(1)))
+            .map_err(de)?;
+        root.draw(&Text::new(
+            (k + 1).to_string(),
+            at,
+            (FONT_FAMILY, 12)
+                .into_font()
+                .color(&ink)
+                .pos(Pos::new(HPos::Center, VPos::Center)),
+        ))
+        .map_err(de)?;
+        placer.reserve((at.0 - 10, at.1 - 10, at.0 + 10, at.1 + 10));
     }
     Ok(())
 }
@@ -707,11 +817,22 @@ fn draw<DB: DrawingBackend>(
     let scale = Scale::of(&ok);
     let mut chart = build_chart(&map_area, input.field)?;
     draw_cells(&mut chart, input.field, &ok, scale)?;
-    draw_contours(root, &mut chart, input, &ok, scale)?;
+    let contours = draw_contours(&mut chart, input, &ok, scale)?;
     draw_outline(&mut chart, input.field)?;
-    draw_features(root, &mut chart, input, scale)?;
-    draw_occluders(root, &mut chart, input)?;
-    draw_marks(root, &chart, input.marks)?;
+    let mut labels = draw_features(&mut chart, input, scale)?;
+    labels.extend(draw_furniture(&mut chart, input)?);
+    // Labels go last, each around what was placed before it: corners and marks, then the
+    // features' and furniture's names, then the contour values.
+    let (xr, yr) = chart.plotting_area().get_pixel_range();
+    let mut placer = Placer::new((xr.start, yr.start, xr.end, yr.end));
+    draw_corners(root, &chart, input.field, &mut placer)?;
+    draw_marks(root, &chart, input.marks, &mut placer)?;
+    for l in labels {
+        draw_label(root, &mut placer, l)?;
+    }
+    for (runs, text) in contours {
+        label_contour(root, &chart, &runs, text, &mut placer)?;
+    }
     draw_colour_bar(&bar_area, scale)?;
     root.present().map_err(de)?;
     Ok(())
