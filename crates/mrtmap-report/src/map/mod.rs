@@ -672,7 +672,8 @@ fn draw_corners<DB: DrawingBackend>(
     let px = |p: &Point2<f64>| chart.backend_coord(&(p.x, p.y));
     if let Some(k) = origin {
         let o = px(&floor[k]);
-        for (axis, name) in [(Vector2::x(), "x"), (Vector2::y(), "y")] {
+        // Each axis's name sits beside its arrow's tip, on the room's side.
+        for (axis, name, turn) in [(Vector2::x(), "x", 1.0), (Vector2::y(), "y", -1.0)] {
             let tip = px(&(floor[k] + axis));
             let d = Vector2::new(f64::from(tip.0 - o.0), f64::from(tip.1 - o.1))
                 .try_normalize(1e-12)
@@ -695,7 +696,11 @@ fn draw_corners<DB: DrawingBackend>(
             };
             root.draw(&Polygon::new(vec![end, wing(l1), wing(l2)], red.filled()))
                 .map_err(de)?;
-            let text_at = at(68.0);
+            let tip_at = at(50.0);
+            let text_at = (
+                tip_at.0 + (turn * d.y * 13.0).round() as i32,
+                tip_at.1 - (turn * d.x * 13.0).round() as i32,
+            );
             placer.reserve(centred_box(text_at, 14, LABEL_H));
             root.draw(&Text::new(
                 name,
