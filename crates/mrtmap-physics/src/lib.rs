@@ -2,7 +2,8 @@
 //!
 //! The comfort physics of mrtmap, with no I/O: temperature units that keep absolute temperature
 //! and temperature difference apart, the ISO 7726 mean radiant temperature (MRT) from view factors,
-//! globe thermometer conversions both ways, operative temperature, PMV/PPD and radiant asymmetry.
+//! globe thermometer conversions both ways, operative temperature, PMV/PPD and radiant asymmetry,
+//! and a person's projected-area factors (seated, standing) with ISO 7726's angle-factor fit.
 //!
 //! ```text
 //!  view factors + surface temperatures ──► mean_radiant_temperature ──► Tr
@@ -33,6 +34,7 @@ mod comfort;
 mod error;
 mod globe;
 mod mrt;
+mod person;
 mod units;
 
 pub use comfort::{
@@ -45,4 +47,8 @@ pub use globe::{
     globe_convection, globe_temperature, mrt_from_globe,
 };
 pub use mrt::{MeanRadiant, RadiantAverage, RadiantSource, mean_radiant_temperature};
+pub use person::{
+    Category, Posture, RectangleOrientation, angle_factor_fit, angle_factor_fit_rect,
+    asymmetry_limits_k, projected_area_factor, projected_area_factor_averaged,
+};
 pub use units::{Temperature, TemperatureDelta, ZERO_CELSIUS_K};

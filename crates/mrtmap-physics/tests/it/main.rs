@@ -4,4 +4,5 @@
 mod comfort;
 mod globe;
 mod mrt;
+mod person;
 mod units;
