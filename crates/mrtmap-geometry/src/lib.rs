@@ -37,7 +37,10 @@ pub use polygon::{Containment, NotSimple, PlaneFrame};
 pub use ray::EmbreeRayCaster;
 pub use ray::{BOX_TRIANGLES, BvhRayCaster, RayCaster, RayHit, Tri, box_corners, box_triangles};
 pub use sampling::DirectionSet;
-pub use solid_angle::{polygon_solid_angle, sphere_view_factor, triangle_solid_angle};
+pub use solid_angle::{
+    clip_polygon_to_halfspace, plane_view_factor, polygon_solid_angle, sphere_view_factor,
+    triangle_solid_angle,
+};
 
 /// Errors of geometric constructions.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -15,7 +15,9 @@ use mrtmap_geometry::nalgebra::{Point3, Vector3};
 use mrtmap_geometry::polygon::point_in_polygon_fast;
 use mrtmap_geometry::sampling::{self, DirectionSet};
 use mrtmap_geometry::{RayCaster, sphere_view_factor};
-use mrtmap_physics::{PhysicsError, RadiantSource, Temperature, mean_radiant_temperature};
+use mrtmap_physics::{
+    MeanRadiant, PhysicsError, RadiantSource, Temperature, mean_radiant_temperature,
+};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -231,6 +233,12 @@ pub enum MrtError {
         /// Σ F.
         sum: f64,
     },
+    /// A query that needs the room's floor (up and the horizontal axes) on a scene without one.
+    #[error("{what} needs a scene with a floor (it gives up and the horizontal axes)")]
+    NeedsFloor {
+        /// What was asked.
+        what: &'static str,
+    },
     /// The point lies inside an occluder.
     #[error("point ({:.2}, {:.2}, {:.2}) lies inside the furniture '{id}'", point[0], point[1], point[2])]
     InsideOccluder {
@@ -331,7 +339,7 @@ impl<'a> MrtEngine<'a> {
             surface_patch.push(k);
             k += 1 + s.features.len();
         }
-        let tracer = match method {
+        match method {
             Method::Exact => {
                 if let Some(o) = scene.occluders.first() {
                     return Err(MrtError::OccludersNeedRayTracing {
@@ -339,7 +347,6 @@ impl<'a> MrtEngine<'a> {
                         first: o.id.clone(),
                     });
                 }
-                None
             }
             Method::MonteCarlo(mc) | Method::Auto(mc) => {
                 if mc.replicates < 2 || mc.rays < 2 * mc.replicates {
@@ -350,24 +357,26 @@ impl<'a> MrtEngine<'a> {
                         min: 2 * r,
                     });
                 }
-                let mut tris = Vec::new();
-                let mut owner = Vec::new();
-                for (t, si) in scene.surface_triangles() {
-                    tris.push(t);
-                    owner.push(Owner::Surface(si));
-                }
-                for (oi, o) in scene.occluders.iter().enumerate() {
-                    for t in o.triangles() {
-                        tris.push(t);
-                        owner.push(Owner::Occluder(oi));
-                    }
-                }
-                Some(Tracer {
-                    caster: caster(&tris),
-                    owner,
-                })
             }
-        };
+        }
+        // Every engine can cast rays: a person's and a plane element's factors are integrated
+        // over directions whatever the sphere's method.
+        let mut tris = Vec::new();
+        let mut owner = Vec::new();
+        for (t, si) in scene.surface_triangles() {
+            tris.push(t);
+            owner.push(Owner::Surface(si));
+        }
+        for (oi, o) in scene.occluders.iter().enumerate() {
+            for t in o.triangles() {
+                tris.push(t);
+                owner.push(Owner::Occluder(oi));
+            }
+        }
+        let tracer = Some(Tracer {
+            caster: caster(&tris),
+            owner,
+        });
         Ok(Self {
             scene,
             bounds: RoomBounds::of_scene(scene),
@@ -456,39 +465,15 @@ impl<'a> MrtEngine<'a> {
                 Err(_) => self.monte_carlo(p, &mc, stream),
             },
         };
-        let mrt_of = |f: &[f64]| {
-            let src: Vec<RadiantSource> = self
-                .patches
-                .iter()
-                .zip(f)
-                .filter(|(_, f)| **f > 0.0)
-                .map(|(pa, &f)| RadiantSource {
-                    view_factor: f.min(1.0),
-                    temperature: pa.temperature,
-                    emissivity: pa.emissivity,
-                    temperature_std_k: pa.temperature_std_k,
-                })
-                .collect();
-            mean_radiant_temperature(&src)
-        };
         let sum: f64 = f.iter().sum();
         if !self.open && (sum - 1.0).abs() > ENCLOSURE_TOLERANCE {
             return Err(MrtError::NotEnclosed { point: arr(p), sum });
         }
-        let m = mrt_of(&f).map_err(|source| MrtError::Physics {
+        let m = self.radiant_of(&f).map_err(|source| MrtError::Physics {
             point: arr(p),
             source,
         })?;
-        let sampling = if replicate_f.len() >= 2 {
-            let vals: Vec<f64> = replicate_f
-                .iter()
-                .filter_map(|g| mrt_of(g).ok())
-                .map(|m| m.temperature.kelvin())
-                .collect();
-            std_error(&vals)
-        } else {
-            0.0
-        };
+        let sampling = self.sampling_error(&replicate_f);
         Ok(PointMrt {
             point: *p,
             mrt: m.temperature,
@@ -500,6 +485,61 @@ impl<'a> MrtEngine<'a> {
             view_factor_std_errors: se,
             rays,
         })
+    }
+
+    /// The radiant temperature of factors `f` per patch: (Σ εFT⁴ / Σ εF)^¼ (normalised, so factors
+    /// that sum short of 1, like a person's, weigh what is seen), with the error from the patches'
+    /// temperature uncertainties.
+    pub(crate) fn radiant_of(&self, f: &[f64]) -> Result<MeanRadiant, PhysicsError> {
+        let src: Vec<RadiantSource> = self
+            .patches
+            .iter()
+            .zip(f)
+            .filter(|(_, f)| **f > 0.0)
+            .map(|(pa, &f)| RadiantSource {
+                view_factor: f.min(1.0),
+                temperature: pa.temperature,
+                emissivity: pa.emissivity,
+                temperature_std_k: pa.temperature_std_k,
+            })
+            .collect();
+        mean_radiant_temperature(&src)
+    }
+
+    /// The sampling standard error (K) of a radiant temperature from its replicates' factors.
+    pub(crate) fn sampling_error(&self, replicate_f: &[Vec<f64>]) -> f64 {
+        if replicate_f.len() < 2 {
+            return 0.0;
+        }
+        let vals: Vec<f64> = replicate_f
+            .iter()
+            .filter_map(|g| self.radiant_of(g).ok())
+            .map(|m| m.temperature.kelvin())
+            .collect();
+        std_error(&vals)
+    }
+
+    /// The Monte Carlo settings rays are cast with (the method's, or the defaults for exact).
+    pub fn ray_settings(&self) -> MonteCarlo {
+        match self.method {
+            Method::MonteCarlo(mc) | Method::Auto(mc) => mc,
+            Method::Exact => MonteCarlo::default(),
+        }
+    }
+
+    /// Whether open scenes are answered.
+    pub(crate) fn answers_open(&self) -> bool {
+        self.open
+    }
+
+    /// The patch list.
+    pub(crate) fn patch_list(&self) -> &[Patch] {
+        &self.patches
+    }
+
+    /// Each surface's own patch index (its features follow it).
+    pub(crate) fn surface_patches(&self) -> &[usize] {
+        &self.surface_patch
     }
 
     fn exact_view_factors(&self, p: &Point3<f64>) -> Vec<f64> {
@@ -524,42 +564,77 @@ impl<'a> MrtEngine<'a> {
         mc: &MonteCarlo,
         stream: u64,
     ) -> (Vec<f64>, Vec<f64>, usize, Vec<Vec<f64>>) {
+        let r = self.ray_factors(&self.ray_hits(p, mc, stream), &|_| 1.0);
+        (r.factors, r.std_errors, r.rays, r.replicates)
+    }
+
+    /// The rays of `mc` cast from `p` on the point's random `stream`: per replicate, each
+    /// direction with the patch it hits (none where it escapes an open scene).
+    pub(crate) fn ray_hits(&self, p: &Point3<f64>, mc: &MonteCarlo, stream: u64) -> RayHits {
         let Some(tracer) = &self.tracer else {
-            return (
-                vec![0.0; self.patches.len()],
-                vec![0.0; self.patches.len()],
-                0,
-                Vec::new(),
-            );
+            return RayHits(Vec::new());
         };
         let mut rng = ChaCha8Rng::seed_from_u64(mc.seed);
         rng.set_stream(stream);
-        let r = mc.replicates;
-        let per = mc.rays.div_ceil(r);
+        let per = mc.rays.div_ceil(mc.replicates);
+        RayHits(
+            (0..mc.replicates)
+                .map(|_| {
+                    sampling::directions(mc.directions, per, &mut rng)
+                        .into_iter()
+                        .map(|d| (d, self.trace(tracer, p, &d)))
+                        .collect()
+                })
+                .collect(),
+        )
+    }
+
+    /// Factors of a receiver whose sensitivity to direction d is `weight(d)` (1 for a sphere;
+    /// 4·fp for a person; 4·max(0, n·d) for a plane element), from cast rays:
+    /// Fᵢ = (1/N) Σ_{rays hitting i} weight(d).
+    pub(crate) fn ray_factors(
+        &self,
+        hits: &RayHits,
+        weight: &dyn Fn(&Vector3<f64>) -> f64,
+    ) -> RayFactors {
         let n = self.patches.len();
+        let r = hits.0.len();
         let mut reps = Vec::with_capacity(r);
-        for _ in 0..r {
-            let mut counts = vec![0u32; n];
-            for d in sampling::directions(mc.directions, per, &mut rng) {
-                if let Some(k) = self.trace(tracer, p, &d) {
-                    counts[k] += 1;
+        let (mut total, mut rays) = (0.0, 0usize);
+        for rep in &hits.0 {
+            let mut sums = vec![0.0f64; n];
+            for (d, hit) in rep {
+                let w = weight(d);
+                total += w;
+                if w != 0.0
+                    && let Some(k) = hit
+                {
+                    sums[*k] += w;
                 }
             }
+            rays += rep.len();
             reps.push(
-                counts
-                    .iter()
-                    .map(|&c| c as f64 / per as f64)
+                sums.iter()
+                    .map(|&c| c / rep.len().max(1) as f64)
                     .collect::<Vec<f64>>(),
             );
         }
         let mut f = vec![0.0; n];
         let mut se = vec![0.0; n];
-        for k in 0..n {
-            let vals: Vec<f64> = reps.iter().map(|g| g[k]).collect();
-            f[k] = vals.iter().sum::<f64>() / r as f64;
-            se[k] = std_error(&vals);
+        if r > 0 {
+            for k in 0..n {
+                let vals: Vec<f64> = reps.iter().map(|g| g[k]).collect();
+                f[k] = vals.iter().sum::<f64>() / r as f64;
+                se[k] = std_error(&vals);
+            }
         }
-        (f, se, per * r, reps)
+        RayFactors {
+            factors: f,
+            std_errors: se,
+            rays,
+            replicates: reps,
+            mean_weight: if rays > 0 { total / rays as f64 } else { 0.0 },
+        }
     }
 
     fn trace(&self, tracer: &Tracer, p: &Point3<f64>, d: &Vector3<f64>) -> Option<usize> {
@@ -587,6 +662,23 @@ impl<'a> MrtEngine<'a> {
             }
         }
     }
+}
+
+/// Cast rays: per replicate, each direction and the patch it hits.
+pub(crate) struct RayHits(Vec<Vec<(Vector3<f64>, Option<usize>)>>);
+
+/// Factors integrated over cast rays with a directional weight.
+pub(crate) struct RayFactors {
+    /// Pooled factor per patch.
+    pub factors: Vec<f64>,
+    /// Their standard errors.
+    pub std_errors: Vec<f64>,
+    /// Rays cast.
+    pub rays: usize,
+    /// Factors per replicate.
+    pub replicates: Vec<Vec<f64>>,
+    /// The weight averaged over every direction, hit or not: what Σ F would be in a closed room.
+    pub mean_weight: f64,
 }
 
 /// Standard error of the mean of `vals` (sample standard deviation / √n).

@@ -23,6 +23,7 @@
 mod bounds;
 mod engine;
 mod field;
+mod person;
 mod scene;
 
 pub use bounds::{Outside, ROOM_TOLERANCE_M, RoomBounds};
@@ -31,6 +32,7 @@ pub use engine::{
     PatchKind, PointMrt, patches,
 };
 pub use field::{Extreme, FieldError, FieldSummary, GridNode, GridSpec, MapFrame, MrtField};
+pub use person::{AsymmetryVerdict, Facing, PersonMrt, PlaneRadiant, RadiantAsymmetry};
 pub use scene::{
     BoxFile, FEATURE_PLANE_TOLERANCE_M, Feature, FeatureFile, FramePose, MAX_COORDINATE_M,
     Occluder, OccluderFile, OccluderShape, PLANARITY_TOLERANCE_M, RadiantScene, SCENE_FORMAT,

@@ -126,3 +126,72 @@ proptest! {
         prop_assert!((s - 1.0).abs() < 1e-9, "{}", s);
     }
 }
+
+mod plane_element {
+    use mrtmap_geometry::nalgebra::{Point3, Vector3};
+    use mrtmap_geometry::plane_view_factor;
+
+    fn p(x: f64, y: f64, z: f64) -> Point3<f64> {
+        Point3::new(x, y, z)
+    }
+
+    /// comfort-person.md §3: element normal +z at the origin; a rectangle in the plane y = c with a
+    /// corner at the foot, side a along x (parallel to the element), side b along the normal.
+    #[test]
+    fn perpendicular_corner_rectangles() {
+        let n = Vector3::z();
+        for (a, b, c, f) in [
+            (1.0, 1.0, 1.0, 0.0557342),
+            (2.0, 1.0, 1.0, 0.0686973),
+            (1.0, 2.0, 1.0, 0.0950679),
+        ] {
+            let rect = [p(0.0, c, 0.0), p(a, c, 0.0), p(a, c, b), p(0.0, c, b)];
+            let got = plane_view_factor(&Point3::origin(), &n, &rect);
+            assert!((got - f).abs() < 1e-7, "({a}, {b}): {got}");
+            // The same rectangle extended below the element: only the front half counts.
+            let through = [p(0.0, c, -b), p(a, c, -b), p(a, c, b), p(0.0, c, b)];
+            let got = plane_view_factor(&Point3::origin(), &n, &through);
+            assert!((got - f).abs() < 1e-7, "clipped ({a}, {b}): {got}");
+        }
+    }
+
+    #[test]
+    fn parallel_corner_rectangles() {
+        let n = Vector3::z();
+        for (a, b, c, f) in [(2.0, 1.0, 1.0, 0.1673750), (3.0, 2.0, 1.5, 0.1880837)] {
+            let rect = [p(0.0, 0.0, c), p(a, 0.0, c), p(a, b, c), p(0.0, b, c)];
+            let got = plane_view_factor(&Point3::origin(), &n, &rect);
+            assert!((got - f).abs() < 1e-7, "({a}, {b}, {c}): {got}");
+            // Behind the element it sees nothing.
+            let below: Vec<_> = rect.iter().map(|q| p(q.x, q.y, -q.z)).collect();
+            assert_eq!(plane_view_factor(&Point3::origin(), &n, &below), 0.0);
+        }
+    }
+
+    /// Cube of side 2, element at the centre facing a face: 0.5541264 to it, 0.1114684 to each side.
+    #[test]
+    fn cube_from_its_centre() {
+        let n = Vector3::z();
+        let top = [
+            p(-1.0, -1.0, 1.0),
+            p(1.0, -1.0, 1.0),
+            p(1.0, 1.0, 1.0),
+            p(-1.0, 1.0, 1.0),
+        ];
+        let side = [
+            p(1.0, -1.0, -1.0),
+            p(1.0, 1.0, -1.0),
+            p(1.0, 1.0, 1.0),
+            p(1.0, -1.0, 1.0),
+        ];
+        let o = Point3::origin();
+        let ft = plane_view_factor(&o, &n, &top);
+        let fs = plane_view_factor(&o, &n, &side);
+        assert!((ft - 0.5541264).abs() < 1e-7, "{ft}");
+        assert!((fs - 0.1114684).abs() < 1e-7, "{fs}");
+        assert!(
+            (ft + 4.0 * fs - 1.0).abs() < 1e-12,
+            "the hemisphere is covered once"
+        );
+    }
+}

@@ -4,4 +4,5 @@
 mod common;
 mod engines;
 mod field;
+mod person;
 mod scene;
