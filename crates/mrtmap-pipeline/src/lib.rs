@@ -37,6 +37,7 @@
 
 pub mod cache;
 pub mod calibration;
+pub mod comfort;
 mod conversion;
 pub mod demo;
 mod error;

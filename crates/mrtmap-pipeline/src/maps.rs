@@ -143,6 +143,7 @@ pub fn make_map(
         scene,
         marks: &map_marks,
         subtitle: format!("{source}; {}×{} grid; {}", spec.nx, spec.ny, method.brief()),
+        quantity: None,
     };
     let (rays, seed) = match method {
         Method::MonteCarlo(mc) | Method::Auto(mc) => (Some(mc.rays), Some(mc.seed)),

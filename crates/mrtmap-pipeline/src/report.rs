@@ -3,14 +3,15 @@
 use std::path::Path;
 
 use mrtmap_report::numbers::{fixed, uncertainty};
-use mrtmap_report::{ReportData, ReportMap};
+use mrtmap_report::{KeyValues, ReportData, ReportMap};
 use mrtmap_scan::FusionReport;
 use mrtmap_scan::segment::SegmentReport;
 use serde::Serialize;
 
 use crate::cache::{StageOutcome, write_json};
+use crate::comfort::value_of;
 use crate::error::Result;
-use crate::run::RunOutcome;
+use crate::run::{ComfortResult, RunOutcome};
 use crate::settings::Project;
 
 /// What ± covers, in words.
@@ -151,6 +152,115 @@ fn room_rows(s: &SegmentReport) -> (String, Vec<[String; 3]>, Vec<[String; 4]>) 
     (text, corners, walls)
 }
 
+/// The comfort section's rows: the person and model, category shares, the worst asymmetry; the
+/// marked points' values; the maps.
+#[allow(clippy::type_complexity)]
+fn comfort_rows(
+    c: &ComfortResult,
+) -> (
+    KeyValues,
+    Vec<String>,
+    Vec<Vec<String>>,
+    Vec<(String, Vec<u8>, String)>,
+) {
+    let s = &c.summary;
+    let pct = |x: f64| format!("{:.0} %", 100.0 * x);
+    let mut rows: KeyValues = vec![
+        (
+            "person".into(),
+            format!(
+                "{}, {}; {:.1} met, {:.2} clo, {:.0} % relative humidity",
+                s.comfort.posture.as_str(),
+                s.comfort.facing().describe(),
+                s.comfort.met,
+                s.comfort.clo,
+                s.comfort.relative_humidity_pct
+            ),
+        ),
+        ("PMV/PPD model".into(), s.pmv_model.clone()),
+        (
+            "nodes".into(),
+            format!(
+                "{} computed, {} left out (inside furniture…)",
+                s.nodes, s.skipped
+            ),
+        ),
+    ];
+    if let Some(sh) = s.pmv_category_share {
+        rows.push((
+            "floor by ISO 7730 PMV category".into(),
+            format!(
+                "A (|PMV| < 0.2) {}, B (< 0.5) {}, C (< 0.7) {}, outside C {}",
+                pct(sh[0]),
+                pct(sh[1]),
+                pct(sh[2]),
+                pct(sh[3])
+            ),
+        ));
+    }
+    if let Some(sh) = s.asymmetry_category_share {
+        rows.push((
+            "floor by radiant-asymmetry category (ISO 7730 Table A.4)".into(),
+            format!(
+                "A/B {}, C {}, outside C {}",
+                pct(sh[0]),
+                pct(sh[1]),
+                pct(sh[2])
+            ),
+        ));
+    }
+    if let Some((a, xy)) = &s.worst_asymmetry {
+        rows.push((
+            "worst radiant asymmetry".into(),
+            format!(
+                "{:.2} K ({}) at ({}, {}): PD {:.1} %, category {}",
+                a.worst.delta_k,
+                asymmetry_words(a.worst.kind),
+                fixed(xy[0], 2),
+                fixed(xy[1], 2),
+                a.worst.pd_pct,
+                a.worst.category.as_str()
+            ),
+        ));
+    }
+    let columns: Vec<String> = s.quantities.iter().map(|q| q.name().to_string()).collect();
+    let points = s
+        .marks
+        .iter()
+        .map(|(name, p)| {
+            let mut row = vec![name.clone()];
+            row.extend(s.quantities.iter().map(|q| {
+                value_of(p, *q).map_or("—".into(), |(v, e)| {
+                    format!("{v:.2} ± {}", uncertainty(e, 2))
+                })
+            }));
+            row
+        })
+        .collect();
+    let maps = c
+        .maps
+        .iter()
+        .map(|(q, title, png)| {
+            (
+                title.clone(),
+                png.clone(),
+                format!("comfort/{}.csv", q.name()),
+            )
+        })
+        .collect();
+    (rows, columns, points, maps)
+}
+
+fn asymmetry_words(k: mrtmap_physics::AsymmetryKind) -> &'static str {
+    use mrtmap_physics::AsymmetryKind as K;
+    match k {
+        K::WarmCeiling => "warm ceiling",
+        K::CoolCeiling => "cool ceiling",
+        K::WarmWall => "warm wall",
+        K::CoolWall => "cool wall",
+    }
+}
+
 /// When (UTC), by which mrtmap version and by which command: "on 2026-12-01 15:50 UTC by
 /// mrtmap 0.1.0: mrtmap run scan --out out".
 pub fn provenance() -> String {
@@ -212,6 +322,8 @@ pub fn timing_rows(stages: &[StageOutcome]) -> Vec<(String, String)> {
 /// The report's tables from a run.
 pub fn report_data(o: &RunOutcome, title: &str, source: &str, p: &Project) -> ReportData {
     let (room_frame, corners, walls) = room_rows(&o.segment);
+    let (comfort, comfort_point_columns, comfort_points, comfort_maps) =
+        o.comfort.as_ref().map(comfort_rows).unwrap_or_default();
     ReportData {
         title: title.into(),
         source: source.into(),
@@ -240,6 +352,10 @@ pub fn report_data(o: &RunOutcome, title: &str, source: &str, p: &Project) -> Re
         room_frame,
         corners,
         walls,
+        comfort,
+        comfort_point_columns,
+        comfort_points,
+        comfort_maps,
         ..Default::default()
     }
 }

@@ -19,10 +19,11 @@ use mrtmap_scan::segment::{MaskInput, SegmentParams, SegmentReport, refined_pose
 use mrtmap_scan::{FuseParams, FusionReport, fuse};
 
 use crate::cache::{Fingerprint, Stage, StageOutcome, read_json, run_or_reuse, write_json};
+use crate::comfort::{ComfortSummary, comfort_title, make_comfort_maps};
 use crate::error::{Error, Result};
 use crate::maps::{Mark, MarkAt, Summary, make_map};
 use crate::progress::Progress;
-use crate::settings::{PointEntry, PointFrame, Project};
+use crate::settings::{PointEntry, PointFrame, Project, Quantity};
 
 /// Fuses `rec` into `out`: cloud.ply, fusion.json and poses.txt (the refined trajectory).
 pub fn fuse_into(
@@ -103,6 +104,95 @@ pub struct MapResult {
     pub csv: String,
 }
 
+/// A person's comfort maps: `out/comfort`.
+#[derive(Clone, Debug)]
+pub struct ComfortResult {
+    /// comfort.json.
+    pub summary: ComfortSummary,
+    /// (quantity, title, PNG) per map.
+    pub maps: Vec<(Quantity, String, Vec<u8>)>,
+}
+
+/// The comfort stage: `out/comfort`, when `[map] quantities` ask for a person's quantities.
+fn comfort_stage(
+    scene: &RadiantScene,
+    out: &Path,
+    p: &Project,
+    force: bool,
+    progress: &dyn Progress,
+) -> Result<Option<(StageOutcome, ComfortResult)>> {
+    let person: Vec<Quantity> = p
+        .map
+        .quantities
+        .iter()
+        .copied()
+        .filter(|q| *q != Quantity::Mrt)
+        .collect();
+    if person.is_empty() {
+        return Ok(None);
+    }
+    let dir = out.join("comfort");
+    let scene_path = out.join("segment").join("scene.json");
+    let marks: Vec<(String, [f64; 2])> = points_in_room(&p.points, scene, &scene_path)?
+        .into_iter()
+        .filter_map(|m| match m.at {
+            MarkAt::Scene([x, y, _]) => Some((m.name, [x, y])),
+            MarkAt::Map(_) => None,
+        })
+        .collect();
+    let fingerprint = Fingerprint::new()
+        .file(&scene_path)
+        .setting("grid", &p.map.grid)
+        .setting("margin_m", &p.map.margin_m)
+        .setting("quantities", &person)
+        .setting("comfort", &p.comfort)
+        .setting("air", &p.air)
+        .setting("mrt", &p.mrt)
+        .setting("points", &p.points);
+    let mut files: Vec<String> = person.iter().map(|q| format!("{}.png", q.name())).collect();
+    files.push("comfort.json".into());
+    let files: Vec<&str> = files.iter().map(String::as_str).collect();
+    let stage = Stage::in_dir("comfort maps", &dir, &files);
+    let mut made = None;
+    let outcome = run_or_reuse(&stage, fingerprint, force, || {
+        progress.begin("mapping a person's comfort");
+        progress.advance(0, 1);
+        let engine = p.mrt.engine(scene)?;
+        let o = make_comfort_maps(
+            &engine,
+            scene,
+            "the scanned room",
+            (p.map.grid, p.map.margin_m),
+            &p.comfort,
+            &p.air,
+            &person,
+            &marks,
+            &dir,
+        )?;
+        made = Some(ComfortResult {
+            summary: o.summary,
+            maps: o.maps,
+        });
+        Ok(())
+    })?;
+    let result = match made {
+        Some(r) => r,
+        None => {
+            let summary: ComfortSummary = read_json(&dir.join("comfort.json"))?;
+            let maps = person
+                .iter()
+                .map(|q| {
+                    let f = dir.join(format!("{}.png", q.name()));
+                    let png = std::fs::read(&f).map_err(|e| mrtmap_io::FileError::io(&f, e))?;
+                    Ok((*q, comfort_title(*q, &p.comfort), png))
+                })
+                .collect::<Result<Vec<_>>>()?;
+            ComfortResult { summary, maps }
+        }
+    };
+    Ok(Some((outcome, result)))
+}
+
 /// The outcome of a run.
 #[derive(Clone, Debug)]
 pub struct RunOutcome {
@@ -116,6 +206,8 @@ pub struct RunOutcome {
     pub segment: SegmentReport,
     /// Maps, by height.
     pub maps: Vec<MapResult>,
+    /// A person's comfort maps, when `[map] quantities` ask for them.
+    pub comfort: Option<ComfortResult>,
     /// Warnings gathered over the stages.
     pub warnings: Vec<String>,
 }
@@ -335,12 +427,20 @@ pub fn run(
         stages.push(st);
         maps.push(m);
     }
+    let comfort = match comfort_stage(&scene, out, p, force, progress)? {
+        Some((st, c)) => {
+            stages.push(st);
+            Some(c)
+        }
+        None => None,
+    };
     Ok(RunOutcome {
         stages,
         scene,
         fusion,
         segment,
         maps,
+        comfort,
         warnings,
     })
 }

@@ -5,7 +5,8 @@
 use std::path::Path;
 
 use mrtmap_geometry::sampling::DirectionSet;
-use mrtmap_radiation::{Method, MonteCarlo, MrtEngine, RadiantScene};
+use mrtmap_physics::Posture;
+use mrtmap_radiation::{Facing, Method, MonteCarlo, MrtEngine, RadiantScene};
 use mrtmap_scan::FuseParams;
 use mrtmap_scan::segment::SegmentParams;
 use serde::{Deserialize, Serialize};
@@ -18,6 +19,8 @@ pub const PROJECT_EXAMPLE: &str = r#"# project.toml: every key is optional (defa
 grid = [20, 20]           # nodes across and along the floor's bounding rectangle
 heights_m = [1.1]         # one map per height above the floor (1.1 m seated head, 1.7 m standing)
 margin_m = 0.1            # distance kept from the walls
+quantities = ["mrt"]      # also: mrt_seated, mrt_standing, asymmetry, operative, pmv, ppd (a person,
+                          # with [comfort]); the person's maps are at the body centre's height
 
 [[points]]                # named points (e.g. globe locations), metres, in the room frame:
 name = "A"                # x, y along the floor from the origin corner, z above the floor
@@ -31,6 +34,16 @@ xyz = [1.2, 0.8, 1.1]
 [air]
 temperature_c = 21.0      # for the report's operative temperature and globe comparisons
 speed_m_s = 0.1
+
+[comfort]                 # a person, for the person's maps and points (ISO 7730, Fanger's PMV)
+posture = "seated"        # seated (body centre 0.6 m) | standing (1.0 m)
+# facing_deg = 90.0       # which way the person faces (0 = +x, 90 = +y); unset: any way (averaged)
+# air_temperature_c = 22  # default: [air] temperature_c; needed for operative, pmv, ppd
+# air_temperature_profile = [[0.1, 21.0], [1.7, 23.0]]  # [height m, °C] for stratified air
+# air_speed_m_s = 0.1     # default: [air] speed_m_s
+relative_humidity_pct = 50.0
+met = 1.2                 # metabolic rate (1.2: seated office work)
+clo = 0.7                 # clothing insulation
 
 [fuse]
 voxel_m = 0.03
@@ -61,6 +74,8 @@ pub struct MapSection {
     pub heights_m: Vec<f64>,
     /// Distance kept from the walls (m).
     pub margin_m: f64,
+    /// What to map: the sphere's MRT at each height, and a person's quantities.
+    pub quantities: Vec<Quantity>,
 }
 
 impl Default for MapSection {
@@ -69,7 +84,164 @@ impl Default for MapSection {
             grid: [20, 20],
             heights_m: vec![1.1],
             margin_m: 0.1,
+            quantities: vec![Quantity::Mrt],
         }
+    }
+}
+
+/// What a map can show (`[map] quantities`, `--quantity`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+#[value(rename_all = "snake_case")]
+pub enum Quantity {
+    /// The MRT of a small sphere at each map height (ISO 7726).
+    Mrt,
+    /// The MRT of a seated person (body centre 0.6 m), facing as `[comfort]` says.
+    MrtSeated,
+    /// The MRT of a standing person (body centre 1.0 m).
+    MrtStanding,
+    /// The worst radiant temperature asymmetry (K) at the abdomen of `[comfort]`'s posture.
+    Asymmetry,
+    /// Operative temperature (ISO 7726) of `[comfort]`'s person.
+    Operative,
+    /// Predicted mean vote (ISO 7730).
+    Pmv,
+    /// Predicted percentage dissatisfied (ISO 7730).
+    Ppd,
+}
+
+impl Quantity {
+    /// Its name in files ("mrt_seated").
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Mrt => "mrt",
+            Self::MrtSeated => "mrt_seated",
+            Self::MrtStanding => "mrt_standing",
+            Self::Asymmetry => "asymmetry",
+            Self::Operative => "operative",
+            Self::Pmv => "pmv",
+            Self::Ppd => "ppd",
+        }
+    }
+
+    /// Whether it needs the air (temperature, humidity…): operative temperature, PMV and PPD.
+    pub fn needs_air(self) -> bool {
+        matches!(self, Self::Operative | Self::Pmv | Self::Ppd)
+    }
+}
+
+/// `[comfort]`: the person whose comfort the person's maps and points describe.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ComfortSection {
+    /// Seated or standing.
+    pub posture: Posture,
+    /// Which way the person faces (degrees from +x towards +y); `None`: any way (averaged).
+    pub facing_deg: Option<f64>,
+    /// Air temperature (°C); default `[air] temperature_c`.
+    pub air_temperature_c: Option<f64>,
+    /// Air temperature by height, `[height m, °C]` pairs (linear between, constant beyond).
+    pub air_temperature_profile: Vec<[f64; 2]>,
+    /// Air speed (m/s); default `[air] speed_m_s`.
+    pub air_speed_m_s: Option<f64>,
+    /// Relative humidity (%).
+    pub relative_humidity_pct: f64,
+    /// Metabolic rate (met).
+    pub met: f64,
+    /// Clothing insulation (clo).
+    pub clo: f64,
+}
+
+impl Default for ComfortSection {
+    fn default() -> Self {
+        Self {
+            posture: Posture::Seated,
+            facing_deg: None,
+            air_temperature_c: None,
+            air_temperature_profile: Vec::new(),
+            air_speed_m_s: None,
+            relative_humidity_pct: 50.0,
+            met: 1.2,
+            clo: 0.7,
+        }
+    }
+}
+
+impl ComfortSection {
+    /// Which way the person faces.
+    pub fn facing(&self) -> Facing {
+        self.facing_deg.map_or(Facing::Any, Facing::Azimuth)
+    }
+
+    /// The air temperature (°C) at `height_m` above the floor: the profile, else the one value
+    /// here, else `[air]`'s; `None` when none is given.
+    pub fn air_at(&self, air: &AirSection, height_m: f64) -> Option<f64> {
+        let p = &self.air_temperature_profile;
+        if let (Some(first), Some(last)) = (p.first(), p.last()) {
+            if height_m <= first[0] {
+                return Some(first[1]);
+            }
+            if height_m >= last[0] {
+                return Some(last[1]);
+            }
+            return p.windows(2).find_map(|w| {
+                let ([h0, t0], [h1, t1]) = (w[0], w[1]);
+                (height_m >= h0 && height_m <= h1)
+                    .then(|| t0 + (t1 - t0) * (height_m - h0) / (h1 - h0).max(1e-12))
+            });
+        }
+        self.air_temperature_c.or(air.temperature_c)
+    }
+
+    /// The air speed (m/s).
+    pub fn air_speed(&self, air: &AirSection) -> f64 {
+        self.air_speed_m_s.unwrap_or(air.speed_m_s)
+    }
+
+    /// Checks ranges, and that the air is given when `quantities` need it.
+    pub fn check(&self, air: &AirSection, quantities: &[Quantity]) -> Result<()> {
+        let bad = |key: &str, v: f64, allowed: &str| {
+            Error::setting(
+                format!("[comfort] {key} = {v}"),
+                format!("is outside {allowed}"),
+            )
+        };
+        if !(0.0..=100.0).contains(&self.relative_humidity_pct) {
+            return Err(bad(
+                "relative_humidity_pct",
+                self.relative_humidity_pct,
+                "0…100 %",
+            ));
+        }
+        if !(0.5..=5.0).contains(&self.met) {
+            return Err(bad("met", self.met, "0.5…5 met"));
+        }
+        if !(0.0..=3.0).contains(&self.clo) {
+            return Err(bad("clo", self.clo, "0…3 clo"));
+        }
+        let v = self.air_speed(air);
+        if !(0.0..=5.0).contains(&v) {
+            return Err(bad("air_speed_m_s", v, "0…5 m/s"));
+        }
+        if let Some(f) = self.facing_deg
+            && !f.is_finite()
+        {
+            return Err(bad("facing_deg", f, "finite degrees"));
+        }
+        let p = &self.air_temperature_profile;
+        if p.windows(2).any(|w| w[1][0] <= w[0][0]) || p.iter().flatten().any(|x| !x.is_finite()) {
+            return Err(Error::setting(
+                "[comfort] air_temperature_profile",
+                "must list [height m, °C] pairs with heights increasing",
+            ));
+        }
+        if quantities.iter().any(|q| q.needs_air()) && self.air_at(air, 1.0).is_none() {
+            return Err(Error::setting(
+                "[map] quantities",
+                "include operative, pmv or ppd, which need the air temperature: set [comfort] air_temperature_c (or [air] temperature_c, --air-c)",
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -337,6 +509,8 @@ pub struct Project {
     pub segment: SegmentSection,
     /// The room frame.
     pub room: RoomSection,
+    /// The person for comfort maps and points.
+    pub comfort: ComfortSection,
     /// View factors.
     pub mrt: MrtSection,
 }
@@ -378,6 +552,7 @@ impl Project {
             ));
         }
         self.fuse.params()?;
+        self.comfort.check(&self.air, &self.map.quantities)?;
         Ok(())
     }
 

@@ -12,6 +12,7 @@ use mrtmap_physics::Temperature;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::bounds::RoomBounds;
 use crate::engine::{MrtEngine, MrtError, PointMrt};
 use crate::scene::RadiantScene;
 
@@ -197,6 +198,17 @@ pub struct Extreme {
     pub uv: [f64; 2],
 }
 
+/// A grid laid over a floor: node coordinates along u and v, and the nodes inside the outline.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GridLayout {
+    /// Node coordinates along u.
+    pub u: Vec<f64>,
+    /// Node coordinates along v.
+    pub v: Vec<f64>,
+    /// (i, j, map coordinates) of the nodes inside the floor outline, row-major (j then i).
+    pub places: Vec<(usize, usize, Point2<f64>)>,
+}
+
 /// MRT over a grid.
 pub struct MrtField {
     /// The frame.
@@ -221,12 +233,13 @@ fn linspace(a: f64, b: f64, n: usize) -> Vec<f64> {
 }
 
 impl MrtField {
-    /// Computes the field on `spec` (in parallel; results do not depend on the thread count).
-    pub fn compute(
-        engine: &MrtEngine<'_>,
-        frame: MapFrame,
-        spec: GridSpec,
-    ) -> Result<Self, FieldError> {
+    /// The grid of `spec` over `frame`: node coordinates along u and v, and the nodes inside the
+    /// floor outline (i, j, map coordinates), checked against the room when `bounds` are known.
+    pub fn layout(
+        frame: &MapFrame,
+        spec: &GridSpec,
+        bounds: Option<&RoomBounds>,
+    ) -> Result<GridLayout, FieldError> {
         if spec.nx == 0 || spec.ny == 0 || spec.nx * spec.ny > 4_000_000 {
             return Err(FieldError::BadGrid(format!(
                 "{}×{} nodes",
@@ -239,7 +252,7 @@ impl MrtField {
                 spec.height_m, spec.margin_m
             )));
         }
-        if let Some(b) = engine.bounds() {
+        if let Some(b) = bounds {
             b.check_height(spec.height_m)?;
         }
         let (lo, hi) = frame.floor_bounds();
@@ -263,6 +276,16 @@ impl MrtField {
                 }
             }
         }
+        Ok(GridLayout { u, v, places })
+    }
+
+    /// Computes the field on `spec` (in parallel; results do not depend on the thread count).
+    pub fn compute(
+        engine: &MrtEngine<'_>,
+        frame: MapFrame,
+        spec: GridSpec,
+    ) -> Result<Self, FieldError> {
+        let GridLayout { u, v, places } = Self::layout(&frame, &spec, engine.bounds())?;
         let nx = spec.nx;
         let nodes = places
             .into_par_iter()

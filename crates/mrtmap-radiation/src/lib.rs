@@ -31,7 +31,9 @@ pub use engine::{
     ENCLOSURE_TOLERANCE, EXACT_OVERLAP_TOLERANCE, Method, MonteCarlo, MrtEngine, MrtError, Patch,
     PatchKind, PointMrt, patches,
 };
-pub use field::{Extreme, FieldError, FieldSummary, GridNode, GridSpec, MapFrame, MrtField};
+pub use field::{
+    Extreme, FieldError, FieldSummary, GridLayout, GridNode, GridSpec, MapFrame, MrtField,
+};
 pub use person::{AsymmetryVerdict, Facing, PersonMrt, PlaneRadiant, RadiantAsymmetry};
 pub use scene::{
     BoxFile, FEATURE_PLANE_TOLERANCE_M, Feature, FeatureFile, FramePose, MAX_COORDINATE_M,

@@ -75,6 +75,15 @@ pub struct ReportData {
     pub corners: Vec<[String; 3]>,
     /// The room's walls: id, from corner, to corner, length (m).
     pub walls: Vec<[String; 4]>,
+    /// A person's comfort: maps (title, PNG, CSV name).
+    pub comfort_maps: Vec<(String, Vec<u8>, String)>,
+    /// The person, the PMV model, category shares and the worst asymmetry.
+    pub comfort: KeyValues,
+    /// The person's values at the marked points: name, then one cell per column of
+    /// `comfort_point_columns`.
+    pub comfort_points: Vec<Vec<String>>,
+    /// The columns of `comfort_points` after the name.
+    pub comfort_point_columns: Vec<String>,
 }
 
 /// HTML-escapes text.
@@ -282,6 +291,31 @@ fn key_value_rows(kv: &KeyValues) -> Vec<Vec<String>> {
     kv.iter().map(|(k, v)| vec![k.clone(), v.clone()]).collect()
 }
 
+/// A person's comfort: what was assumed, how much of the floor is in each ISO 7730 category,
+/// the worst asymmetry, the values at the marked points, and one map per quantity.
+fn comfort_section(o: &mut String, d: &ReportData) {
+    if d.comfort.is_empty() && d.comfort_maps.is_empty() {
+        return;
+    }
+    o.push_str("<h2>Comfort of a person</h2>");
+    plain_rows(o, &["what", "value"], &key_value_rows(&d.comfort));
+    if !d.comfort_points.is_empty() {
+        let mut headers = vec!["point"];
+        headers.extend(d.comfort_point_columns.iter().map(String::as_str));
+        plain_rows(o, &headers, &d.comfort_points);
+    }
+    let b64 = base64::engine::general_purpose::STANDARD;
+    for (title, png, csv) in &d.comfort_maps {
+        o.push_str(&format!(
+            "<h3>{}</h3><img alt=\"{}\" src=\"data:image/png;base64,{}\"><p>Grid values: <code>{}</code>.</p>",
+            esc(title),
+            esc(title),
+            b64.encode(png),
+            esc(csv)
+        ));
+    }
+}
+
 /// Where the coordinates are measured from: the room frame, its corners and walls.
 fn room_section(o: &mut String, d: &ReportData) {
     if d.room_frame.is_empty() {
@@ -335,6 +369,7 @@ pub fn render_html(d: &ReportData) -> String {
     for m in &d.maps {
         map_section(&mut o, m);
     }
+    comfort_section(&mut o, d);
     comparison_section(&mut o, d);
     validation_section(&mut o, d);
     points_section(&mut o, d);

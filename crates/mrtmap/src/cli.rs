@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use mrtmap_pipeline::settings::PointFrame;
+use mrtmap_pipeline::settings::{PointFrame, Quantity};
 use mrtmap_pipeline::{DirectionChoice, MethodChoice, MrtSection};
 
 /// Map the mean radiant temperature (MRT) of a room.
@@ -29,6 +29,8 @@ pub enum Command {
     Mrt(MrtArgs),
     /// Convert a black-globe reading to MRT (ISO 7726, or mixed convection), or back.
     Globe(GlobeArgs),
+    /// Operative temperature and PMV/PPD (ISO 7730) from air and mean radiant temperature.
+    Comfort(ComfortArgs),
     /// Write the built-in example scene (an office with a cold window) as scene.json.
     ExampleScene(ExampleSceneArgs),
     /// Simulate a handheld thermal + RGB-D scan of a room, with exact truth.
@@ -338,6 +340,10 @@ pub struct RunArgs {
     /// Map height above the floor (m), repeatable ([map] heights_m).
     #[arg(long = "height")]
     pub heights: Vec<f64>,
+    /// What to map besides MRT, repeatable ([map] quantities): mrt_seated, mrt_standing,
+    /// asymmetry, operative, pmv, ppd (the person and air from [comfort] and [air]).
+    #[arg(long = "quantity", value_enum)]
+    pub quantities: Vec<Quantity>,
     /// Margin from the walls (m) ([map] margin_m).
     #[arg(long = "margin-m")]
     pub margin_m: Option<f64>,
@@ -621,6 +627,15 @@ pub struct MapArgs {
     pub marks: Vec<(String, Vec<f64>)>,
     #[command(flatten)]
     pub method: MethodArgs,
+    /// What else to map, repeatable: a person's MRT (mrt_seated, mrt_standing), radiant asymmetry,
+    /// operative temperature, PMV, PPD; the person and the air come from --config's [comfort] and
+    /// [air]. Written as QUANTITY.png/.svg/.csv and comfort.json beside the MRT map.
+    #[arg(long = "quantity", value_enum)]
+    pub quantities: Vec<Quantity>,
+    /// A project.toml whose [comfort] and [air] describe the person, and whose [map] quantities
+    /// are mapped unless --quantity is given.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
     /// Output folder for mrt_grid.csv, mrt_map.png, mrt_map.svg and summary.json.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
@@ -641,7 +656,68 @@ pub struct MrtArgs {
     pub frame: PointFrame,
     #[command(flatten)]
     pub method: MethodArgs,
+    /// The MRT of a person instead of a small sphere: --at is the body centre (0.6 m above the
+    /// floor seated, 1.0 m standing); angle factors from the projected-area factors of a seated or
+    /// standing body.
+    #[arg(long, value_enum)]
+    pub person: Option<PostureArg>,
+    /// Which way the person faces, degrees from +x towards +y (0 = +x, 90 = +y); without it,
+    /// any way (fp averaged over azimuth).
+    #[arg(long, allow_negative_numbers = true, requires = "person")]
+    pub facing: Option<f64>,
+    /// Also the plane radiant temperatures of a small element's six faces and the radiant
+    /// asymmetries (vertical, and the worst horizontal pair every 15°) with ISO 7730's PD and category.
+    #[arg(long)]
+    pub plane: bool,
     /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Seated or standing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum PostureArg {
+    /// Seated: body centre 0.6 m above the floor.
+    Seated,
+    /// Standing: body centre 1.0 m above the floor.
+    Standing,
+}
+
+impl From<PostureArg> for mrtmap_physics::Posture {
+    fn from(p: PostureArg) -> Self {
+        match p {
+            PostureArg::Seated => Self::Seated,
+            PostureArg::Standing => Self::Standing,
+        }
+    }
+}
+
+/// `mrtmap comfort`.
+#[derive(Debug, Args)]
+pub struct ComfortArgs {
+    /// Air temperature (°C).
+    #[arg(long, allow_negative_numbers = true, required_unless_present = "csv")]
+    pub ta: Option<f64>,
+    /// Mean radiant temperature (°C).
+    #[arg(long, allow_negative_numbers = true, required_unless_present = "csv")]
+    pub tr: Option<f64>,
+    /// Air speed (m/s); PMV uses the relative air speed v + 0.3 (met − 1) above 1 met.
+    #[arg(long, default_value_t = 0.1)]
+    pub v: f64,
+    /// Relative humidity (%).
+    #[arg(long, default_value_t = 50.0)]
+    pub rh: f64,
+    /// Metabolic rate (met).
+    #[arg(long, default_value_t = 1.2)]
+    pub met: f64,
+    /// Clothing insulation (clo).
+    #[arg(long, default_value_t = 0.7)]
+    pub clo: f64,
+    /// Many at once: a CSV with the columns ta,tr,v,rh,met,clo (header first); prints a CSV with
+    /// operative_c, pmv, ppd added.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["ta", "tr"])]
+    pub csv: Option<PathBuf>,
+    /// Print JSON.
     #[arg(long)]
     pub json: bool,
 }

@@ -52,6 +52,19 @@ pub struct MapInput<'a> {
     pub marks: &'a [MapMark],
     /// Second title line (method, grid…).
     pub subtitle: String,
+    /// Another quantity on the field's grid instead of its MRT (a person's MRT, PMV…).
+    pub quantity: Option<MapQuantity>,
+}
+
+/// A quantity other than the sphere's MRT, drawn on a field's grid.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MapQuantity {
+    /// The title ("Operative temperature of a seated person (°C)").
+    pub title: String,
+    /// The colour bar's unit ("°C", "K", "%", or "" for PMV).
+    pub unit: String,
+    /// Values at nodes (i, j, value); nodes without a value are left empty.
+    pub values: Vec<(usize, usize, f64)>,
 }
 
 /// Colour of a value `t` in 0…1 on the map's palette (blue cold → red warm).
@@ -199,6 +212,19 @@ impl Scale {
 }
 
 /// The computed nodes of a field.
+/// The nodes to colour: the quantity's values when one is given, else the field's MRT.
+fn nodes_of(input: &MapInput<'_>) -> Vec<Node> {
+    let Some(q) = &input.quantity else {
+        return computed_nodes(input.field);
+    };
+    let f = input.field;
+    q.values
+        .iter()
+        .filter(|(i, j, v)| *i < f.u.len() && *j < f.v.len() && v.is_finite())
+        .map(|&(i, j, v)| (i, j, Point2::new(f.u[i], f.v[j]), v))
+        .collect()
+}
+
 fn computed_nodes(field: &MrtField) -> Vec<Node> {
     field
         .nodes
@@ -216,10 +242,13 @@ fn draw_titles<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     input: &MapInput<'_>,
 ) -> Result<(), ReportError> {
-    let title = format!(
-        "Mean radiant temperature at {:.2} m above the floor (°C)",
-        input.field.spec.height_m
-    );
+    let title = match &input.quantity {
+        Some(q) => q.title.clone(),
+        None => format!(
+            "Mean radiant temperature at {:.2} m above the floor (°C)",
+            input.field.spec.height_m
+        ),
+    };
     root.draw(&Text::new(
         title,
         (20, 12),
@@ -745,10 +774,11 @@ fn draw_corners<DB: DrawingBackend>(
     Ok(())
 }
 
-/// The colour bar with its ticks in °C.
+/// The colour bar with its ticks, in `unit`.
 fn draw_colour_bar<DB: DrawingBackend>(
     bar_area: &DrawingArea<DB, Shift>,
     scale: Scale,
+    unit: &str,
 ) -> Result<(), ReportError> {
     let (_, bh) = bar_area.dim_in_pixel();
     let (x0, y0, bar_h) = (30i32, 40i32, (bh as i32 - 100).max(100));
@@ -772,7 +802,7 @@ fn draw_colour_bar<DB: DrawingBackend>(
         .map_err(de)?;
     bar_area
         .draw(&Text::new(
-            "°C",
+            unit.to_string(),
             (x0, y0 - 26),
             (FONT_FAMILY, 15).into_font().color(&BLACK),
         ))
@@ -818,7 +848,7 @@ fn draw<DB: DrawingBackend>(
     let (w, _) = root.dim_in_pixel();
     let body = root.margin(70, 10, 10, 10);
     let (map_area, bar_area) = body.split_horizontally(w as i32 - 20 - 140);
-    let ok = computed_nodes(input.field);
+    let ok = nodes_of(input);
     let scale = Scale::of(&ok);
     let mut chart = build_chart(&map_area, input.field)?;
     draw_cells(&mut chart, input.field, &ok, scale)?;
@@ -838,7 +868,8 @@ fn draw<DB: DrawingBackend>(
     for (runs, text) in contours {
         label_contour(root, &chart, &runs, text, &mut placer)?;
     }
-    draw_colour_bar(&bar_area, scale)?;
+    let unit = input.quantity.as_ref().map_or("°C", |q| q.unit.as_str());
+    draw_colour_bar(&bar_area, scale, unit)?;
     root.present().map_err(de)?;
     Ok(())
 }

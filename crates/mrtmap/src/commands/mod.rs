@@ -2,6 +2,7 @@
 //! what they share for output is in `crate::output`.
 
 mod calibrate;
+mod comfort;
 mod convert;
 mod demo;
 mod example_scene;
@@ -26,6 +27,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Map(a) => map::run(&a),
         Command::Mrt(a) => mrt::run(&a),
         Command::Globe(a) => globe::run(&a),
+        Command::Comfort(a) => comfort::run(&a),
         Command::ExampleScene(a) => example_scene::run(&a),
         Command::Simulate(a) => simulate::run(&a),
         Command::Rooms(a) => rooms::run(&a),

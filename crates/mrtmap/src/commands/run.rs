@@ -26,6 +26,9 @@ fn settings(a: &RunArgs) -> anyhow::Result<Project> {
     if let Some(m) = a.margin_m {
         p.map.margin_m = m;
     }
+    if !a.quantities.is_empty() {
+        p.map.quantities = a.quantities.clone();
+    }
     for (name, c) in &a.marks {
         let &[x, y, z] = c.as_slice() else {
             bail!(

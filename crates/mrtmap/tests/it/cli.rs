@@ -532,3 +532,213 @@ fn validate_refuses_globes_outside_the_room_and_says_why_a_value_is_missing() {
         "{text}"
     );
 }
+
+#[test]
+fn comfort_gives_operative_temperature_and_pmv() {
+    // ISO 7730 Table D.1 row 7 (vr 0.1 at 1.2 met is v = 0.04): PMV 0.36, PPD 7.7 (pythermalcomfort 0.3620 / 7.73).
+    let v = ok_json(&[
+        "comfort", "--ta", "23.5", "--tr", "23.5", "--v", "0.04", "--rh", "40", "--met", "1.2",
+        "--clo", "1.0", "--json",
+    ]);
+    assert!((v["pmv"].as_f64().unwrap() - 0.3620).abs() < 0.01, "{v}");
+    assert!((v["ppd_pct"].as_f64().unwrap() - 7.73).abs() < 0.1, "{v}");
+    assert!((v["operative_c"].as_f64().unwrap() - 23.5).abs() < 1e-9);
+    assert_eq!(v["category"], "B");
+    // Operative temperature, ISO 7726: (22, 28, 0.1) → 25.0; (22, 28, 0.5) → 23.8541.
+    for (va, to) in [("0.1", 25.0), ("0.5", 23.8541)] {
+        let v = ok_json(&["comfort", "--ta", "22", "--tr", "28", "--v", va, "--json"]);
+        assert!(
+            (v["operative_c"].as_f64().unwrap() - to).abs() < 1e-4,
+            "{v}"
+        );
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("in.csv");
+    std::fs::write(
+        &csv,
+        "ta,tr,v,rh,met,clo\n22,22,0.04,60,1.2,0.5\n27,27,oops,60,1.2,0.5\n",
+    )
+    .unwrap();
+    fails_with(
+        &["comfort", "--csv", csv.to_str().unwrap()],
+        "in.csv:3: column v is not a number",
+    );
+}
+
+#[test]
+fn mrt_of_a_person_and_plane_radiant_temperatures_at_a_point() {
+    // comfort-person.md, worked example A: a 5 × 4 × 2.7 m room, ceiling 35 °C, the rest 20 °C.
+    let dir = tempfile::tempdir().unwrap();
+    let scene = edited_example(dir.path(), "a.json", |v| {
+        let box_ = |x: [f64; 3]| serde_json::json!(x);
+        let (sx, sy, sz) = (5.0, 4.0, 2.7);
+        let surf = |id: &str, kind: &str, t: f64, p: [[f64; 3]; 4]| {
+            serde_json::json!({"id": id, "kind": kind, "temperature_c": t,
+                "polygon": p.iter().map(|x| box_(*x)).collect::<Vec<_>>()})
+        };
+        v["surfaces"] = serde_json::json!([
+            surf(
+                "floor",
+                "floor",
+                20.0,
+                [[0., 0., 0.], [sx, 0., 0.], [sx, sy, 0.], [0., sy, 0.]]
+            ),
+            surf(
+                "ceiling",
+                "ceiling",
+                35.0,
+                [[0., 0., sz], [sx, 0., sz], [sx, sy, sz], [0., sy, sz]]
+            ),
+            surf(
+                "s",
+                "wall",
+                20.0,
+                [[0., 0., 0.], [sx, 0., 0.], [sx, 0., sz], [0., 0., sz]]
+            ),
+            surf(
+                "e",
+                "wall",
+                20.0,
+                [[sx, 0., 0.], [sx, sy, 0.], [sx, sy, sz], [sx, 0., sz]]
+            ),
+            surf(
+                "n",
+                "wall",
+                20.0,
+                [[sx, sy, 0.], [0., sy, 0.], [0., sy, sz], [sx, sy, sz]]
+            ),
+            surf(
+                "w",
+                "wall",
+                20.0,
+                [[0., sy, 0.], [0., 0., 0.], [0., 0., sz], [0., sy, sz]]
+            ),
+        ]);
+        v["occluders"] = serde_json::json!([]);
+    });
+    let v = ok_json(&[
+        "mrt",
+        "--scene",
+        &scene,
+        "--at",
+        "2.5,2,0.6",
+        "--person",
+        "seated",
+        "--rays",
+        "400000",
+        "--plane",
+        "--json",
+    ]);
+    let person = &v["persons"][0];
+    assert!(
+        (person["mrt_c"].as_f64().unwrap() - 22.495).abs() < 0.01,
+        "{person}"
+    );
+    let plane = &v["planes"][0];
+    assert!(
+        (plane["faces"][0][1].as_f64().unwrap() - 28.975).abs() < 0.01,
+        "{plane}"
+    );
+    assert!((plane["vertical_k"].as_f64().unwrap() - 8.975).abs() < 0.01);
+    assert_eq!(plane["vertical"]["kind"], "warm_ceiling");
+    assert_eq!(plane["vertical"]["category"], "Outside");
+    let facing = ok_json(&[
+        "mrt",
+        "--scene",
+        &scene,
+        "--at",
+        "2.5,2,0.6",
+        "--person",
+        "seated",
+        "--facing",
+        "0",
+        "--rays",
+        "400000",
+        "--json",
+    ]);
+    assert!((facing["persons"][0]["mrt_c"].as_f64().unwrap() - 22.490).abs() < 0.01);
+    let text = crate::ok(&["mrt", "--scene", &scene, "--at", "2.5,2,0.6", "--plane"]);
+    assert!(
+        text.contains("vertical asymmetry   8.97 K (warm ceiling): 16.3 % dissatisfied, ISO 7730 category outside C"),
+        "{text}"
+    );
+    fails_with(
+        &[
+            "mrt", "--scene", &scene, "--at", "9,2,0.6", "--person", "standing",
+        ],
+        "outside the walls",
+    );
+}
+
+#[test]
+fn map_draws_a_persons_comfort_beside_the_mrt() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("m");
+    fails_with(
+        &["map", "--quantity", "pmv", "--out", out.to_str().unwrap()],
+        "need the air temperature",
+    );
+    let cfg = dir.path().join("p.toml");
+    std::fs::write(&cfg, "[air]\ntemperature_c = 21.0\n[comfort]\nclo = 1.0\n").unwrap();
+    let text = crate::ok(&[
+        "map",
+        "--config",
+        cfg.to_str().unwrap(),
+        "--quantity",
+        "mrt_seated",
+        "--quantity",
+        "pmv",
+        "--quantity",
+        "asymmetry",
+        "--grid",
+        "8x6",
+        "--rays",
+        "4000",
+        "--mark",
+        "W=3.9,1.8",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(text.contains("floor by ISO 7730 PMV category"), "{text}");
+    for f in [
+        "mrt_seated.png",
+        "pmv.svg",
+        "asymmetry.csv",
+        "comfort.json",
+        "mrt_map.png",
+    ] {
+        assert!(out.join(f).exists(), "{f}");
+    }
+    let c: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("comfort.json")).unwrap()).unwrap();
+    let share: f64 = c["pmv_category_share"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .sum();
+    assert!((share - 1.0).abs() < 1e-9, "{c}");
+    assert_eq!(c["nodes"].as_u64().unwrap(), 48);
+    // By the cold window a seated person is cooler than in the middle of the room.
+    let csv = std::fs::read_to_string(out.join("mrt_seated.csv")).unwrap();
+    let by_x: Vec<(f64, f64)> = csv
+        .lines()
+        .skip(1)
+        .filter_map(|l| {
+            let c: Vec<&str> = l.split(',').collect();
+            Some((c[0].parse().ok()?, c[2].parse().ok()?))
+        })
+        .collect();
+    let near = by_x
+        .iter()
+        .filter(|(x, _)| *x > 3.8)
+        .map(|v| v.1)
+        .fold(f64::INFINITY, f64::min);
+    let middle = by_x
+        .iter()
+        .filter(|(x, _)| (*x - 2.0).abs() < 0.4)
+        .map(|v| v.1)
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert!(near < middle - 0.5, "window {near}, middle {middle}");
+    assert!(c["marks"][0][1]["thermal"]["pmv"].as_f64().unwrap() < 0.0);
+}

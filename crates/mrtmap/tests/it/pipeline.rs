@@ -179,8 +179,19 @@ fn report_numbers_match_the_csv_and_it_renders() {
         "10x8",
         "--mark",
         "P=0.2,0.5,1.0",
+        "--quantity",
+        "mrt_seated",
+        "--quantity",
+        "pmv",
+        "--air-c",
+        "21",
     ]);
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    // A person's comfort: its maps, the floor by category, the marked point's values.
+    assert!(html.contains("<h2>Comfort of a person</h2>"));
+    assert!(html.contains("floor by ISO 7730 PMV category"));
+    assert!(html.contains("<h3>PMV (ISO 7730) of a seated person"));
+    assert!(out.join("comfort/pmv.csv").exists() && out.join("comfort/comfort.json").exists());
     assert!(
         html.contains("data:image/png;base64,") && !html.contains("src=\"map-"),
         "images are embedded"

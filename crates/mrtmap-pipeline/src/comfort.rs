@@ -1,0 +1,529 @@
+//! Comfort for a person: the person's MRT, radiant asymmetry, operative temperature and PMV/PPD
+//! at points and over the floor grid, written as one map (PNG, SVG, CSV) per quantity and
+//! `comfort.json` (the share of the floor in each ISO 7730 category, the worst asymmetry and
+//! where, the values at the marked points).
+//!
+//! PMV/PPD: ISO 7730:2005 (Fanger; the variant of pythermalcomfort's `pmv_ppd_iso`), with the
+//! relative air speed vr = v + 0.3 (met − 1) for met > 1 (ISO 7730 / pythermalcomfort
+//! `v_relative`) and the clothing insulation as given (no dynamic correction). Operative
+//! temperature: ISO 7726, (ta √(10 v) + tr) / (1 + √(10 v)), with the person's tr. Standard errors
+//! follow the person's MRT error through each formula (numerical derivative).
+
+use std::path::Path;
+
+use mrtmap_geometry::nalgebra::Point2;
+use mrtmap_physics::{
+    Category, OperativeMethod, PmvInputs, Posture, Temperature, operative_temperature, pmv_ppd,
+};
+use mrtmap_radiation::{
+    AsymmetryVerdict, GridSpec, MapFrame, MrtEngine, MrtError, MrtField, RadiantAsymmetry,
+    RadiantScene,
+};
+use mrtmap_report::{MapInput, MapMark, MapQuantity, render_png, render_svg};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::cache::write_json;
+use crate::error::{Error, Result};
+use crate::settings::{AirSection, ComfortSection, Quantity};
+
+/// The relative air speed ISO 7730 uses: v + 0.3 (met − 1) for met > 1.
+pub fn relative_air_speed(v: f64, met: f64) -> f64 {
+    if met > 1.0 { v + 0.3 * (met - 1.0) } else { v }
+}
+
+/// The air around a person and what they wear and do.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Air {
+    /// Air temperature at the body centre (°C).
+    pub temperature_c: f64,
+    /// Air speed (m/s).
+    pub speed_m_s: f64,
+    /// Relative humidity (%).
+    pub relative_humidity_pct: f64,
+    /// Metabolic rate (met).
+    pub met: f64,
+    /// Clothing (clo).
+    pub clo: f64,
+}
+
+/// Operative temperature, PMV and PPD from air and a radiant temperature, each with the standard
+/// error that `tr_se_k` causes.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Thermal {
+    /// Operative temperature (°C).
+    pub operative_c: f64,
+    /// Its standard error (K).
+    pub operative_se_k: f64,
+    /// PMV.
+    pub pmv: f64,
+    /// Its standard error.
+    pub pmv_se: f64,
+    /// PPD (%).
+    pub ppd_pct: f64,
+    /// Its standard error (%).
+    pub ppd_se_pct: f64,
+    /// Whether the inputs lie within ISO 7730's ranges.
+    pub within_iso_ranges: bool,
+    /// ISO 7730 category of the PMV.
+    pub category: Category,
+}
+
+/// Operative temperature and PMV/PPD of a person at mean radiant temperature `tr_c` ± `tr_se_k`.
+pub fn thermal(air: &Air, tr_c: f64, tr_se_k: f64) -> std::result::Result<Thermal, String> {
+    let c = Temperature::from_celsius;
+    let vr = relative_air_speed(air.speed_m_s, air.met);
+    let pmv_at = |tr: f64| {
+        pmv_ppd(&PmvInputs {
+            air: c(air.temperature_c),
+            mrt: c(tr),
+            relative_air_speed_m_s: vr,
+            relative_humidity_pct: air.relative_humidity_pct,
+            met: air.met,
+            clo: air.clo,
+            external_work_met: 0.0,
+        })
+        .map_err(|e| e.to_string())
+    };
+    let to = |tr: f64| {
+        operative_temperature(
+            c(air.temperature_c),
+            c(tr),
+            air.speed_m_s,
+            OperativeMethod::Iso,
+        )
+        .map(|t| t.celsius())
+        .map_err(|e| e.to_string())
+    };
+    let h = 0.01;
+    let (p, p_hi, p_lo) = (pmv_at(tr_c)?, pmv_at(tr_c + h)?, pmv_at(tr_c - h)?);
+    let (o, o_hi) = (to(tr_c)?, to(tr_c + h)?);
+    Ok(Thermal {
+        operative_c: o,
+        operative_se_k: ((o_hi - o) / h).abs() * tr_se_k,
+        pmv: p.pmv,
+        pmv_se: ((p_hi.pmv - p_lo.pmv) / (2.0 * h)).abs() * tr_se_k,
+        ppd_pct: p.ppd_pct,
+        ppd_se_pct: ((p_hi.ppd_pct - p_lo.ppd_pct) / (2.0 * h)).abs() * tr_se_k,
+        within_iso_ranges: p.within_iso_ranges,
+        category: Category::of_pmv(p.pmv),
+    })
+}
+
+/// A person's comfort at one place on the floor.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ComfortPoint {
+    /// Map coordinates (m).
+    pub xy: [f64; 2],
+    /// Posture.
+    pub posture: Posture,
+    /// The seated person's MRT (°C) and its standard error (K), when asked for.
+    pub mrt_seated: Option<(f64, f64)>,
+    /// The standing person's MRT (°C) and its standard error (K), when asked for.
+    pub mrt_standing: Option<(f64, f64)>,
+    /// Radiant asymmetry at the abdomen of the posture: vertical (signed, K), horizontal (K),
+    /// and the worse of the two as ISO 7730 judges it.
+    pub asymmetry: Option<AsymmetrySummary>,
+    /// Operative temperature, PMV, PPD (with the air given).
+    pub thermal: Option<Thermal>,
+}
+
+/// Radiant asymmetry at a point, for files.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AsymmetrySummary {
+    /// Up-facing minus down-facing plane radiant temperature (K).
+    pub vertical_k: f64,
+    /// The largest difference between opposite horizontal faces (K).
+    pub horizontal_k: f64,
+    /// The warmer horizontal face's direction (degrees from +x towards +y).
+    pub horizontal_warm_azimuth_deg: f64,
+    /// The worse verdict (higher PD).
+    pub worst: AsymmetryVerdict,
+    /// Its standard error (K), from the plane radiant temperatures'.
+    pub std_error_k: f64,
+}
+
+impl AsymmetrySummary {
+    fn of(a: &RadiantAsymmetry) -> Self {
+        let se =
+            a.six.iter().map(|t| t.std_error_k).fold(0.0f64, f64::max) * std::f64::consts::SQRT_2;
+        Self {
+            vertical_k: a.vertical_k,
+            horizontal_k: a.horizontal_k,
+            horizontal_warm_azimuth_deg: a.horizontal_warm_azimuth_deg,
+            worst: a.worst(),
+            std_error_k: se,
+        }
+    }
+}
+
+/// What to compute: the person's quantities of `quantities`.
+fn wants(quantities: &[Quantity], q: Quantity) -> bool {
+    quantities.contains(&q)
+}
+
+/// The person's quantities at map coordinates `xy` (`stream` selects the random streams).
+pub fn comfort_at(
+    engine: &MrtEngine<'_>,
+    frame: &MapFrame,
+    xy: Point2<f64>,
+    c: &ComfortSection,
+    air: &AirSection,
+    quantities: &[Quantity],
+    stream: u64,
+) -> std::result::Result<ComfortPoint, MrtError> {
+    let facing = c.facing();
+    let person = |posture: Posture| {
+        let centre = frame.point(&xy, posture.centre_height_m());
+        engine
+            .person_at(&centre, posture, facing, stream)
+            .map(|p| (p.mrt.celsius(), p.std_error_k))
+    };
+    let seated = (wants(quantities, Quantity::MrtSeated)
+        || (c.posture == Posture::Seated && quantities.iter().any(|q| q.needs_air())))
+    .then(|| person(Posture::Seated))
+    .transpose()?;
+    let standing = (wants(quantities, Quantity::MrtStanding)
+        || (c.posture == Posture::Standing && quantities.iter().any(|q| q.needs_air())))
+    .then(|| person(Posture::Standing))
+    .transpose()?;
+    let asymmetry = wants(quantities, Quantity::Asymmetry)
+        .then(|| {
+            let p = frame.point(&xy, c.posture.abdomen_height_m());
+            engine
+                .asymmetry_at(&p, stream)
+                .map(|a| AsymmetrySummary::of(&a))
+        })
+        .transpose()?;
+    let own = match c.posture {
+        Posture::Seated => seated,
+        Posture::Standing => standing,
+    };
+    let thermal = match (own, c.air_at(air, c.posture.centre_height_m())) {
+        (Some((tr, se)), Some(ta)) if quantities.iter().any(|q| q.needs_air()) => {
+            let a = Air {
+                temperature_c: ta,
+                speed_m_s: c.air_speed(air),
+                relative_humidity_pct: c.relative_humidity_pct,
+                met: c.met,
+                clo: c.clo,
+            };
+            thermal(&a, tr, se).ok()
+        }
+        _ => None,
+    };
+    Ok(ComfortPoint {
+        xy: [xy.x, xy.y],
+        posture: c.posture,
+        mrt_seated: seated,
+        mrt_standing: standing,
+        asymmetry,
+        thermal,
+    })
+}
+
+/// One quantity's value and standard error at a point, when computed.
+pub fn value_of(p: &ComfortPoint, q: Quantity) -> Option<(f64, f64)> {
+    match q {
+        Quantity::Mrt => None,
+        Quantity::MrtSeated => p.mrt_seated,
+        Quantity::MrtStanding => p.mrt_standing,
+        Quantity::Asymmetry => p.asymmetry.map(|a| (a.worst.delta_k, a.std_error_k)),
+        Quantity::Operative => p.thermal.map(|t| (t.operative_c, t.operative_se_k)),
+        Quantity::Pmv => p.thermal.map(|t| (t.pmv, t.pmv_se)),
+        Quantity::Ppd => p.thermal.map(|t| (t.ppd_pct, t.ppd_se_pct)),
+    }
+}
+
+/// The title of a quantity's map.
+pub fn comfort_title(q: Quantity, c: &ComfortSection) -> String {
+    title_of(q, c).0
+}
+
+/// Title and unit of a quantity's map.
+fn title_of(q: Quantity, c: &ComfortSection) -> (String, &'static str) {
+    let who = |p: Posture| {
+        format!(
+            "a {} person (body centre {:.1} m), {}",
+            p.as_str(),
+            p.centre_height_m(),
+            match c.facing_deg {
+                Some(a) => format!("facing {a}°"),
+                None => "any direction".into(),
+            }
+        )
+    };
+    match q {
+        Quantity::Mrt => ("Mean radiant temperature (°C)".into(), "°C"),
+        Quantity::MrtSeated => (format!("MRT of {} (°C)", who(Posture::Seated)), "°C"),
+        Quantity::MrtStanding => (format!("MRT of {} (°C)", who(Posture::Standing)), "°C"),
+        Quantity::Asymmetry => (
+            format!(
+                "Worst radiant asymmetry at {:.1} m, {} (K)",
+                c.posture.abdomen_height_m(),
+                c.posture.as_str()
+            ),
+            "K",
+        ),
+        Quantity::Operative => (
+            format!("Operative temperature of {} (°C)", who(c.posture)),
+            "°C",
+        ),
+        Quantity::Pmv => (format!("PMV (ISO 7730) of {}", who(c.posture)), "PMV"),
+        Quantity::Ppd => (format!("PPD (ISO 7730) of {} (%)", who(c.posture)), "%"),
+    }
+}
+
+/// A node of the comfort grid.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ComfortNode {
+    /// Grid indices.
+    pub i: usize,
+    /// Grid indices.
+    pub j: usize,
+    /// The values, or why not.
+    pub point: std::result::Result<ComfortPoint, String>,
+}
+
+/// `comfort.json`: what the comfort maps say as a whole.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ComfortSummary {
+    /// The person.
+    pub comfort: ComfortSection,
+    /// The PMV/PPD variant.
+    pub pmv_model: String,
+    /// Quantities mapped.
+    pub quantities: Vec<Quantity>,
+    /// Nodes computed and refused.
+    pub nodes: usize,
+    /// Nodes that could not be computed (inside furniture…).
+    pub skipped: usize,
+    /// Share of the computed floor in each ISO 7730 PMV category (A, B, C, outside), when PMV was
+    /// computed.
+    pub pmv_category_share: Option<[f64; 4]>,
+    /// Share of the computed floor in each radiant-asymmetry category (A/B, C, outside).
+    pub asymmetry_category_share: Option<[f64; 3]>,
+    /// The worst asymmetry on the grid and where (map x, y).
+    pub worst_asymmetry: Option<(AsymmetrySummary, [f64; 2])>,
+    /// The marked points' values.
+    pub marks: Vec<(String, ComfortPoint)>,
+    /// Seconds to compute.
+    pub compute_secs: f64,
+}
+
+/// The PMV/PPD variant, in words.
+pub const PMV_MODEL: &str = "ISO 7730:2005 (Fanger), as pythermalcomfort pmv_ppd_iso; vr = v + 0.3 (met − 1) above 1 met; clo as given";
+
+/// A comfort map set computed and written.
+pub struct ComfortOutput {
+    /// The summary (also comfort.json).
+    pub summary: ComfortSummary,
+    /// (quantity, title, PNG) per map.
+    pub maps: Vec<(Quantity, String, Vec<u8>)>,
+}
+
+/// Computes the person's quantities of `quantities` over the floor grid and at `marks` (map x, y
+/// with names), writing `<quantity>.csv`, `.png`, `.svg` and `comfort.json` into `out`.
+#[allow(clippy::too_many_arguments)]
+pub fn make_comfort_maps(
+    engine: &MrtEngine<'_>,
+    scene: &RadiantScene,
+    source: &str,
+    (grid, margin_m): ([usize; 2], f64),
+    c: &ComfortSection,
+    air: &AirSection,
+    quantities: &[Quantity],
+    marks: &[(String, [f64; 2])],
+    out: &Path,
+) -> Result<ComfortOutput> {
+    let frame = MapFrame::of_scene(scene).map_err(|e| Error::Map {
+        scene: source.to_string(),
+        source: e,
+    })?;
+    let person: Vec<Quantity> = quantities
+        .iter()
+        .copied()
+        .filter(|q| *q != Quantity::Mrt)
+        .collect();
+    let spec = GridSpec {
+        nx: grid[0],
+        ny: grid[1],
+        height_m: c.posture.centre_height_m(),
+        margin_m,
+    };
+    let layout = MrtField::layout(&frame, &spec, engine.bounds())?;
+    for (name, xy) in marks {
+        let p = frame.point(&Point2::new(xy[0], xy[1]), spec.height_m);
+        engine.check_inside(&p).map_err(|source| Error::Point {
+            name: name.clone(),
+            source,
+        })?;
+    }
+    let t0 = std::time::Instant::now();
+    let nodes: Vec<ComfortNode> = layout
+        .places
+        .par_iter()
+        .map(|&(i, j, uv)| ComfortNode {
+            i,
+            j,
+            point: comfort_at(
+                engine,
+                &frame,
+                uv,
+                c,
+                air,
+                &person,
+                (j * grid[0] + i) as u64,
+            )
+            .map_err(|e| e.to_string()),
+        })
+        .collect();
+    let mark_values = marks
+        .iter()
+        .enumerate()
+        .map(|(k, (name, xy))| {
+            comfort_at(
+                engine,
+                &frame,
+                Point2::new(xy[0], xy[1]),
+                c,
+                air,
+                &person,
+                (grid[0] * grid[1] + k) as u64,
+            )
+            .map(|p| (name.clone(), p))
+            .map_err(|source| Error::Point {
+                name: name.clone(),
+                source,
+            })
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let secs = t0.elapsed().as_secs_f64();
+    let field = MrtField {
+        frame,
+        spec,
+        u: layout.u,
+        v: layout.v,
+        nodes: Vec::new(),
+    };
+    let map_marks: Vec<MapMark> = marks
+        .iter()
+        .map(|(name, xy)| MapMark {
+            name: name.clone(),
+            uv: Point2::new(xy[0], xy[1]),
+        })
+        .collect();
+    let mut maps = Vec::new();
+    for &q in &person {
+        let (title, unit) = title_of(q, c);
+        let values: Vec<(usize, usize, f64)> = nodes
+            .iter()
+            .filter_map(|n| {
+                let v = value_of(n.point.as_ref().ok()?, q)?;
+                Some((n.i, n.j, v.0))
+            })
+            .collect();
+        let input = MapInput {
+            field: &field,
+            scene,
+            marks: &map_marks,
+            subtitle: format!(
+                "{source}; {}×{} grid; {} person rays per point",
+                grid[0],
+                grid[1],
+                engine.ray_settings().rays
+            ),
+            quantity: Some(MapQuantity {
+                title: title.clone(),
+                unit: unit.into(),
+                values,
+            }),
+        };
+        let png = render_png(&input)?;
+        mrtmap_io::write_atomic(&out.join(format!("{}.png", q.name())), &png)?;
+        mrtmap_io::write_atomic(
+            &out.join(format!("{}.svg", q.name())),
+            render_svg(&input)?.as_bytes(),
+        )?;
+        mrtmap_io::write_atomic(
+            &out.join(format!("{}.csv", q.name())),
+            quantity_csv(&field, &nodes, q).as_bytes(),
+        )?;
+        maps.push((q, title, png));
+    }
+    let summary = summarise(&nodes, c, &person, mark_values, secs);
+    write_json(&out.join("comfort.json"), &summary)?;
+    Ok(ComfortOutput { summary, maps })
+}
+
+/// One quantity over the grid as CSV: x, y, value, standard error, i, j, note.
+fn quantity_csv(field: &MrtField, nodes: &[ComfortNode], q: Quantity) -> String {
+    let mut s = format!("x,y,{},std_error,i,j,note\n", q.name());
+    for n in nodes {
+        let (x, y) = (field.u[n.i], field.v[n.j]);
+        let line = match n.point.as_ref().map(|p| value_of(p, q)) {
+            Ok(Some((v, e))) => format!("{x:.4},{y:.4},{v:.4},{e:.4},{},{},\n", n.i, n.j),
+            Ok(None) => format!("{x:.4},{y:.4},,,{},{},\"not computed\"\n", n.i, n.j),
+            Err(e) => format!(
+                "{x:.4},{y:.4},,,{},{},\"{}\"\n",
+                n.i,
+                n.j,
+                e.replace('"', "'")
+            ),
+        };
+        s.push_str(&line);
+    }
+    s
+}
+
+fn summarise(
+    nodes: &[ComfortNode],
+    c: &ComfortSection,
+    quantities: &[Quantity],
+    marks: Vec<(String, ComfortPoint)>,
+    compute_secs: f64,
+) -> ComfortSummary {
+    let ok: Vec<&ComfortPoint> = nodes.iter().filter_map(|n| n.point.as_ref().ok()).collect();
+    let n = ok.len().max(1) as f64;
+    let pmv_category_share = ok.iter().all(|p| p.thermal.is_some()).then(|| {
+        let mut share = [0.0; 4];
+        for p in &ok {
+            if let Some(t) = p.thermal {
+                share[t.category as usize] += 1.0 / n;
+            }
+        }
+        share
+    });
+    let asym: Vec<(AsymmetrySummary, [f64; 2])> = ok
+        .iter()
+        .filter_map(|p| p.asymmetry.map(|a| (a, p.xy)))
+        .collect();
+    let asymmetry_category_share = (!asym.is_empty()).then(|| {
+        let mut share = [0.0; 3];
+        for (a, _) in &asym {
+            let k = match a.worst.category {
+                Category::A | Category::B => 0,
+                Category::C => 1,
+                Category::Outside => 2,
+            };
+            share[k] += 1.0 / asym.len() as f64;
+        }
+        share
+    });
+    let worst_asymmetry = asym
+        .iter()
+        .max_by(|a, b| a.0.worst.pd_pct.total_cmp(&b.0.worst.pd_pct))
+        .copied();
+    ComfortSummary {
+        comfort: c.clone(),
+        pmv_model: PMV_MODEL.into(),
+        quantities: quantities.to_vec(),
+        nodes: ok.len(),
+        skipped: nodes.len() - ok.len(),
+        pmv_category_share,
+        asymmetry_category_share,
+        worst_asymmetry,
+        marks,
+        compute_secs,
+    }
+}
