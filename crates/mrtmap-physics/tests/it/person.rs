@@ -196,3 +196,29 @@ fn iso_7730_table_d1_rows_7_to_13() {
         );
     }
 }
+
+/// comfort-person.md §1 closure table and worked example A by the fit: room 5 × 4 × 2.7 m, a seated
+/// person at (2.5, 2.0, 0.6); ceiling 35 °C, the rest 20 °C → 22.357 °C (normalised).
+#[test]
+fn the_fit_in_a_box_room() {
+    let fit = |o, u, v, c| angle_factor_fit_rect(Seated, o, u, v, c).unwrap();
+    let wall_x = fit(Vertical, (-2.0, 2.0), (-0.6, 2.1), 2.5);
+    let wall_y = fit(Vertical, (-2.5, 2.5), (-0.6, 2.1), 2.0);
+    let floor = fit(Horizontal, (-2.5, 2.5), (-2.0, 2.0), 0.6);
+    let ceiling = fit(Horizontal, (-2.5, 2.5), (-2.0, 2.0), 2.1);
+    for (got, want, what) in [
+        (wall_x, 0.0950, "wall ⊥x"),
+        (wall_y, 0.1390, "wall ⊥y"),
+        (floor, 0.3690, "floor"),
+        (ceiling, 0.1447, "ceiling"),
+        (2.0 * wall_x + 2.0 * wall_y + floor + ceiling, 0.9817, "sum"),
+    ] {
+        assert!((got - want).abs() <= 5e-5, "{what}: {got}");
+    }
+    let t4 = |c: f64| Temperature::from_celsius(c).fourth_power();
+    let sum = 2.0 * wall_x + 2.0 * wall_y + floor + ceiling;
+    let mrt = Temperature::from_fourth_power(
+        ((2.0 * wall_x + 2.0 * wall_y + floor) * t4(20.0) + ceiling * t4(35.0)) / sum,
+    );
+    assert!((mrt.celsius() - 22.357).abs() < 0.01, "{}", mrt.celsius());
+}
