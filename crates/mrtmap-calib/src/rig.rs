@@ -24,6 +24,7 @@ pub fn updated_rig(r: &StereoResult, existing: Option<&Rig>) -> Rig {
         depth_scale: existing.map_or(1000.0, |e| e.depth_scale),
         thermal: r.thermal,
         thermal_encoding: existing.map_or(ThermalEncoding::Centikelvin, |e| e.thermal_encoding),
+        thermal_accuracy_k: existing.and_then(|e| e.thermal_accuracy_k),
         depth_from_thermal: depth_from_rgb * r.rgb_from_thermal,
         rgb: Some(RgbCamera {
             camera: r.rgb,

@@ -9,7 +9,7 @@ use mrtmap_physics::{
 };
 use mrtmap_radiation::{Method, MonteCarlo, MrtEngine, RadiantScene};
 use mrtmap_report::ComparisonRow;
-use mrtmap_sim::{NoiseLevel, SimConfig, Truth, simulate};
+use mrtmap_sim::{NoiseLevel, RadiometricModel, SimConfig, Truth, simulate};
 use serde::Serialize;
 
 use crate::cache::{Fingerprint, Stage, StageOutcome, read_json, run_or_reuse, write_json};
@@ -40,6 +40,10 @@ pub struct DemoSettings {
     pub air_speed_m_s: f64,
     /// Depth image size.
     pub depth_size: (usize, usize),
+    /// The thermal camera's radiometric errors.
+    pub radiometric: RadiometricModel,
+    /// Contact-thermometer readings written to references.csv.
+    pub references: usize,
     /// Rerun every stage.
     pub force: bool,
 }
@@ -86,6 +90,8 @@ fn simulate_stage(
         seconds: s.seconds,
         seed: s.seed,
         noise: s.noise,
+        radiometric: s.radiometric,
+        references: s.references,
         ..SimConfig::default()
     };
     set_depth_size(&mut cfg, s.depth_size)?;
@@ -94,7 +100,9 @@ fn simulate_stage(
         .setting("seconds", &s.seconds)
         .setting("seed", &s.seed)
         .setting("noise", &s.noise)
-        .setting("depth_size", &s.depth_size);
+        .setting("depth_size", &s.depth_size)
+        .setting("radiometric", &s.radiometric)
+        .setting("references", &s.references);
     let stage = Stage {
         name: "simulate".into(),
         stamp: out.join("simulate.json"),

@@ -41,6 +41,7 @@ pub mod comfort;
 mod conversion;
 pub mod demo;
 mod error;
+pub mod level;
 pub mod maps;
 pub mod progress;
 pub mod report;

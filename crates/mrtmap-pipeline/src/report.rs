@@ -15,9 +15,10 @@ use crate::run::{ComfortResult, RunOutcome};
 use crate::settings::Project;
 
 /// What ± covers, in words.
-const WHAT_PLUS_MINUS_COVERS: &str = "view-factor sampling and the fused surface temperatures' random error; not the \
-     thermal camera's absolute accuracy (a common offset passes one to one into MRT), \
-     emissivity, or the room's geometry: check against a black globe (mrtmap validate)";
+const WHAT_PLUS_MINUS_COVERS: &str = "view-factor sampling, the fused surface temperatures' random error and the \
+     uncertainty of their common level (the references' fit, or the camera's stated accuracy: a \
+     common offset passes one to one into MRT); not emissivity or the room's geometry: check \
+     against a black globe (mrtmap validate)";
 
 fn surface_rows(s: &SegmentReport) -> Vec<[String; 6]> {
     s.surfaces
@@ -261,6 +262,69 @@ fn asymmetry_words(k: mrtmap_physics::AsymmetryKind) -> &'static str {
     }
 }
 
+/// "What the temperatures rest on": the level and the self-calibration; the references table.
+#[allow(clippy::type_complexity)]
+fn level_rows(o: &RunOutcome) -> (KeyValues, Vec<[String; 5]>) {
+    let mut rows: KeyValues = Vec::new();
+    let mut refs = Vec::new();
+    if let Some(l) = &o.level {
+        let text = if l.basis == "camera" {
+            format!(
+                "the thermal camera's own level: no usable reference reading, so its stated absolute accuracy (±{:.1} K) is part of every ± (add references.csv or [[references]] to fix it)",
+                l.std_k
+            )
+        } else {
+            format!(
+                "{}: the camera read {:+.2} K at the scene's mean temperature, gain {:.3}; the level is known to ±{} K, part of every ±",
+                l.basis,
+                l.offset_at_mean_k,
+                l.beta,
+                uncertainty(l.std_k, 2)
+            )
+        };
+        rows.push(("absolute level".into(), text));
+        refs = l
+            .references
+            .iter()
+            .map(|r| {
+                [
+                    r.label.clone(),
+                    format!("{:.2}", r.reference_c),
+                    r.camera_c.map_or("not seen".into(), |c| format!("{c:.2}")),
+                    r.residual_k.map_or("—".into(), |x| format!("{x:+.2}")),
+                    if r.used {
+                        "yes".into()
+                    } else {
+                        r.note.clone().unwrap_or_else(|| "no".into())
+                    },
+                ]
+            })
+            .collect();
+    }
+    let r = &o.fusion.radiometric;
+    if r.enabled {
+        rows.push((
+            "frames' self-calibration".into(),
+            format!(
+                "{} frames got their own offset ({} kept the previous one); offsets removed {:+.2}…{:+.2} K; vignetting {:+.2} K at the corners; residual against the map {:.3} → {:.3} K rms",
+                r.frames_calibrated,
+                r.frames_carried,
+                r.offset_range_k[0],
+                r.offset_range_k[1],
+                r.vignetting_k,
+                r.residual_rms_before_k,
+                r.residual_rms_after_k
+            ),
+        ));
+    } else {
+        rows.push((
+            "frames' self-calibration".into(),
+            "off ([fuse] self_calibrate = false): each frame's offset and the vignetting stay in the temperatures".into(),
+        ));
+    }
+    (rows, refs)
+}
+
 /// When (UTC), by which mrtmap version and by which command: "on 2026-12-01 15:50 UTC by
 /// mrtmap 0.1.0: mrtmap run scan --out out".
 pub fn provenance() -> String {
@@ -324,6 +388,7 @@ pub fn report_data(o: &RunOutcome, title: &str, source: &str, p: &Project) -> Re
     let (room_frame, corners, walls) = room_rows(&o.segment);
     let (comfort, comfort_point_columns, comfort_points, comfort_maps) =
         o.comfort.as_ref().map(comfort_rows).unwrap_or_default();
+    let (level, references) = level_rows(o);
     ReportData {
         title: title.into(),
         source: source.into(),
@@ -356,6 +421,8 @@ pub fn report_data(o: &RunOutcome, title: &str, source: &str, p: &Project) -> Re
         comfort_point_columns,
         comfort_points,
         comfort_maps,
+        level,
+        references,
         ..Default::default()
     }
 }

@@ -311,6 +311,7 @@ pub fn convert(source: &Path, out: &Path, o: &SourceOptions) -> Result<Conversio
         depth_scale: o.depth_scale.unwrap_or(1000.0),
         thermal: given.thermal,
         thermal_encoding: given.thermal_encoding,
+        thermal_accuracy_k: given.thermal_accuracy_k,
         depth_from_thermal: given.depth_from_thermal,
         rgb: Some(RgbCamera {
             camera: cal.camera,

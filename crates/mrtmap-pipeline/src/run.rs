@@ -12,7 +12,7 @@
 
 use std::path::Path;
 
-use mrtmap_geometry::nalgebra::Point3;
+use mrtmap_geometry::nalgebra::{Isometry3, Point3};
 use mrtmap_io::{Recording, Trajectory, read_cloud_ply, write_atomic, write_cloud_ply};
 use mrtmap_radiation::{GridSpec, RadiantScene};
 use mrtmap_scan::segment::{MaskInput, SegmentParams, SegmentReport, refined_poses, segment};
@@ -21,6 +21,7 @@ use mrtmap_scan::{FuseParams, FusionReport, fuse};
 use crate::cache::{Fingerprint, Stage, StageOutcome, read_json, run_or_reuse, write_json};
 use crate::comfort::{ComfortSummary, comfort_title, make_comfort_maps};
 use crate::error::{Error, Result};
+use crate::level::{DEFAULT_CAMERA_ACCURACY_K, Level, Reference, find_level, read_references};
 use crate::maps::{Mark, MarkAt, Summary, make_map};
 use crate::progress::Progress;
 use crate::settings::{PointEntry, PointFrame, Project, Quantity};
@@ -54,12 +55,79 @@ pub fn fuse_into(
     Ok(fused.report)
 }
 
-/// Segments the fusion in `fused` (cloud.ply, poses.txt) into `out`: scene.json, segments.ply and
-/// segment.json. Features are labelled by the masks of `masks` when given.
+/// What fixes the temperatures' absolute level: reference readings and the camera's accuracy.
+#[derive(Clone, Debug, Default)]
+pub struct LevelInputs {
+    /// Contact-thermometer readings (references.csv and `[[references]]`).
+    pub references: Vec<Reference>,
+    /// The camera's stated absolute accuracy (K), used when no reading is usable.
+    pub camera_accuracy_k: f64,
+}
+
+impl LevelInputs {
+    /// The recording's references.csv (when present) and the project's `[[references]]`.
+    pub fn of(rec: &Recording, p: &Project) -> Result<Self> {
+        let csv = rec.dir.join("references.csv");
+        let mut references = if csv.exists() {
+            read_references(&csv)?
+        } else {
+            Vec::new()
+        };
+        references.extend(p.references.iter().cloned());
+        Ok(Self {
+            references,
+            camera_accuracy_k: rec
+                .rig
+                .thermal_accuracy_k
+                .unwrap_or(DEFAULT_CAMERA_ACCURACY_K),
+        })
+    }
+}
+
+/// The scene's temperatures carried to the level: (T − α)/β, uncertainties scaled by 1/β, and
+/// the level's uncertainty recorded.
+fn apply_level(scene: &mut RadiantScene, level: &Level) {
+    let fix = |t: &mut mrtmap_physics::Temperature| {
+        *t = mrtmap_physics::Temperature::from_celsius(level.correct(t.celsius()));
+    };
+    let scale = |s: &mut Option<f64>| {
+        if let Some(v) = s {
+            *v /= level.beta.abs();
+        }
+    };
+    for s in &mut scene.surfaces {
+        fix(&mut s.temperature);
+        scale(&mut s.temperature_std_k);
+        for f in &mut s.features {
+            fix(&mut f.temperature);
+            scale(&mut f.temperature_std_k);
+        }
+    }
+    for o in &mut scene.occluders {
+        fix(&mut o.temperature);
+    }
+    scene.temperature_level_std_k = level.std_k;
+}
+
+/// The area-weighted mean temperature of a scene's surfaces (°C).
+fn mean_temperature_c(scene: &RadiantScene) -> f64 {
+    let (mut a, mut t) = (0.0, 0.0);
+    for s in &scene.surfaces {
+        let area = mrtmap_geometry::polygon::area_3d(&s.polygon);
+        a += area;
+        t += area * s.temperature.celsius();
+    }
+    if a > 0.0 { t / a } else { 20.0 }
+}
+
+/// Segments the fusion in `fused` (cloud.ply, poses.txt) into `out`: scene.json, segments.ply,
+/// segment.json and level.json. Features are labelled by the masks of `masks` when given; the
+/// temperatures are carried to the level the references of `level` fix.
 pub fn segment_into(
     fused: &Path,
     masks: Option<&Recording>,
     params: &SegmentParams,
+    level: &LevelInputs,
     out: &Path,
 ) -> Result<SegmentReport> {
     let cloud_path = fused.join("cloud.ply");
@@ -70,12 +138,26 @@ pub fn segment_into(
         recording: r,
         world_from_depth: f,
     });
-    let seg = segment(&cloud, &poses.poses, mask_input.as_ref(), params).map_err(|source| {
+    let mut seg = segment(&cloud, &poses.poses, mask_input.as_ref(), params).map_err(|source| {
         Error::Segment {
             cloud: cloud_path.clone(),
             source,
         }
     })?;
+    let world_from_room = seg
+        .report
+        .world_from_room
+        .to_isometry()
+        .unwrap_or_else(Isometry3::identity);
+    let found = find_level(
+        &level.references,
+        &cloud,
+        &world_from_room,
+        mean_temperature_c(&seg.scene),
+        level.camera_accuracy_k,
+    );
+    apply_level(&mut seg.scene, &found);
+    write_json(&out.join("level.json"), &found)?;
     write_atomic(
         &out.join("scene.json"),
         (seg.scene.to_json() + "\n").as_bytes(),
@@ -208,6 +290,8 @@ pub struct RunOutcome {
     pub maps: Vec<MapResult>,
     /// A person's comfort maps, when `[map] quantities` ask for them.
     pub comfort: Option<ComfortResult>,
+    /// The temperatures' absolute level (level.json).
+    pub level: Option<Level>,
     /// Warnings gathered over the stages.
     pub warnings: Vec<String>,
 }
@@ -249,17 +333,25 @@ fn segment_stage(
         .file(&fused.join("poses.txt"))
         .maybe_file(use_masks.then(|| rec.dir.join("masks.txt")).as_deref())
         .setting("segment", &p.segment)
-        .setting("room", &p.room);
+        .setting("room", &p.room)
+        .maybe_file(
+            Some(rec.dir.join("references.csv"))
+                .filter(|f| f.exists())
+                .as_deref(),
+        )
+        .setting("references", &p.references)
+        .setting("camera_accuracy_k", &rec.rig.thermal_accuracy_k);
     let stage = Stage::in_dir(
         "segment",
         &dir,
-        &["scene.json", "segment.json", "segments.ply"],
+        &["scene.json", "segment.json", "segments.ply", "level.json"],
     );
     let outcome = run_or_reuse(&stage, fingerprint, force, || {
         progress.begin("segmenting surfaces and features");
         progress.advance(0, 1);
         let masks = use_masks.then_some(rec);
-        segment_into(&fused, masks, &p.segment.params(&p.room), &dir).map(|_| ())
+        let level = LevelInputs::of(rec, p)?;
+        segment_into(&fused, masks, &p.segment.params(&p.room), &level, &dir).map(|_| ())
     })?;
     Ok((outcome, read_json(&dir.join("segment.json"))?))
 }
@@ -427,6 +519,7 @@ pub fn run(
         stages.push(st);
         maps.push(m);
     }
+    let level: Option<Level> = read_json(&out.join("segment").join("level.json")).ok();
     let comfort = match comfort_stage(&scene, out, p, force, progress)? {
         Some((st, c)) => {
             stages.push(st);
@@ -441,6 +534,7 @@ pub fn run(
         segment,
         maps,
         comfort,
+        level,
         warnings,
     })
 }

@@ -50,6 +50,7 @@ voxel_m = 0.03
 icp = true                # refine poses by ICP against the map (as the seed paper)
 sync_tolerance_ms = 20.0  # thermal frame ↔ nearest depth frame
 depth_stride = 2          # every 2nd depth pixel
+self_calibrate = true     # remove each frame's offset (FFC, drift) and the vignetting, from overlaps
 
 [segment]
 feature_threshold_k = 0.3 # a texel differing from its surface's background by more is a feature
@@ -313,6 +314,9 @@ pub struct FuseSection {
     pub sync_tolerance_ms: f64,
     /// Every N-th depth pixel in each direction.
     pub depth_stride: u32,
+    /// Estimate and remove each frame's offset (flat-field corrections, drift) and the lens's
+    /// vignetting from the frames' overlaps.
+    pub self_calibrate: bool,
 }
 
 impl Default for FuseSection {
@@ -322,6 +326,7 @@ impl Default for FuseSection {
             icp: true,
             sync_tolerance_ms: 20.0,
             depth_stride: 2,
+            self_calibrate: true,
         }
     }
 }
@@ -351,6 +356,7 @@ impl FuseSection {
         };
         p.icp.enabled = self.icp;
         p.depth.stride = self.depth_stride.max(1);
+        p.radiometric.enabled = self.self_calibrate;
         Ok(p)
     }
 }
@@ -511,6 +517,8 @@ pub struct Project {
     pub room: RoomSection,
     /// The person for comfort maps and points.
     pub comfort: ComfortSection,
+    /// Contact-thermometer readings of surface points (besides the recording's references.csv).
+    pub references: Vec<crate::level::Reference>,
     /// View factors.
     pub mrt: MrtSection,
 }

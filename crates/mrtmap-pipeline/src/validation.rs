@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use mrtmap_geometry::nalgebra::Point3;
 use mrtmap_radiation::{Method, MonteCarlo, MrtEngine, RadiantScene};
-use mrtmap_report::{ValidationRow, parse_globe_csv, validate, validation_csv};
+use mrtmap_report::{GlobeRow, ValidationRow, parse_globe_csv, validate, validation_csv};
 
 use crate::cache::write_json;
 use crate::error::{Error, Result};
@@ -20,6 +20,9 @@ pub struct Validation {
     pub scene: PathBuf,
     /// One row per globe reading.
     pub rows: Vec<ValidationRow>,
+    /// The shift given to every temperature so that the map matches the calibrating readings (K),
+    /// when some were named.
+    pub level_shift_k: Option<f64>,
 }
 
 /// The scene of a `run` output folder or of a folder holding scene.json.
@@ -35,9 +38,81 @@ fn scene_of(map: &Path) -> Result<PathBuf> {
         })
 }
 
+/// The scene with every temperature shifted by `shift_k`.
+fn shifted(scene: &RadiantScene, shift_k: f64) -> Result<RadiantScene> {
+    let mut f = scene.to_file();
+    for s in &mut f.surfaces {
+        s.temperature_c += shift_k;
+        for x in &mut s.features {
+            x.temperature_c += shift_k;
+        }
+    }
+    for o in &mut f.occluders {
+        o.temperature_c += shift_k;
+    }
+    Ok(RadiantScene::new(&f)?)
+}
+
+/// The level shift that makes the map's MRT match the ISO 7726 MRT of the readings labelled
+/// `labels` (mean difference, refined once for the T⁴ average), and the rows' MRT recomputed.
+fn calibrate_level(
+    scene: &RadiantScene,
+    readings: &[GlobeRow],
+    labels: &[String],
+    globe: &Path,
+) -> Result<f64> {
+    let idx: Vec<usize> = labels
+        .iter()
+        .map(|l| {
+            readings.iter().position(|r| &r.label == l).ok_or_else(|| {
+                Error::source(
+                    globe,
+                    format!("has no reading labelled '{l}' to calibrate with (--calibrate-with)"),
+                )
+            })
+        })
+        .collect::<Result<_>>()?;
+    let mut shift = 0.0;
+    for _ in 0..2 {
+        let s = shifted(scene, shift)?;
+        let engine = MrtEngine::new(
+            &s,
+            Method::Auto(MonteCarlo {
+                rays: RAYS,
+                ..MonteCarlo::default()
+            }),
+        )?;
+        let rows = validate(
+            &idx.iter().map(|&k| readings[k].clone()).collect::<Vec<_>>(),
+            &|x: &[f64; 3]| {
+                engine
+                    .at(&Point3::from(*x), 0)
+                    .map(|r| (r.mrt.celsius(), r.std_error_k))
+                    .map_err(|e| e.to_string())
+            },
+        );
+        let d: Vec<f64> = rows.iter().filter_map(|r| r.diff_iso_k).collect();
+        if d.len() != idx.len() {
+            return Err(Error::source(
+                globe,
+                "a calibrating reading has no ISO 7726 MRT or no map MRT: choose readings that convert",
+            ));
+        }
+        shift -= d.iter().sum::<f64>() / d.len() as f64;
+    }
+    Ok(shift)
+}
+
 /// Compares the MRT of the scene in `map` with the globe readings of `globe`, writing
-/// validation.csv and validation.json into `out`.
-pub fn validate_map(map: &Path, globe: &Path, frame: PointFrame, out: &Path) -> Result<Validation> {
+/// validation.csv and validation.json into `out`. Readings labelled in `calibrate_with` fix the
+/// map's temperature level first (every temperature shifted by one amount) and are not judged.
+pub fn validate_map(
+    map: &Path,
+    globe: &Path,
+    frame: PointFrame,
+    calibrate_with: &[String],
+    out: &Path,
+) -> Result<Validation> {
     let scene_path = scene_of(map)?;
     let scene = RadiantScene::load(&scene_path)?;
     let text = std::fs::read_to_string(globe).map_err(|e| mrtmap_io::FileError::io(globe, e))?;
@@ -65,13 +140,39 @@ pub fn validate_map(map: &Path, globe: &Path, frame: PointFrame, out: &Path) -> 
         })?;
         r.xyz = [p.x, p.y, p.z];
     }
+    let level_shift_k = if calibrate_with.is_empty() {
+        None
+    } else {
+        Some(calibrate_level(&scene, &readings, calibrate_with, globe)?)
+    };
+    let calibrated;
+    let engine = match level_shift_k {
+        Some(s) => {
+            calibrated = shifted(&scene, s)?;
+            MrtEngine::new(
+                &calibrated,
+                Method::Auto(MonteCarlo {
+                    rays: RAYS,
+                    ..MonteCarlo::default()
+                }),
+            )?
+        }
+        None => engine,
+    };
     let ours = |x: &[f64; 3]| {
         engine
             .at(&Point3::from(*x), 0)
             .map(|r| (r.mrt.celsius(), r.std_error_k))
             .map_err(|e| e.to_string())
     };
-    let rows = validate(&readings, &ours);
+    let mut rows = validate(&readings, &ours);
+    for r in &mut rows {
+        if calibrate_with.contains(&r.globe.label) {
+            r.calibrates = true;
+            r.meets_required = None;
+            r.meets_desired = None;
+        }
+    }
     mrtmap_io::write_atomic(
         &out.join("validation.csv"),
         validation_csv(&rows)?.as_bytes(),
@@ -80,5 +181,6 @@ pub fn validate_map(map: &Path, globe: &Path, frame: PointFrame, out: &Path) -> 
     Ok(Validation {
         scene: scene_path,
         rows,
+        level_shift_k,
     })
 }

@@ -503,7 +503,12 @@ impl<'a> MrtEngine<'a> {
                 temperature_std_k: pa.temperature_std_k,
             })
             .collect();
-        mean_radiant_temperature(&src)
+        let mut m = mean_radiant_temperature(&src)?;
+        // A common level error moves every temperature, and so the MRT, one to one.
+        m.std_from_temperatures_k = m
+            .std_from_temperatures_k
+            .hypot(self.scene.temperature_level_std_k);
+        Ok(m)
     }
 
     /// The sampling standard error (K) of a radiant temperature from its replicates' factors.

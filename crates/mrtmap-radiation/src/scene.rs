@@ -90,6 +90,11 @@ pub struct SceneFile {
     /// scenes.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub world_from_room: Option<FramePose>,
+    /// Standard uncertainty of the temperatures' common level (K): what every temperature may be
+    /// off by together (a thermal camera's absolute accuracy, or what reference readings left);
+    /// it passes one to one into every MRT's standard error.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub temperature_level_std_k: Option<f64>,
     /// The room's surfaces.
     pub surfaces: Vec<SurfaceFile>,
     /// Optional occluders (boxes or triangle meshes).
@@ -266,6 +271,12 @@ pub enum SceneError {
         id: String,
         /// Vertex count.
         count: usize,
+    },
+    /// A common-level uncertainty that is negative, huge or not a number.
+    #[error("temperature_level_std_k = {value} is outside 0…100 K")]
+    LevelStd {
+        /// As written.
+        value: f64,
     },
     /// A coordinate or value that is NaN or infinite.
     #[error("{element} '{id}': {what} is not a finite number")]
@@ -548,6 +559,8 @@ pub struct RadiantScene {
     pub up_given: Option<Unit<Vector3<f64>>>,
     /// p_in_world = world_from_room · p_in_room, when the scene came from a scan.
     pub world_from_room: Option<Isometry3<f64>>,
+    /// Standard uncertainty of the temperatures' common level (K; 0 when not stated).
+    pub temperature_level_std_k: f64,
     /// Surfaces.
     pub surfaces: Vec<Surface>,
     /// Occluders.
@@ -974,9 +987,14 @@ impl RadiantScene {
                 emissivity: check_emissivity("occluder", &o.id, o.emissivity)?,
             });
         }
+        let level = file.temperature_level_std_k.unwrap_or(0.0);
+        if !(level.is_finite() && (0.0..=100.0).contains(&level)) {
+            return Err(SceneError::LevelStd { value: level });
+        }
         let scene = Self {
             up_given,
             world_from_room,
+            temperature_level_std_k: level,
             surfaces,
             occluders,
         };
@@ -1048,6 +1066,8 @@ impl RadiantScene {
             format: SCENE_FORMAT.into(),
             up: self.up_given.map(|u| [u.x, u.y, u.z]),
             world_from_room: self.world_from_room.as_ref().map(FramePose::from_isometry),
+            temperature_level_std_k: (self.temperature_level_std_k > 0.0)
+                .then_some(self.temperature_level_std_k),
             surfaces: self
                 .surfaces
                 .iter()

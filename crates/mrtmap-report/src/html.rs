@@ -84,6 +84,10 @@ pub struct ReportData {
     pub comfort_points: Vec<Vec<String>>,
     /// The columns of `comfort_points` after the name.
     pub comfort_point_columns: Vec<String>,
+    /// What the temperatures rest on: the level, the self-calibration.
+    pub level: KeyValues,
+    /// Reference readings: label, reading, camera, residual, used.
+    pub references: Vec<[String; 5]>,
 }
 
 /// HTML-escapes text.
@@ -316,6 +320,28 @@ fn comfort_section(o: &mut String, d: &ReportData) {
     }
 }
 
+/// What the temperatures rest on: the absolute level (references or the camera's), the reference
+/// readings with their residuals, and the frames' self-calibration.
+fn level_section(o: &mut String, d: &ReportData) {
+    if d.level.is_empty() {
+        return;
+    }
+    o.push_str("<h2>What the temperatures rest on</h2>");
+    plain_rows(o, &["what", "value"], &key_value_rows(&d.level));
+    let refs: Vec<Vec<String>> = d.references.iter().map(|r| r.to_vec()).collect();
+    plain_rows(
+        o,
+        &[
+            "reference",
+            "reading (°C)",
+            "camera (°C)",
+            "corrected − reading (K)",
+            "used",
+        ],
+        &refs,
+    );
+}
+
 /// Where the coordinates are measured from: the room frame, its corners and walls.
 fn room_section(o: &mut String, d: &ReportData) {
     if d.room_frame.is_empty() {
@@ -366,6 +392,7 @@ pub fn render_html(d: &ReportData) -> String {
         }
     }
     room_section(&mut o, d);
+    level_section(&mut o, d);
     for m in &d.maps {
         map_section(&mut o, m);
     }

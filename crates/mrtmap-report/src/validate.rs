@@ -199,6 +199,8 @@ pub struct ValidationRow {
     pub meets_required: Option<bool>,
     /// Whether it meets the desired accuracy (±0.2 K).
     pub meets_desired: Option<bool>,
+    /// Whether this reading fixed the map's temperature level (it is then not judged).
+    pub calibrates: bool,
 }
 
 /// The flat JSON form of a [`ValidationRow`].
@@ -220,6 +222,7 @@ struct ValidationJson<'a> {
     diff_mixed_k: Option<f64>,
     meets_required: Option<bool>,
     meets_desired: Option<bool>,
+    calibrates: bool,
 }
 
 impl Serialize for ValidationRow {
@@ -238,6 +241,7 @@ impl Serialize for ValidationRow {
             diff_mixed_k: self.diff_mixed_k,
             meets_required: self.meets_required,
             meets_desired: self.meets_desired,
+            calibrates: self.calibrates,
         }
         .serialize(s)
     }
@@ -284,6 +288,7 @@ pub fn validate(rows: &[GlobeRow], ours: &MrtAt<'_>) -> Vec<ValidationRow> {
                 mrt_iso_c: iso_c,
                 mrt_mixed_c: mixed_c,
                 ours_c: ours,
+                calibrates: false,
             }
         })
         .collect()
@@ -310,6 +315,7 @@ pub fn validation_csv(rows: &[ValidationRow]) -> Result<String, ReportError> {
         "diff_mixed_k",
         "meets_required_2k",
         "meets_desired_0_2k",
+        "calibrates",
     ];
     let f = |x: Option<f64>| x.map(|v| format!("{v:.3}")).unwrap_or_default();
     let b = |x: Option<bool>| x.map(|v| v.to_string()).unwrap_or_default();
@@ -334,6 +340,7 @@ pub fn validation_csv(rows: &[ValidationRow]) -> Result<String, ReportError> {
             f(r.diff_mixed_k),
             b(r.meets_required),
             b(r.meets_desired),
+            r.calibrates.to_string(),
         ]);
     }
     for rec in &records {

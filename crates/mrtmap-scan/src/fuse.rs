@@ -21,6 +21,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::frame::{DepthPoints, DepthSampling, RayTable, ThermalImage, depth_points};
 use crate::observe::{ObservationCounts, ObservationParams, observe};
+use crate::radiometric::{
+    Calibrator, FrameResiduals, RadiometricReport, SelfCalibration, frame_residuals,
+};
 use crate::sync::{SkipReason, pair_frames};
 use crate::voxels::{FrameVoxels, VoxelMap};
 
@@ -89,6 +92,9 @@ pub struct FuseParams {
     pub icp: IcpSettings,
     /// Frames prepared in parallel at a time.
     pub chunk: usize,
+    /// Radiometric self-calibration (per-frame offsets, vignetting).
+    #[serde(default)]
+    pub radiometric: SelfCalibration,
 }
 
 impl Default for FuseParams {
@@ -100,6 +106,7 @@ impl Default for FuseParams {
             observation: ObservationParams::default(),
             icp: IcpSettings::default(),
             chunk: 8,
+            radiometric: SelfCalibration::default(),
         }
     }
 }
@@ -169,6 +176,9 @@ pub struct FusionReport {
     pub timing_s: Timing,
     /// Thermal frames per second of wall time.
     pub frames_per_second: f64,
+    /// Radiometric self-calibration: offsets removed per frame, vignetting, consistency.
+    #[serde(default)]
+    pub radiometric: RadiometricReport,
     /// The parameters used.
     pub parameters: FuseParams,
 }
@@ -224,6 +234,7 @@ struct Fuser<'a> {
     poses: Vec<(f64, Isometry3<f64>)>,
     timing: Timing,
     done: u64,
+    calibrator: Calibrator,
 }
 
 impl Fuser<'_> {
@@ -374,10 +385,17 @@ impl Fuser<'_> {
         work
     }
 
-    /// Observes the frames' temperatures on their points, in parallel.
-    fn observe(&mut self, work: &[Posed]) -> Vec<(FrameVoxels, ObservationCounts)> {
+    /// Observes the frames' temperatures on their points, in parallel; with self-calibration,
+    /// each frame is compared with the map as it stood at the chunk's start and corrected.
+    fn observe(&mut self, work: &[Posed]) -> Vec<Observed> {
         let t2 = Instant::now();
         let (rec, params) = (self.rec, self.params);
+        let cal = params.radiometric;
+        let (map, a, carried) = (
+            &self.map,
+            self.calibrator.vignetting(),
+            self.calibrator.last_offset(),
+        );
         let results = work
             .par_iter()
             .map(|(pr, wd, wt)| {
@@ -391,14 +409,39 @@ impl Fuser<'_> {
                     &pr.thermal,
                     &params.observation,
                 );
+                let (residuals, offset, a) = if cal.enabled {
+                    let pairs: Vec<(f64, f64)> = obs
+                        .iter()
+                        .filter_map(|o| {
+                            map.reference_k(&o.p, cal.min_map_observations, cal.max_map_spread_k)
+                                .map(|t| (o.t_k - t, o.rho))
+                        })
+                        .collect();
+                    let r = frame_residuals(&pairs, a, cal.outlier_k);
+                    let offset = if r.n >= cal.min_overlap {
+                        r.median_k
+                    } else {
+                        carried
+                    };
+                    (r, offset, a)
+                } else {
+                    (FrameResiduals::default(), 0.0, 0.0)
+                };
                 let mut fv = FrameVoxels::default();
                 for (p, n) in pts.iter().zip(&nrm) {
                     fv.add_point(params.voxel_m, p, n);
                 }
                 for o in &obs {
-                    fv.add_temperature(params.voxel_m, &o.p, o.t_k, o.w);
+                    let t = o.t_k - offset - a * o.rho;
+                    fv.add_temperature(params.voxel_m, &o.p, t, o.w);
                 }
-                (fv, counts)
+                Observed {
+                    voxels: fv,
+                    counts,
+                    thermal_t: pr.thermal_t,
+                    residuals,
+                    offset,
+                }
             })
             .collect();
         self.timing.observe_cpu += t2.elapsed().as_secs_f64() * rayon::current_num_threads() as f64;
@@ -406,14 +449,18 @@ impl Fuser<'_> {
     }
 
     /// Merges the frames into the map in frame order, and rebuilds the ICP target when due.
-    fn merge(
-        &mut self,
-        results: Vec<(FrameVoxels, ObservationCounts)>,
-        total: u64,
-        progress: &(dyn Fn(u64, u64) + Sync),
-    ) {
+    fn merge(&mut self, results: Vec<Observed>, total: u64, progress: &(dyn Fn(u64, u64) + Sync)) {
         let t3 = Instant::now();
-        for (fv, counts) in results {
+        for o in results {
+            let (fv, counts) = (o.voxels, o.counts);
+            if self.params.radiometric.enabled && counts.kept > 0 {
+                self.calibrator.record(
+                    o.thermal_t,
+                    &o.residuals,
+                    o.offset,
+                    self.params.radiometric.min_overlap,
+                );
+            }
             if counts.kept == 0 {
                 self.skip(SkipReason::NothingVisible);
             } else {
@@ -451,6 +498,8 @@ impl Fuser<'_> {
         report.icp.final_correction_m = self.correction.translation.vector.norm();
         report.icp.final_correction_deg = rotation_deg(&self.correction);
         report.frames_per_second = report.thermal_frames as f64 / self.timing.total.max(1e-9);
+        report.radiometric =
+            std::mem::take(&mut self.calibrator).finish(self.params.radiometric.enabled);
         report.timing_s = self.timing;
         Fused {
             cloud,
@@ -462,6 +511,15 @@ impl Fuser<'_> {
 
 /// Normals of a frame's points.
 type Vector3List = Vec<Vector3<f64>>;
+
+/// A frame observed: its voxels, counts, and its comparison with the map.
+struct Observed {
+    voxels: FrameVoxels,
+    counts: ObservationCounts,
+    thermal_t: f64,
+    residuals: FrameResiduals,
+    offset: f64,
+}
 
 /// Fuses a recording. `progress(done, total)` is called after each frame.
 pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) + Sync)) -> Fused {
@@ -491,6 +549,7 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
         poses: Vec::new(),
         timing: Timing::default(),
         done: 0,
+        calibrator: Calibrator::default(),
     };
     let mut usable: Vec<(usize, usize)> = Vec::new();
     for p in &pairs {

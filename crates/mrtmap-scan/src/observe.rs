@@ -66,6 +66,8 @@ pub struct Observation {
     pub t_k: f64,
     /// Weight.
     pub w: f64,
+    /// Squared distance from the image centre, relative to the corners' (0 centre, 1 corners).
+    pub rho: f64,
 }
 
 /// Counts of what happened to a frame's points.
@@ -231,6 +233,8 @@ pub fn observe(
             n,
             t_k: t,
             w: weight(cos, d, &px, contrast, cam, params),
+            rho: ((px.x - cam.cx).powi(2) + (px.y - cam.cy).powi(2))
+                / (cam.cx.powi(2) + cam.cy.powi(2)).max(1e-9),
         });
     }
     (out, counts)

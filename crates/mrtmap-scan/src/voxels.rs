@@ -85,6 +85,18 @@ impl VoxelMap {
         }
     }
 
+    /// The fused temperature (K) of the voxel holding `p`, when it has at least `min_count`
+    /// observations with a spread of at most `max_spread_k`: a reference for self-calibration.
+    pub fn reference_k(&self, p: &Point3<f64>, min_count: u64, max_spread_k: f64) -> Option<f64> {
+        let v = self.map.get(&voxel_key(p, self.voxel_m))?;
+        if v.temperature.count() < min_count
+            || v.temperature.std_dev_k().is_none_or(|s| s > max_spread_k)
+        {
+            return None;
+        }
+        v.temperature.mean().map(|t| t.kelvin())
+    }
+
     /// Centroids and averaged unit normals of voxels with at least `min_points` points, keeping
     /// one voxel in `every`³ (those whose keys are multiples of `every`): the ICP target.
     pub fn surface(&self, min_points: u32, every: i32) -> (Vec<Point3<f64>>, Vec<Vector3<f64>>) {

@@ -106,6 +106,7 @@ fn main() {
             &p,
             ThermalEncoding::Centikelvin,
             &ThermalNoise::REALISTIC,
+            None,
             &mut rng,
         );
     });

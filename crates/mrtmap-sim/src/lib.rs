@@ -15,6 +15,7 @@
 
 mod evaluate;
 mod evaluate_scene;
+mod radiometric;
 mod render;
 mod room;
 mod sensors;
@@ -24,6 +25,9 @@ mod walk;
 
 pub use evaluate::{CloudScore, score_cloud, truth_at};
 pub use evaluate_scene::{FeatureScore, PointScore, SceneScore, SurfaceScore, score_scene};
+pub use radiometric::{
+    CameraErrors, FfcPeriod, RadiometricModel, ReferenceReading, reference_readings,
+};
 pub use render::{Element, Hit, RoomRenderer, temperature_at};
 pub use room::{
     FeatureSpec, FurnitureSpec, GRADIENT_STRIP_M, PRESETS, PlacedFeature, PointSpec, Room,

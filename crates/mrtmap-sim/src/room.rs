@@ -537,6 +537,7 @@ impl Room {
             format: SCENE_FORMAT.into(),
             up: Some([up.x, up.y, up.z]),
             world_from_room: None,
+            temperature_level_std_k: None,
             surfaces,
             occluders: self.occluder_files(world_from_room),
         })

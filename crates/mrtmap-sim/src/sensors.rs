@@ -6,6 +6,8 @@ use mrtmap_geometry::nalgebra::{Isometry3, Point2, Vector3};
 use mrtmap_io::masks::{InstanceInfo, MaskLabels};
 use mrtmap_io::{Image16, ThermalEncoding, gaussian_blur};
 use mrtmap_physics::ZERO_CELSIUS_K;
+
+use crate::radiometric::CameraErrors;
 use rand::Rng;
 use rand_distr::{Distribution, Normal};
 use serde::{Deserialize, Serialize};
@@ -232,6 +234,7 @@ pub fn render_thermal<R: Rng>(
     room_from_cam: &Isometry3<f64>,
     encoding: ThermalEncoding,
     noise: &ThermalNoise,
+    camera: Option<(&CameraErrors, f64)>,
     rng: &mut R,
 ) -> Image16 {
     let (w, h) = (cam.width as usize, cam.height as usize);
@@ -268,10 +271,16 @@ pub fn render_thermal<R: Rng>(
     }
     let std = Normal::new(0.0, 1.0).unwrap_or_else(|_| unreachable!("unit normal"));
     let mut img = Image16::zeros(cam.width, cam.height);
-    for (p, r) in img.data.iter_mut().zip(&rad) {
+    let rmax2 = cam.cx.powi(2) + cam.cy.powi(2);
+    for (k, (p, r)) in img.data.iter_mut().zip(&rad).enumerate() {
         let mut t = r.powf(0.25);
         if noise.netd_k > 0.0 {
             t += noise.netd_k * std.sample(rng);
+        }
+        if let Some((errors, time_s)) = camera {
+            let (u, v) = ((k % w) as f64, (k / w) as f64);
+            let rho = ((u - cam.cx).powi(2) + (v - cam.cy).powi(2)) / rmax2;
+            t = errors.read(t, time_s, rho, k);
         }
         *p = encoding.raw(t + noise.bias_k);
     }

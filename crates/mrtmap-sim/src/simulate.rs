@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use mrtmap_geometry::camera::{BrownConrady, PinholeCamera};
-use mrtmap_geometry::nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion, Vector3};
+use mrtmap_geometry::nalgebra::{Isometry3, Point3, Translation3, Unit, UnitQuaternion, Vector3};
 use mrtmap_io::masks::{labels_path, mask_labels_json};
 use mrtmap_io::{
     EncodeError, FileError, PartialDir, RgbCamera, Rig, ThermalEncoding, Trajectory,
@@ -18,6 +18,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::SimError;
+use crate::radiometric::{CameraErrors, RadiometricModel, ReferenceReading, reference_readings};
 use crate::render::RoomRenderer;
 use crate::room::Room;
 use crate::sensors::{
@@ -100,6 +101,13 @@ pub struct SimConfig {
     pub walk: WalkParams,
     /// Monte Carlo rays per truth point (rooms with furniture or not convex).
     pub truth_rays: usize,
+    /// The thermal camera's radiometric errors (offset, gain, FFC, drift, vignetting, fixed
+    /// pattern); none by default.
+    pub radiometric: RadiometricModel,
+    /// Contact-thermometer readings written to references.csv (0: none).
+    pub references: usize,
+    /// Their standard uncertainty (K).
+    pub reference_std_k: f64,
 }
 
 impl Default for SimConfig {
@@ -129,6 +137,9 @@ impl Default for SimConfig {
             drift: Drift::NONE,
             walk: WalkParams::default(),
             truth_rays: 100_000,
+            radiometric: RadiometricModel::NONE,
+            references: 0,
+            reference_std_k: 0.1,
         }
     }
 }
@@ -296,6 +307,13 @@ fn rig(cfg: &SimConfig) -> Rig {
         depth_scale: cfg.depth_scale,
         thermal: cfg.thermal_camera,
         thermal_encoding: ThermalEncoding::Centikelvin,
+        // What the simulated camera can be off by: a Lepton's datasheet ±5 K with radiometric
+        // errors, else only the constant bias asked for.
+        thermal_accuracy_k: Some(if cfg.radiometric.is_perfect() {
+            cfg.thermal_noise.bias_k.abs()
+        } else {
+            5.0
+        }),
         depth_from_thermal: cfg.depth_from_thermal,
         rgb: Some(RgbCamera {
             camera: cfg.depth_camera,
@@ -311,6 +329,7 @@ struct Frames<'a> {
     walk: Walk,
     cfg: &'a SimConfig,
     realistic: bool,
+    camera: Option<CameraErrors>,
     out: &'a Out,
     tick: &'a (dyn Fn() + Sync),
 }
@@ -366,6 +385,7 @@ impl Frames<'_> {
                 &pose,
                 ThermalEncoding::Centikelvin,
                 &noise,
+                self.camera.as_ref().map(|c| (c, t)),
                 &mut self.rng(2, k),
             );
             self.out
@@ -435,6 +455,49 @@ fn write_lists(
     Ok(())
 }
 
+/// radiometric_truth.json: the camera's errors and each thermal frame's offset; and
+/// references.csv (in the recording's world frame) when contact readings are asked for.
+fn write_camera_truth(
+    files: &Out,
+    room: &Room,
+    cfg: &SimConfig,
+    camera: Option<&CameraErrors>,
+    thermal_t: &[f64],
+    world_from_room: &Isometry3<f64>,
+) -> Result<(), SimError> {
+    let refs = reference_readings(room, cfg.references, cfg.reference_std_k, cfg.seed);
+    if !refs.is_empty() {
+        let mut csv = String::from(
+            "# contact-thermometer readings of surface points (x, y, z in the frame of trajectory.txt)\nlabel,x,y,z,temperature_c,std_k\n",
+        );
+        for r in &refs {
+            let p = world_from_room * Point3::from(r.xyz_room);
+            csv.push_str(&format!(
+                "{},{:.4},{:.4},{:.4},{:.3},{}\n",
+                r.label, p.x, p.y, p.z, r.temperature_c, r.std_k
+            ));
+        }
+        files.write("references.csv", csv.as_bytes())?;
+    }
+    #[derive(Serialize)]
+    struct CameraTruth<'a> {
+        camera: Option<&'a CameraErrors>,
+        /// (time since the scan's start, offset common to the image) per thermal frame.
+        frame_offsets_k: Vec<(f64, f64)>,
+        references: &'a [ReferenceReading],
+    }
+    let truth = CameraTruth {
+        camera,
+        frame_offsets_k: thermal_t
+            .iter()
+            .map(|&t| (t, camera.map_or(0.0, |c| c.offset_at(t))))
+            .collect(),
+        references: &refs,
+    };
+    let json = serde_json::to_string_pretty(&truth)?;
+    files.write("radiometric_truth.json", (json + "\n").as_bytes())
+}
+
 /// Simulates a scan of `room` into the folder `out` (written as `out.partial` and renamed when
 /// complete).
 pub fn simulate(
@@ -471,12 +534,22 @@ pub fn simulate(
     let done = AtomicU64::new(0);
     let tick = || progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
     files.write("rig.toml", rig(cfg).to_toml().as_bytes())?;
+    let camera = (!cfg.radiometric.is_perfect()).then(|| {
+        CameraErrors::draw(
+            cfg.radiometric,
+            cfg.seconds,
+            cfg.thermal_camera.width as usize,
+            cfg.thermal_camera.height as usize,
+            cfg.seed,
+        )
+    });
     let frames = Frames {
         room,
         renderer: RoomRenderer::new(room),
         walk,
         cfg,
         realistic: cfg.noise == NoiseLevel::Realistic,
+        camera,
         out: &files,
         tick: &tick,
     };
@@ -489,6 +562,14 @@ pub fn simulate(
     let truth = compute_truth(room, &world_from_room, cfg.truth_rays, cfg.seed)?;
     let truth_json = serde_json::to_string_pretty(&truth)?;
     files.write("truth.json", (truth_json + "\n").as_bytes())?;
+    write_camera_truth(
+        &files,
+        room,
+        cfg,
+        frames.camera.as_ref(),
+        &thermal_t,
+        &world_from_room,
+    )?;
     let out = dir.finish()?;
     Ok(SimSummary {
         out,

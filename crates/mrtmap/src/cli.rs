@@ -364,6 +364,9 @@ pub struct RunArgs {
     /// ICP refinement ([fuse] icp).
     #[arg(long, value_enum)]
     pub icp: Option<OnOff>,
+    /// Radiometric self-calibration of the frames ([fuse] self_calibrate).
+    #[arg(long, value_enum)]
+    pub self_calibrate: Option<OnOff>,
     /// Do not use the recording's instance masks ([segment] masks = false).
     #[arg(long)]
     pub no_masks: bool,
@@ -401,9 +404,94 @@ pub struct DemoArgs {
     /// Random seed of the simulation.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    #[command(flatten)]
+    pub camera: CameraErrorArgs,
     /// Rerun every stage.
     #[arg(long)]
     pub force: bool,
+}
+
+/// A simulated camera's radiometric errors.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CameraErrorsArg {
+    /// A perfect camera (the NETD and blur of --noise remain).
+    None,
+    /// A Lepton 3.5-like unit: offset 1.5 K, gain 2 %, FFC every 30–120 s (σ 0.3 K new offsets,
+    /// σ 0.3 K/min drift between them), vignetting −0.6 K at the corners, fixed pattern σ 0.08 K.
+    Realistic,
+}
+
+/// The thermal camera's radiometric errors in a simulation; each term can be set on its own.
+#[derive(Debug, Args, Clone)]
+pub struct CameraErrorArgs {
+    /// The camera's radiometric errors (the truth goes to radiometric_truth.json).
+    #[arg(long, value_enum, default_value_t = CameraErrorsArg::None)]
+    pub camera_errors: CameraErrorsArg,
+    /// This unit's constant offset (K).
+    #[arg(long, allow_negative_numbers = true)]
+    pub unit_offset_k: Option<f64>,
+    /// Relative gain error about 20 °C (0.02: contrasts 2 % too large).
+    #[arg(long, allow_negative_numbers = true)]
+    pub gain: Option<f64>,
+    /// Time between flat-field corrections, MIN,MAX seconds (0,0: none).
+    #[arg(long, value_name = "MIN,MAX", value_parser = parse_interval)]
+    pub ffc_interval_s: Option<[f64; 2]>,
+    /// σ of the offset each flat-field correction sets (K).
+    #[arg(long)]
+    pub ffc_offset_k: Option<f64>,
+    /// σ of the offset's drift between flat-field corrections (K per minute).
+    #[arg(long)]
+    pub drift_k_per_min: Option<f64>,
+    /// Vignetting: what the image corners read more than the centre (K).
+    #[arg(long, allow_negative_numbers = true)]
+    pub vignetting_k: Option<f64>,
+    /// σ of the per-pixel fixed pattern (K).
+    #[arg(long)]
+    pub fixed_pattern_k: Option<f64>,
+    /// Contact-thermometer readings of surface points to write to references.csv (default: 2 with
+    /// camera errors, 0 without).
+    #[arg(long)]
+    pub references: Option<usize>,
+}
+
+impl CameraErrorArgs {
+    /// The model these flags describe.
+    pub fn model(&self) -> mrtmap_sim::RadiometricModel {
+        use mrtmap_sim::RadiometricModel as M;
+        let mut m = match self.camera_errors {
+            CameraErrorsArg::None => M::NONE,
+            CameraErrorsArg::Realistic => M::REALISTIC,
+        };
+        let set = |x: &mut f64, v: Option<f64>| {
+            if let Some(v) = v {
+                *x = v;
+            }
+        };
+        set(&mut m.unit_offset_k, self.unit_offset_k);
+        set(&mut m.gain, self.gain);
+        set(&mut m.ffc_offset_sigma_k, self.ffc_offset_k);
+        set(&mut m.drift_sigma_k_per_min, self.drift_k_per_min);
+        set(&mut m.vignetting_k, self.vignetting_k);
+        set(&mut m.fixed_pattern_sigma_k, self.fixed_pattern_k);
+        if let Some(i) = self.ffc_interval_s {
+            m.ffc_interval_s = i;
+        }
+        m
+    }
+
+    /// How many reference readings to write.
+    pub fn references(&self) -> usize {
+        self.references
+            .unwrap_or(if self.model().is_perfect() { 0 } else { 2 })
+    }
+}
+
+fn parse_interval(s: &str) -> Result<[f64; 2], String> {
+    let v = numbers(s, &[2], "MIN,MAX (two numbers in seconds)")?;
+    if !(v[0] >= 0.0 && v[1] >= v[0]) {
+        return Err(format!("expected 0 <= MIN <= MAX, got '{s}'"));
+    }
+    Ok([v[0], v[1]])
 }
 
 /// `mrtmap validate`.
@@ -421,6 +509,11 @@ pub struct ValidateArgs {
     /// The frame of the globes' x, y, z: room (scene.json's, default) or scan.
     #[arg(long, value_enum, default_value_t = PointFrame::Room)]
     pub frame: PointFrame,
+    /// Readings (by label, comma-separated) that fix the map's temperature level instead of
+    /// reference readings: every temperature is shifted so that the map matches their ISO 7726
+    /// MRT; they are then shown but not judged, and the others are compared.
+    #[arg(long, value_name = "LABEL,…", value_delimiter = ',')]
+    pub calibrate_with: Vec<String>,
     /// Where to write validation.csv and validation.json (default: the map folder).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
@@ -448,6 +541,11 @@ pub struct SegmentArgs {
     /// by default the start of the longest wall with the room at x, y ≥ 0.
     #[arg(long, value_name = "N")]
     pub origin_corner: Option<usize>,
+    /// Contact-thermometer readings (label,x,y,z,temperature_c[,std_k], x, y, z in the frame of
+    /// trajectory.txt) that fix the temperatures' absolute level (one: offset; two or more on
+    /// different temperatures: gain too).
+    #[arg(long, value_name = "CSV")]
+    pub references: Option<PathBuf>,
 }
 
 /// On or off.
@@ -484,6 +582,10 @@ pub struct FuseArgs {
     /// Use every N-th depth pixel in each direction.
     #[arg(long, default_value_t = 2)]
     pub depth_stride: u32,
+    /// Radiometric self-calibration: estimate and remove each frame's offset (flat-field
+    /// corrections, drift) and the vignetting from the frames' overlaps.
+    #[arg(long, value_enum, default_value_t = OnOff::On)]
+    pub self_calibrate: OnOff,
 }
 
 /// Sensor noise of a simulation.
@@ -548,6 +650,8 @@ pub struct SimulateArgs {
     /// Monte Carlo rays per truth point (rooms with furniture or not convex).
     #[arg(long, default_value_t = 100_000)]
     pub truth_rays: usize,
+    #[command(flatten)]
+    pub camera: CameraErrorArgs,
 }
 
 /// `mrtmap rooms`.
@@ -623,7 +727,7 @@ pub struct MapArgs {
     pub margin_m: f64,
     /// A point to mark and report, NAME=U,V in map coordinates (x,y for a z-up scene) or
     /// NAME=X,Y,Z in scene coordinates. Repeatable.
-    #[arg(long = "mark", value_name = "NAME=U,V", value_parser = parse_mark)]
+    #[arg(long = "mark", value_name = "NAME=U,V", allow_hyphen_values = true, value_parser = parse_mark)]
     pub marks: Vec<(String, Vec<f64>)>,
     #[command(flatten)]
     pub method: MethodArgs,
@@ -648,7 +752,7 @@ pub struct MrtArgs {
     pub scene: SceneArgs,
     /// A point X,Y,Z (m) in the scene file's frame: for a scanned room, its room frame (x, y along
     /// the floor from the origin corner, z above the floor). Repeatable.
-    #[arg(long = "at", value_name = "X,Y,Z", required = true, value_parser = parse_point)]
+    #[arg(long = "at", value_name = "X,Y,Z", required = true, allow_hyphen_values = true, value_parser = parse_point)]
     pub at: Vec<[f64; 3]>,
     /// The frame of --at: room (the scene file's, default) or scan (the scan's world frame; needs
     /// a scene written by segmentation, which records where the room sits in the scan).

@@ -54,6 +54,8 @@ struct ThermalSection {
     distortion: [f64; 5],
     encoding: String,
     depth_from_thermal: PoseFile,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    absolute_accuracy_k: Option<f64>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -129,6 +131,9 @@ pub struct Rig {
     pub thermal_encoding: ThermalEncoding,
     /// p_in_depth = depth_from_thermal · p_in_thermal.
     pub depth_from_thermal: Isometry3<f64>,
+    /// The thermal camera's stated absolute accuracy (K, `[thermal] absolute_accuracy_k`); `None`:
+    /// not stated (a Lepton 3.5's ±5 K is then assumed).
+    pub thermal_accuracy_k: Option<f64>,
     /// Optional colour camera.
     pub rgb: Option<RgbCamera>,
 }
@@ -214,6 +219,13 @@ impl Rig {
         };
         let depth_from_thermal =
             pose("[thermal] depth_from_thermal", &t.depth_from_thermal).map_err(bad)?;
+        if let Some(a) = t.absolute_accuracy_k
+            && !(a.is_finite() && (0.0..=100.0).contains(&a))
+        {
+            return Err(bad(format!(
+                "[thermal] absolute_accuracy_k = {a} is outside 0…100 K"
+            )));
+        }
         let rgb = match &f.rgb {
             None => None,
             Some(r) => Some(RgbCamera {
@@ -234,6 +246,7 @@ impl Rig {
             thermal,
             thermal_encoding,
             depth_from_thermal,
+            thermal_accuracy_k: t.absolute_accuracy_k,
             rgb,
         })
     }
@@ -268,6 +281,7 @@ impl Rig {
                 distortion: self.thermal.distortion.to_array(),
                 encoding: self.thermal_encoding.as_str().to_string(),
                 depth_from_thermal: PoseFile::from_isometry(&self.depth_from_thermal),
+                absolute_accuracy_k: self.thermal_accuracy_k,
             },
             rgb: self.rgb.map(|r| RgbSection {
                 width: r.camera.width,

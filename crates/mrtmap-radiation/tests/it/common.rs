@@ -60,6 +60,7 @@ pub fn box_room(sx: f64, sy: f64, sz: f64, t: [f64; 6]) -> SceneFile {
         format: SCENE_FORMAT.into(),
         up: None,
         world_from_room: None,
+        temperature_level_std_k: None,
         surfaces: vec![
             surface(
                 "floor",
@@ -138,6 +139,7 @@ pub fn l_room() -> SceneFile {
         format: SCENE_FORMAT.into(),
         up: None,
         world_from_room: None,
+        temperature_level_std_k: None,
         surfaces,
         occluders: Vec::new(),
     }

@@ -804,6 +804,7 @@ pub fn segment(
         format: SCENE_FORMAT.into(),
         up: Some([up.x, up.y, up.z]),
         world_from_room: None,
+        temperature_level_std_k: None,
         surfaces,
         occluders,
     };

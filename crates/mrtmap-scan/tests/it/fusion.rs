@@ -38,6 +38,15 @@ fn realistic_fusion_stays_accurate() {
     assert!(s.abs_error_median_k < 0.05, "{s:?}");
     assert!(s.abs_error_p95_k < 0.3, "{s:?}");
     assert!(s.bias_k.abs() < 0.02, "{s:?}");
+    // A camera without radiometric errors: self-calibration invents no offsets, no vignetting.
+    let r = &fused.report.radiometric;
+    assert!(r.enabled && r.frames_calibrated > 0, "{r:?}");
+    assert!(
+        r.offset_range_k[0] > -0.02 && r.offset_range_k[1] < 0.02,
+        "{:?}",
+        r.offset_range_k
+    );
+    assert!(r.vignetting_k.abs() < 0.03, "{}", r.vignetting_k);
 }
 
 /// With pose drift, ICP against the map at least halves the cloud's distance to the true surfaces

@@ -380,6 +380,7 @@ fn assemble_rig(
         depth_scale,
         thermal: t,
         thermal_encoding: ThermalEncoding::Centikelvin,
+        thermal_accuracy_k: None,
         depth_from_thermal: x,
         rgb: rgb_cam,
     })

@@ -24,6 +24,7 @@ fn rig() -> Rig {
         depth_scale: 1000.0,
         thermal,
         thermal_encoding: ThermalEncoding::Centikelvin,
+        thermal_accuracy_k: None,
         depth_from_thermal: Isometry3::new(
             Vector3::new(0.04, -0.02, 0.005),
             Vector3::new(0.0, 0.02, 0.01),

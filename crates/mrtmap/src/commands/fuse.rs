@@ -14,6 +14,7 @@ pub fn run(a: &FuseArgs) -> anyhow::Result<()> {
         icp: a.icp == OnOff::On,
         sync_tolerance_ms: a.sync_tolerance_ms,
         depth_stride: a.depth_stride,
+        self_calibrate: a.self_calibrate == OnOff::On,
     };
     let params = settings.params()?;
     let prepared = prepare(&a.recording, &a.out, &a.src.options())?;

@@ -48,6 +48,9 @@ fn settings(a: &RunArgs) -> anyhow::Result<Project> {
     if let Some(i) = a.icp {
         p.fuse.icp = i == OnOff::On;
     }
+    if let Some(s) = a.self_calibrate {
+        p.fuse.self_calibrate = s == OnOff::On;
+    }
     if a.no_masks {
         p.segment.masks = false;
     }

@@ -2,7 +2,8 @@
 
 use anyhow::bail;
 use mrtmap_io::Recording;
-use mrtmap_pipeline::run::segment_into;
+use mrtmap_pipeline::level::{DEFAULT_CAMERA_ACCURACY_K, read_references};
+use mrtmap_pipeline::run::{LevelInputs, segment_into};
 use mrtmap_pipeline::settings::{RoomSection, SegmentSection};
 use mrtmap_scan::segment::{SegmentReport, Votes};
 
@@ -33,7 +34,20 @@ pub fn run(a: &SegmentArgs) -> anyhow::Result<()> {
     let room = RoomSection {
         origin_corner: a.origin_corner,
     };
-    let report = segment_into(&a.fused, masks.as_ref(), &section.params(&room), &a.out)?;
+    let level = LevelInputs {
+        references: match &a.references {
+            Some(f) => read_references(f)?,
+            None => Vec::new(),
+        },
+        camera_accuracy_k: DEFAULT_CAMERA_ACCURACY_K,
+    };
+    let report = segment_into(
+        &a.fused,
+        masks.as_ref(),
+        &section.params(&room),
+        &level,
+        &a.out,
+    )?;
     print_report(&report);
     for w in &report.warnings {
         outln!("  warning: {w}");

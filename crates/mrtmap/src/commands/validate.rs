@@ -8,7 +8,7 @@ use crate::cli::ValidateArgs;
 
 pub fn run(a: &ValidateArgs) -> anyhow::Result<()> {
     let out = a.out.clone().unwrap_or_else(|| a.map.clone());
-    let v = validate_map(&a.map, &a.globe, a.frame, &out)?;
+    let v = validate_map(&a.map, &a.globe, a.frame, &a.calibrate_with, &out)?;
     let (scene_path, result) = (&v.scene, &v.rows);
     outln!("scene: {}", scene_path.display());
     outln!(
@@ -43,6 +43,7 @@ pub fn run(a: &ValidateArgs) -> anyhow::Result<()> {
             }
         };
         let class = match (r.meets_desired, r.meets_required) {
+            _ if r.calibrates => "fixed the level: not judged".into(),
             (Some(true), _) => format!("meets desired ±{ISO_DESIRED_K} K"),
             (_, Some(true)) => format!("meets required ±{ISO_REQUIRED_K} K"),
             (_, Some(false)) => format!("outside ±{ISO_REQUIRED_K} K"),
@@ -59,6 +60,12 @@ pub fn run(a: &ValidateArgs) -> anyhow::Result<()> {
             ours,
             r.diff_iso_k.map_or("—".into(), |v| format!("{v:+.2}")),
             r.diff_mixed_k.map_or("—".into(), |v| format!("{v:+.2}")),
+        );
+    }
+    if let Some(s) = v.level_shift_k {
+        outln!(
+            "every temperature shifted by {s:+.2} K so that the map matches {} (ISO 7726); the others are compared",
+            a.calibrate_with.join(", ")
         );
     }
     for (k, n) in notes.iter().enumerate() {

@@ -742,3 +742,49 @@ fn map_draws_a_persons_comfort_beside_the_mrt() {
     assert!(near < middle - 0.5, "window {near}, middle {middle}");
     assert!(c["marks"][0][1]["thermal"]["pmv"].as_f64().unwrap() < 0.0);
 }
+
+#[test]
+fn validate_can_take_the_level_from_named_globe_readings() {
+    let dir = tempfile::tempdir().unwrap();
+    edited_example(dir.path(), "scene.json", |_| {});
+    let globe = dir.path().join("globe.csv");
+    std::fs::write(
+        &globe,
+        "label,x,y,z,tg_c,ta_c,va_m_s,diameter_m,emissivity\n\
+         cal,2.0,1.8,1.1,22.0,21.0,0.1,0.15,0.95\n\
+         other,1.0,1.0,1.1,22.0,21.0,0.1,0.15,0.95\n",
+    )
+    .unwrap();
+    let (d, g) = (dir.path().to_str().unwrap(), globe.to_str().unwrap());
+    let text = crate::ok(&[
+        "validate",
+        "--map",
+        d,
+        "--globe",
+        g,
+        "--calibrate-with",
+        "cal",
+    ]);
+    assert!(text.contains("fixed the level: not judged"), "{text}");
+    assert!(text.contains("every temperature shifted by +"), "{text}");
+    let v: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("validation.json")).unwrap())
+            .unwrap();
+    assert_eq!(v[0]["calibrates"], true);
+    assert!(v[0]["meets_required"].is_null());
+    assert!(v[0]["diff_iso_k"].as_f64().unwrap().abs() < 0.01, "{v}");
+    assert_eq!(v[1]["calibrates"], false);
+    assert!(v[1]["meets_required"].is_boolean());
+    fails_with(
+        &[
+            "validate",
+            "--map",
+            d,
+            "--globe",
+            g,
+            "--calibrate-with",
+            "nope",
+        ],
+        "has no reading labelled 'nope' to calibrate with",
+    );
+}

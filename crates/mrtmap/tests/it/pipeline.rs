@@ -410,3 +410,149 @@ fn demo_prints_the_papers_table_and_grid_error() {
     let html = std::fs::read_to_string(out.join("run/report.html")).unwrap();
     assert!(html.contains("Against the truth") && html.contains("id=\"grid-rmse\""));
 }
+
+/// A simulated camera with a unit offset, gain error, frequent flat-field corrections, drift and
+/// vignetting: self-calibration tracks the frames' offsets and the vignetting, two reference
+/// readings fix the level and the gain, and without them the stated ± covers the error.
+#[test]
+fn camera_errors_are_self_calibrated_and_anchored_by_references() {
+    let dir = tempfile::tempdir().unwrap();
+    let sim = |name: &str, refs: &str| {
+        let rec = dir.path().join(name);
+        ok(&[
+            "simulate",
+            "--room",
+            "office",
+            "--out",
+            rec.to_str().unwrap(),
+            "--seconds",
+            "20",
+            "--depth-size",
+            "160x120",
+            "--noise",
+            "none",
+            "--truth-rays",
+            "1000",
+            "--camera-errors",
+            "realistic",
+            "--ffc-interval-s",
+            "5,8",
+            "--references",
+            refs,
+        ]);
+        rec
+    };
+    let with = sim("with", "2");
+    let run = dir.path().join("run");
+    ok(&[
+        "run",
+        with.to_str().unwrap(),
+        "--out",
+        run.to_str().unwrap(),
+        "--grid",
+        "8x6",
+    ]);
+    // The frames' offsets against the truth's, up to one constant.
+    let fusion = read_json(&run.join("fuse/fusion.json"));
+    let truth = read_json(&with.join("radiometric_truth.json"));
+    let r = &fusion["radiometric"];
+    let vig = r["vignetting_k"].as_f64().unwrap();
+    assert!((vig + 0.6).abs() < 0.15, "vignetting {vig}");
+    let est: Vec<f64> = r["offsets_k"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x[1].as_f64().unwrap())
+        .collect();
+    let tru: Vec<f64> = truth["frame_offsets_k"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x[1].as_f64().unwrap())
+        .collect();
+    assert!(truth["camera"]["ffc"].as_array().unwrap().len() >= 3);
+    assert_eq!(est.len(), tru.len(), "every frame fused");
+    // Skip the first frames (no map to compare with yet). The estimate must explain most of the
+    // offsets' variation (FFC jumps of several tenths of a kelvin, drift).
+    let sd = |v: &[f64]| {
+        let m = v.iter().sum::<f64>() / v.len() as f64;
+        (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / v.len() as f64).sqrt()
+    };
+    let d: Vec<f64> = est.iter().zip(&tru).skip(20).map(|(e, t)| e - t).collect();
+    let t_sd = sd(&tru[20..]);
+    assert!(t_sd > 0.2, "the truth's offsets vary: {t_sd}");
+    assert!(
+        sd(&d) < 0.4 * t_sd,
+        "offsets track the truth's: sd {} vs {t_sd}",
+        sd(&d)
+    );
+    // Two readings fix offset and gain.
+    let level = read_json(&run.join("segment/level.json"));
+    assert_eq!(level["basis"], "references (offset and gain)", "{level}");
+    let beta = level["beta"].as_f64().unwrap();
+    assert!((beta - 1.02).abs() < 0.01, "gain {beta}");
+    // MRT at the validation points against the truth.
+    let t = read_json(&with.join("truth.json"));
+    let scene = run.join("segment/scene.json");
+    let errors = |scene: &Path, t: &Value| -> Vec<(f64, f64)> {
+        t["points"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| {
+                let w = p["xyz_world"].as_array().unwrap();
+                let at = format!("{},{},{}", w[0], w[1], w[2]);
+                let v: Value = serde_json::from_str(&ok(&[
+                    "mrt",
+                    "--scene",
+                    scene.to_str().unwrap(),
+                    "--at",
+                    &at,
+                    "--frame",
+                    "scan",
+                    "--json",
+                ]))
+                .unwrap();
+                let q = &v["points"][0];
+                (
+                    q["mrt_c"].as_f64().unwrap() - p["mrt_c"].as_f64().unwrap(),
+                    q["std_error_k"].as_f64().unwrap(),
+                )
+            })
+            .collect()
+    };
+    for (e, se) in errors(&scene, &t) {
+        assert!(e.abs() < 0.3, "with references: {e:+.3} K");
+        assert!(
+            se > 0.05 && se < 0.3,
+            "the level's uncertainty is in the ±: {se}"
+        );
+    }
+    // Without references: the camera's level, off by the unit's offset, and a ± that says so.
+    let without = sim("without", "0");
+    let run2 = dir.path().join("run2");
+    ok(&[
+        "run",
+        without.to_str().unwrap(),
+        "--out",
+        run2.to_str().unwrap(),
+        "--grid",
+        "8x6",
+    ]);
+    let level = read_json(&run2.join("segment/level.json"));
+    assert_eq!(level["basis"], "camera");
+    let errs = errors(
+        &run2.join("segment/scene.json"),
+        &read_json(&without.join("truth.json")),
+    );
+    for (e, se) in &errs {
+        assert!(e.abs() > 1.0 && e.abs() < 2.0 * se, "{e:+.3} K ± {se}");
+    }
+    // … while its differences between points stay right.
+    let first = errs[0].0;
+    for (e, _) in &errs {
+        assert!((e - first).abs() < 0.15, "relative: {:+.3} K", e - first);
+    }
+    let html = std::fs::read_to_string(run.join("report.html")).unwrap();
+    assert!(html.contains("<h2>What the temperatures rest on</h2>"));
+}

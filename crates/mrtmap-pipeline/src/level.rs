@@ -1,0 +1,414 @@
+//! The absolute level of the temperatures: contact-thermometer reference readings fix the thermal
+//! camera's offset (one reading) and gain (two or more on different temperatures); without any,
+//! the level is the camera's and its stated absolute accuracy goes into every ±.
+//!
+//! A recording may hold `references.csv` (`label,x,y,z,temperature_c[,std_k]`, x, y, z in the frame
+//! of trajectory.txt; `#` comments); project.toml may add `[[references]]` (room frame by default).
+//! The camera's reading at a reference is the fused cloud's around it (within 5 cm, else 10 cm).
+//! The fit is weighted least squares camera = α + β·true; with three or more readings, the one whose
+//! leave-one-out residual is largest beyond max(3σ, 0.5 K) (judged against an offset alone, with
+//! 3 % gain slack, when only two others remain) is named and left out. The scene's temperatures
+//! become (T − α)/β, and the level's standard uncertainty at the scene's mean temperature is
+//! written as the scene's `temperature_level_std_k`.
+
+use std::path::Path;
+
+use mrtmap_geometry::nalgebra::{Isometry3, Point3};
+use mrtmap_io::ThermalCloud;
+use mrtmap_physics::ZERO_CELSIUS_K;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+use crate::settings::PointFrame;
+
+/// A thermal camera's absolute accuracy when the rig does not state one (K): the Lepton 3.5's
+/// datasheet (high gain).
+pub const DEFAULT_CAMERA_ACCURACY_K: f64 = 5.0;
+
+/// A contact (or spot) thermometer's reading of a surface point.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Reference {
+    /// Label.
+    pub label: String,
+    /// The point (m).
+    pub xyz: [f64; 3],
+    /// The reading (°C).
+    pub temperature_c: f64,
+    /// Its standard uncertainty (K).
+    #[serde(default = "default_std")]
+    pub std_k: f64,
+    /// The frame of `xyz`: room (project.toml's default) or scan (references.csv's).
+    #[serde(default)]
+    pub frame: PointFrame,
+}
+
+fn default_std() -> f64 {
+    0.2
+}
+
+/// Reads `references.csv`; errors name the file and line.
+pub fn read_references(path: &Path) -> Result<Vec<Reference>> {
+    let text = std::fs::read_to_string(path).map_err(|e| mrtmap_io::FileError::io(path, e))?;
+    let bad = |line: usize, msg: String| Error::Config {
+        path: path.to_path_buf(),
+        line,
+        message: msg,
+    };
+    let mut out = Vec::new();
+    let mut header: Option<Vec<String>> = None;
+    for (k, raw) in text.lines().enumerate() {
+        let line = raw.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+        let Some(h) = &header else {
+            let names: Vec<String> = cells.iter().map(|c| c.to_lowercase()).collect();
+            for need in ["label", "x", "y", "z", "temperature_c"] {
+                if !names.iter().any(|n| n == need) {
+                    return Err(bad(
+                        k + 1,
+                        format!(
+                            "the header has no column '{need}' (needs label,x,y,z,temperature_c and optionally std_k)"
+                        ),
+                    ));
+                }
+            }
+            header = Some(names);
+            continue;
+        };
+        let col = |name: &str| h.iter().position(|n| n == name).and_then(|i| cells.get(i));
+        let num = |name: &str| -> Result<f64> {
+            let v = col(name).copied().unwrap_or("");
+            v.parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| bad(k + 1, format!("{name} '{v}' is not a number")))
+        };
+        let std_k = match col("std_k") {
+            Some(s) if !s.is_empty() => num("std_k")?,
+            _ => default_std(),
+        };
+        if !(std_k > 0.0 && std_k < 50.0) {
+            return Err(bad(k + 1, format!("std_k {std_k} is outside 0…50 K")));
+        }
+        out.push(Reference {
+            label: col("label").map_or(String::new(), |s| s.to_string()),
+            xyz: [num("x")?, num("y")?, num("z")?],
+            temperature_c: num("temperature_c")?,
+            std_k,
+            frame: PointFrame::Scan,
+        });
+    }
+    Ok(out)
+}
+
+/// How one reference was used.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ReferenceUse {
+    /// Label.
+    pub label: String,
+    /// The reading (°C).
+    pub reference_c: f64,
+    /// The camera's (fused) temperature there (°C), when the scan saw the point.
+    pub camera_c: Option<f64>,
+    /// Corrected camera temperature − reading (K), when used or judged.
+    pub residual_k: Option<f64>,
+    /// Whether the fit used it; else why not.
+    pub used: bool,
+    /// Why it was left out.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+}
+
+/// The temperatures' level: what the fit found and what it rests on (`level.json`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Level {
+    /// "references (offset and gain)", "reference (offset)" or "camera".
+    pub basis: String,
+    /// α: the camera's reading of a 0 °C surface… in the fit camera = α + β·true (°C).
+    pub alpha_c: f64,
+    /// β: the camera's gain relative to the truth.
+    pub beta: f64,
+    /// The offset removed at the scene's mean temperature (K): camera − true.
+    pub offset_at_mean_k: f64,
+    /// The standard uncertainty of the level left (K).
+    pub std_k: f64,
+    /// The readings and how each was used.
+    pub references: Vec<ReferenceUse>,
+}
+
+/// The camera's fused temperature around a point (°C): within 5 cm, else 10 cm; `None` unseen.
+fn camera_at(cloud: &ThermalCloud, p: &Point3<f64>) -> Option<(f64, f64)> {
+    for r in [0.05f64, 0.10] {
+        let (mut sw, mut st, mut stt) = (0.0, 0.0, 0.0);
+        let mut n = 0;
+        for (k, q) in cloud.positions.iter().enumerate() {
+            let d2 = (q[0] as f64 - p.x).powi(2)
+                + (q[1] as f64 - p.y).powi(2)
+                + (q[2] as f64 - p.z).powi(2);
+            if d2 <= r * r {
+                let w = cloud.observations[k].max(1) as f64;
+                let t = cloud.temperature_k[k] as f64 - ZERO_CELSIUS_K;
+                sw += w;
+                st += w * t;
+                stt += w * t * t;
+                n += 1;
+            }
+        }
+        if n >= 3 {
+            let m = st / sw;
+            let sd = (stt / sw - m * m).max(0.0).sqrt();
+            return Some((m, sd / (n as f64).sqrt()));
+        }
+    }
+    None
+}
+
+/// Weighted least squares camera = α + β·true over `pts` (true, camera, σ): (α, β, σ of the fit's
+/// prediction of the true temperature at `at_c`).
+fn fit(pts: &[(f64, f64, f64)], at_c: f64, gain: bool) -> (f64, f64, f64) {
+    let w: Vec<f64> = pts.iter().map(|p| 1.0 / (p.2 * p.2)).collect();
+    let sw: f64 = w.iter().sum();
+    let mx = pts.iter().zip(&w).map(|(p, w)| w * p.0).sum::<f64>() / sw;
+    let my = pts.iter().zip(&w).map(|(p, w)| w * p.1).sum::<f64>() / sw;
+    if !gain {
+        let alpha = my - mx;
+        return (alpha, 1.0, (1.0 / sw).sqrt());
+    }
+    let sxx: f64 = pts
+        .iter()
+        .zip(&w)
+        .map(|(p, w)| w * (p.0 - mx).powi(2))
+        .sum();
+    let sxy: f64 = pts
+        .iter()
+        .zip(&w)
+        .map(|(p, w)| w * (p.0 - mx) * (p.1 - my))
+        .sum();
+    let beta = sxy / sxx;
+    let alpha = my - beta * mx;
+    let var = 1.0 / sw + (at_c - mx).powi(2) / sxx;
+    (alpha, beta, var.sqrt() / beta.abs())
+}
+
+/// The level from `refs` (in the scan's frame, or the room's through `world_from_room`) seen in
+/// `cloud`, for a scene whose mean temperature is `mean_c`; `camera_accuracy_k` when none is usable.
+pub fn find_level(
+    refs: &[Reference],
+    cloud: &ThermalCloud,
+    world_from_room: &Isometry3<f64>,
+    mean_c: f64,
+    camera_accuracy_k: f64,
+) -> Level {
+    let mut uses: Vec<ReferenceUse> = Vec::new();
+    let mut pts: Vec<(f64, f64, f64, usize)> = Vec::new();
+    for r in refs {
+        let p = match r.frame {
+            PointFrame::Scan => Point3::from(r.xyz),
+            PointFrame::Room => world_from_room * Point3::from(r.xyz),
+        };
+        let seen = camera_at(cloud, &p);
+        if let Some((c, se)) = seen {
+            pts.push((r.temperature_c, c, r.std_k.hypot(se), uses.len()));
+        }
+        uses.push(ReferenceUse {
+            label: r.label.clone(),
+            reference_c: r.temperature_c,
+            camera_c: seen.map(|s| s.0),
+            residual_k: None,
+            used: seen.is_some(),
+            note: seen
+                .is_none()
+                .then(|| "the scan saw no surface within 10 cm of this point".into()),
+        });
+    }
+    let span = |p: &[(f64, f64, f64, usize)]| {
+        p.iter().map(|x| x.0).fold(f64::NEG_INFINITY, f64::max)
+            - p.iter().map(|x| x.0).fold(f64::INFINITY, f64::min)
+    };
+    let solve = |p: &[(f64, f64, f64, usize)]| {
+        let gain = p.len() >= 2 && span(p) >= 2.0;
+        let q: Vec<(f64, f64, f64)> = p.iter().map(|x| (x.0, x.1, x.2)).collect();
+        (fit(&q, mean_c, gain), gain)
+    };
+    // Leave-one-out: a reading that disagrees with the others is named and left out.
+    if pts.len() >= 3 {
+        let mut worst: Option<(usize, f64)> = None;
+        for k in 0..pts.len() {
+            let others: Vec<_> = pts
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| *i != k)
+                .map(|x| *x.1)
+                .collect();
+            // Two others fit any gain exactly: judge against an offset alone then, allowing for a
+            // gain error of up to 3 % over the distance from their mean.
+            let ((a, b, s), slack) = if others.len() >= 3 {
+                (solve(&others).0, 0.0)
+            } else {
+                let q: Vec<(f64, f64, f64)> = others.iter().map(|x| (x.0, x.1, x.2)).collect();
+                let m = q.iter().map(|x| x.0).sum::<f64>() / q.len() as f64;
+                (fit(&q, mean_c, false), 0.03 * (pts[k].0 - m).abs())
+            };
+            let resid = (pts[k].1 - a) / b - pts[k].0;
+            let limit = (3.0 * pts[k].2.hypot(s)).max(0.5) + slack;
+            if resid.abs() > limit && worst.is_none_or(|w| resid.abs() > w.1) {
+                worst = Some((k, resid.abs()));
+            }
+        }
+        if let Some((k, r)) = worst {
+            let u = &mut uses[pts[k].3];
+            u.used = false;
+            u.note = Some(format!("disagrees with the others by {r:.2} K: left out"));
+            pts.remove(k);
+        }
+    }
+    if pts.is_empty() {
+        return Level {
+            basis: "camera".into(),
+            alpha_c: 0.0,
+            beta: 1.0,
+            offset_at_mean_k: 0.0,
+            std_k: camera_accuracy_k,
+            references: uses,
+        };
+    }
+    let ((alpha, beta, std_k), gain) = solve(&pts);
+    for u in &mut uses {
+        if let Some(c) = u.camera_c {
+            u.residual_k = Some((c - alpha) / beta - u.reference_c);
+        }
+    }
+    Level {
+        basis: if gain {
+            "references (offset and gain)".into()
+        } else {
+            "references (offset)".into()
+        },
+        alpha_c: alpha,
+        beta,
+        offset_at_mean_k: alpha + (beta - 1.0) * mean_c,
+        std_k,
+        references: uses,
+    }
+}
+
+impl Level {
+    /// The true temperature (°C) of a camera temperature.
+    pub fn correct(&self, camera_c: f64) -> f64 {
+        (camera_c - self.alpha_c) / self.beta
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    /// A cloud of three patches at x = 0, 5, 10 m read by a camera with offset and gain.
+    fn cloud(true_c: [f64; 3], alpha: f64, beta: f64) -> ThermalCloud {
+        let mut c = ThermalCloud::default();
+        for (k, t) in true_c.iter().enumerate() {
+            for i in 0..10 {
+                let cam = alpha + beta * t;
+                c.push(
+                    [5.0 * k as f32 + 0.002 * i as f32, 0.0, 0.0],
+                    [0.0, 0.0, 1.0],
+                    (cam + ZERO_CELSIUS_K) as f32,
+                    0.0,
+                    5,
+                );
+            }
+        }
+        c
+    }
+
+    fn reading(label: &str, x: f64, t: f64) -> Reference {
+        Reference {
+            label: label.into(),
+            xyz: [x, 0.0, 0.0],
+            temperature_c: t,
+            std_k: 0.1,
+            frame: PointFrame::Scan,
+        }
+    }
+
+    #[test]
+    fn one_reading_fixes_the_offset_two_the_gain() {
+        let c = cloud([10.0, 20.0, 30.0], 1.5, 1.02);
+        let id = Isometry3::identity();
+        let one = find_level(&[reading("a", 5.0, 20.0)], &c, &id, 20.0, 5.0);
+        assert_eq!(one.basis, "references (offset)");
+        assert!((one.correct(1.5 + 1.02 * 20.0) - 20.0).abs() < 1e-3);
+        assert!((one.std_k - 0.1).abs() < 0.01, "{}", one.std_k);
+        let two = find_level(
+            &[reading("a", 0.0, 10.0), reading("b", 10.0, 30.0)],
+            &c,
+            &id,
+            20.0,
+            5.0,
+        );
+        assert_eq!(two.basis, "references (offset and gain)");
+        assert!((two.beta - 1.02).abs() < 1e-3 && (two.alpha_c - 1.5).abs() < 1e-2);
+        assert!((two.correct(1.5 + 1.02 * 20.0) - 20.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn a_disagreeing_reading_is_named_and_an_unseen_one_noted() {
+        let c = cloud([10.0, 20.0, 30.0], 0.0, 1.0);
+        let id = Isometry3::identity();
+        let l = find_level(
+            &[
+                reading("a", 0.0, 10.0),
+                reading("b", 5.0, 22.0),
+                reading("c", 10.0, 30.0),
+                reading("far", 50.0, 20.0),
+            ],
+            &c,
+            &id,
+            20.0,
+            5.0,
+        );
+        let b = l.references.iter().find(|r| r.label == "b").unwrap();
+        assert!(
+            !b.used && b.note.as_deref().unwrap().contains("disagrees"),
+            "{b:?}"
+        );
+        let far = l.references.iter().find(|r| r.label == "far").unwrap();
+        assert!(!far.used && far.camera_c.is_none());
+        // The cloud stores kelvin as f32 (about 3e-5 K apart near 293 K).
+        assert!(
+            (l.beta - 1.0).abs() < 1e-5 && l.alpha_c.abs() < 1e-3,
+            "{l:?}"
+        );
+        let none = find_level(&[], &c, &id, 20.0, 5.0);
+        assert_eq!((none.basis.as_str(), none.std_k), ("camera", 5.0));
+    }
+
+    #[test]
+    fn references_csv_errors_name_the_line() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("references.csv");
+        std::fs::write(
+            &p,
+            "# ok\nlabel,x,y,z,temperature_c\nw,1,2,3,20.5\nv,1,2,x,20\n",
+        )
+        .unwrap();
+        let e = read_references(&p).unwrap_err().to_string();
+        assert!(
+            e.ends_with("references.csv:4: z 'x' is not a number"),
+            "{e}"
+        );
+        std::fs::write(&p, "label,x,y,temperature_c\n").unwrap();
+        let e = read_references(&p).unwrap_err().to_string();
+        assert!(e.contains(":1: the header has no column 'z'"), "{e}");
+        std::fs::write(&p, "temperature_c,label,z,y,x,std_k\n20.5,w,3,2,1,0.05\n").unwrap();
+        let r = read_references(&p).unwrap();
+        assert_eq!(
+            (r[0].xyz, r[0].std_k, r[0].frame),
+            ([1.0, 2.0, 3.0], 0.05, PointFrame::Scan)
+        );
+    }
+}
