@@ -410,8 +410,10 @@ impl Fuser<'_> {
                     &params.observation,
                 );
                 let (residuals, offset, a) = if cal.enabled {
+                    // Every third observation is plenty for a median and a slope.
                     let pairs: Vec<(f64, f64)> = obs
                         .iter()
+                        .step_by(3)
                         .filter_map(|o| {
                             map.reference_k(&o.p, cal.min_map_observations, cal.max_map_spread_k)
                                 .map(|t| (o.t_k - t, o.rho))

@@ -18,7 +18,8 @@ use serde::{Deserialize, Serialize};
 pub struct SelfCalibration {
     /// Whether per-frame offsets and vignetting are estimated and removed.
     pub enabled: bool,
-    /// Voxels a frame must share with the map to get its own offset (else the last one is kept).
+    /// Samples (every third observation) a frame must share with the map to get its own offset
+    /// (else the last one is kept).
     pub min_overlap: usize,
     /// Map voxels used need this many observations …
     pub min_map_observations: u64,
@@ -32,7 +33,7 @@ impl Default for SelfCalibration {
     fn default() -> Self {
         Self {
             enabled: true,
-            min_overlap: 200,
+            min_overlap: 100,
             min_map_observations: 4,
             max_map_spread_k: 0.4,
             outlier_k: 1.0,
