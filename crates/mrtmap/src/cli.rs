@@ -414,6 +414,8 @@ pub struct DemoArgs {
 /// A simulated camera's radiometric errors.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum CameraErrorsArg {
+    /// Realistic with --noise realistic, none with --noise none.
+    Auto,
     /// A perfect camera (the NETD and blur of --noise remain).
     None,
     /// A Lepton 3.5-like unit: offset 1.5 K, gain 2 %, FFC every 30–120 s (σ 0.3 K new offsets,
@@ -425,7 +427,7 @@ pub enum CameraErrorsArg {
 #[derive(Debug, Args, Clone)]
 pub struct CameraErrorArgs {
     /// The camera's radiometric errors (the truth goes to radiometric_truth.json).
-    #[arg(long, value_enum, default_value_t = CameraErrorsArg::None)]
+    #[arg(long, value_enum, default_value_t = CameraErrorsArg::Auto)]
     pub camera_errors: CameraErrorsArg,
     /// This unit's constant offset (K).
     #[arg(long, allow_negative_numbers = true)]
@@ -455,12 +457,14 @@ pub struct CameraErrorArgs {
 }
 
 impl CameraErrorArgs {
-    /// The model these flags describe.
-    pub fn model(&self) -> mrtmap_sim::RadiometricModel {
+    /// The model these flags describe, with sensor noise `noise`.
+    pub fn model(&self, noise: NoiseArg) -> mrtmap_sim::RadiometricModel {
         use mrtmap_sim::RadiometricModel as M;
-        let mut m = match self.camera_errors {
-            CameraErrorsArg::None => M::NONE,
-            CameraErrorsArg::Realistic => M::REALISTIC,
+        let mut m = match (self.camera_errors, noise) {
+            (CameraErrorsArg::None, _) | (CameraErrorsArg::Auto, NoiseArg::None) => M::NONE,
+            (CameraErrorsArg::Realistic, _) | (CameraErrorsArg::Auto, NoiseArg::Realistic) => {
+                M::REALISTIC
+            }
         };
         let set = |x: &mut f64, v: Option<f64>| {
             if let Some(v) = v {
@@ -480,9 +484,9 @@ impl CameraErrorArgs {
     }
 
     /// How many reference readings to write.
-    pub fn references(&self) -> usize {
+    pub fn references(&self, noise: NoiseArg) -> usize {
         self.references
-            .unwrap_or(if self.model().is_perfect() { 0 } else { 2 })
+            .unwrap_or(if self.model(noise).is_perfect() { 0 } else { 2 })
     }
 }
 

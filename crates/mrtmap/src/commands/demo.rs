@@ -18,8 +18,8 @@ pub fn run(a: &DemoArgs) -> anyhow::Result<()> {
         },
         air_speed_m_s: a.air_speed,
         depth_size: a.depth_size,
-        radiometric: a.camera.model(),
-        references: a.camera.references(),
+        radiometric: a.camera.model(a.noise),
+        references: a.camera.references(a.noise),
         force: a.force,
     };
     // Measured: 60 s at 640×480 wrote 453 MB, 20 s at 320×240 85 MB (recording, cloud, maps,

@@ -35,8 +35,8 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<()> {
     cfg.thermal_hz = a.thermal_hz;
     cfg.rgb_hz = a.rgb_hz;
     cfg.truth_rays = a.truth_rays;
-    cfg.radiometric = a.camera.model();
-    cfg.references = a.camera.references();
+    cfg.radiometric = a.camera.model(a.noise);
+    cfg.references = a.camera.references(a.noise);
     let bar = Bar::new(" frames");
     bar.begin(&format!("simulating {}", room.file.name));
     let t0 = Instant::now();
