@@ -222,3 +222,76 @@ fn the_fit_in_a_box_room() {
     );
     assert!((mrt.celsius() - 22.357).abs() < 0.01, "{}", mrt.celsius());
 }
+
+/// (1/π) ∫ fp dΩ over a corner rectangle, by the midpoint rule on `n`×`n` cells: a vertical one in
+/// the plane x = c (u along y, v up), or a horizontal one at height c above the centre (u along x,
+/// v along y). `facing` None averages over azimuth; Some(0) faces +x.
+fn fp_integral(
+    posture: Posture,
+    vertical: bool,
+    a: f64,
+    b: f64,
+    c: f64,
+    facing: Option<f64>,
+) -> f64 {
+    let n = 600;
+    let (du, dv) = (a / n as f64, b / n as f64);
+    let mut sum = 0.0;
+    for i in 0..n {
+        for j in 0..n {
+            let (u, v) = ((i as f64 + 0.5) * du, (j as f64 + 0.5) * dv);
+            let p = if vertical { [c, u, v] } else { [u, v, c] };
+            let r = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+            let alt = (p[2] / r).asin().to_degrees();
+            let fp = match facing {
+                None => projected_area_factor_averaged(posture, alt),
+                Some(f) => projected_area_factor(posture, p[1].atan2(p[0]).to_degrees() - f, alt),
+            };
+            sum += fp * c / r.powi(3) * du * dv;
+        }
+    }
+    sum / std::f64::consts::PI
+}
+
+/// comfort-person.md §1: the fp-table integrals of the corner rectangles (±1e-4) and the window
+/// example (averaged 0.03978 seated / 0.04236 standing, facing the wall 0.04669 / 0.04839).
+#[test]
+fn fp_table_integrals_over_rectangles() {
+    let rows = [
+        (1.0, 1.0, [0.0440, 0.0363, 0.0468, 0.0297]),
+        (2.0, 1.0, [0.0578, 0.0488, 0.0618, 0.0427]),
+        (1.0, 2.0, [0.0557, 0.0488, 0.0572, 0.0427]),
+        (0.5, 3.0, [0.0351, 0.0307, 0.0355, 0.0260]),
+        (3.0, 3.0, [0.0905, 0.0845, 0.0924, 0.0805]),
+        (10.0, 10.0, [0.1137, 0.1120, 0.1139, 0.1100]),
+    ];
+    let kinds = [
+        (Seated, true),
+        (Seated, false),
+        (Standing, true),
+        (Standing, false),
+    ];
+    for (x, y, want) in rows {
+        for (k, (p, vertical)) in kinds.iter().enumerate() {
+            let f = fp_integral(*p, *vertical, x, y, 1.0, None);
+            assert!(
+                (f - want[k]).abs() <= 1e-4,
+                "{p:?} vertical {vertical} ({x}, {y}): {f:.5}"
+            );
+        }
+    }
+    // The window: c = 2, u ∈ [−0.5, 1.5], v ∈ [0.2, 1.7], composed of corner rectangles.
+    let window = |p: Posture, facing: Option<f64>| {
+        let g = |u: f64, v: f64| {
+            let mirror = |f: Option<f64>| f.map(|a| if u < 0.0 { -a } else { a });
+            u.signum() * v.signum() * fp_integral(p, true, u.abs(), v.abs(), 2.0, mirror(facing))
+        };
+        g(1.5, 1.7) - g(-0.5, 1.7) - g(1.5, 0.2) + g(-0.5, 0.2)
+    };
+    for (p, averaged, facing) in [(Seated, 0.03978, 0.04669), (Standing, 0.04236, 0.04839)] {
+        let a = window(p, None);
+        let f = window(p, Some(0.0));
+        assert!((a - averaged).abs() <= 1e-4, "{p:?} averaged {a:.5}");
+        assert!((f - facing).abs() <= 1e-4, "{p:?} facing {f:.5}");
+    }
+}
