@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use mrtmap_report::numbers::{fixed, uncertainty};
+use mrtmap_report::numbers::{fixed, signed, uncertainty};
 use mrtmap_report::{KeyValues, ReportData, ReportMap};
 use mrtmap_scan::FusionReport;
 use mrtmap_scan::segment::SegmentReport;
@@ -51,7 +51,7 @@ fn feature_rows(s: &SegmentReport) -> Vec<[String; 6]> {
                 f.host.clone(),
                 format!("{} ({}{share})", f.label, f.label_source),
                 format!("{:.2}", f.temperature_c),
-                format!("{:+.2}", f.contrast_k),
+                signed(f.contrast_k, 2),
                 format!("{:.2}", f.area_m2),
             ]
         })
@@ -275,9 +275,9 @@ fn level_rows(o: &RunOutcome) -> (KeyValues, Vec<[String; 5]>) {
             )
         } else {
             format!(
-                "{}: the camera read {:+.2} K at the scene's mean temperature, gain {:.3}; the level is known to ±{} K, part of every ±",
+                "{}: the camera read {} K at the scene's mean temperature, gain {:.3}; the level is known to ±{} K, part of every ±",
                 l.basis,
-                l.offset_at_mean_k,
+                signed(l.offset_at_mean_k, 2),
                 l.beta,
                 uncertainty(l.std_k, 2)
             )
@@ -291,7 +291,7 @@ fn level_rows(o: &RunOutcome) -> (KeyValues, Vec<[String; 5]>) {
                     r.label.clone(),
                     format!("{:.2}", r.reference_c),
                     r.camera_c.map_or("not seen".into(), |c| format!("{c:.2}")),
-                    r.residual_k.map_or("—".into(), |x| format!("{x:+.2}")),
+                    r.residual_k.map_or("—".into(), |x| signed(x, 2)),
                     if r.used {
                         "yes".into()
                     } else {
@@ -306,12 +306,12 @@ fn level_rows(o: &RunOutcome) -> (KeyValues, Vec<[String; 5]>) {
         rows.push((
             "frames' self-calibration".into(),
             format!(
-                "{} frames got their own offset ({} kept the previous one); offsets removed {:+.2}…{:+.2} K; vignetting {:+.2} K at the corners; residual against the map {:.3} → {:.3} K rms",
+                "{} frames got their own offset ({} kept the previous one); offsets removed {}…{} K; vignetting {} K at the corners; residual against the map {:.3} → {:.3} K rms",
                 r.frames_calibrated,
                 r.frames_carried,
-                r.offset_range_k[0],
-                r.offset_range_k[1],
-                r.vignetting_k,
+                signed(r.offset_range_k[0], 2),
+                signed(r.offset_range_k[1], 2),
+                signed(r.vignetting_k, 2),
                 r.residual_rms_before_k,
                 r.residual_rms_after_k
             ),

@@ -4,7 +4,7 @@ use base64::Engine;
 use mrtmap_radiation::PointRecord;
 use serde::Serialize;
 
-use crate::numbers::{uncertainty, xyz};
+use crate::numbers::{signed, uncertainty, xyz};
 use crate::tables::MapSummary;
 use crate::validate::ValidationRow;
 
@@ -123,7 +123,7 @@ const STYLE: &str = "body{font-family:system-ui,sans-serif;margin:2em auto;max-w
 h1{font-size:1.6em}h2{margin-top:1.6em;border-bottom:1px solid #ccc}table{border-collapse:collapse;margin:.6em 0}\
 td,th{border:1px solid #ccc;padding:.25em .6em;text-align:right}th{background:#f3f3f3}td:first-child{text-align:left}\
 .ok{color:#176d1a}.bad{color:#b00020}.warn{background:#fff4d6;padding:.4em .8em;border-left:4px solid #e0a800}\
-img{max-width:100%;border:1px solid #ddd}pre{background:#f7f7f7;padding:.8em;overflow-x:auto}";
+img{max-width:100%;border:1px solid #ddd}table.kv td{text-align:left}pre{background:#f7f7f7;padding:.8em;overflow-x:auto}";
 
 fn map_section(o: &mut String, m: &ReportMap) {
     let b64 = base64::engine::general_purpose::STANDARD;
@@ -168,9 +168,9 @@ fn comparison_section(o: &mut String, d: &ReportData) {
                 format!("{:.2}", c.globe_c),
                 num(&format!("cmp-{}-ours", c.name), c.ours_c, 2),
                 format!(
-                    "<span class=\"{}\">{:+.2}</span>",
+                    "<span class=\"{}\">{}</span>",
                     if c.diff_k.abs() <= 0.2 { "ok" } else { "bad" },
-                    c.diff_k
+                    signed(c.diff_k, 2)
                 ),
             ]
         })
@@ -218,8 +218,8 @@ fn validation_row(r: &ValidationRow) -> Vec<String> {
             .as_ref()
             .map(|(o, s)| format!("{o:.2} ± {}", uncertainty(*s, 2)))
             .unwrap_or_else(|e| esc(e)),
-        r.diff_iso_k.map_or("—".into(), |v| format!("{v:+.2}")),
-        r.diff_mixed_k.map_or("—".into(), |v| format!("{v:+.2}")),
+        r.diff_iso_k.map_or("—".into(), |v| signed(v, 2)),
+        r.diff_mixed_k.map_or("—".into(), |v| signed(v, 2)),
         yes(r.meets_required),
         yes(r.meets_desired),
     ]
@@ -291,6 +291,16 @@ fn plain_table<R: AsRef<[String]>>(o: &mut String, heading: &str, headers: &[&st
     plain_rows(o, headers, &rows);
 }
 
+/// A two-column what/value table whose values are text (left-aligned).
+fn kv_table(o: &mut String, kv: &KeyValues) {
+    if kv.is_empty() {
+        return;
+    }
+    let mut t = String::new();
+    plain_rows(&mut t, &["what", "value"], &key_value_rows(kv));
+    o.push_str(&t.replacen("<table>", "<table class=\"kv\">", 1));
+}
+
 fn key_value_rows(kv: &KeyValues) -> Vec<Vec<String>> {
     kv.iter().map(|(k, v)| vec![k.clone(), v.clone()]).collect()
 }
@@ -302,7 +312,7 @@ fn comfort_section(o: &mut String, d: &ReportData) {
         return;
     }
     o.push_str("<h2>Comfort of a person</h2>");
-    plain_rows(o, &["what", "value"], &key_value_rows(&d.comfort));
+    kv_table(o, &d.comfort);
     if !d.comfort_points.is_empty() {
         let mut headers = vec!["point"];
         headers.extend(d.comfort_point_columns.iter().map(String::as_str));
@@ -327,7 +337,7 @@ fn level_section(o: &mut String, d: &ReportData) {
         return;
     }
     o.push_str("<h2>What the temperatures rest on</h2>");
-    plain_rows(o, &["what", "value"], &key_value_rows(&d.level));
+    kv_table(o, &d.level);
     let refs: Vec<Vec<String>> = d.references.iter().map(|r| r.to_vec()).collect();
     plain_rows(
         o,

@@ -10,6 +10,17 @@ pub fn fixed(x: f64, decimals: usize) -> String {
     }
 }
 
+/// `x` with its sign and `decimals` decimals ("+0.12", "-0.12"); a value that rounds to zero
+/// prints as "0.00".
+pub fn signed(x: f64, decimals: usize) -> String {
+    let s = fixed(x, decimals);
+    if s.bytes().all(|b| b == b'0' || b == b'.') || s.starts_with('-') {
+        s
+    } else {
+        format!("+{s}")
+    }
+}
+
 /// An uncertainty (≥ 0) with at least `min_decimals` decimals and as many more as its first
 /// significant digit needs: 0.004 → "0.004", 0.0004 → "0.0004", 0.04 → "0.04" (two minimum), 0 → "0.00".
 pub fn uncertainty(x: f64, min_decimals: usize) -> String {
@@ -41,6 +52,9 @@ mod tests {
         assert_eq!(fixed(-0.006, 2), "-0.01");
         assert_eq!(fixed(-1.234, 1), "-1.2");
         assert_eq!(xyz(&[-0.004, 1.0, -2.5]), "(0.00, 1.00, -2.50)");
+        assert_eq!(signed(-0.001, 2), "0.00");
+        assert_eq!(signed(0.123, 2), "+0.12");
+        assert_eq!(signed(-0.126, 2), "-0.13");
     }
 
     #[test]

@@ -59,12 +59,12 @@ pub fn run(a: &DemoArgs) -> anyhow::Result<()> {
     );
     for r in &d.rows {
         outln!(
-            "  {:<6} {:>12.2} {:>18.2} {:>10.2} {:>+14.2} K",
+            "  {:<6} {:>12.2} {:>18.2} {:>10.2} {:>14} K",
             r.name,
             r.truth_c,
             r.globe_c,
             r.ours_c,
-            r.diff_k
+            mrtmap_report::numbers::signed(r.diff_k, 2)
         );
     }
     outln!(

@@ -1,7 +1,7 @@
 //! `mrtmap validate`: a map against black-globe readings.
 
 use mrtmap_pipeline::validation::validate_map;
-use mrtmap_report::numbers::uncertainty;
+use mrtmap_report::numbers::{signed, uncertainty};
 use mrtmap_report::{ISO_DESIRED_K, ISO_REQUIRED_K};
 
 use crate::cli::ValidateArgs;
@@ -58,8 +58,8 @@ pub fn run(a: &ValidateArgs) -> anyhow::Result<()> {
             iso,
             mixed,
             ours,
-            r.diff_iso_k.map_or("—".into(), |v| format!("{v:+.2}")),
-            r.diff_mixed_k.map_or("—".into(), |v| format!("{v:+.2}")),
+            r.diff_iso_k.map_or("—".into(), |v| signed(v, 2)),
+            r.diff_mixed_k.map_or("—".into(), |v| signed(v, 2)),
         );
     }
     if let Some(s) = v.level_shift_k {
