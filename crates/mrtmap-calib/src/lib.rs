@@ -18,6 +18,7 @@ pub mod detect;
 pub mod gray;
 pub mod lm;
 pub mod pairs;
+pub mod quality;
 pub mod report;
 pub mod rig;
 pub mod synth;
@@ -33,6 +34,7 @@ pub use calibrate::{
 pub use detect::{Corner, DetectOptions, Detection, detect};
 pub use gray::Gray;
 pub use pairs::{ImagePair, find_pairs, list_images};
+pub use quality::plausibility;
 
 /// Why a calibration could not be done.
 #[derive(Debug, thiserror::Error)]

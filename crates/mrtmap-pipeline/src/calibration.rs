@@ -419,6 +419,7 @@ pub fn write_stereo_report(
         "rgb_alone": r.rgb_alone,
         "thermal_alone": r.thermal_alone,
         "pairs": pairs,
+        "warnings": mrtmap_calib::plausibility(r),
     });
     write_json(&rep.join("calibration.json"), &doc)?;
     write_atomic(

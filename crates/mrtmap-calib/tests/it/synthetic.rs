@@ -94,6 +94,20 @@ fn stereo_calibration_recovers_the_synthetic_rig() {
         r.rgb_error.mean_px,
         r.thermal_error.mean_px
     );
+    // A right calibration raises no warning; the same with the thermal camera moved 40 cm does.
+    assert_eq!(mrtmap_calib::plausibility(&r), Vec::<String>::new());
+    let mut far = r.clone();
+    far.rgb_from_thermal.translation.vector.z += 0.4;
+    let w = mrtmap_calib::plausibility(&far);
+    assert!(
+        w.len() == 1 && w[0].contains("from the colour camera"),
+        "{w:?}"
+    );
+    let mut loose = r.clone();
+    if let Some(s) = loose.std.as_mut() {
+        s[21] = 0.05;
+    }
+    assert!(mrtmap_calib::plausibility(&loose)[0].contains("poorly constrained"));
     assert!(used >= 15, "only {used} pairs used");
     assert!(rel(r.rgb.fx, rig.rgb.fx) < 0.005);
     assert!(rel(r.rgb.fy, rig.rgb.fy) < 0.005);

@@ -224,6 +224,9 @@ fn print_stereo<'a>(r: &StereoResult, names: impl Iterator<Item = &'a str>) {
         )
     );
     print_extrinsic(r);
+    for w in mrtmap_calib::plausibility(r) {
+        outln!("warning: {w}");
+    }
     let used = r
         .pairs
         .iter()
