@@ -612,7 +612,8 @@ fn median_offset(
 type Tied = Vec<(usize, Isometry3<f64>, Isometry3<f64>)>;
 
 /// Ties each candidate's thermal numbering by the board shift that puts the thermal camera
-/// nearest `t0`; a pair for which no shift comes within 0.4 squares is rejected.
+/// nearest `t0` across the view (x, y); a pair for which no shift comes within 0.4 squares is
+/// rejected.
 fn tie_shifts(
     board: &Board,
     cands: &[Cand],
@@ -627,7 +628,10 @@ fn tie_shifts(
         for di in -reach..=reach {
             for dj in -reach..=reach {
                 let tt = cand.tt * board_shift(board, di, dj).inverse();
-                let d = ((tt * cand.tc.inverse()).translation.vector - t0).norm();
+                // Across the view only: a single small camera's board distance is its noisiest
+                // coordinate, while a board shift moves the thermal camera sideways.
+                let e = (tt * cand.tc.inverse()).translation.vector - t0;
+                let d = e.x.hypot(e.y);
                 if best.is_none_or(|b| d < b.0) {
                     best = Some((d, di, dj));
                 }

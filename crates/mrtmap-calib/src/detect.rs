@@ -2,7 +2,8 @@
 //!
 //! The ChESS corner detector and grid labelling of `calib-targets` find the corners; small images
 //! (a 160×120 thermal camera) are first upsampled so that a square spans enough pixels for the
-//! detector's ring. Saddle points do not care which squares are bright, so thermal images with
+//! detector's ring; large ones are also tried at half and a third of their size, and the scale
+//! with the most corners wins. Saddle points do not care which squares are bright, so thermal images with
 //! inverted contrast need no special case. On images that were not upsampled each corner is
 //! refined by the gradient-orthogonality method (as OpenCV's `cornerSubPix`); corners that
 //! disagree with a homography fitted to the rest are dropped.
@@ -93,9 +94,38 @@ pub fn detect(img: &Gray, max_grid: (u32, u32), opts: &DetectOptions) -> Option<
     let up = img.to_luma8_scaled(scale);
     let mut params = ChessboardParams::default();
     params.min_corner_strength = 0.0;
-    let all = detect_chessboard_all(&up, &default_chess_config(), &params);
-    let best = all.into_iter().max_by_key(|d| d.corners.len())?;
-    let s = scale as f64;
+    // Large images are also tried at half and a third of their size: the detector's ring is a few
+    // pixels wide, and on large squares of crumpled foil it meets the foil's own texture first.
+    let mut tries: Vec<(image::GrayImage, f64)> = vec![(up, scale as f64)];
+    if scale == 1 && img.width.min(img.height) >= 480 {
+        for k in [2u32, 3] {
+            let small = image::imageops::resize(
+                &tries[0].0,
+                img.width / k,
+                img.height / k,
+                image::imageops::FilterType::Triangle,
+            );
+            tries.push((small, 1.0 / k as f64));
+        }
+    }
+    let mut found = Vec::new();
+    for (im, f) in &tries {
+        let all = detect_chessboard_all(im, &default_chess_config(), &params);
+        if let Some(d) = all.into_iter().max_by_key(|d| d.corners.len()) {
+            found.push((d, *f));
+        }
+    }
+    // Most corners; on a tie the finest scale (it comes first).
+    let mut pick = 0;
+    for k in 1..found.len() {
+        if found[k].0.corners.len() > found[pick].0.corners.len() {
+            pick = k;
+        }
+    }
+    if found.is_empty() {
+        return None;
+    }
+    let (best, s) = found.swap_remove(pick);
     let mut corners: Vec<Corner> = best
         .corners
         .iter()
@@ -111,7 +141,7 @@ pub fn detect(img: &Gray, max_grid: (u32, u32), opts: &DetectOptions) -> Option<
         .map(|c| c as f64 / s)
         .unwrap_or_else(|| median_neighbour_distance(&corners));
     corners = clip_to_board(corners, max_grid);
-    if opts.subpixel && scale == 1 {
+    if opts.subpixel && s <= 1.0 {
         let half = (opts.window * cell_px).clamp(1.5, 6.0);
         for c in &mut corners {
             if let Some(p) = refine_corner(img, Point2::new(c.x, c.y), half) {

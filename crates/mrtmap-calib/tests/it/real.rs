@@ -55,3 +55,34 @@ fn real_thermal_board_intrinsics() {
     assert!(used >= 50, "only {used} frames used");
     assert!(r.error.mean_px < 0.3, "MRE {:.3} px", r.error.mean_px);
 }
+
+/// The hand-made foil board of `thermal-rgb-pairs` (ZED 2i colour 1280×720, Lepton 3.5 ironbow
+/// 120×160, 4×6 inner corners): the board is found in 34 of the 35 colour images (20 before large
+/// images were also tried at half and a third of their size) and 32 of the 35 thermal ones.
+/// OpenCV finds it in every image; the pose is not yet within its bounds (issue 14).
+#[test]
+fn real_foil_board_pairs_are_detected() {
+    let Some(dir) = data_dir() else {
+        println!("skipped: shared/data not found (set MRTMAP_DATA_DIR)");
+        return;
+    };
+    let pairs = dir.join("thermal-rgb-pairs");
+    if !pairs.is_dir() {
+        println!("skipped: shared/data/thermal-rgb-pairs not found");
+        return;
+    }
+    let count = |sub: &str| {
+        let images = list_images(&pairs.join(sub)).expect("list");
+        assert_eq!(images.len(), 35, "{sub}");
+        images
+            .iter()
+            .filter(|p| {
+                let g = Gray::read(p).expect("image");
+                detect(&g, (4, 6), &DetectOptions::default()).is_some()
+            })
+            .count()
+    };
+    let (rgb, thermal) = (count("rgb"), count("thermal"));
+    assert!(rgb >= 34, "colour: {rgb} of 35");
+    assert!(thermal >= 32, "thermal: {thermal} of 35");
+}
