@@ -576,23 +576,25 @@ fn quarter_turns(
 
 /// The thermal camera's position relative to the colour camera: the median over the pairs that
 /// show the whole board in both images (their numbering is not ambiguous up to a shift).
+/// Whether a detection holds every inner corner of the board.
+fn full(board: &Board, d: &Option<Detection>) -> bool {
+    d.as_ref().is_some_and(|d| {
+        let (w, h) = d.extent();
+        d.corners.len() == board.corners()
+            && ((w, h) == (board.cols as i32, board.rows as i32)
+                || (w, h) == (board.rows as i32, board.cols as i32))
+    })
+}
+
 fn median_offset(
     board: &Board,
     cands: &[Cand],
     rgb_dets: &[Option<Detection>],
     th_dets: &[Option<Detection>],
 ) -> Result<Vector3<f64>, CalibError> {
-    let full = |d: &Option<Detection>| {
-        d.as_ref().is_some_and(|d| {
-            let (w, h) = d.extent();
-            d.corners.len() == board.corners()
-                && ((w, h) == (board.cols as i32, board.rows as i32)
-                    || (w, h) == (board.rows as i32, board.cols as i32))
-        })
-    };
     let ts: Vec<Vector3<f64>> = cands
         .iter()
-        .filter(|c| full(&rgb_dets[c.k]) && full(&th_dets[c.k]))
+        .filter(|c| full(board, &rgb_dets[c.k]) && full(board, &th_dets[c.k]))
         .map(|c| (c.tt * c.tc.inverse()).translation.vector)
         .collect();
     if ts.is_empty() {
@@ -613,11 +615,13 @@ type Tied = Vec<(usize, Isometry3<f64>, Isometry3<f64>)>;
 
 /// Ties each candidate's thermal numbering by the board shift that puts the thermal camera
 /// nearest `t0` across the view (x, y); a pair for which no shift comes within 0.4 squares is
-/// rejected.
+/// rejected. A pair whose both images show the whole board needs no shift (its numbering is
+/// fixed once turned): it is kept unless it lies more than two squares away.
 fn tie_shifts(
     board: &Board,
     cands: &[Cand],
     t0: &Vector3<f64>,
+    whole: &dyn Fn(usize) -> bool,
     status: &mut [PairStatus],
 ) -> (Tied, Vec<Option<Vec<Corner>>>) {
     let mut used = Vec::new();
@@ -637,8 +641,15 @@ fn tie_shifts(
                 }
             }
         }
-        let Some((d, di, dj)) = best else { continue };
-        if d > 0.4 * board.square_m {
+        let Some((mut d, mut di, mut dj)) = best else {
+            continue;
+        };
+        if whole(cand.k) {
+            let e = (cand.tt * cand.tc.inverse()).translation.vector - t0;
+            (d, di, dj) = (e.x.hypot(e.y), 0, 0);
+        }
+        let limit = if whole(cand.k) { 2.0 } else { 0.4 };
+        if d > limit * board.square_m {
             status[cand.k] = PairStatus::Rejected(format!(
                 "the thermal corners cannot be matched to the colour corners (the best numbering puts the thermal camera {:.0} mm from where the other pairs do)",
                 d * 1e3
@@ -728,7 +739,8 @@ pub fn calibrate_stereo(
     let mut status = initial_status(&rgb_dets, &th_dets);
     let cands = quarter_turns(board, &th_dets, &rgb_alone, &thermal_alone);
     let t0 = median_offset(board, &cands, &rgb_dets, &th_dets)?;
-    let (used, th_labels) = tie_shifts(board, &cands, &t0, &mut status);
+    let whole = |k: usize| full(board, &rgb_dets[k]) && full(board, &th_dets[k]);
+    let (used, th_labels) = tie_shifts(board, &cands, &t0, &whole, &mut status);
     let e0 = Isometry3::from_parts(
         Translation3::from(t0),
         mean_rotation(&used.iter().map(|u| u.2.rotation).collect::<Vec<_>>()),
