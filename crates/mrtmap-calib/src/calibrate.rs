@@ -382,6 +382,9 @@ pub struct StereoResult {
     /// The thermal corners' labels after tying them to the colour image's numbering (per pair).
     #[serde(skip)]
     pub thermal_labels: Vec<Option<Vec<Corner>>>,
+    /// Which model the held-out pairs chose, in words.
+    #[serde(default)]
+    pub model_choice: String,
 }
 
 /// Relabels corners by k quarter turns then a shift that brings the smallest labels to (0, 0);
@@ -683,6 +686,41 @@ impl Joint<'_> {
         )
     }
 
+    /// Two-fold held-out error: fitted on every other active pair, the other pairs' reprojection
+    /// error (their poses refitted with the intrinsics and extrinsic fixed), summed over both folds;
+    /// `None` with fewer than six active pairs.
+    fn held_out_error(&self, s: &crate::lm::Solved, free: &[bool], active: &[bool]) -> Option<f64> {
+        let act: Vec<usize> = (0..active.len()).filter(|v| active[*v]).collect();
+        if act.len() < 6 {
+            return None;
+        }
+        let none = vec![false; free.len()];
+        let mut total = 0.0;
+        for fold in 0..2 {
+            let train: Vec<bool> = (0..active.len())
+                .map(|v| {
+                    active[v]
+                        && act
+                            .iter()
+                            .position(|a| *a == v)
+                            .is_some_and(|i| i % 2 != fold)
+                })
+                .collect();
+            let test: Vec<bool> = (0..active.len()).map(|v| active[v] && !train[v]).collect();
+            let fit = solve(
+                &self.prob,
+                s.global.clone(),
+                s.views.clone(),
+                free,
+                &train,
+                100,
+            );
+            let posed = solve(&self.prob, fit.global.clone(), fit.views, &none, &test, 50);
+            total += posed.sum_sq;
+        }
+        Some(total)
+    }
+
     /// Refits without the pairs whose error is far above the others', twice at most and keeping
     /// at least three; `status` says why a pair was dropped.
     fn reject_outliers(
@@ -762,11 +800,54 @@ pub fn calibrate_stereo(
     let mut free: Vec<bool> = opts.model_rgb.free().to_vec();
     free.extend(opts.model_thermal.free());
     free.extend([true; 6]);
-    let joint = Joint { prob, free };
+    let mut joint = Joint { prob, free };
     let views: Vec<[f64; 6]> = used.iter().map(|u| vec6(&u.1)).collect();
     let mut active = vec![true; idx.len()];
     let first = solve(&joint.prob, g, views, &joint.free, &active, 100);
-    let s = joint.reject_outliers(first, &mut active, &idx, &mut status);
+    let mut s = joint.reject_outliers(first, &mut active, &idx, &mut status);
+    // The thermal principal point: free, or at the image centre, whichever predicts held-out pairs
+    // better (a small sensor's views may not constrain it, and a wrong one tilts the pose).
+    let centred = |g: &[f64]| {
+        let mut g = g.to_vec();
+        g[11] = (thermal_size.0 as f64 - 1.0) / 2.0;
+        g[12] = (thermal_size.1 as f64 - 1.0) / 2.0;
+        g
+    };
+    let mut fixed_free = joint.free.clone();
+    fixed_free[11] = false;
+    fixed_free[12] = false;
+    let free_err = joint.held_out_error(&s, &joint.free, &active);
+    let centre_err = joint.held_out_error(
+        &crate::lm::Solved {
+            global: centred(&s.global),
+            ..s.clone()
+        },
+        &fixed_free,
+        &active,
+    );
+    let principal_point_centred = matches!((free_err, centre_err), (Some(f), Some(c)) if c <= f);
+    let model_choice = match (free_err, centre_err) {
+        (Some(f), Some(c)) => format!(
+            "thermal principal point {} (held-out squared error {c:.1} px² at the centre, {f:.1} px² free)",
+            if principal_point_centred {
+                "at the image centre"
+            } else {
+                "fitted"
+            }
+        ),
+        _ => "thermal principal point fitted (too few pairs to compare on held-out ones)".into(),
+    };
+    if principal_point_centred {
+        joint.free = fixed_free;
+        s = solve(
+            &joint.prob,
+            centred(&s.global),
+            s.views,
+            &joint.free,
+            &active,
+            100,
+        );
+    }
     let mut results: Vec<PairResult> = (0..n)
         .map(|k| PairResult {
             status: status[k].clone(),
@@ -800,6 +881,7 @@ pub fn calibrate_stereo(
         rgb_alone,
         thermal_alone,
         thermal_labels: th_labels,
+        model_choice,
     })
 }
 

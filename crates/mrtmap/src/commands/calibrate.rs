@@ -224,6 +224,7 @@ fn print_stereo<'a>(r: &StereoResult, names: impl Iterator<Item = &'a str>) {
         )
     );
     print_extrinsic(r);
+    outln!("model: {}", r.model_choice);
     for w in mrtmap_calib::plausibility(r) {
         outln!("warning: {w}");
     }
