@@ -420,6 +420,7 @@ pub fn write_stereo_report(
         "thermal_alone": r.thermal_alone,
         "pairs": pairs,
         "warnings": mrtmap_calib::plausibility(r),
+        "model_choice": r.model_choice,
     });
     write_json(&rep.join("calibration.json"), &doc)?;
     write_atomic(
