@@ -340,11 +340,7 @@ pub fn make_comfort_maps(
         scene: source.to_string(),
         source: e,
     })?;
-    let person: Vec<Quantity> = quantities
-        .iter()
-        .copied()
-        .filter(|q| *q != Quantity::Mrt)
-        .collect();
+    let person = Quantity::person(quantities);
     let spec = GridSpec {
         nx: grid[0],
         ny: grid[1],

@@ -203,13 +203,7 @@ fn comfort_stage(
     force: bool,
     progress: &dyn Progress,
 ) -> Result<Option<(StageOutcome, ComfortResult)>> {
-    let person: Vec<Quantity> = p
-        .map
-        .quantities
-        .iter()
-        .copied()
-        .filter(|q| *q != Quantity::Mrt)
-        .collect();
+    let person = Quantity::person(&p.map.quantities);
     if person.is_empty() {
         return Ok(None);
     }

@@ -125,6 +125,11 @@ impl Quantity {
         }
     }
 
+    /// The person's quantities among `qs` (all but the sphere's MRT, which every map run draws).
+    pub fn person(qs: &[Quantity]) -> Vec<Quantity> {
+        qs.iter().copied().filter(|q| *q != Quantity::Mrt).collect()
+    }
+
     /// Whether it needs the air (temperature, humidity…): operative temperature, PMV and PPD.
     pub fn needs_air(self) -> bool {
         matches!(self, Self::Operative | Self::Pmv | Self::Ppd)

@@ -38,6 +38,17 @@ fn scene_of(map: &Path) -> Result<PathBuf> {
         })
 }
 
+/// The engine MRTs are compared with globes by: exact where valid, else Monte Carlo of `RAYS`.
+fn globe_engine(scene: &RadiantScene) -> Result<MrtEngine<'_>> {
+    Ok(MrtEngine::new(
+        scene,
+        Method::Auto(MonteCarlo {
+            rays: RAYS,
+            ..MonteCarlo::default()
+        }),
+    )?)
+}
+
 /// The scene with every temperature shifted by `shift_k`.
 fn shifted(scene: &RadiantScene, shift_k: f64) -> Result<RadiantScene> {
     let mut f = scene.to_file();
@@ -75,13 +86,7 @@ fn calibrate_level(
     let mut shift = 0.0;
     for _ in 0..2 {
         let s = shifted(scene, shift)?;
-        let engine = MrtEngine::new(
-            &s,
-            Method::Auto(MonteCarlo {
-                rays: RAYS,
-                ..MonteCarlo::default()
-            }),
-        )?;
+        let engine = globe_engine(&s)?;
         let rows = validate(
             &idx.iter().map(|&k| readings[k].clone()).collect::<Vec<_>>(),
             &|x: &[f64; 3]| {
@@ -117,13 +122,7 @@ pub fn validate_map(
     let scene = RadiantScene::load(&scene_path)?;
     let text = std::fs::read_to_string(globe).map_err(|e| mrtmap_io::FileError::io(globe, e))?;
     let mut readings = parse_globe_csv(&text, &globe.display().to_string())?;
-    let engine = MrtEngine::new(
-        &scene,
-        Method::Auto(MonteCarlo {
-            rays: RAYS,
-            ..MonteCarlo::default()
-        }),
-    )?;
+    let engine = globe_engine(&scene)?;
     for r in &mut readings {
         let p = to_scene_frame(r.xyz, frame, &scene, &scene_path.display().to_string())?;
         engine.check_inside(&p).map_err(|e| Error::Config {
@@ -149,13 +148,7 @@ pub fn validate_map(
     let engine = match level_shift_k {
         Some(s) => {
             calibrated = shifted(&scene, s)?;
-            MrtEngine::new(
-                &calibrated,
-                Method::Auto(MonteCarlo {
-                    rays: RAYS,
-                    ..MonteCarlo::default()
-                }),
-            )?
+            globe_engine(&calibrated)?
         }
         None => engine,
     };

@@ -20,13 +20,7 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
     if !a.quantities.is_empty() {
         project.map.quantities = a.quantities.clone();
     }
-    let person: Vec<Quantity> = project
-        .map
-        .quantities
-        .iter()
-        .copied()
-        .filter(|q| *q != Quantity::Mrt)
-        .collect();
+    let person = Quantity::person(&project.map.quantities);
     project.comfort.check(&project.air, &person)?;
     let (scene, source) = load_scene(a.scene.scene.as_deref())?;
     let section = a.method.section();
