@@ -5,12 +5,12 @@
 use mrtmap_geometry::PlaneFrame;
 use mrtmap_geometry::nalgebra::{Isometry3, Point2, Point3, Unit, Vector2, Vector3};
 use mrtmap_geometry::plane::{Plane, RansacParams, intersect_three, ransac_plane};
-use mrtmap_geometry::polygon::{centroid, signed_area};
-use mrtmap_geometry::shape2d::line_intersection;
+use mrtmap_geometry::polygon::centroid;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
+use super::outline::{self, OutlineError, OutlineParams};
 use super::{SegmentError, SegmentParams};
 
 /// What a plane is.
@@ -56,6 +56,8 @@ pub struct Envelope {
     pub ceiling: usize,
     /// Walls in order around the room (counter-clockwise seen from above).
     pub walls: Vec<usize>,
+    /// How much of each wall was seen.
+    pub seen: Vec<WallSeen>,
     /// Corners at the floor: corner k is where wall k−1 meets wall k.
     pub floor_corners: Vec<Point3<f64>>,
     /// Corners at the ceiling.
@@ -66,6 +68,17 @@ pub struct Envelope {
     pub frame: PlaneFrame,
 }
 
+/// How much of a wall the scan saw.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WallSeen {
+    /// Never seen: placed at the edge of the floor and ceiling seen.
+    pub inferred: bool,
+    /// The share of its length along which its points were seen.
+    pub observed: f64,
+    /// Its length at the floor (m).
+    pub length_m: f64,
+}
+
 /// Up from the camera poses: the mean of the cameras' "up" (−y in OpenCV's convention) over the
 /// walk. Tilt sweeps cancel over a walk that looks all around.
 pub fn up_from_poses(world_from_camera: &[Isometry3<f64>]) -> Option<Unit<Vector3<f64>>> {
@@ -73,11 +86,6 @@ pub fn up_from_poses(world_from_camera: &[Isometry3<f64>]) -> Option<Unit<Vector
         .iter()
         .fold(Vector3::zeros(), |a, p| a - p.rotation * Vector3::y());
     Unit::try_new(s, 1e-9)
-}
-
-fn percentile(v: &mut [f64], q: f64) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[((v.len() - 1) as f64 * q).round() as usize]
 }
 
 /// The mean of the cloud's points `idx`.
@@ -239,358 +247,63 @@ fn room_centre(points: &[Point3<f64>], caps: &Caps) -> Point3<f64> {
     centroid(&inside)
 }
 
-/// The bins (start, end, count) of the contiguous run of occupied 10 cm bins (gaps up to 30 cm)
-/// holding the most points.
-fn main_run_bins(count: &[usize]) -> (usize, usize, usize) {
-    let (mut best, mut cur_start, mut gap, mut cur_n) =
-        ((0usize, 0usize, 0usize), None::<usize>, 0usize, 0usize);
-    for (b, &c) in count.iter().enumerate() {
-        if c >= 3 {
-            if cur_start.is_none() {
-                cur_start = Some(b);
-                cur_n = 0;
-            }
-            cur_n += c;
-            gap = 0;
-            if cur_n > best.2 {
-                best = (cur_start.unwrap_or(b), b, cur_n);
-            }
-        } else if cur_start.is_some() {
-            gap += 1;
-            if gap > 3 {
-                cur_start = None;
-            }
-        }
-    }
-    best
-}
-
-/// The wall's main run: 10 cm bins along it, the contiguous run (gaps up to 30 cm) holding the
-/// most inliers. Inliers elsewhere on the infinite plane belong to other surfaces and are dropped;
-/// returns the coverage, the occupied share of the run. A plane through the points of two corners
-/// (an artefact of mixed normals) covers little of its run.
-fn keep_main_run(plane: &mut FoundPlane, points: &[Point3<f64>], up: &Unit<Vector3<f64>>) -> f64 {
-    let d = up.cross(&plane.plane.normal);
-    let s: Vec<f64> = plane
-        .inliers
-        .iter()
-        .map(|&i| d.dot(&points[i].coords))
-        .collect();
-    let lo = s.iter().cloned().fold(f64::INFINITY, f64::min);
-    let hi = s.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
-    let bins = (((hi - lo) / 0.1).ceil() as usize).clamp(1, 100_000);
-    let bin = |v: f64| (((v - lo) / 0.1) as usize).min(bins - 1);
-    let mut count = vec![0usize; bins];
-    for v in &s {
-        count[bin(*v)] += 1;
-    }
-    let (b0, b1, _) = main_run_bins(&count);
-    plane.inliers = plane
-        .inliers
-        .iter()
-        .zip(&s)
-        .filter(|(_, v)| (b0..=b1).contains(&bin(**v)))
-        .map(|(i, _)| *i)
-        .collect();
-    plane.points = plane.inliers.len();
-    count[b0..=b1].iter().filter(|&&c| c >= 3).count() as f64 / (b1 - b0 + 1) as f64
-}
-
-/// A vertical plane through `c` with `normal` made exactly horizontal, pointing into the room.
-fn vertical_plane(
-    normal: &Vector3<f64>,
-    c: &Point3<f64>,
-    up: &Unit<Vector3<f64>>,
-    centre: &Point3<f64>,
-) -> Plane {
-    let n = Unit::new_normalize(normal - up.as_ref() * normal.dot(up));
-    let pl = Plane::from_point_normal(c, n);
-    if pl.distance(centre) < 0.0 {
-        pl.flipped()
-    } else {
-        pl
-    }
-}
-
-/// Walls: vertical planes spanning much of the room's height, reaching the ceiling (furniture does
-/// not), seen along most of their length; made exactly vertical, facing into the room.
-fn find_walls(
+/// The points of vertical surfaces between two heights, on the floor plan: cloud indices, 2D
+/// positions and 2D unit normals.
+fn vertical_points(
     points: &[Point3<f64>],
-    planes: &mut [FoundPlane],
-    caps: &Caps,
-    centre: &Point3<f64>,
-    p: &SegmentParams,
-) -> Vec<usize> {
-    let sin_v = p.vertical_deg.to_radians().sin();
-    let up = caps.up;
-    let mut walls = Vec::new();
-    for (k, plane) in planes.iter_mut().enumerate() {
-        if plane.class != PlaneClass::Slanted || plane.plane.normal.dot(&up).abs() > sin_v {
-            continue; // horizontal (classified above) or slanted
-        }
-        let mut hs: Vec<f64> = plane
-            .inliers
-            .iter()
-            .map(|&i| height(&points[i], &up))
-            .collect();
-        let (bottom, top) = (percentile(&mut hs, 0.05), percentile(&mut hs, 0.98));
-        let along = keep_main_run(plane, points, &up);
-        if top - bottom >= p.wall_min_height_fraction * (caps.h_ceiling - caps.h_floor)
-            && top >= caps.h_ceiling - p.wall_ceiling_gap_m
-            && along >= 0.5
-        {
-            let c = mean_of(points, &plane.inliers);
-            plane.plane = vertical_plane(&plane.plane.normal, &c, &up, centre);
-            plane.class = PlaneClass::Wall;
-            walls.push(k);
-        } else {
-            plane.class = PlaneClass::OtherVertical;
-        }
-    }
-    walls
-}
-
-/// Whether walls `a` and `b` are one wall found twice: directions within `merge_deg`, lines within
-/// `merge_distance_m`, extents overlapping.
-fn same_wall(
-    points: &[Point3<f64>],
-    planes: &[FoundPlane],
-    (a, b): (usize, usize),
-    up: &Unit<Vector3<f64>>,
-    p: &SegmentParams,
-) -> bool {
-    let (pa, pb) = (planes[a].plane, planes[b].plane);
-    if pa.normal.dot(&pb.normal) < p.merge_deg.to_radians().cos() {
-        return false;
-    }
-    if pa.distance(&mean_of(points, &planes[b].inliers)).abs() > p.merge_distance_m {
-        return false;
-    }
-    let d = up.cross(&pa.normal);
-    let span = |k: usize| {
-        let mut s: Vec<f64> = planes[k]
-            .inliers
-            .iter()
-            .map(|&i| d.dot(&points[i].coords))
-            .collect();
-        (percentile(&mut s, 0.05), percentile(&mut s, 0.95))
-    };
-    let ((a0, a1), (b0, b1)) = (span(a), span(b));
-    a1.min(b1) - a0.max(b0) > 0.0
-}
-
-/// One wall found twice (a doubled slab in a noisy cloud): merges walls that are the same wall
-/// into the first and refits it.
-fn merge_doubled_walls(
-    points: &[Point3<f64>],
-    planes: &mut [FoundPlane],
-    walls: &mut Vec<usize>,
-    up: &Unit<Vector3<f64>>,
-    centre: &Point3<f64>,
-    p: &SegmentParams,
-) {
-    'again: loop {
-        for a in 0..walls.len() {
-            for b in (a + 1)..walls.len() {
-                let (ka, kb) = (walls[a], walls[b]);
-                if !same_wall(points, planes, (ka, kb), up, p) {
-                    continue;
-                }
-                let moved = std::mem::take(&mut planes[kb].inliers);
-                planes[ka].inliers.extend(moved);
-                planes[ka].points = planes[ka].inliers.len();
-                planes[kb].points = 0;
-                planes[kb].class = PlaneClass::OtherVertical;
-                let pts: Vec<Point3<f64>> = planes[ka].inliers.iter().map(|&i| points[i]).collect();
-                if let Some(f) = Plane::fit(&pts) {
-                    planes[ka].plane = vertical_plane(&f.normal, &centroid(&pts), up, centre);
-                }
-                walls.remove(b);
-                continue 'again;
-            }
-        }
-        break;
-    }
-}
-
-/// A shadow of a wall: a weaker vertical plane, tilted a few degrees from a wall, whose points
-/// mostly lie within the wall's slab (RANSAC's leftovers of a thick fused wall plus whatever
-/// stands against it; long scans gather enough of them). It is not a wall of its own: drops walls
-/// within `SHADOW_DEG` of a wall with `SHADOW_RATIO` times their points when most of their points
-/// lie within two inlier distances of that wall's plane.
-fn drop_shadow_walls(
-    points: &[Point3<f64>],
-    planes: &mut [FoundPlane],
-    walls: &mut Vec<usize>,
-    p: &SegmentParams,
-) {
-    const SHADOW_DEG: f64 = 15.0;
-    const SHADOW_RATIO: usize = 4;
-    let shadows: Vec<usize> = walls
-        .iter()
-        .copied()
-        .filter(|&w| {
-            walls.iter().any(|&v| {
-                let (pv, pw) = (&planes[v].plane, &planes[w].plane);
-                v != w
-                    && planes[v].points >= SHADOW_RATIO * planes[w].points
-                    && pv.normal.dot(&pw.normal) >= SHADOW_DEG.to_radians().cos()
-                    && planes[w]
-                        .inliers
-                        .iter()
-                        .filter(|&&i| pv.distance(&points[i]).abs() < 2.0 * p.plane_distance_m)
-                        .count()
-                        * 2
-                        > planes[w].points
-            })
-        })
-        .collect();
-    for &w in &shadows {
-        planes[w].class = PlaneClass::OtherVertical;
-    }
-    walls.retain(|w| !shadows.contains(w));
-}
-
-/// A wall's line on the floor plan and the extent of its points along it.
-struct Line {
-    k: usize,
-    p: Point2<f64>,
-    d: Vector2<f64>,
-    ends: [Point2<f64>; 2],
-}
-
-impl Line {
-    fn length(&self) -> f64 {
-        (self.ends[1] - self.ends[0]).norm()
-    }
-}
-
-/// The walls' lines and extents in the horizontal frame.
-fn wall_lines(
-    points: &[Point3<f64>],
-    planes: &[FoundPlane],
-    walls: &[usize],
+    normals: &[Vector3<f64>],
     frame: &PlaneFrame,
-) -> Vec<Line> {
-    walls
-        .iter()
-        .map(|&k| {
-            let pl = &planes[k].plane;
-            let n2 = Vector2::new(frame.u.dot(&pl.normal), frame.v.dot(&pl.normal)).normalize();
-            let d = Vector2::new(-n2.y, n2.x);
-            let on = frame.to_2d(&pl.project(&frame.origin));
-            let mut s: Vec<f64> = planes[k]
-                .inliers
-                .iter()
-                .map(|&i| (frame.to_2d(&points[i]) - on).dot(&d))
-                .collect();
-            let (a, b) = (percentile(&mut s, 0.02), percentile(&mut s, 0.98));
-            Line {
-                k,
-                p: on,
-                d,
-                ends: [on + d * a, on + d * b],
-            }
-        })
-        .collect()
-}
-
-/// The wall lines, for an error message.
-fn describe_lines(lines: &[Line], planes: &[FoundPlane]) -> String {
-    lines
-        .iter()
-        .map(|l| {
-            let d = l.ends[1] - l.ends[0];
-            format!(
-                "{:.0}° {:.2} m long at ({:.2}, {:.2}), {} points",
-                d.y.atan2(d.x).to_degrees(),
-                d.norm(),
-                l.ends[0].x,
-                l.ends[0].y,
-                planes[l.k].points
-            )
-        })
-        .collect::<Vec<_>>()
-        .join("; ")
-}
-
-/// At one end of a wall: the wall it meets there and the corner.
-type End = Option<(usize, Point2<f64>)>;
-
-/// Links wall ends: the corner of two walls is their lines' intersection; ends are paired
-/// greedily by how far the corner lies from both ends.
-fn link_ends(lines: &[Line], p: &SegmentParams) -> Vec<[End; 2]> {
-    let mut pairs: Vec<(f64, usize, usize, usize, usize, Point2<f64>)> = Vec::new();
-    for a in 0..lines.len() {
-        for b in (a + 1)..lines.len() {
-            let (la, lb) = (&lines[a], &lines[b]);
-            if la.d.dot(&lb.d).abs() > p.corner_min_angle_deg.to_radians().cos() {
-                continue;
-            }
-            let Some(c) = line_intersection(&la.p, &la.d, &lb.p, &lb.d) else {
-                continue;
-            };
-            for ea in 0..2 {
-                for eb in 0..2 {
-                    let cost = (c - la.ends[ea]).norm() + (c - lb.ends[eb]).norm();
-                    if cost < p.corner_max_gap_m {
-                        pairs.push((cost, a, ea, b, eb, c));
-                    }
-                }
-            }
+    (lo, hi): (f64, f64),
+    p: &SegmentParams,
+) -> (Vec<usize>, Vec<Point2<f64>>, Vec<Vector2<f64>>) {
+    let sin_v = p.vertical_deg.to_radians().sin();
+    let mut out = (Vec::new(), Vec::new(), Vec::new());
+    for (i, (q, n)) in points.iter().zip(normals).enumerate() {
+        let h = frame.normal.dot(&(q - frame.origin));
+        if h < lo || h > hi || n.dot(&frame.normal).abs() > sin_v {
+            continue;
         }
-    }
-    pairs.sort_by(|x, y| x.0.total_cmp(&y.0));
-    let mut link: Vec<[End; 2]> = vec![[None, None]; lines.len()];
-    for (_, a, ea, b, eb, c) in pairs {
-        if link[a][ea].is_none() && link[b][eb].is_none() && link[a][1 - ea].map(|l| l.0) != Some(b)
-        {
-            link[a][ea] = Some((b, c));
-            link[b][eb] = Some((a, c));
-        }
-    }
-    link
-}
-
-/// Walks the loop of linked walls from the longest: the lines in order and the corners, corner
-/// `k` joining walls `k` and `k + 1`; `None` with the walls linked when the loop does not close.
-fn walk_loop(lines: &[Line], link: &[[End; 2]]) -> Result<(Vec<usize>, Vec<Point2<f64>>), usize> {
-    let start = (0..lines.len())
-        .max_by(|&a, &b| lines[a].length().total_cmp(&lines[b].length()))
-        .ok_or(0usize)?;
-    let mut order = vec![start];
-    let mut corners = Vec::new();
-    let (mut cur, mut out_end) = (start, 1usize);
-    loop {
-        let Some((next, c)) = link[cur][out_end] else {
-            return Err(order.len());
+        let Some(n2) = Vector2::new(frame.u.dot(n), frame.v.dot(n)).try_normalize(1e-6) else {
+            continue;
         };
-        corners.push(c);
-        if next == start {
-            break;
-        }
-        if order.contains(&next) || order.len() > lines.len() {
-            return Err(order.len());
-        }
-        let in_end = if link[next][0].map(|l| l.0) == Some(cur) {
-            0
-        } else {
-            1
-        };
-        order.push(next);
-        cur = next;
-        out_end = 1 - in_end;
+        out.0.push(i);
+        out.1.push(frame.to_2d(q));
+        out.2.push(n2);
     }
-    if order.len() < 3 {
-        return Err(order.len());
+    out
+}
+
+/// The share of a wall's length (between its floor corners, 2D) along which points of vertical
+/// surfaces lie within `band` of it with agreeing normals (10 cm bins with two points or more).
+fn observed_share(
+    a: &Point2<f64>,
+    b: &Point2<f64>,
+    inward: &Vector2<f64>,
+    pts: &[Point2<f64>],
+    nrm: &[Vector2<f64>],
+    band: f64,
+) -> f64 {
+    let len = (b - a).norm();
+    let bins = ((len / 0.1).ceil() as usize).max(1);
+    let d = (b - a) / len.max(1e-9);
+    let mut count = vec![0usize; bins];
+    for (q, n) in pts.iter().zip(nrm) {
+        let off = (q - a).dot(inward);
+        let s = (q - a).dot(&d);
+        if off.abs() <= band && n.dot(inward) >= 0.9 && s >= 0.0 && s < len {
+            count[((s / 0.1) as usize).min(bins - 1)] += 1;
+        }
     }
-    Ok((order, corners))
+    count.iter().filter(|&&c| c >= 2).count() as f64 / bins as f64
 }
 
 /// Classifies planes against an up estimate, picks floor and ceiling, refines up from the floor,
-/// links the walls into a loop and computes the corners.
+/// finds the outline of walls on the floor plan (`outline`) and computes the corners. The walls
+/// become planes of their own, appended to `planes`; vertical planes found by RANSAC on a wall
+/// are replaced by it.
 pub fn envelope(
     points: &[Point3<f64>],
+    normals: &[Vector3<f64>],
     mut planes: Vec<FoundPlane>,
     up0: Unit<Vector3<f64>>,
     p: &SegmentParams,
@@ -598,36 +311,102 @@ pub fn envelope(
     let caps = floor_and_ceiling(points, &mut planes, up0, p)?;
     let up = caps.up;
     let centre = room_centre(points, &caps);
-    let mut walls = find_walls(points, &mut planes, &caps, &centre, p);
-    merge_doubled_walls(points, &mut planes, &mut walls, &up, &centre, p);
-    drop_shadow_walls(points, &mut planes, &mut walls, p);
-    // The horizontal frame and the walls' lines and extents in it.
+    // The horizontal frame: origin on the floor.
     let frame = PlaneFrame::new(planes[caps.floor].plane.project(&centre), up, &Vector3::x());
-    let lines = wall_lines(points, &planes, &walls, &frame);
-    let link = link_ends(&lines, p);
-    let found = describe_lines(&lines, &planes);
-    if lines.is_empty() {
-        return Err(SegmentError::NoWalls);
+    let h_room = caps.h_ceiling - caps.h_floor;
+    let evidence: Vec<Point2<f64>> = planes[caps.floor]
+        .inliers
+        .iter()
+        .chain(&planes[caps.ceiling].inliers)
+        .map(|&i| frame.to_2d(&points[i]))
+        .collect();
+    let op = OutlineParams::default();
+    // Walls reach the ceiling, furniture does not: their points just below the ceiling first; the
+    // upper half of the room when that gives no outline (a scan that never looked up).
+    let bands = [
+        (
+            h_room - p.wall_ceiling_gap_m.max(0.2 * h_room),
+            h_room - 0.05,
+        ),
+        (0.5 * h_room, h_room - 0.05),
+    ];
+    let mut result = Err(OutlineError::NothingSeen);
+    let mut used = (Vec::new(), Vec::new(), Vec::new());
+    for band in bands {
+        let vp = vertical_points(points, normals, &frame, band, p);
+        let lines = outline::wall_lines(&vp.1, &vp.2, &op);
+        result = outline::outline(lines, &evidence, &op);
+        used = vp;
+        if result.is_ok() {
+            break;
+        }
     }
-    let (order, mut corners2) =
-        walk_loop(&lines, &link).map_err(|walls| SegmentError::OpenOutline {
-            walls,
-            found: found.clone(),
-        })?;
-    // corners2[k] joins order[k] and order[k+1]; rotate so corner k joins wall k−1 and wall k.
-    corners2.rotate_right(1);
-    let mut wall_order: Vec<usize> = order.iter().map(|&i| lines[i].k).collect();
-    if signed_area(&corners2) < 0.0 {
-        // Counter-clockwise seen from above: reverse, keeping corner k between walls k−1 and k
-        // (the new corner k is the old corner n−k).
-        wall_order.reverse();
-        corners2.reverse();
-        corners2.rotate_right(1);
+    let out = result.map_err(|e| match e {
+        OutlineError::NothingSeen => SegmentError::NoWalls,
+        OutlineError::Open(a, b) => SegmentError::OpenOutline {
+            from: arr(&frame.to_3d(&a)),
+            to: arr(&frame.to_3d(&b)),
+            length_m: (b - a).norm(),
+        },
+    })?;
+    let all = vertical_points(points, normals, &frame, (0.05 * h_room, h_room - 0.05), p);
+    // The walls' planes, made exactly vertical, facing into the room.
+    let n = out.walls.len();
+    let to3 = |v: &Vector2<f64>| frame.u.as_ref() * v.x + frame.v.as_ref() * v.y;
+    let mut walls = Vec::with_capacity(n);
+    for k in 0..n {
+        let line = &out.lines[out.walls[k]];
+        let normal = Unit::new_normalize(to3(&out.normals[k]));
+        let plane = Plane::from_point_normal(&frame.to_3d(&out.corners[k]), normal);
+        let inliers: Vec<usize> = line.points.iter().map(|&i| used.0[i]).collect();
+        let (a, b) = (out.corners[k], out.corners[(k + 1) % n]);
+        walls.push((
+            FoundPlane {
+                plane,
+                points: inliers.len(),
+                inliers,
+                class: PlaneClass::Wall,
+            },
+            WallSeen {
+                inferred: line.inferred,
+                observed: observed_share(&a, &b, &out.normals[k], &all.1, &all.2, op.band_m),
+                length_m: (b - a).norm(),
+            },
+        ));
     }
-    for k in walls.iter().filter(|k| !wall_order.contains(k)) {
-        planes[*k].class = PlaneClass::OtherVertical;
+    // Vertical RANSAC planes: dropped where they are a wall, otherwise other vertical surfaces.
+    let sin_v = p.vertical_deg.to_radians().sin();
+    let (floor_plane, ceiling_plane) = (caps.floor, caps.ceiling);
+    let mut kept = Vec::with_capacity(planes.len() + n);
+    let (mut floor, mut ceiling) = (0, 0);
+    for (k, mut f) in planes.into_iter().enumerate() {
+        if f.class == PlaneClass::Slanted && f.plane.normal.dot(&up).abs() <= sin_v {
+            let c = mean_of(points, &f.inliers);
+            let on_wall = walls.iter().any(|(w, _)| {
+                w.plane.normal.dot(&f.plane.normal).abs() > 10f64.to_radians().cos()
+                    && w.plane.distance(&c).abs() < 0.15
+            });
+            if on_wall {
+                continue;
+            }
+            f.class = PlaneClass::OtherVertical;
+        }
+        if k == floor_plane {
+            floor = kept.len();
+        }
+        if k == ceiling_plane {
+            ceiling = kept.len();
+        }
+        kept.push(f);
     }
-    let n = wall_order.len();
+    let first_wall = kept.len();
+    let mut seen = Vec::with_capacity(n);
+    for (w, s) in walls {
+        kept.push(w);
+        seen.push(s);
+    }
+    let planes = kept;
+    let wall_order: Vec<usize> = (first_wall..first_wall + n).collect();
     let corner3 = |k: usize, cap: &Plane| {
         let (a, b) = (
             &planes[wall_order[(k + n - 1) % n]].plane,
@@ -635,25 +414,28 @@ pub fn envelope(
         );
         intersect_three(a, b, cap)
     };
-    let floor_corners: Option<Vec<Point3<f64>>> = (0..n)
-        .map(|k| corner3(k, &planes[caps.floor].plane))
-        .collect();
-    let ceiling_corners: Option<Vec<Point3<f64>>> = (0..n)
-        .map(|k| corner3(k, &planes[caps.ceiling].plane))
-        .collect();
+    let floor_corners: Option<Vec<Point3<f64>>> =
+        (0..n).map(|k| corner3(k, &planes[floor].plane)).collect();
+    let ceiling_corners: Option<Vec<Point3<f64>>> =
+        (0..n).map(|k| corner3(k, &planes[ceiling].plane)).collect();
     let (Some(floor_corners), Some(ceiling_corners)) = (floor_corners, ceiling_corners) else {
-        return Err(SegmentError::OpenOutline { walls: n, found });
+        return Err(SegmentError::NoWalls);
     };
     Ok(Envelope {
         up,
-        floor: caps.floor,
-        ceiling: caps.ceiling,
+        floor,
+        ceiling,
         walls: wall_order,
+        seen,
         floor_corners,
         ceiling_corners,
         planes,
         frame,
     })
+}
+
+fn arr(p: &Point3<f64>) -> [f64; 3] {
+    [p.x, p.y, p.z]
 }
 
 #[cfg(test)]
@@ -727,30 +509,76 @@ mod tests {
         v
     }
 
-    #[test]
-    fn a_box_room_closes_with_four_walls() {
-        let (pts, planes) = box_room(&[]);
-        let env = envelope(&pts, planes, Vector3::z_axis(), &SegmentParams::default())
-            .expect("an envelope");
+    /// Each point's normal: its plane's, facing the box's centre.
+    fn normals_of(pts: &[Point3<f64>], planes: &[FoundPlane]) -> Vec<Vector3<f64>> {
+        let centre = Point3::new(2.0, 1.5, 1.35);
+        let mut n = vec![Vector3::zeros(); pts.len()];
+        for f in planes {
+            for &i in &f.inliers {
+                let v = f.plane.normal.into_inner();
+                n[i] = if v.dot(&(centre - pts[i])) < 0.0 {
+                    -v
+                } else {
+                    v
+                };
+            }
+        }
+        n
+    }
+
+    fn corners_are_the_box(env: &Envelope, tol: f64) {
         assert_eq!(env.walls.len(), 4);
         for c in &env.floor_corners {
             let near = [[0.0, 0.0], [4.0, 0.0], [4.0, 3.0], [0.0, 3.0]]
                 .iter()
                 .map(|q| (c.x - q[0]).hypot(c.y - q[1]))
                 .fold(f64::INFINITY, f64::min);
-            assert!(near < 1e-6 && c.z.abs() < 1e-6, "corner {c:?}");
+            assert!(near < tol && c.z.abs() < 1e-6, "corner {c:?}");
+        }
+        assert_eq!(
+            env.planes
+                .iter()
+                .filter(|f| f.class == PlaneClass::Wall)
+                .count(),
+            4
+        );
+        for (k, &w) in env.walls.iter().enumerate() {
+            // Walls face into the room.
+            let inside = Point3::new(2.0, 1.5, 1.0);
+            assert!(env.planes[w].plane.distance(&inside) > 0.0, "wall {k}");
+            assert!(env.seen[k].observed > 0.65, "wall {k}: {:?}", env.seen[k]);
+            assert!(!env.seen[k].inferred);
         }
     }
 
-    /// A wall's shadow plane is dropped instead of breaking the loop of walls.
+    #[test]
+    fn a_box_room_closes_with_four_walls() {
+        let (pts, planes) = box_room(&[]);
+        let nrm = normals_of(&pts, &planes);
+        let env = envelope(
+            &pts,
+            &nrm,
+            planes,
+            Vector3::z_axis(),
+            &SegmentParams::default(),
+        )
+        .expect("an envelope");
+        corners_are_the_box(&env, 1e-3);
+    }
+
+    /// A wall's shadow plane does not break the loop of walls or become one.
     #[test]
     fn a_shadow_of_a_wall_is_not_a_wall() {
         let (pts, planes) = box_room(&[shadow_of_front_wall()]);
-        let shadow = planes.len() - 1;
-        let env = envelope(&pts, planes, Vector3::z_axis(), &SegmentParams::default())
-            .expect("an envelope");
-        assert_eq!(env.walls.len(), 4);
-        assert!(!env.walls.contains(&shadow));
-        assert_eq!(env.planes[shadow].class, PlaneClass::OtherVertical);
+        let nrm = normals_of(&pts, &planes);
+        let env = envelope(
+            &pts,
+            &nrm,
+            planes,
+            Vector3::z_axis(),
+            &SegmentParams::default(),
+        )
+        .expect("an envelope");
+        corners_are_the_box(&env, 1e-3);
     }
 }

@@ -9,6 +9,7 @@ mod envelope;
 mod features;
 mod furniture;
 pub mod labels;
+mod outline;
 pub mod room;
 
 use std::collections::BTreeMap;
@@ -46,14 +47,9 @@ pub struct SegmentParams {
     pub horizontal_deg: f64,
     /// Vertical: normal within this of horizontal (degrees).
     pub vertical_deg: f64,
-    /// A wall spans at least this fraction of the floor-to-ceiling height…
-    pub wall_min_height_fraction: f64,
-    /// …and reaches within this of the ceiling (m); furniture does not.
+    /// Walls are found from their points this far below the ceiling (m; at least a fifth of the
+    /// room's height): walls reach the ceiling, furniture does not.
     pub wall_ceiling_gap_m: f64,
-    /// Walls meet at corners of at least this angle (degrees).
-    pub corner_min_angle_deg: f64,
-    /// A corner may lie at most this far (sum over both walls, m) beyond the walls' seen ends.
-    pub corner_max_gap_m: f64,
     /// Points within this distance of a surface belong to it (m); more where the surface's fused
     /// points are spread wider (three robust standard deviations, up to 0.35 m).
     pub surface_band_m: f64,
@@ -85,10 +81,7 @@ impl Default for SegmentParams {
             merge_distance_m: 0.25,
             horizontal_deg: 15.0,
             vertical_deg: 15.0,
-            wall_min_height_fraction: 0.5,
             wall_ceiling_gap_m: 0.4,
-            corner_min_angle_deg: 20.0,
-            corner_max_gap_m: 3.0,
             surface_band_m: 0.10,
             texel_m: 0.03,
             feature_threshold_k: 0.3,
@@ -117,17 +110,22 @@ pub enum SegmentError {
     )]
     NoCeiling,
     /// No walls.
-    #[error("no walls found: no vertical plane spans half the room's height")]
+    #[error(
+        "no walls found: no vertical surface reaches the ceiling around a floor or ceiling seen (did the scan look at the walls up to the ceiling?)"
+    )]
     NoWalls,
     /// The walls do not close into a loop.
     #[error(
-        "the walls do not close into an outline of the room ({walls} linked; wall planes found: {found}): parts of the room may be unscanned"
+        "the room's outline does not close: from ({:.2}, {:.2}, {:.2}) to ({:.2}, {:.2}, {:.2}) in the scan's frame ({length_m:.2} m) neither a wall nor the floor's or ceiling's edge was seen; scan that part of the room",
+        from[0], from[1], from[2], to[0], to[1], to[2]
     )]
     OpenOutline {
-        /// Walls linked before the loop broke.
-        walls: usize,
-        /// The wall planes found (direction on the floor, extent, points).
-        found: String,
+        /// Where the unseen part begins, on the floor (scan's frame).
+        from: [f64; 3],
+        /// Where it ends.
+        to: [f64; 3],
+        /// Its length (m).
+        length_m: f64,
     },
     /// The origin corner asked for does not exist.
     #[error(
@@ -240,6 +238,9 @@ pub struct SegmentReport {
     pub masks: Option<MaskSummary>,
     /// Things to check.
     pub warnings: Vec<String>,
+    /// Walls never seen, placed at the edge of the floor and ceiling seen (ids).
+    #[serde(default)]
+    pub inferred_walls: Vec<String>,
 }
 
 /// The result of segmentation.
@@ -741,7 +742,7 @@ pub fn segment(
     let pts = Points::of(cloud);
     let up0 = up_from_poses(camera_poses).ok_or(SegmentError::NoPoses)?;
     let planes = envelope::find_planes(&pts.pos, &pts.nrm, p);
-    let env = envelope::envelope(&pts.pos, planes, up0, p)?;
+    let env = envelope::envelope(&pts.pos, &pts.nrm, planes, up0, p)?;
     let up = env.up;
     let height_m = env.planes[env.floor]
         .plane
@@ -813,6 +814,23 @@ pub fn segment(
     in_room.up = Some([0.0, 0.0, 1.0]);
     in_room.world_from_room = Some(FramePose::from_isometry(&world_from_room));
     let scene = RadiantScene::new(&in_room)?;
+    let mut inferred_walls = Vec::new();
+    for (k, seen) in env.seen.iter().enumerate() {
+        let id = &geoms[2 + k].id;
+        if seen.inferred {
+            inferred_walls.push(id.clone());
+            warnings.push(format!(
+                "{id} ({:.2} m) was not seen as a wall: it is placed at the edge of the floor and ceiling seen; scan it up to the ceiling to place it from its own points",
+                seen.length_m
+            ));
+        } else if seen.observed < 0.3 && seen.length_m > 0.5 {
+            warnings.push(format!(
+                "{id} ({:.2} m) was seen along only {:.0} % of its length",
+                seen.length_m,
+                seen.observed * 100.0
+            ));
+        }
+    }
     if frame.outside_quadrant > 0 {
         warnings.push(format!(
             "with the origin at corner {}, {} corner(s) of the room lie at x < 0 or y < 0",
@@ -841,6 +859,7 @@ pub fn segment(
             .collect(),
         masks: mask_summary,
         warnings,
+        inferred_walls,
     };
     Ok(Segmentation {
         scene,

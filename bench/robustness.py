@@ -1,0 +1,133 @@
+#!/usr/bin/env python3
+"""The robustness study: every preset room x seeds x noise, simulate a short walk, run the whole
+pipeline, and compare the map with the truth.
+
+    robustness.py MRTMAP WORKDIR [--rooms office,l-shaped,radiant-ceiling] [--seeds 1-10]
+                  [--noise realistic,none] [--drift none] [--seconds 60] [--keep]
+
+Prints one row per scan and a summary per room and noise; writes WORKDIR/robustness.json. A scan
+whose segmentation fails counts as a failure with its message. Grid errors are at the truth's
+20x20 nodes (mrtmap mrt --frame scan on the run's scene); a node the run refuses (outside its
+room or inside its furniture) is counted, not compared."""
+import argparse
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+import time
+
+
+def seeds(spec):
+    out = []
+    for part in spec.split(","):
+        if "-" in part:
+            a, b = part.split("-")
+            out += range(int(a), int(b) + 1)
+        else:
+            out.append(int(part))
+    return out
+
+
+def mrt_at(mrtmap, scene, places):
+    """MRT at each place (None where refused), in chunks; a refused chunk goes point by point."""
+    def call(chunk):
+        args = [mrtmap, "mrt", "--scene", scene, "--frame", "scan", "--json"]
+        for p in chunk:
+            args.append("--at=" + ",".join(f"{v:.5f}" for v in p))
+        r = subprocess.run(args, capture_output=True, text=True)
+        if r.returncode != 0:
+            return None
+        return [o["mrt_c"] for o in json.loads(r.stdout)["points"]]
+
+    out = []
+    for k in range(0, len(places), 40):
+        chunk = places[k:k + 40]
+        got = call(chunk)
+        if got is None:
+            got = [(call([p]) or [None])[0] for p in chunk]
+        out += got
+    return out
+
+
+def one(mrtmap, work, room, seed, noise, drift, secs, keep):
+    name = f"{room}-s{seed}-{noise}-{drift}"
+    rec, run = os.path.join(work, name), os.path.join(work, name + ".run")
+    row = {"room": room, "seed": seed, "noise": noise, "drift": drift}
+    t0 = time.time()
+    if not os.path.exists(os.path.join(rec, "truth.json")):
+        subprocess.run([mrtmap, "simulate", "--room", room, "--seed", str(seed), "--noise", noise,
+                        "--drift", drift, "--seconds", str(secs), "--out", rec],
+                       check=True, capture_output=True)
+    t1 = time.time()
+    shutil.rmtree(run, ignore_errors=True)
+    r = subprocess.run([mrtmap, "run", rec, "--out", run], capture_output=True, text=True)
+    t2 = time.time()
+    row["simulate_s"], row["run_s"] = round(t1 - t0, 1), round(t2 - t1, 1)
+    if r.returncode != 0:
+        row["error"] = (r.stderr.strip().splitlines() or ["?"])[-1]
+    else:
+        truth = json.load(open(os.path.join(rec, "truth.json")))
+        nodes = [n for n in truth["grid"]["nodes"] if n["mrt_c"] is not None]
+        got = mrt_at(mrtmap, os.path.join(run, "segment", "scene.json"),
+                     [n["xyz_world"] for n in nodes] + [p["xyz_world"] for p in truth["points"]])
+        g = [(v - n["mrt_c"]) for v, n in zip(got, nodes) if v is not None]
+        pts = {p["name"]: (None if v is None else round(v - p["mrt_c"], 3))
+               for p, v in zip(truth["points"], got[len(nodes):])}
+        row.update({
+            "nodes": len(g), "refused": len(nodes) - len(g),
+            "max_abs_k": max(abs(x) for x in g) if g else None,
+            "rmse_k": math.sqrt(sum(x * x for x in g) / len(g)) if g else None,
+            "points_k": pts,
+        })
+    if not keep:
+        shutil.rmtree(rec, ignore_errors=True)
+        shutil.rmtree(run, ignore_errors=True)
+    return row
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("mrtmap")
+    ap.add_argument("work")
+    ap.add_argument("--rooms", default="office,l-shaped,radiant-ceiling")
+    ap.add_argument("--seeds", default="1-10")
+    ap.add_argument("--noise", default="realistic,none")
+    ap.add_argument("--drift", default="none")
+    ap.add_argument("--seconds", default="60")
+    ap.add_argument("--keep", action="store_true")
+    a = ap.parse_args()
+    os.makedirs(a.work, exist_ok=True)
+    rows = []
+    for noise in a.noise.split(","):
+        for drift in a.drift.split(","):
+            for room in a.rooms.split(","):
+                for seed in seeds(a.seeds):
+                    row = one(a.mrtmap, a.work, room, seed, noise, drift, a.seconds, a.keep)
+                    rows.append(row)
+                    if "error" in row:
+                        desc = "FAILED: " + row["error"]
+                    else:
+                        desc = (f"grid max |Δ| {row['max_abs_k']:.3f} K, RMSE {row['rmse_k']:.3f} K, "
+                                f"{row['refused']} nodes refused; " +
+                                " ".join(f"{k} {v:+.3f}" if v is not None else f"{k} —"
+                                         for k, v in row["points_k"].items()))
+                    print(f"{room:<16} seed {seed:>3} {noise:<9} {drift:<8} run {row['run_s']:5.1f} s  {desc}",
+                          flush=True)
+    print("\nsummary (room, noise, drift: scans, failures, worst grid max |Δ|, worst RMSE, median run time):")
+    groups = {}
+    for r in rows:
+        groups.setdefault((r["room"], r["noise"], r["drift"]), []).append(r)
+    for (room, noise, drift), rs in groups.items():
+        ok = [r for r in rs if "error" not in r]
+        worst = max((r["max_abs_k"] for r in ok), default=float("nan"))
+        rmse = max((r["rmse_k"] for r in ok), default=float("nan"))
+        times = sorted(r["run_s"] for r in rs)
+        print(f"  {room:<16} {noise:<9} {drift:<8} {len(rs):>3} scans, {len(rs) - len(ok)} failed, "
+              f"max |Δ| {worst:.3f} K, RMSE {rmse:.3f} K, run {times[len(times) // 2]:.1f} s")
+    json.dump(rows, open(os.path.join(a.work, "robustness.json"), "w"), indent=1)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,826 @@
+//! The room's outline on the floor plan, robust to how the walk went.
+//!
+//! 1. Wall lines: the points of vertical surfaces near the ceiling (walls reach it, furniture does
+//!    not), seen from above, vote with their normals' directions (a Hough transform on the
+//!    normals); each direction's points vote for an offset; each peak is a line, refitted to its
+//!    points. A wall seen briefly, at a grazing angle or only above furniture still gives a line.
+//! 2. Where the room is: the floor and ceiling points seen, on a 5 cm raster.
+//! 3. The plane is cut into cells by every line (and, along each wall direction, by the floor and
+//!    ceiling's extreme extent, for a wall never seen); a cell is the room's when most of it was
+//!    seen as floor or ceiling. The kept cells' boundary is the loop of walls, counter-clockwise;
+//!    its corners are the lines' intersections. Spurious lines inside the room (a tall cupboard's
+//!    side, a wall's shadow) cut cells that are kept on both sides and drop out; lines outside it
+//!    bound cells that are empty. The loop closes whenever the floor or ceiling was seen.
+
+use mrtmap_geometry::nalgebra::{Point2, Vector2};
+
+/// A wall line on the floor plan: the points `q` with `n·q = rho`; `n` points into the room once
+/// the line is on the outline.
+#[derive(Clone, Debug)]
+pub struct WallLine {
+    /// Unit normal.
+    pub n: Vector2<f64>,
+    /// Offset along the normal (m).
+    pub rho: f64,
+    /// The wall points (indices into the points given) on the line.
+    pub points: Vec<usize>,
+    /// Placed at the edge of the floor and ceiling seen, not from wall points.
+    pub inferred: bool,
+}
+
+impl WallLine {
+    fn direction(&self) -> Vector2<f64> {
+        Vector2::new(-self.n.y, self.n.x)
+    }
+
+    fn distance(&self, q: &Point2<f64>) -> f64 {
+        self.n.dot(&q.coords) - self.rho
+    }
+}
+
+/// The outline: walls in order counter-clockwise seen from above.
+#[derive(Clone, Debug)]
+pub struct Outline {
+    /// Every line found (walls and others).
+    pub lines: Vec<WallLine>,
+    /// The line of each wall, in order around the room.
+    pub walls: Vec<usize>,
+    /// Corner `k`, where wall `k − 1` meets wall `k`.
+    pub corners: Vec<Point2<f64>>,
+    /// Each wall's inward unit normal.
+    pub normals: Vec<Vector2<f64>>,
+}
+
+/// Why no outline.
+#[derive(Clone, Debug, PartialEq)]
+pub enum OutlineError {
+    /// Too few wall points or no floor or ceiling seen.
+    NothingSeen,
+    /// The kept cells reach the edge of the search area (never with a floor or ceiling seen):
+    /// the part of the boundary that is not a wall, from one point to another.
+    Open(Point2<f64>, Point2<f64>),
+}
+
+/// Settings of the outline search.
+#[derive(Clone, Copy, Debug)]
+pub struct OutlineParams {
+    /// Points within this distance of a line are its points (m).
+    pub band_m: f64,
+    /// Normals within this angle of a line's normal vote for it (degrees).
+    pub normal_deg: f64,
+    /// A line needs this many points…
+    pub min_points: usize,
+    /// …along at least this length (m).
+    pub min_length_m: f64,
+    /// Lines closer than this in angle (degrees) and offset (m) are one line.
+    pub merge_deg: f64,
+    /// See `merge_deg`.
+    pub merge_m: f64,
+    /// Raster cell for the floor and ceiling seen (m).
+    pub cell_m: f64,
+}
+
+impl Default for OutlineParams {
+    fn default() -> Self {
+        Self {
+            band_m: 0.08,
+            normal_deg: 20.0,
+            min_points: 80,
+            min_length_m: 0.3,
+            merge_deg: 6.0,
+            merge_m: 0.15,
+            cell_m: 0.05,
+        }
+    }
+}
+
+fn wrap_deg(a: f64) -> f64 {
+    a.rem_euclid(360.0)
+}
+
+fn angle_diff_deg(a: f64, b: f64) -> f64 {
+    let d = wrap_deg(a - b);
+    d.min(360.0 - d)
+}
+
+/// A line through `pts` robust to a minority off it: total least squares, then again on the points
+/// within 2.5 robust standard deviations of the first fit (at least 1 cm).
+fn fit_line(pts: &[Point2<f64>], n0: &Vector2<f64>) -> Option<(Vector2<f64>, f64)> {
+    let (n, rho) = fit_line_tls(pts, n0)?;
+    let mut r: Vec<f64> = pts.iter().map(|q| (n.dot(&q.coords) - rho).abs()).collect();
+    let mut sorted = r.clone();
+    sorted.sort_by(f64::total_cmp);
+    let cut = (2.5 * 1.4826 * sorted[sorted.len() / 2]).max(0.01);
+    let near: Vec<Point2<f64>> = pts
+        .iter()
+        .zip(r.iter_mut())
+        .filter(|(_, r)| **r <= cut)
+        .map(|(q, _)| *q)
+        .collect();
+    fit_line_tls(&near, &n).or(Some((n, rho)))
+}
+
+/// Total least squares line through `pts`, its normal oriented like `n0`.
+fn fit_line_tls(pts: &[Point2<f64>], n0: &Vector2<f64>) -> Option<(Vector2<f64>, f64)> {
+    if pts.len() < 2 {
+        return None;
+    }
+    let c = pts.iter().fold(Vector2::zeros(), |a, q| a + q.coords) / pts.len() as f64;
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for q in pts {
+        let d = q.coords - c;
+        sxx += d.x * d.x;
+        sxy += d.x * d.y;
+        syy += d.y * d.y;
+    }
+    // The direction of least spread: the eigenvector of the smaller eigenvalue.
+    let theta = 0.5 * (2.0 * sxy).atan2(sxx - syy); // direction of largest spread
+    let mut n = Vector2::new(-theta.sin(), theta.cos());
+    if n.dot(n0) < 0.0 {
+        n = -n;
+    }
+    Some((n, n.dot(&c)))
+}
+
+/// The points' extent along a line in 10 cm bins: the occupied length (bins with two points or
+/// more, in runs of at least `min_len`) and which points lie in those runs.
+fn runs_along(
+    line: &WallLine,
+    pts: &[Point2<f64>],
+    idx: &[usize],
+    min_len: f64,
+) -> (f64, Vec<usize>) {
+    if idx.is_empty() {
+        return (0.0, Vec::new());
+    }
+    let d = line.direction();
+    let s: Vec<f64> = idx.iter().map(|&i| d.dot(&pts[i].coords)).collect();
+    let lo = s.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = s.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let bins = (((hi - lo) / 0.1).floor() as usize + 1).min(200_000);
+    let bin = |v: f64| (((v - lo) / 0.1) as usize).min(bins - 1);
+    let mut count = vec![0usize; bins];
+    for v in &s {
+        count[bin(*v)] += 1;
+    }
+    // Runs of occupied bins with gaps of at most 30 cm.
+    let mut keep = vec![false; bins];
+    let mut total = 0.0;
+    let mut b = 0;
+    while b < bins {
+        if count[b] < 2 {
+            b += 1;
+            continue;
+        }
+        let (start, mut end, mut gap, mut occupied) = (b, b, 0, 0usize);
+        let mut c = b;
+        while c < bins && gap <= 3 {
+            if count[c] >= 2 {
+                end = c;
+                gap = 0;
+                occupied += 1;
+            } else {
+                gap += 1;
+            }
+            c += 1;
+        }
+        if (end - start + 1) as f64 * 0.1 >= min_len {
+            keep[start..=end].iter_mut().for_each(|k| *k = true);
+            total += occupied as f64 * 0.1;
+        }
+        b = end + 1;
+    }
+    let kept = idx
+        .iter()
+        .zip(&s)
+        .filter(|(_, v)| keep[bin(**v)])
+        .map(|(i, _)| *i)
+        .collect();
+    (total, kept)
+}
+
+/// Wall lines from points on the floor plan with their (horizontal, unit) normals: a Hough
+/// transform on the normals' directions, then on the offsets along each direction.
+pub fn wall_lines(
+    pts: &[Point2<f64>],
+    normals: &[Vector2<f64>],
+    p: &OutlineParams,
+) -> Vec<WallLine> {
+    let angle: Vec<f64> = normals
+        .iter()
+        .map(|n| wrap_deg(n.y.atan2(n.x).to_degrees()))
+        .collect();
+    let mut free = vec![true; pts.len()];
+    let mut exhausted = [false; 360];
+    let mut lines: Vec<WallLine> = Vec::new();
+    for _ in 0..64 {
+        // The direction most free points face (1° bins, summed over ±3°).
+        let mut hist = [0usize; 360];
+        for (i, a) in angle.iter().enumerate() {
+            if free[i] {
+                hist[(*a as usize).min(359)] += 1;
+            }
+        }
+        let score = |b: usize| (0..7).map(|k| hist[(b + 360 + k - 3) % 360]).sum::<usize>();
+        let Some(peak) = (0..360)
+            .filter(|&b| !exhausted[b])
+            .max_by_key(|&b| (score(b), std::cmp::Reverse(b)))
+        else {
+            break;
+        };
+        if score(peak) < p.min_points {
+            break;
+        }
+        let near: Vec<usize> = (0..pts.len())
+            .filter(|&i| free[i] && angle_diff_deg(angle[i], peak as f64 + 0.5) <= p.normal_deg)
+            .collect();
+        // The direction: the mean of the near normals.
+        let mean = near
+            .iter()
+            .fold(Vector2::zeros(), |a, &i| a + normals[i])
+            .try_normalize(1e-9)
+            .unwrap_or_else(|| {
+                let r = (peak as f64 + 0.5).to_radians();
+                Vector2::new(r.cos(), r.sin())
+            });
+        // Offsets along it, 2 cm bins; peaks in turn.
+        let rho: Vec<f64> = near.iter().map(|&i| mean.dot(&pts[i].coords)).collect();
+        let lo = rho.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = rho.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let nb = (((hi - lo) / 0.02).floor() as usize + 1).min(100_000);
+        let mut rh = vec![0usize; nb];
+        for r in &rho {
+            rh[(((r - lo) / 0.02) as usize).min(nb - 1)] += 1;
+        }
+        let half = (p.band_m / 0.02).round() as usize;
+        let window = |b: usize| {
+            rh[b.saturating_sub(half)..(b + half + 1).min(nb)]
+                .iter()
+                .sum::<usize>()
+        };
+        let mut used = vec![false; nb];
+        let mut found_any = false;
+        while let Some(b) = (0..nb)
+            .filter(|&b| !used[b])
+            .max_by_key(|&b| (window(b), std::cmp::Reverse(b)))
+        {
+            if window(b) < p.min_points {
+                break;
+            }
+            used[b.saturating_sub(2 * half)..(b + 2 * half + 1).min(nb)]
+                .iter_mut()
+                .for_each(|u| *u = true);
+            let r0 = lo + (b as f64 + 0.5) * 0.02;
+            let on: Vec<usize> = near
+                .iter()
+                .zip(&rho)
+                .filter(|(_, r)| (**r - r0).abs() <= p.band_m)
+                .map(|(i, _)| *i)
+                .collect();
+            let q: Vec<Point2<f64>> = on.iter().map(|&i| pts[i]).collect();
+            let Some((n, rho_fit)) = fit_line(&q, &mean) else {
+                continue;
+            };
+            let mut line = WallLine {
+                n,
+                rho: rho_fit,
+                points: Vec::new(),
+                inferred: false,
+            };
+            // Its points: near the refitted line with agreeing normals, in runs along it.
+            let cos_n = p.normal_deg.to_radians().cos();
+            let cand: Vec<usize> = (0..pts.len())
+                .filter(|&i| {
+                    free[i]
+                        && line.distance(&pts[i]).abs() <= p.band_m
+                        && normals[i].dot(&line.n) >= cos_n
+                })
+                .collect();
+            let (length, kept) = runs_along(&line, pts, &cand, p.min_length_m);
+            if kept.len() < p.min_points || length < p.min_length_m {
+                continue;
+            }
+            for &i in &kept {
+                free[i] = false;
+            }
+            line.points = kept;
+            found_any = true;
+            lines.push(line);
+        }
+        if !found_any {
+            for k in 0..7 {
+                exhausted[(peak + 360 + k - 3) % 360] = true;
+            }
+        }
+        // Points of this direction on no line are spent either way.
+        for &i in &near {
+            if angle_diff_deg(angle[i], peak as f64 + 0.5) <= 3.5 {
+                free[i] = false;
+            }
+        }
+    }
+    // Noise (the blended normals where walls meet the ceiling, clutter) makes weak lines: a wall
+    // has at least a twentieth of the points of the best-seen wall.
+    let strongest = lines.iter().map(|l| l.points.len()).max().unwrap_or(0);
+    lines.retain(|l| l.points.len() * 20 >= strongest);
+    merge_lines(lines, pts, p)
+}
+
+/// Lines that are one wall found twice (within `merge_deg` and `merge_m`, facing the same way):
+/// merged and refitted.
+fn merge_lines(mut lines: Vec<WallLine>, pts: &[Point2<f64>], p: &OutlineParams) -> Vec<WallLine> {
+    lines.sort_by_key(|l| std::cmp::Reverse(l.points.len()));
+    let mut out: Vec<WallLine> = Vec::new();
+    for l in lines {
+        let centre = l
+            .points
+            .iter()
+            .fold(Vector2::zeros(), |a, &i| a + pts[i].coords)
+            / l.points.len().max(1) as f64;
+        let same = out.iter_mut().find(|m| {
+            m.n.dot(&l.n) >= p.merge_deg.to_radians().cos()
+                && m.distance(&Point2::from(centre)).abs() <= p.merge_m
+        });
+        match same {
+            Some(m) => {
+                m.points.extend(l.points);
+                let q: Vec<Point2<f64>> = m.points.iter().map(|&i| pts[i]).collect();
+                if let Some((n, rho)) = fit_line(&q, &m.n) {
+                    m.n = n;
+                    m.rho = rho;
+                }
+            }
+            None => out.push(l),
+        }
+    }
+    out
+}
+
+/// Where floor or ceiling was seen: a raster of `cell_m` over the area, closed (gaps of one cell
+/// filled).
+struct Seen {
+    origin: Point2<f64>,
+    cell: f64,
+    w: usize,
+    h: usize,
+    seen: Vec<bool>,
+}
+
+impl Seen {
+    fn new(evidence: &[Point2<f64>], lo: Point2<f64>, hi: Point2<f64>, cell: f64) -> Self {
+        let w = (((hi.x - lo.x) / cell).ceil() as usize).clamp(1, 4000);
+        let h = (((hi.y - lo.y) / cell).ceil() as usize).clamp(1, 4000);
+        let mut seen = vec![false; w * h];
+        for q in evidence {
+            let (x, y) = ((q.x - lo.x) / cell, (q.y - lo.y) / cell);
+            if x >= 0.0 && y >= 0.0 && (x as usize) < w && (y as usize) < h {
+                seen[y as usize * w + x as usize] = true;
+            }
+        }
+        let grow = |s: &[bool], value: bool| {
+            let mut out = s.to_vec();
+            for y in 0..h {
+                for x in 0..w {
+                    if s[y * w + x] == value {
+                        continue;
+                    }
+                    let hit = (y.saturating_sub(1)..(y + 2).min(h)).any(|yy| {
+                        (x.saturating_sub(1)..(x + 2).min(w)).any(|xx| s[yy * w + xx] == value)
+                    });
+                    if hit {
+                        out[y * w + x] = value;
+                    }
+                }
+            }
+            out
+        };
+        let seen = grow(&grow(&seen, true), false);
+        Self {
+            origin: lo,
+            cell,
+            w,
+            h,
+            seen,
+        }
+    }
+
+    /// The share of the raster cells whose centres lie in the convex polygon `poly` that were seen,
+    /// and how many there were.
+    fn share(&self, poly: &[Point2<f64>]) -> (f64, usize) {
+        let (mut lo, mut hi) = (poly[0], poly[0]);
+        for q in poly {
+            lo = lo.inf(q);
+            hi = hi.sup(q);
+        }
+        let x0 = (((lo.x - self.origin.x) / self.cell).floor().max(0.0)) as usize;
+        let y0 = (((lo.y - self.origin.y) / self.cell).floor().max(0.0)) as usize;
+        let x1 = ((((hi.x - self.origin.x) / self.cell).ceil().max(0.0)) as usize).min(self.w);
+        let y1 = ((((hi.y - self.origin.y) / self.cell).ceil().max(0.0)) as usize).min(self.h);
+        let (mut total, mut seen) = (0usize, 0usize);
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let c = Point2::new(
+                    self.origin.x + (x as f64 + 0.5) * self.cell,
+                    self.origin.y + (y as f64 + 0.5) * self.cell,
+                );
+                if inside_convex(&c, poly) {
+                    total += 1;
+                    seen += self.seen[y * self.w + x] as usize;
+                }
+            }
+        }
+        (seen as f64 / total.max(1) as f64, total)
+    }
+}
+
+/// Whether `q` lies inside the counter-clockwise convex polygon.
+fn inside_convex(q: &Point2<f64>, poly: &[Point2<f64>]) -> bool {
+    (0..poly.len()).all(|i| {
+        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+        (b - a).perp(&(q - a)) >= 0.0
+    })
+}
+
+/// A cell of the arrangement: a convex counter-clockwise polygon, the line of each edge (edge `i`
+/// from vertex `i` to `i + 1`; `None` for the search area's edge) and the cell's side of every
+/// line.
+#[derive(Clone, Debug)]
+struct Cell {
+    poly: Vec<Point2<f64>>,
+    edge_line: Vec<Option<usize>>,
+    side: Vec<bool>,
+}
+
+/// The part of a cell on the side of `line` where `distance ≥ 0` (`keep_positive`) or `≤ 0`; the
+/// new edge is labelled with the line.
+fn clip_cell(cell: &Cell, line: &WallLine, k: usize, keep_positive: bool) -> Option<Cell> {
+    let sgn = if keep_positive { 1.0 } else { -1.0 };
+    let d: Vec<f64> = cell.poly.iter().map(|q| sgn * line.distance(q)).collect();
+    let n = cell.poly.len();
+    let (mut poly, mut labels) = (Vec::new(), Vec::new());
+    for i in 0..n {
+        let j = (i + 1) % n;
+        let (a, b) = (cell.poly[i], cell.poly[j]);
+        if d[i] >= 0.0 {
+            poly.push(a);
+            labels.push(cell.edge_line[i]);
+        }
+        if (d[i] >= 0.0) != (d[j] >= 0.0) {
+            let t = d[i] / (d[i] - d[j]);
+            poly.push(a + (b - a) * t);
+            // Entering the kept side continues edge i; leaving it runs along the line.
+            labels.push(if d[i] >= 0.0 {
+                Some(k)
+            } else {
+                cell.edge_line[i]
+            });
+        }
+    }
+    // Remove repeated vertices (an edge of zero length).
+    let mut out_p: Vec<Point2<f64>> = Vec::with_capacity(poly.len());
+    let mut out_l = Vec::with_capacity(poly.len());
+    for (q, l) in poly.iter().zip(&labels) {
+        if out_p
+            .last()
+            .is_some_and(|last: &Point2<f64>| (q - last).norm() < 1e-9)
+        {
+            *out_l.last_mut().expect("a label per vertex") = *l;
+            continue;
+        }
+        out_p.push(*q);
+        out_l.push(*l);
+    }
+    while out_p.len() > 1 && (out_p[0] - out_p[out_p.len() - 1]).norm() < 1e-9 {
+        out_p.pop();
+        out_l.pop();
+    }
+    if out_p.len() < 3 || mrtmap_geometry::polygon::signed_area(&out_p) < 1e-6 {
+        return None;
+    }
+    let mut side = cell.side.clone();
+    side[k] = keep_positive;
+    Some(Cell {
+        poly: out_p,
+        edge_line: out_l,
+        side,
+    })
+}
+
+/// The room's outline from wall lines and where floor or ceiling was seen (`evidence`, points on
+/// the floor plan). Adds, along each wall direction, lines at the evidence's extreme extent where
+/// no wall was found there.
+pub fn outline(
+    mut lines: Vec<WallLine>,
+    evidence: &[Point2<f64>],
+    p: &OutlineParams,
+) -> Result<Outline, OutlineError> {
+    if evidence.len() < 10 || lines.is_empty() {
+        return Err(OutlineError::NothingSeen);
+    }
+    let (mut lo, mut hi) = (evidence[0], evidence[0]);
+    for q in evidence {
+        lo = lo.inf(q);
+        hi = hi.sup(q);
+    }
+    let margin = Vector2::new(0.5, 0.5);
+    let (lo, hi) = (lo - margin, hi + margin);
+    let seen = Seen::new(evidence, lo, hi, p.cell_m);
+    // Inferred lines: along each line's normal (and its opposite), the evidence's extreme.
+    let found = lines.len();
+    for k in 0..found {
+        for sgn in [1.0, -1.0] {
+            let n = lines[k].n * sgn;
+            let mut proj: Vec<f64> = evidence.iter().map(|q| n.dot(&q.coords)).collect();
+            proj.sort_by(f64::total_cmp);
+            let rho = proj[proj.len() / 1000];
+            let covered = lines.iter().any(|l| {
+                l.n.dot(&n) >= (2.0 * p.merge_deg).to_radians().cos()
+                    && (l.rho - rho).abs() <= 2.0 * p.merge_m
+            });
+            if !covered {
+                lines.push(WallLine {
+                    n,
+                    rho,
+                    points: Vec::new(),
+                    inferred: true,
+                });
+            }
+        }
+    }
+    let lines = lines;
+    // The arrangement.
+    let nl = lines.len();
+    let mut cells = vec![Cell {
+        poly: vec![lo, Point2::new(hi.x, lo.y), hi, Point2::new(lo.x, hi.y)],
+        edge_line: vec![None; 4],
+        side: vec![false; nl],
+    }];
+    for (k, line) in lines.iter().enumerate() {
+        cells = cells
+            .iter()
+            .flat_map(|c| [clip_cell(c, line, k, true), clip_cell(c, line, k, false)])
+            .flatten()
+            .collect();
+    }
+    let keep: Vec<bool> = cells
+        .iter()
+        .map(|c| {
+            let (share, total) = seen.share(&c.poly);
+            total > 0 && share >= 0.5
+        })
+        .collect();
+    let index: std::collections::HashMap<&[bool], usize> = cells
+        .iter()
+        .enumerate()
+        .map(|(i, c)| (c.side.as_slice(), i))
+        .collect();
+    let neighbour = |i: usize, k: usize| {
+        let mut s = cells[i].side.clone();
+        s[k] = !s[k];
+        index.get(s.as_slice()).copied()
+    };
+    // The connected kept cells with the largest area.
+    let mut comp = vec![usize::MAX; cells.len()];
+    let mut best: Option<(f64, usize)> = None;
+    for start in 0..cells.len() {
+        if !keep[start] || comp[start] != usize::MAX {
+            continue;
+        }
+        let (mut stack, mut area) = (vec![start], 0.0);
+        comp[start] = start;
+        while let Some(i) = stack.pop() {
+            area += mrtmap_geometry::polygon::signed_area(&cells[i].poly);
+            for k in cells[i].edge_line.iter().flatten() {
+                if let Some(j) = neighbour(i, *k)
+                    && keep[j]
+                    && comp[j] == usize::MAX
+                {
+                    comp[j] = start;
+                    stack.push(j);
+                }
+            }
+        }
+        if best.is_none_or(|b| area > b.0) {
+            best = Some((area, start));
+        }
+    }
+    let Some((_, root)) = best else {
+        return Err(OutlineError::NothingSeen);
+    };
+    // Boundary edges: a kept cell's edge whose neighbour across is not kept.
+    let mut edges: Vec<(Point2<f64>, Point2<f64>, Option<usize>)> = Vec::new();
+    for (i, c) in cells.iter().enumerate() {
+        if comp[i] != root {
+            continue;
+        }
+        for e in 0..c.poly.len() {
+            let (a, b) = (c.poly[e], c.poly[(e + 1) % c.poly.len()]);
+            let outside = match c.edge_line[e] {
+                None => true,
+                Some(k) => neighbour(i, k).is_none_or(|j| comp[j] != root),
+            };
+            if outside {
+                edges.push((a, b, c.edge_line[e]));
+            }
+        }
+    }
+    let loops = chain(&edges);
+    let outer = loops
+        .into_iter()
+        .max_by(|a, b| loop_area(a, &edges).total_cmp(&loop_area(b, &edges)))
+        .ok_or(OutlineError::NothingSeen)?;
+    // Merge consecutive edges on one line.
+    let mut walls: Vec<(Option<usize>, Point2<f64>, Point2<f64>)> = Vec::new();
+    for &e in &outer {
+        let (a, b, l) = edges[e];
+        match walls.last_mut() {
+            Some(last) if last.0 == l => last.2 = b,
+            _ => walls.push((l, a, b)),
+        }
+    }
+    if walls.len() > 1 && walls[0].0 == walls[walls.len() - 1].0 {
+        let last = walls.pop().expect("more than one");
+        walls[0].1 = last.1;
+    }
+    if let Some(open) = walls.iter().find(|w| w.0.is_none()) {
+        return Err(OutlineError::Open(open.1, open.2));
+    }
+    if walls.len() < 3 {
+        return Err(OutlineError::NothingSeen);
+    }
+    let normals = walls
+        .iter()
+        .map(|w| {
+            let d = (w.2 - w.1).normalize();
+            Vector2::new(-d.y, d.x)
+        })
+        .collect();
+    Ok(Outline {
+        walls: walls.iter().map(|w| w.0.expect("checked above")).collect(),
+        corners: walls.iter().map(|w| w.1).collect(),
+        normals,
+        lines,
+    })
+}
+
+/// Chains directed edges into loops by matching each edge's end with another's start.
+fn chain(edges: &[(Point2<f64>, Point2<f64>, Option<usize>)]) -> Vec<Vec<usize>> {
+    let mut used = vec![false; edges.len()];
+    let mut loops = Vec::new();
+    for start in 0..edges.len() {
+        if used[start] {
+            continue;
+        }
+        used[start] = true;
+        let mut lp = vec![start];
+        let mut cur = start;
+        loop {
+            let end = edges[cur].1;
+            let next = (0..edges.len())
+                .filter(|&j| !used[j] || j == start)
+                .min_by(|&a, &b| {
+                    (edges[a].0 - end)
+                        .norm()
+                        .total_cmp(&(edges[b].0 - end).norm())
+                });
+            match next {
+                Some(j) if (edges[j].0 - end).norm() < 1e-6 => {
+                    if j == start {
+                        loops.push(lp);
+                        break;
+                    }
+                    used[j] = true;
+                    lp.push(j);
+                    cur = j;
+                }
+                _ => break,
+            }
+        }
+    }
+    loops
+}
+
+fn loop_area(lp: &[usize], edges: &[(Point2<f64>, Point2<f64>, Option<usize>)]) -> f64 {
+    let pts: Vec<Point2<f64>> = lp.iter().map(|&e| edges[e].0).collect();
+    mrtmap_geometry::polygon::signed_area(&pts)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Wall points, their normals, and floor points.
+    type Fixture = (Vec<Point2<f64>>, Vec<Vector2<f64>>, Vec<Point2<f64>>);
+
+    /// Points every 3 cm along the polygon's edges (normals into the room) and filling it.
+    fn room(poly: &[[f64; 2]], skip_wall: Option<usize>) -> Fixture {
+        let (mut pts, mut nrm) = (Vec::new(), Vec::new());
+        let n = poly.len();
+        for k in 0..n {
+            if Some(k) == skip_wall {
+                continue;
+            }
+            let (a, b) = (Point2::from(poly[k]), Point2::from(poly[(k + 1) % n]));
+            let d = (b - a).normalize();
+            let inward = Vector2::new(-d.y, d.x);
+            let steps = ((b - a).norm() / 0.03) as usize;
+            for s in 0..steps {
+                for layer in 0..8 {
+                    pts.push(
+                        a + (b - a) * (s as f64 / steps as f64)
+                            + inward * (0.004 * (layer as f64 - 3.5)),
+                    );
+                    nrm.push(inward);
+                }
+            }
+        }
+        let p2: Vec<Point2<f64>> = poly.iter().map(|q| Point2::from(*q)).collect();
+        let mut ev = Vec::new();
+        for i in -10..310 {
+            for j in -10..260 {
+                let q = Point2::new(i as f64 * 0.02, j as f64 * 0.02);
+                if mrtmap_geometry::polygon::point_in_polygon_fast(&q, &p2) {
+                    ev.push(q);
+                }
+            }
+        }
+        (pts, nrm, ev)
+    }
+
+    const L: [[f64; 2]; 6] = [
+        [0.0, 0.0],
+        [6.0, 0.0],
+        [6.0, 2.5],
+        [3.5, 2.5],
+        [3.5, 5.0],
+        [0.0, 5.0],
+    ];
+
+    fn corners_match(o: &Outline, truth: &[[f64; 2]], tol: f64) {
+        assert_eq!(o.corners.len(), truth.len(), "corners {:?}", o.corners);
+        for t in truth {
+            let near = o
+                .corners
+                .iter()
+                .map(|c| (c - Point2::from(*t)).norm())
+                .fold(f64::INFINITY, f64::min);
+            assert!(near < tol, "no corner near {t:?}: {:?}", o.corners);
+        }
+    }
+
+    #[test]
+    fn an_l_shaped_room_closes_with_six_walls() {
+        let (pts, nrm, ev) = room(&L, None);
+        let p = OutlineParams::default();
+        let lines = wall_lines(&pts, &nrm, &p);
+        let o = outline(lines, &ev, &p).expect("an outline");
+        corners_match(&o, &L, 0.01);
+        assert!(o.walls.iter().all(|&w| !o.lines[w].inferred));
+        // Counter-clockwise, normals into the room.
+        assert!(mrtmap_geometry::polygon::signed_area(&o.corners) > 0.0);
+    }
+
+    #[test]
+    fn a_wall_never_seen_is_inferred_from_the_floor() {
+        let (pts, nrm, ev) = room(&L, Some(1));
+        let p = OutlineParams::default();
+        let o = outline(wall_lines(&pts, &nrm, &p), &ev, &p).expect("an outline");
+        // The inferred wall lies at the floor seen, here on a 2 cm grid: within a few
+        // centimetres of the truth.
+        corners_match(&o, &L, 0.05);
+        let inferred: Vec<usize> = o
+            .walls
+            .iter()
+            .copied()
+            .filter(|&w| o.lines[w].inferred)
+            .collect();
+        assert_eq!(inferred.len(), 1);
+    }
+
+    #[test]
+    fn a_line_inside_the_room_is_not_a_wall() {
+        let (mut pts, mut nrm, ev) = room(&L, None);
+        // A tall cupboard's side across the long leg.
+        for s in 0..60 {
+            for layer in 0..8 {
+                pts.push(Point2::new(
+                    2.0 + 0.004 * layer as f64,
+                    0.5 + s as f64 * 0.03,
+                ));
+                nrm.push(Vector2::new(1.0, 0.0));
+            }
+        }
+        let p = OutlineParams::default();
+        let o = outline(wall_lines(&pts, &nrm, &p), &ev, &p).expect("an outline");
+        corners_match(&o, &L, 0.01);
+    }
+
+    #[test]
+    fn nothing_seen_is_an_error() {
+        let p = OutlineParams::default();
+        assert_eq!(
+            outline(Vec::new(), &[], &p).unwrap_err(),
+            OutlineError::NothingSeen
+        );
+    }
+}
