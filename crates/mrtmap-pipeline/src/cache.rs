@@ -52,9 +52,10 @@ pub struct Fingerprint {
 }
 
 impl Fingerprint {
-    /// An empty fingerprint.
+    /// A fingerprint of no inputs, made by this version of mrtmap: another version's outputs are
+    /// not reused (its algorithms may differ).
     pub fn new() -> Self {
-        Self::default()
+        Self::default().setting("mrtmap_version", &env!("CARGO_PKG_VERSION"))
     }
 
     /// Adds an input file; a folder adds each file directly in it, in name order.

@@ -98,6 +98,9 @@ fn apply_level(scene: &mut RadiantScene, level: &Level) {
     for s in &mut scene.surfaces {
         fix(&mut s.temperature);
         scale(&mut s.temperature_std_k);
+        if let Some(r) = &mut s.raster {
+            r.map_celsius(|c| level.correct(c));
+        }
         for f in &mut s.features {
             fix(&mut f.temperature);
             scale(&mut f.temperature_std_k);

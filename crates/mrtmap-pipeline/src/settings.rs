@@ -55,6 +55,7 @@ self_calibrate = true     # remove each frame's offset (FFC, drift) and the vign
 [segment]
 feature_threshold_k = 0.3 # a texel differing from its surface's background by more is a feature
 feature_min_area_m2 = 0.04
+raster_m = 0.15           # each surface's temperature raster (texel, m); 0: one temperature per surface
 masks = true              # label features by the recording's instance masks when it has masks.txt
 
 [mrt]
@@ -374,6 +375,8 @@ pub struct SegmentSection {
     pub feature_threshold_k: f64,
     /// Smallest feature (m²).
     pub feature_min_area_m2: f64,
+    /// Texel of each surface's temperature raster (m); 0 for one temperature per surface.
+    pub raster_m: f64,
     /// Label features by the recording's instance masks when it has them.
     pub masks: bool,
 }
@@ -383,6 +386,7 @@ impl Default for SegmentSection {
         Self {
             feature_threshold_k: 0.3,
             feature_min_area_m2: 0.04,
+            raster_m: 0.15,
             masks: true,
         }
     }
@@ -394,6 +398,7 @@ impl SegmentSection {
         SegmentParams {
             feature_threshold_k: self.feature_threshold_k,
             feature_min_area_m2: self.feature_min_area_m2,
+            raster_m: self.raster_m,
             origin_corner: room.origin_corner,
             ..SegmentParams::default()
         }
@@ -565,6 +570,13 @@ impl Project {
             ));
         }
         self.fuse.params()?;
+        let r = self.segment.raster_m;
+        if !(r == 0.0 || (r.is_finite() && (0.03..=2.0).contains(&r))) {
+            return Err(Error::setting(
+                format!("[segment] raster_m = {r}"),
+                "must be 0 (no raster) or between 0.03 and 2 m",
+            ));
+        }
         self.comfort.check(&self.air, &self.map.quantities)?;
         Ok(())
     }

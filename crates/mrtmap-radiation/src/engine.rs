@@ -469,11 +469,14 @@ impl<'a> MrtEngine<'a> {
         if !self.open && (sum - 1.0).abs() > ENCLOSURE_TOLERANCE {
             return Err(MrtError::NotEnclosed { point: arr(p), sum });
         }
-        let m = self.radiant_of(&f).map_err(|source| MrtError::Physics {
-            point: arr(p),
-            source,
-        })?;
-        let sampling = self.sampling_error(&replicate_f);
+        let seen = self.seen_temperatures(p, &|_| 1.0);
+        let m = self
+            .radiant_of(&f, seen.as_deref())
+            .map_err(|source| MrtError::Physics {
+                point: arr(p),
+                source,
+            })?;
+        let sampling = self.sampling_error(&replicate_f, seen.as_deref());
         Ok(PointMrt {
             point: *p,
             mrt: m.temperature,
@@ -487,18 +490,43 @@ impl<'a> MrtEngine<'a> {
         })
     }
 
+    /// Each patch's temperature seen from `p` by a receiver of directional weight `weight`: a
+    /// surface with a raster radiates at its texels' average weighted by their solid angles (see
+    /// `raster`); `None` when the scene has no raster (every patch at its own temperature).
+    pub(crate) fn seen_temperatures(
+        &self,
+        p: &Point3<f64>,
+        weight: &dyn Fn(&Vector3<f64>) -> f64,
+    ) -> Option<Vec<Temperature>> {
+        if self.scene.surfaces.iter().all(|s| s.raster.is_none()) {
+            return None;
+        }
+        let mut t: Vec<Temperature> = self.patches.iter().map(|pa| pa.temperature).collect();
+        for (si, s) in self.scene.surfaces.iter().enumerate() {
+            if let Some(seen) = s.raster.as_ref().and_then(|r| r.seen_from(p, weight)) {
+                t[self.surface_patch[si]] = seen;
+            }
+        }
+        Some(t)
+    }
+
     /// The radiant temperature of factors `f` per patch: (Σ εFT⁴ / Σ εF)^¼ (normalised, so factors
     /// that sum short of 1, like a person's, weigh what is seen), with the error from the patches'
-    /// temperature uncertainties.
-    pub(crate) fn radiant_of(&self, f: &[f64]) -> Result<MeanRadiant, PhysicsError> {
+    /// temperature uncertainties. `seen` overrides the patches' temperatures (rasters).
+    pub(crate) fn radiant_of(
+        &self,
+        f: &[f64],
+        seen: Option<&[Temperature]>,
+    ) -> Result<MeanRadiant, PhysicsError> {
         let src: Vec<RadiantSource> = self
             .patches
             .iter()
+            .enumerate()
             .zip(f)
             .filter(|(_, f)| **f > 0.0)
-            .map(|(pa, &f)| RadiantSource {
+            .map(|((k, pa), &f)| RadiantSource {
                 view_factor: f.min(1.0),
-                temperature: pa.temperature,
+                temperature: seen.map_or(pa.temperature, |s| s[k]),
                 emissivity: pa.emissivity,
                 temperature_std_k: pa.temperature_std_k,
             })
@@ -512,13 +540,17 @@ impl<'a> MrtEngine<'a> {
     }
 
     /// The sampling standard error (K) of a radiant temperature from its replicates' factors.
-    pub(crate) fn sampling_error(&self, replicate_f: &[Vec<f64>]) -> f64 {
+    pub(crate) fn sampling_error(
+        &self,
+        replicate_f: &[Vec<f64>],
+        seen: Option<&[Temperature]>,
+    ) -> f64 {
         if replicate_f.len() < 2 {
             return 0.0;
         }
         let vals: Vec<f64> = replicate_f
             .iter()
-            .filter_map(|g| self.radiant_of(g).ok())
+            .filter_map(|g| self.radiant_of(g, seen).ok())
             .map(|m| m.temperature.kelvin())
             .collect();
         std_error(&vals)

@@ -24,6 +24,7 @@ mod bounds;
 mod engine;
 mod field;
 mod person;
+mod raster;
 mod scene;
 
 pub use bounds::{Outside, ROOM_TOLERANCE_M, RoomBounds};
@@ -35,6 +36,7 @@ pub use field::{
     Extreme, FieldError, FieldSummary, GridLayout, GridNode, GridSpec, MapFrame, MrtField,
 };
 pub use person::{AsymmetryVerdict, Facing, PersonMrt, PlaneRadiant, RadiantAsymmetry};
+pub use raster::{MAX_TEXELS, Raster, RasterFile, Texel};
 pub use scene::{
     BoxFile, FEATURE_PLANE_TOLERANCE_M, Feature, FeatureFile, FramePose, MAX_COORDINATE_M,
     Occluder, OccluderFile, OccluderShape, PLANARITY_TOLERANCE_M, RadiantScene, SCENE_FORMAT,

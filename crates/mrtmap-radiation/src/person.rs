@@ -161,6 +161,7 @@ impl MrtEngine<'_> {
         &self,
         p: &Point3<f64>,
         r: &RayFactors,
+        weight: &dyn Fn(&Vector3<f64>) -> f64,
     ) -> Result<(Temperature, f64), MrtError> {
         let seen: f64 = r.factors.iter().sum();
         let coverage = if r.mean_weight > 0.0 {
@@ -174,13 +175,14 @@ impl MrtEngine<'_> {
                 sum: coverage,
             });
         }
+        let seen = self.seen_temperatures(p, weight);
         let m = self
-            .radiant_of(&r.factors)
+            .radiant_of(&r.factors, seen.as_deref())
             .map_err(|source| MrtError::Physics {
                 point: [p.x, p.y, p.z],
                 source,
             })?;
-        let sampling = self.sampling_error(&r.replicates);
+        let sampling = self.sampling_error(&r.replicates, seen.as_deref());
         Ok((m.temperature, sampling.hypot(m.std_from_temperatures_k)))
     }
 
@@ -195,8 +197,9 @@ impl MrtEngine<'_> {
         self.check_place(centre)?;
         let [up, x, y] = axes(self)?;
         let hits = self.ray_hits(centre, &self.ray_settings(), stream);
-        let r = self.ray_factors(&hits, &person_weight(posture, facing, up, x, y));
-        let (mrt, std_error_k) = self.radiant_from_rays(centre, &r)?;
+        let weight = person_weight(posture, facing, up, x, y);
+        let r = self.ray_factors(&hits, &weight);
+        let (mrt, std_error_k) = self.radiant_from_rays(centre, &r, &weight)?;
         Ok(PersonMrt {
             centre: *centre,
             posture,
@@ -252,9 +255,13 @@ impl MrtEngine<'_> {
                             sum,
                         });
                     }
-                    let m = self.radiant_of(&f).map_err(|source| MrtError::Physics {
-                        point: [p.x, p.y, p.z],
-                        source,
+                    let weight = |d: &Vector3<f64>| 4.0 * n.dot(d).max(0.0);
+                    let seen = self.seen_temperatures(p, &weight);
+                    let m = self.radiant_of(&f, seen.as_deref()).map_err(|source| {
+                        MrtError::Physics {
+                            point: [p.x, p.y, p.z],
+                            source,
+                        }
                     })?;
                     return Ok(PlaneRadiant {
                         normal: n,
@@ -264,8 +271,9 @@ impl MrtEngine<'_> {
                     });
                 }
                 let h = hits.get_or_insert_with(|| self.ray_hits(p, &self.ray_settings(), stream));
-                let r = self.ray_factors(h, &|d: &Vector3<f64>| 4.0 * n.dot(d).max(0.0));
-                let (t, se) = self.radiant_from_rays(p, &r)?;
+                let weight = |d: &Vector3<f64>| 4.0 * n.dot(d).max(0.0);
+                let r = self.ray_factors(h, &weight);
+                let (t, se) = self.radiant_from_rays(p, &r, &weight)?;
                 Ok(PlaneRadiant {
                     normal: n,
                     temperature: t,

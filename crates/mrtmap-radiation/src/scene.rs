@@ -16,6 +16,8 @@ use mrtmap_geometry::{Tri, box_triangles};
 use mrtmap_physics::Temperature;
 use serde::{Deserialize, Serialize};
 
+use crate::raster::{Raster, RasterFile};
+
 /// The `format` value of version 1.
 pub const SCENE_FORMAT: &str = "mrtmap-scene/1";
 /// Largest distance of a vertex from its polygon's best-fit plane (m).
@@ -128,6 +130,10 @@ pub struct SurfaceFile {
     /// Features on this surface.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub features: Vec<FeatureFile>,
+    /// A temperature raster over the surface's background (written by segmentation); without
+    /// one the background radiates at `temperature_c` everywhere.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub raster: Option<RasterFile>,
 }
 
 /// One feature (window, light, painting…) in the file.
@@ -232,6 +238,14 @@ pub enum SceneError {
         line: usize,
         /// 1-based column.
         column: usize,
+    },
+    /// A surface's raster breaks a rule.
+    #[error("surface '{id}': raster: {detail}")]
+    BadRaster {
+        /// The surface.
+        id: String,
+        /// What is wrong.
+        detail: String,
     },
     /// Wrong or missing `format`.
     #[error("unsupported format {found:?}: expected \"{SCENE_FORMAT}\"")]
@@ -471,6 +485,8 @@ pub struct Surface {
     pub frame: PlaneFrame,
     /// The polygon in `frame`'s 2D coordinates.
     pub polygon_2d: Vec<Point2<f64>>,
+    /// Its temperature raster, if any.
+    pub raster: Option<Raster>,
 }
 
 /// A validated feature.
@@ -802,6 +818,11 @@ fn check_surface(s: &SurfaceFile, si: usize, ids: &mut Ids) -> Result<Surface, S
         ids.claim(&f.id, format!("feature {} of surface '{}'", fi + 1, s.id))?;
         features.push(check_feature(f, &s.id, &frame, &poly2, &features)?);
     }
+    let raster = s
+        .raster
+        .as_ref()
+        .map(|r| Raster::check(r, &s.id, &poly, &frame.normal))
+        .transpose()?;
     Ok(Surface {
         id: s.id.clone(),
         kind,
@@ -811,6 +832,7 @@ fn check_surface(s: &SurfaceFile, si: usize, ids: &mut Ids) -> Result<Surface, S
         emissivity,
         temperature_std_k,
         observed_fraction: s.observed_fraction,
+        raster,
         features,
         frame,
         polygon_2d: poly2,
@@ -897,8 +919,17 @@ impl SceneFile {
             let v = to_from_this.rotation * Vector3::from(u);
             [v.x, v.y, v.z]
         });
+        let turn = |v: &[f64; 3]| {
+            let w = to_from_this.rotation * Vector3::from(*v);
+            [w.x, w.y, w.z]
+        };
         for s in &mut out.surfaces {
             s.polygon = poly(&s.polygon);
+            if let Some(r) = &mut s.raster {
+                r.origin = map(&r.origin);
+                r.u = turn(&r.u);
+                r.v = turn(&r.v);
+            }
             for f in &mut s.features {
                 f.polygon = poly(&f.polygon);
             }
@@ -1080,6 +1111,7 @@ impl RadiantScene {
                     emissivity: s.emissivity,
                     temperature_std_k: s.temperature_std_k,
                     observed_fraction: s.observed_fraction,
+                    raster: s.raster.as_ref().map(|r| r.file.clone()),
                     features: s
                         .features
                         .iter()

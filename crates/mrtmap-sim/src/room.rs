@@ -628,6 +628,7 @@ impl Room {
                 temperature_std_k: None,
                 observed_fraction: None,
                 features,
+                raster: None,
             });
         }
         out

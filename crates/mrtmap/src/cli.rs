@@ -541,6 +541,10 @@ pub struct SegmentArgs {
     /// Smallest feature (m²).
     #[arg(long = "feature-min-area-m2", default_value_t = 0.04)]
     pub feature_min_area_m2: f64,
+    /// Texel of each surface's temperature raster in scene.json (m), so that a stratified wall
+    /// radiates as it is; 0 for one temperature per surface.
+    #[arg(long = "raster-m", default_value_t = 0.15)]
+    pub raster_m: f64,
     /// The floor corner at the room frame's origin, as numbered in segment.json's floor_corners;
     /// by default the start of the longest wall with the room at x, y ≥ 0.
     #[arg(long, value_name = "N")]

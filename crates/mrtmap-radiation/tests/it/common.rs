@@ -28,6 +28,7 @@ pub fn surface(id: &str, kind: &str, polygon: Vec<[f64; 3]>, t: f64) -> SurfaceF
         temperature_std_k: None,
         observed_fraction: None,
         features: Vec::new(),
+        raster: None,
     }
 }
 

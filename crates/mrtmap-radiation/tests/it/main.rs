@@ -5,4 +5,5 @@ mod common;
 mod engines;
 mod field;
 mod person;
+mod raster;
 mod scene;

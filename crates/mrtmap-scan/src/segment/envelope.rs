@@ -321,14 +321,15 @@ pub fn envelope(
         .map(|&i| frame.to_2d(&points[i]))
         .collect();
     let op = OutlineParams::default();
-    // Walls reach the ceiling, furniture does not: their points just below the ceiling first; the
-    // upper half of the room when that gives no outline (a scan that never looked up).
+    // Walls reach the ceiling, most furniture stays below half the room's height (a bookcase
+    // that does not gives a line inside the room, which the cells drop): the upper half of the
+    // room first; just below the ceiling when that gives no outline.
     let bands = [
+        (0.5 * h_room, h_room - 0.05),
         (
             h_room - p.wall_ceiling_gap_m.max(0.2 * h_room),
             h_room - 0.05,
         ),
-        (0.5 * h_room, h_room - 0.05),
     ];
     let mut result = Err(OutlineError::NothingSeen);
     let mut used = (Vec::new(), Vec::new(), Vec::new());

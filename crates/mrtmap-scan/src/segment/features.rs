@@ -16,7 +16,8 @@ use mrtmap_geometry::polygon::{
     point_in_polygon_fast, polygon_inside, polygons_overlap, signed_area,
 };
 use mrtmap_geometry::shape2d::{clip_convex, convex_hull, min_area_rectangle, simplify_closed};
-use mrtmap_physics::{RadiantAverage, Temperature};
+use mrtmap_physics::{RadiantAverage, Temperature, ZERO_CELSIUS_K};
+use mrtmap_radiation::RasterFile;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -55,6 +56,8 @@ pub struct SurfaceAnalysis {
     pub dropped: Vec<String>,
     /// The background model.
     pub background: Background,
+    /// The background's temperature raster (see [`background_raster`]), when asked for.
+    pub raster: Option<RasterFile>,
 }
 
 /// Background model coefficients: T = a + b·v.
@@ -373,7 +376,7 @@ fn outline(
         return Err(String::new());
     };
     let mut poly = if area / rect_area >= 0.75 {
-        rect.to_vec()
+        robust_rectangle(g, comp, &rect).unwrap_or(rect).to_vec()
     } else {
         simplify_closed(&convex_hull(&corners), 0.5 * t)
     };
@@ -382,12 +385,55 @@ fn outline(
         poly = ccw(clip_convex(&poly, &ccw(convex_hull(host))));
         poly.dedup_by(|a, b| (*a - *b).norm() < 1e-6);
     }
+    // Vertices within a millimetre of the previous one (around the loop) are one vertex.
+    poly.dedup_by(|a, b| (*a - *b).norm() < 1e-3);
+    while poly.len() > 3 && (poly[0] - poly[poly.len() - 1]).norm() < 1e-3 {
+        poly.pop();
+    }
     if poly.len() < 3 || !polygon_inside(&poly, host, 1e-3) {
         return Err(format!(
             "a {area:.2} m² region does not fit inside its surface"
         ));
     }
+    if mrtmap_geometry::polygon::check_simple(&poly, 1e-6).is_err() {
+        return Err(format!("a {area:.2} m² region's outline is degenerate"));
+    }
     Ok(poly)
+}
+
+/// The rectangle `rect` of a region's texels, each side moved to where the region fills half of
+/// the texel rows along it: the extreme texels of a blurred, noisy edge (a 45 °C radiator's glow)
+/// stretch the smallest enclosing rectangle outwards, but not the rows' half-occupancy.
+fn robust_rectangle(g: &Grid, comp: &[usize], rect: &[Point2<f64>; 4]) -> Option<[Point2<f64>; 4]> {
+    let o = rect[0];
+    let (ea, eb) = (rect[1] - rect[0], rect[3] - rect[0]);
+    let (la, lb) = (ea.norm(), eb.norm());
+    let (ua, ub) = (ea.try_normalize(1e-12)?, eb.try_normalize(1e-12)?);
+    let t = g.t;
+    let (na, nb) = ((la / t).ceil() as usize + 1, (lb / t).ceil() as usize + 1);
+    let (mut rows_a, mut rows_b) = (vec![0usize; na], vec![0usize; nb]);
+    for &c in comp {
+        let d = g.centre_of(c) - o;
+        let (a, b) = (d.dot(&ua), d.dot(&ub));
+        rows_a[((a / t).max(0.0) as usize).min(na - 1)] += 1;
+        rows_b[((b / t).max(0.0) as usize).min(nb - 1)] += 1;
+    }
+    // Extent along one axis: the first and last slices holding half the typical slice's texels.
+    let extent = |rows: &[usize]| -> Option<(f64, f64)> {
+        let mut full: Vec<usize> = rows.iter().copied().filter(|&n| n > 0).collect();
+        full.sort_unstable();
+        let typical = *full.get(full.len() * 3 / 4)?;
+        let first = rows.iter().position(|&n| 2 * n >= typical)?;
+        let last = rows.iter().rposition(|&n| 2 * n >= typical)?;
+        Some((first as f64 * t, (last + 1) as f64 * t))
+    };
+    let ((a0, a1), (b0, b1)) = (extent(&rows_a)?, extent(&rows_b)?);
+    let (a0, a1, b0, b1) = (a0.max(0.0), a1.min(la), b0.max(0.0), b1.min(lb));
+    if a1 - a0 < t || b1 - b0 < t {
+        return None;
+    }
+    let at = |a: f64, b: f64| o + ua * a + ub * b;
+    Some([at(a0, b0), at(a1, b0), at(a1, b1), at(a0, b1)])
 }
 
 /// A feature of region `comp` with outline `poly`: its temperature from interior texels (all four
@@ -495,6 +541,7 @@ pub fn analyse_surface(
         features: Vec::new(),
         dropped: Vec::new(),
         background: Background::default(),
+        raster: None,
     };
     if cells.len() < 3 {
         return out;
@@ -547,7 +594,126 @@ pub fn analyse_surface(
         out.temperature_k = Some(t);
         out.temperature_std_k = std;
     }
+    if p.raster_m > 0.0 {
+        out.raster = background_raster(&g, &in_feature, &bg, frame, p.raster_m);
+    }
     out
+}
+
+/// The background's temperature raster at about `raster_m` (a whole number of analysis texels):
+/// each raster texel the radiant average of its observed background texels, leaving out features
+/// and a 10 cm margin around them (where the thermal camera's blur spreads a feature's
+/// temperature); a raster texel with less than a quarter of its texels so observed is filled
+/// from its neighbours (repeatedly, then the background model where nothing is near) and listed
+/// as filled.
+fn background_raster(
+    g: &Grid,
+    in_feature: &[bool],
+    bg: &Background,
+    frame: &PlaneFrame,
+    raster_m: f64,
+) -> Option<RasterFile> {
+    let k = ((raster_m / g.t).round() as usize).max(1);
+    let (cols, rows) = (g.nx.div_ceil(k), g.ny.div_ceil(k));
+    // Features grown by the margin.
+    let margin = (0.10 / g.t).ceil() as usize;
+    let mut near_feature = in_feature.to_vec();
+    for c in (0..in_feature.len()).filter(|&c| in_feature[c]) {
+        let (i, j) = (c % g.nx, c / g.nx);
+        for jj in j.saturating_sub(margin)..(j + margin + 1).min(g.ny) {
+            for ii in i.saturating_sub(margin)..(i + margin + 1).min(g.nx) {
+                near_feature[jj * g.nx + ii] = true;
+            }
+        }
+    }
+    let mut value: Vec<Option<f64>> = vec![None; cols * rows];
+    let mut on_surface = vec![false; cols * rows];
+    for j in 0..g.ny {
+        for i in 0..g.nx {
+            let c = j * g.nx + i;
+            if g.inside[c] {
+                on_surface[(j / k) * cols + i / k] = true;
+            }
+        }
+    }
+    for r in 0..cols * rows {
+        if !on_surface[r] {
+            continue;
+        }
+        let (col, row) = (r % cols, r / cols);
+        let mut avg = RadiantAverage::new();
+        let mut inside = 0usize;
+        for j in row * k..((row + 1) * k).min(g.ny) {
+            for i in col * k..((col + 1) * k).min(g.nx) {
+                let c = j * g.nx + i;
+                if !g.inside[c] {
+                    continue;
+                }
+                inside += 1;
+                if g.observed(c) && !near_feature[c] {
+                    avg.add(Temperature::from_kelvin(g.kelvin(c)), 1.0);
+                }
+            }
+        }
+        if avg.count() * 4 >= inside.max(1) as u64
+            && let Some(t) = avg.mean()
+        {
+            value[r] = Some(t.kelvin());
+        }
+    }
+    if value.iter().all(Option::is_none) {
+        return None;
+    }
+    let mut filled = Vec::new();
+    loop {
+        let mut next = value.clone();
+        let mut changed = false;
+        for r in 0..cols * rows {
+            if !on_surface[r] || value[r].is_some() {
+                continue;
+            }
+            let (col, row) = (r % cols, r / cols);
+            let mut avg = RadiantAverage::new();
+            for rr in row.saturating_sub(1)..(row + 2).min(rows) {
+                for cc in col.saturating_sub(1)..(col + 2).min(cols) {
+                    if let Some(t) = value[rr * cols + cc] {
+                        avg.add(Temperature::from_kelvin(t), 1.0);
+                    }
+                }
+            }
+            if let Some(t) = avg.mean() {
+                next[r] = Some(t.kelvin());
+                filled.push(r);
+                changed = true;
+            }
+        }
+        value = next;
+        if !changed {
+            break;
+        }
+    }
+    for r in 0..cols * rows {
+        if on_surface[r] && value[r].is_none() {
+            let v = g.lo.y + ((r / cols) as f64 + 0.5) * k as f64 * g.t;
+            value[r] = Some(bg.a + bg.b * v);
+            filled.push(r);
+        }
+    }
+    filled.sort_unstable();
+    let o = frame.to_3d(&g.lo);
+    Some(RasterFile {
+        texel_m: k as f64 * g.t,
+        origin: [o.x, o.y, o.z],
+        u: [frame.u.x, frame.u.y, frame.u.z],
+        v: [frame.v.x, frame.v.y, frame.v.z],
+        cols,
+        rows,
+        temperature_c: value
+            .iter()
+            .map(|t| t.map(|t| t - ZERO_CELSIUS_K))
+            .collect(),
+        filled,
+    })
 }
 
 #[cfg(test)]

@@ -9,7 +9,8 @@
 //! room's axes (along the longest wall, across it, up), spanning the 1st–99th percentiles of its
 //! points, extended to the floor when it ends within 15 cm of it (furniture stands on the floor),
 //! at the radiant average of its points. Groups reaching within 15 cm of the ceiling are wall
-//! remainders too.
+//! remainders too, and so are groups most of whose points were seen in one frame only (depth
+//! noise off a wall; real furniture is seen frame after frame).
 
 use std::collections::{HashMap, VecDeque};
 
@@ -144,8 +145,19 @@ fn furniture_box(
     comp: Vec<usize>,
     pos: &[Point3<f64>],
     temp_k: &[f64],
+    observations: &[u32],
     room: &Room<'_>,
 ) -> Option<FoundFurniture> {
+    // Most of its points seen in one frame only: depth noise off a wall, not an object (furniture
+    // is seen from frame after frame like the walls behind it).
+    let mut obs: Vec<u32> = comp
+        .iter()
+        .map(|&i| observations.get(i).copied().unwrap_or(1))
+        .collect();
+    obs.sort_unstable();
+    if obs[obs.len() / 2] <= 1 {
+        return None;
+    }
     let (u, v) = axes(room);
     let up = &room.up;
     let mut a: Vec<f64> = comp.iter().map(|&i| u.dot(&pos[i].coords)).collect();
@@ -193,6 +205,7 @@ fn furniture_box(
 pub fn find_furniture(
     pos: &[Point3<f64>],
     temp_k: &[f64],
+    observations: &[u32],
     surface_id: &[i32],
     room: &Room<'_>,
     p: &SegmentParams,
@@ -201,6 +214,7 @@ pub fn find_furniture(
     cell_components(&grid)
         .into_iter()
         .filter(|comp| comp.len() >= p.furniture_min_points)
-        .filter_map(|comp| furniture_box(comp, pos, temp_k, room))
+        .filter(|comp| !comp.is_empty())
+        .filter_map(|comp| furniture_box(comp, pos, temp_k, observations, room))
         .collect()
 }

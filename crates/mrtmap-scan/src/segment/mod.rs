@@ -55,6 +55,9 @@ pub struct SegmentParams {
     pub surface_band_m: f64,
     /// Texel size for the thermal analysis (m).
     pub texel_m: f64,
+    /// Texel size of each surface's temperature raster in scene.json (m; a whole number of
+    /// analysis texels); 0 for none (each surface at one temperature).
+    pub raster_m: f64,
     /// A texel belongs to a feature when it differs from the background by more than this (K).
     pub feature_threshold_k: f64,
     /// Smallest feature (m²).
@@ -84,6 +87,7 @@ impl Default for SegmentParams {
             wall_ceiling_gap_m: 0.4,
             surface_band_m: 0.10,
             texel_m: 0.03,
+            raster_m: 0.15,
             feature_threshold_k: 0.3,
             feature_min_area_m2: 0.04,
             furniture_wall_clearance_m: 0.15,
@@ -279,6 +283,7 @@ struct Points {
     pos: Vec<Point3<f64>>,
     nrm: Vec<Vector3<f64>>,
     temp: Vec<f64>,
+    obs: Vec<u32>,
 }
 
 impl Points {
@@ -295,6 +300,7 @@ impl Points {
                 .map(|n| Vector3::new(n[0] as f64, n[1] as f64, n[2] as f64))
                 .collect(),
             temp: cloud.temperature_k.iter().map(|t| *t as f64).collect(),
+            obs: cloud.observations.clone(),
         }
     }
 }
@@ -461,7 +467,7 @@ fn furniture_of(
         floor_2d: &floor_2d,
         wall_planes: &wall_planes,
     };
-    furniture::find_furniture(&pts.pos, &pts.temp, surface_id, &room, p)
+    furniture::find_furniture(&pts.pos, &pts.temp, &pts.obs, surface_id, &room, p)
 }
 
 /// A label's vote, if masks gave one.
@@ -624,6 +630,7 @@ fn build_surfaces(
             temperature_std_k: Some(a.temperature_std_k),
             observed_fraction: Some(a.observed_fraction),
             features: std::mem::take(&mut per_surface[s]),
+            raster: a.raster.clone(),
         });
         summaries.push(SurfaceSummary {
             id: g.id.clone(),

@@ -179,3 +179,37 @@ fn the_room_frame_does_not_depend_on_where_the_walk_started() {
         assert!(!r.room.chosen && r.room.origin_corner == 1);
     }
 }
+
+/// A walk that broke the outline before it was found from cells on the floor plan (L-shaped room,
+/// seed 5: "the walls do not close"), with realistic noise: every wall found from its own
+/// points, corners within 5 cm, MRT at A–D within 0.2 K.
+#[test]
+fn a_realistic_walk_of_another_seed_closes_the_l_shaped_outline() {
+    for (room, walls) in [("l-shaped", 6)] {
+        let (s, report, _) = run_seeded(room, NoiseLevel::Realistic, 30.0, 5);
+        assert_eq!(
+            report
+                .surfaces
+                .iter()
+                .filter(|x| x.kind == mrtmap_radiation::SurfaceKind::Wall)
+                .count(),
+            walls,
+            "{room}"
+        );
+        assert!(report.inferred_walls.is_empty(), "{room}: {report:?}");
+        assert!(
+            s.corner_max_error_m < 0.05,
+            "{room}: corners off by {:.1} mm",
+            s.corner_max_error_m * 1e3
+        );
+        for p in &s.points {
+            assert!(
+                p.error_k.abs() < 0.2,
+                "{room}: MRT at {} off by {:.3} K",
+                p.name,
+                p.error_k
+            );
+        }
+        println!("{room} seed 5: {:?}", s.points);
+    }
+}

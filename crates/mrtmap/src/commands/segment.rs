@@ -16,6 +16,12 @@ pub fn run(a: &SegmentArgs) -> anyhow::Result<()> {
             a.fused.display()
         );
     }
+    if !(a.raster_m == 0.0 || (a.raster_m.is_finite() && (0.03..=2.0).contains(&a.raster_m))) {
+        bail!(
+            "--raster-m {} must be 0 (no raster) or between 0.03 and 2 m",
+            a.raster_m
+        );
+    }
     let masks = match &a.masks {
         Some(dir) => {
             let r = Recording::open(dir)?;
@@ -29,6 +35,7 @@ pub fn run(a: &SegmentArgs) -> anyhow::Result<()> {
     let section = SegmentSection {
         feature_threshold_k: a.feature_threshold_k,
         feature_min_area_m2: a.feature_min_area_m2,
+        raster_m: a.raster_m,
         masks: masks.is_some(),
     };
     let room = RoomSection {
