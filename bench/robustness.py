@@ -74,7 +74,7 @@ def near_furniture(rec, nodes, clearance=0.1):
     return out
 
 
-def one(mrtmap, work, room, seed, noise, drift, secs, keep, camera):
+def one(mrtmap, work, room, seed, noise, drift, secs, keep, camera, reuse_fusion=False):
     name = f"{room}-s{seed}-{noise}-{drift}-cam{camera}"
     rec, run = os.path.join(work, name), os.path.join(work, name + ".run")
     row = {"room": room, "seed": seed, "noise": noise, "drift": drift, "camera_errors": camera}
@@ -86,7 +86,13 @@ def one(mrtmap, work, room, seed, noise, drift, secs, keep, camera):
                         "--out", rec],
                        check=True, capture_output=True)
     t1 = time.time()
-    shutil.rmtree(run, ignore_errors=True)
+    if reuse_fusion and os.path.exists(os.path.join(run, "fuse", "cloud.ply")):
+        for entry in os.listdir(run):
+            if entry != "fuse":
+                path = os.path.join(run, entry)
+                shutil.rmtree(path) if os.path.isdir(path) else os.remove(path)
+    else:
+        shutil.rmtree(run, ignore_errors=True)
     r = subprocess.run([mrtmap, "run", rec, "--out", run], capture_output=True, text=True)
     t2 = time.time()
     row["simulate_s"], row["run_s"] = round(t1 - t0, 1), round(t2 - t1, 1)
@@ -129,6 +135,8 @@ def main():
                     help="the simulator's radiometric camera errors: auto (realistic with realistic "
                          "noise, corrected from two reference readings), none, realistic")
     ap.add_argument("--keep", action="store_true")
+    ap.add_argument("--reuse-fusion", action="store_true",
+                    help="with --keep: keep the fusion of an earlier study (segmentation work)")
     a = ap.parse_args()
     os.makedirs(a.work, exist_ok=True)
     rows = []
@@ -137,7 +145,7 @@ def main():
             for room in a.rooms.split(","):
                 for seed in seeds(a.seeds):
                     row = one(a.mrtmap, a.work, room, seed, noise, drift, a.seconds, a.keep,
-                              a.camera_errors)
+                              a.camera_errors, a.reuse_fusion)
                     rows.append(row)
                     if "error" in row:
                         desc = "FAILED: " + row["error"]

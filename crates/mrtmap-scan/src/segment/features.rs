@@ -602,8 +602,8 @@ pub fn analyse_surface(
 
 /// The background's temperature raster at about `raster_m` (a whole number of analysis texels):
 /// each raster texel the radiant average of its observed background texels, leaving out features
-/// and a 10 cm margin around them (where the thermal camera's blur spreads a feature's
-/// temperature); a raster texel with less than a quarter of its texels so observed is filled
+/// and a 10 cm margin around them and along the surface's edges (where the thermal camera's blur
+/// spreads a feature's or the next surface's temperature); a raster texel with less than a quarter of its texels so observed is filled
 /// from its neighbours (repeatedly, then the background model where nothing is near) and listed
 /// as filled.
 fn background_raster(
@@ -615,10 +615,15 @@ fn background_raster(
 ) -> Option<RasterFile> {
     let k = ((raster_m / g.t).round() as usize).max(1);
     let (cols, rows) = (g.nx.div_ceil(k), g.ny.div_ceil(k));
-    // Features grown by the margin.
+    // Features and the surface's own edges (where a corner mixes in the next surface's
+    // temperature), grown by the margin.
     let margin = (0.10 / g.t).ceil() as usize;
     let mut near_feature = in_feature.to_vec();
-    for c in (0..in_feature.len()).filter(|&c| in_feature[c]) {
+    let edge = |c: usize| {
+        let (i, j) = (c % g.nx, c / g.nx);
+        !g.inside[c] || i == 0 || j == 0 || i + 1 == g.nx || j + 1 == g.ny
+    };
+    for c in (0..in_feature.len()).filter(|&c| in_feature[c] || edge(c)) {
         let (i, j) = (c % g.nx, c / g.nx);
         for jj in j.saturating_sub(margin)..(j + margin + 1).min(g.ny) {
             for ii in i.saturating_sub(margin)..(i + margin + 1).min(g.nx) {

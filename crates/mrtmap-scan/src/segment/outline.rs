@@ -1,16 +1,20 @@
 //! The room's outline on the floor plan, robust to how the walk went.
 //!
-//! 1. Wall lines: the points of vertical surfaces near the ceiling (walls reach it, furniture does
-//!    not), seen from above, vote with their normals' directions (a Hough transform on the
-//!    normals); each direction's points vote for an offset; each peak is a line, refitted to its
-//!    points. A wall seen briefly, at a grazing angle or only above furniture still gives a line.
+//! 1. Wall lines: the points of vertical surfaces in the upper half of the room (walls reach the
+//!    ceiling, most furniture does not), seen from above, vote with their normals' directions (a
+//!    Hough transform on the normals); each direction's points vote for an offset; each peak is a
+//!    line, refitted to the middle of its points (a far wall is fused as thick as the depth noise
+//!    there). Lines of noise are sparse or thick and are dropped. A wall seen briefly, at a grazing
+//!    angle or only above furniture still gives a line.
 //! 2. Where the room is: the floor and ceiling points seen, on a 5 cm raster.
 //! 3. The plane is cut into cells by every line (and, along each wall direction, by the floor and
 //!    ceiling's extreme extent, for a wall never seen); a cell is the room's when most of it was
 //!    seen as floor or ceiling. The kept cells' boundary is the loop of walls, counter-clockwise;
 //!    its corners are the lines' intersections. Spurious lines inside the room (a tall cupboard's
 //!    side, a wall's shadow) cut cells that are kept on both sides and drop out; lines outside it
-//!    bound cells that are empty. The loop closes whenever the floor or ceiling was seen.
+//!    bound cells that are empty. The loop closes whenever the floor or ceiling was seen. Walls
+//!    shorter than 30 cm (slivers where lines cross near a corner) are removed by extending their
+//!    neighbours.
 
 use mrtmap_geometry::nalgebra::{Point2, Vector2};
 use mrtmap_geometry::shape2d::line_intersection;
@@ -69,7 +73,8 @@ pub enum OutlineError {
 /// Settings of the outline search.
 #[derive(Clone, Copy, Debug)]
 pub struct OutlineParams {
-    /// Points within this distance of a line are its points (m).
+    /// Points within this distance of a line's offset peak start its fit, and lie on it at least
+    /// this far (m; more on a thick wall).
     pub band_m: f64,
     /// Normals within this angle of a line's normal vote for it (degrees).
     pub normal_deg: f64,
