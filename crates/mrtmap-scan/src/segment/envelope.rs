@@ -321,9 +321,9 @@ pub fn envelope(
         .map(|&i| frame.to_2d(&points[i]))
         .collect();
     let op = OutlineParams::default();
-    // Walls reach the ceiling, most furniture stays below half the room's height (a bookcase
-    // that does not gives a line inside the room, which the cells drop): the upper half of the
-    // room first; just below the ceiling when that gives no outline.
+    // Walls reach the ceiling, furniture mostly does not: their points in the upper half of the
+    // room, and just below the ceiling; of the two outlines, the one with fewer walls inferred,
+    // then fewer walls (lines of noise add walls, they do not remove any).
     let bands = [
         (0.5 * h_room, h_room - 0.05),
         (
@@ -333,13 +333,24 @@ pub fn envelope(
     ];
     let mut result = Err(OutlineError::NothingSeen);
     let mut used = (Vec::new(), Vec::new(), Vec::new());
+    let score = |o: &outline::Outline| {
+        (
+            o.walls.iter().filter(|&&w| o.lines[w].inferred).count(),
+            o.walls.len(),
+        )
+    };
     for band in bands {
         let vp = vertical_points(points, normals, &frame, band, p);
         let lines = outline::wall_lines(&vp.1, &vp.2, &op);
-        result = outline::outline(lines, &evidence, &op);
-        used = vp;
-        if result.is_ok() {
-            break;
+        let this = outline::outline(lines, &evidence, &op);
+        let better = match (&this, &result) {
+            (Ok(a), Ok(b)) => score(a) < score(b),
+            (Ok(_), Err(_)) => true,
+            _ => false,
+        };
+        if better || (result.is_err() && this.is_err()) {
+            result = this;
+            used = vp;
         }
     }
     let out = result.map_err(|e| match e {

@@ -160,11 +160,36 @@ impl Grid {
         ]
     }
 
+    /// Which texels lie within `m` of the grid's edge or of a texel outside the surface.
+    fn near_edge(&self, m: f64) -> Vec<bool> {
+        let r = (m / self.t).ceil() as usize;
+        let mut out = vec![false; self.nx * self.ny];
+        for c in 0..self.nx * self.ny {
+            let (i, j) = (c % self.nx, c / self.nx);
+            if i < r || j < r || i + r >= self.nx || j + r >= self.ny {
+                out[c] = true;
+            }
+            if self.inside[c] {
+                continue;
+            }
+            for jj in j.saturating_sub(r)..(j + r + 1).min(self.ny) {
+                for ii in i.saturating_sub(r)..(i + r + 1).min(self.nx) {
+                    out[jj * self.nx + ii] = true;
+                }
+            }
+        }
+        out
+    }
+
     /// Whether all four neighbours of texel `c` exist and are in `set`.
     fn interior_of(&self, c: usize, set: &[bool]) -> bool {
         self.neighbours(c).iter().all(|&(ok, d)| ok && set[d])
     }
 }
+
+/// A warm or cold region lying mostly within this of its surface's edge is the neighbouring
+/// surface's temperature blurred in at the corner (m).
+const EDGE_STRIP_M: f64 = 0.12;
 
 /// Texels within this of the background model count as background when fitting it (K).
 const BACKGROUND_TOLERANCE_K: f64 = 0.3;
@@ -554,6 +579,7 @@ pub fn analyse_surface(
     out.background = bg;
     let resid = |c: usize| g.kelvin(c) - bg.a - bg.b * g.centre_of(c).y;
     let mut in_feature = vec![false; nx * ny];
+    let near_edge = g.near_edge(EDGE_STRIP_M);
     for sign in [1.0f64, -1.0] {
         let mask = threshold_mask(&g, &resid, sign, p.feature_threshold_k);
         for region in components(&g, &mask) {
@@ -562,6 +588,16 @@ pub fn analyse_surface(
             };
             let area = comp.len() as f64 * g.t * g.t;
             if area < p.feature_min_area_m2 {
+                continue;
+            }
+            // A strip along the surface's edge is the next surface's temperature blurred in at
+            // the corner (optics, registration, voxels), not a feature of this one.
+            let strip = comp.iter().filter(|&&c| near_edge[c]).count();
+            if strip * 5 >= comp.len() * 4 {
+                out.dropped.push(format!(
+                    "a {area:.2} m² strip along the surface's edge ({:+.1} K): the next surface's temperature blurred in",
+                    comp.iter().map(|&c| resid(c)).sum::<f64>() / comp.len() as f64
+                ));
                 continue;
             }
             let poly = match outline(&g, &comp, host, area) {

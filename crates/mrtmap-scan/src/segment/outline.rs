@@ -108,6 +108,10 @@ impl Default for OutlineParams {
 /// walls next to nothing is seen (a lower share let thin slivers of noise in on 30 s walks).
 const KEEP_SHARE: f64 = 0.5;
 
+/// A line with at least this share of the densest line's points per length is a wall whatever
+/// its thickness, and its direction may carry an inferred wall.
+const STRONG_DENSITY: f64 = 0.3;
+
 /// How far from a wall line its points are sought when the line is refined (m).
 const WIDE_M: f64 = 0.3;
 
@@ -385,7 +389,8 @@ pub fn wall_lines(
     let densest = lines.iter().map(|l| l.density).fold(0.0, f64::max);
     lines.retain(|l| {
         l.points.len() * 20 >= strongest
-            && (l.density >= 0.3 * densest || (l.density >= 0.1 * densest && l.thickness <= 0.1))
+            && (l.density >= STRONG_DENSITY * densest
+                || (l.density >= 0.1 * densest && l.thickness <= 0.1))
     });
     merge_lines(lines, pts, p)
 }
@@ -619,9 +624,14 @@ pub fn outline(
     // Inferred lines: along each line's normal (and its opposite), the extreme of the evidence in
     // well-filled raster cells (the depth noise of a far wall scatters a few floor points beyond
     // it; the floor seen ends densely at the wall).
+    // Only the directions of well-seen walls (a weak line's direction would cut a corner off).
     let dense = seen.dense(evidence);
     let found = lines.len();
+    let densest = lines.iter().map(|l| l.density).fold(0.0, f64::max);
     for k in 0..found {
+        if lines[k].density < STRONG_DENSITY * densest {
+            continue;
+        }
         for sgn in [1.0, -1.0] {
             let n = lines[k].n * sgn;
             let mut proj: Vec<f64> = dense.iter().map(|q| n.dot(&q.coords)).collect();
