@@ -25,7 +25,11 @@ fn surface_rows(s: &SegmentReport) -> Vec<[String; 6]> {
         .iter()
         .map(|x| {
             [
-                x.id.clone(),
+                if s.inferred_walls.contains(&x.id) {
+                    format!("{} (inferred: not seen, placed at the floor's edge)", x.id)
+                } else {
+                    x.id.clone()
+                },
                 x.kind.as_str().to_string(),
                 x.temperature_c
                     .map_or("not observed".into(), |t| format!("{t:.2}")),
