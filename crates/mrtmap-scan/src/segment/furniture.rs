@@ -8,7 +8,8 @@
 //! horizontal axes becomes a box in the
 //! room's axes (along the longest wall, across it, up), spanning the 1st–99th percentiles of its
 //! points, extended to the floor when it ends within 15 cm of it (furniture stands on the floor),
-//! at the radiant average of its points. Groups reaching within 15 cm of the ceiling are wall
+//! at the radiant average of its points, grown over floor never seen on sides where a few of its
+//! points continue (a sofa seen from its end). Groups reaching within 15 cm of the ceiling are wall
 //! remainders too, and so are groups most of whose points were seen in one frame only (depth
 //! noise off a wall; real furniture is seen frame after frame).
 
@@ -53,7 +54,12 @@ pub struct Room<'a> {
     pub floor_2d: &'a [Point2<f64>],
     /// The walls' planes with the clearance furniture keeps from each.
     pub wall_planes: &'a [(mrtmap_geometry::Plane, f64)],
+    /// The 5 cm cells (along, across) where the floor was seen.
+    pub floor_seen: &'a std::collections::HashSet<(i32, i32)>,
 }
+
+/// Side of a floor cell (m).
+pub const FLOOR_CELL_M: f64 = 0.05;
 
 /// The room's horizontal axes (along, across).
 fn axes(room: &Room<'_>) -> (Vector3<f64>, Vector3<f64>) {
@@ -139,6 +145,62 @@ fn cell_components(grid: &HashMap<Cell, Vec<usize>>) -> Vec<Vec<usize>> {
     out
 }
 
+/// A box standing on the floor (`h0` = 0) grown, on the sides where a few of its points lie more
+/// than 10 cm beyond it (`beyond`: the part of a sofa the walk saw only from its end), 5 cm at a
+/// time and by at most 1 m, over floor that was never seen and lies inside the room (that part hides
+/// the floor under it); growth stops at floor seen (a fifth of a strip) or at the outline.
+fn grow_over_hidden_floor(
+    room: &Room<'_>,
+    [mut a0, mut a1, mut b0, mut b1]: [f64; 4],
+    beyond: [f64; 4],
+    h0: f64,
+) -> (f64, f64, f64, f64) {
+    if h0 > 0.0 || room.floor_seen.is_empty() {
+        return (a0, a1, b0, b1);
+    }
+    let c = FLOOR_CELL_M;
+    // Whether the strip of floor cells from `s0` to `s1` at `t` (across the strip) is hidden
+    // floor inside the room; `along_b` when the strip runs along b.
+    let hidden = |along_b: bool, s0: f64, s1: f64, t: f64| {
+        let kt = (t / c).floor() as i32;
+        let (mut seen, mut total) = (0usize, 0usize);
+        for k in (s0 / c).floor() as i32..=(s1 / c).floor() as i32 {
+            let cell = if along_b { (kt, k) } else { (k, kt) };
+            let centre = Point2::new((cell.0 as f64 + 0.5) * c, (cell.1 as f64 + 0.5) * c);
+            if point_in_polygon(&centre, room.floor_2d, 0.0) != Containment::Inside {
+                return false;
+            }
+            total += 1;
+            seen += usize::from(room.floor_seen.contains(&cell));
+        }
+        total > 0 && seen * 5 < total
+    };
+    let grow = beyond.map(|d| d > 0.1);
+    for _ in 0..20 {
+        let mut grew = false;
+        if grow[0] && hidden(true, b0, b1, a0 - c / 2.0) {
+            a0 -= c;
+            grew = true;
+        }
+        if grow[1] && hidden(true, b0, b1, a1 + c / 2.0) {
+            a1 += c;
+            grew = true;
+        }
+        if grow[2] && hidden(false, a0, a1, b0 - c / 2.0) {
+            b0 -= c;
+            grew = true;
+        }
+        if grow[3] && hidden(false, a0, a1, b1 + c / 2.0) {
+            b1 += c;
+            grew = true;
+        }
+        if !grew {
+            break;
+        }
+    }
+    (a0, a1, b0, b1)
+}
+
 /// A group's box in the room's axes (1–99 % of its points; standing on the floor when within
 /// 15 cm of it), unless it is the remainder of a wall, the floor or a picture.
 fn furniture_box(
@@ -168,6 +230,13 @@ fn furniture_box(
         .collect();
     let (a0, a1) = (percentile(&mut a, 0.01), percentile(&mut a, 0.99));
     let (b0, b1) = (percentile(&mut b, 0.01), percentile(&mut b, 0.99));
+    // The extreme points beyond the trimmed box, per side (a, b; low, high).
+    let beyond = [
+        a0 - a[0],
+        a[a.len() - 1] - a1,
+        b0 - b[0],
+        b[b.len() - 1] - b1,
+    ];
     let (mut h0, h1) = (percentile(&mut h, 0.01), percentile(&mut h, 0.99));
     if h0 < 0.15 {
         h0 = 0.0;
@@ -177,6 +246,7 @@ fn furniture_box(
     if h1 > room.room_height - 0.15 || h1 < 0.2 {
         return None;
     }
+    let (a0, a1, b0, b1) = grow_over_hidden_floor(room, [a0, a1, b0, b1], beyond, h0);
     let size = [a1 - a0, b1 - b0, h1 - h0];
     // Thinner than 15 cm across, it is the noisy remainder of a wall or a picture, not furniture.
     if size[0].min(size[1]) < 0.15 || size[2] < 0.05 || size[0] * size[1] * size[2] < 0.02 {

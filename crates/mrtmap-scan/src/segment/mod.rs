@@ -459,6 +459,20 @@ fn furniture_of(
         .enumerate()
         .map(|(w, &k)| (env.planes[k].plane, bands[w + 2] + 0.05))
         .collect();
+    // Where the floor (surface 0) was seen, in 5 cm cells of the room's axes.
+    let c = furniture::FLOOR_CELL_M;
+    let floor_seen: std::collections::HashSet<(i32, i32)> = pts
+        .pos
+        .iter()
+        .zip(surface_id)
+        .filter(|(_, s)| **s == 0)
+        .map(|(q, _)| {
+            (
+                (u.dot(&q.coords) / c).floor() as i32,
+                (v.dot(&q.coords) / c).floor() as i32,
+            )
+        })
+        .collect();
     let room = furniture::Room {
         up,
         along: *longest,
@@ -466,6 +480,7 @@ fn furniture_of(
         room_height: height_m,
         floor_2d: &floor_2d,
         wall_planes: &wall_planes,
+        floor_seen: &floor_seen,
     };
     furniture::find_furniture(&pts.pos, &pts.temp, &pts.obs, surface_id, &room, p)
 }
