@@ -593,4 +593,38 @@ mod tests {
         .expect("an envelope");
         corners_are_the_box(&env, 1e-3);
     }
+
+    /// A wall never seen (its points removed) is inferred at the edge of the floor and ceiling
+    /// seen, and said to be.
+    #[test]
+    fn a_wall_never_seen_is_inferred_and_flagged() {
+        let (pts, mut planes) = box_room(&[]);
+        // The wall at x = 4 (sheet 3) was never seen.
+        planes.remove(3);
+        let nrm = normals_of(&pts, &planes);
+        let env = envelope(
+            &pts,
+            &nrm,
+            planes,
+            Vector3::z_axis(),
+            &SegmentParams::default(),
+        )
+        .expect("an envelope");
+        assert_eq!(env.walls.len(), 4);
+        let inferred: Vec<&WallSeen> = env.seen.iter().filter(|s| s.inferred).collect();
+        assert_eq!(inferred.len(), 1, "{:?}", env.seen);
+        assert!(
+            (inferred[0].length_m - 3.0).abs() < 0.1,
+            "{:?}",
+            inferred[0]
+        );
+        for c in &env.floor_corners {
+            let near = [[0.0, 0.0], [4.0, 0.0], [4.0, 3.0], [0.0, 3.0]]
+                .iter()
+                .map(|q| (c.x - q[0]).hypot(c.y - q[1]))
+                .fold(f64::INFINITY, f64::min);
+            // The floor's points are 5 cm apart: the inferred wall lies within one spacing.
+            assert!(near < 0.06, "corner {c:?}");
+        }
+    }
 }
