@@ -837,18 +837,31 @@ pub fn segment(
     in_room.world_from_room = Some(FramePose::from_isometry(&world_from_room));
     let scene = RadiantScene::new(&in_room)?;
     let mut inferred_walls = Vec::new();
+    let n_walls = env.floor_corners.len();
+    // Where wall k runs, in the room's frame: from corner k to corner k + 1 (numbered as in the
+    // report's corner table).
+    let span = |k: usize| {
+        let at = |j: usize| {
+            let q = world_from_room.inverse() * env.floor_corners[j % n_walls];
+            let number = (j + n_walls - frame.first_index) % n_walls + 1;
+            format!("corner {number} ({:.2}, {:.2})", q.x, q.y)
+        };
+        format!("from {} to {}", at(k), at(k + 1))
+    };
     for (k, seen) in env.seen.iter().enumerate() {
         let id = &geoms[2 + k].id;
         if seen.inferred {
             inferred_walls.push(id.clone());
             warnings.push(format!(
-                "{id} ({:.2} m) was not seen as a wall: it is placed at the edge of the floor and ceiling seen; scan it up to the ceiling to place it from its own points",
-                seen.length_m
+                "{id} ({:.2} m, {}) was not seen as a wall: it is placed at the edge of the floor and ceiling seen; scan it up to the ceiling to place it from its own points",
+                seen.length_m,
+                span(k)
             ));
         } else if seen.observed < 0.3 && seen.length_m > 0.5 {
             warnings.push(format!(
-                "{id} ({:.2} m) was seen along only {:.0} % of its length",
+                "{id} ({:.2} m, {}) was seen along only {:.0} % of its length",
                 seen.length_m,
+                span(k),
                 seen.observed * 100.0
             ));
         }
