@@ -538,7 +538,21 @@ mod tests {
         n
     }
 
-    fn corners_are_the_box(env: &Envelope, tol: f64) {
+    /// The envelope of `pts` and `planes`, each point's normal its plane's.
+    fn envelope_of(pts: &[Point3<f64>], planes: Vec<FoundPlane>) -> Envelope {
+        let nrm = normals_of(pts, &planes);
+        envelope(
+            pts,
+            &nrm,
+            planes,
+            Vector3::z_axis(),
+            &SegmentParams::default(),
+        )
+        .expect("an envelope")
+    }
+
+    /// Four corners, each within `tol` of the box's, on the floor.
+    fn corners_near_the_box(env: &Envelope, tol: f64) {
         assert_eq!(env.walls.len(), 4);
         for c in &env.floor_corners {
             let near = [[0.0, 0.0], [4.0, 0.0], [4.0, 3.0], [0.0, 3.0]]
@@ -547,6 +561,10 @@ mod tests {
                 .fold(f64::INFINITY, f64::min);
             assert!(near < tol && c.z.abs() < 1e-6, "corner {c:?}");
         }
+    }
+
+    fn corners_are_the_box(env: &Envelope, tol: f64) {
+        corners_near_the_box(env, tol);
         assert_eq!(
             env.planes
                 .iter()
@@ -566,32 +584,14 @@ mod tests {
     #[test]
     fn a_box_room_closes_with_four_walls() {
         let (pts, planes) = box_room(&[]);
-        let nrm = normals_of(&pts, &planes);
-        let env = envelope(
-            &pts,
-            &nrm,
-            planes,
-            Vector3::z_axis(),
-            &SegmentParams::default(),
-        )
-        .expect("an envelope");
-        corners_are_the_box(&env, 1e-3);
+        corners_are_the_box(&envelope_of(&pts, planes), 1e-3);
     }
 
     /// A wall's shadow plane does not break the loop of walls or become one.
     #[test]
     fn a_shadow_of_a_wall_is_not_a_wall() {
         let (pts, planes) = box_room(&[shadow_of_front_wall()]);
-        let nrm = normals_of(&pts, &planes);
-        let env = envelope(
-            &pts,
-            &nrm,
-            planes,
-            Vector3::z_axis(),
-            &SegmentParams::default(),
-        )
-        .expect("an envelope");
-        corners_are_the_box(&env, 1e-3);
+        corners_are_the_box(&envelope_of(&pts, planes), 1e-3);
     }
 
     /// A wall never seen (its points removed) is inferred at the edge of the floor and ceiling
@@ -601,15 +601,7 @@ mod tests {
         let (pts, mut planes) = box_room(&[]);
         // The wall at x = 4 (sheet 3) was never seen.
         planes.remove(3);
-        let nrm = normals_of(&pts, &planes);
-        let env = envelope(
-            &pts,
-            &nrm,
-            planes,
-            Vector3::z_axis(),
-            &SegmentParams::default(),
-        )
-        .expect("an envelope");
+        let env = envelope_of(&pts, planes);
         assert_eq!(env.walls.len(), 4);
         let inferred: Vec<&WallSeen> = env.seen.iter().filter(|s| s.inferred).collect();
         assert_eq!(inferred.len(), 1, "{:?}", env.seen);
@@ -618,13 +610,7 @@ mod tests {
             "{:?}",
             inferred[0]
         );
-        for c in &env.floor_corners {
-            let near = [[0.0, 0.0], [4.0, 0.0], [4.0, 3.0], [0.0, 3.0]]
-                .iter()
-                .map(|q| (c.x - q[0]).hypot(c.y - q[1]))
-                .fold(f64::INFINITY, f64::min);
-            // The floor's points are 5 cm apart: the inferred wall lies within one spacing.
-            assert!(near < 0.06, "corner {c:?}");
-        }
+        // The floor's points are 5 cm apart: the inferred wall lies within one spacing.
+        corners_near_the_box(&env, 0.06);
     }
 }

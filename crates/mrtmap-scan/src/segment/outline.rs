@@ -128,17 +128,33 @@ fn angle_diff_deg(a: f64, b: f64) -> f64 {
 /// within 2.5 robust standard deviations of the first fit (at least 1 cm).
 fn fit_line(pts: &[Point2<f64>], n0: &Vector2<f64>) -> Option<(Vector2<f64>, f64)> {
     let (n, rho) = fit_line_tls(pts, n0)?;
-    let mut r: Vec<f64> = pts.iter().map(|q| (n.dot(&q.coords) - rho).abs()).collect();
-    let mut sorted = r.clone();
-    sorted.sort_by(f64::total_cmp);
-    let cut = (2.5 * 1.4826 * sorted[sorted.len() / 2]).max(0.01);
+    Some(trimmed_fit(pts, (n, rho), (0.01, f64::INFINITY)).map_or((n, rho), |(n, rho, _)| (n, rho)))
+}
+
+/// The line `(n, rho)` refitted to the points of `pts` within 2.5 robust standard deviations of
+/// their median distance from it (the cut clamped to `clamp`), and the cut.
+fn trimmed_fit(
+    pts: &[Point2<f64>],
+    (n, rho): (Vector2<f64>, f64),
+    clamp: (f64, f64),
+) -> Option<(Vector2<f64>, f64, f64)> {
+    if pts.is_empty() {
+        return None;
+    }
+    let dist = |q: &Point2<f64>| n.dot(&q.coords) - rho;
+    let mut r: Vec<f64> = pts.iter().map(dist).collect();
+    r.sort_by(f64::total_cmp);
+    let med = r[r.len() / 2];
+    let mut dev: Vec<f64> = r.iter().map(|x| (x - med).abs()).collect();
+    dev.sort_by(f64::total_cmp);
+    let cut = (2.5 * 1.4826 * dev[dev.len() / 2]).clamp(clamp.0, clamp.1);
     let near: Vec<Point2<f64>> = pts
         .iter()
-        .zip(r.iter_mut())
-        .filter(|(_, r)| **r <= cut)
-        .map(|(q, _)| *q)
+        .filter(|q| (dist(q) - med).abs() <= cut)
+        .copied()
         .collect();
-    fit_line_tls(&near, &n).or(Some((n, rho)))
+    let (n, rho) = fit_line_tls(&near, &n)?;
+    Some((n, rho, cut))
 }
 
 /// Total least squares line through `pts`, its normal oriented like `n0`.
@@ -326,21 +342,12 @@ pub fn wall_lines(
                 if near.len() < p.min_points {
                     break;
                 }
-                let mut r: Vec<f64> = near.iter().map(|&i| line.distance(&pts[i])).collect();
-                r.sort_by(f64::total_cmp);
-                let med = r[r.len() / 2];
-                let mut dev: Vec<f64> = r.iter().map(|x| (x - med).abs()).collect();
-                dev.sort_by(f64::total_cmp);
-                let cut = (2.5 * 1.4826 * dev[dev.len() / 2]).clamp(0.02, WIDE_M);
-                band = cut.max(p.band_m);
-                let q: Vec<Point2<f64>> = near
-                    .iter()
-                    .map(|&i| pts[i])
-                    .filter(|q| (line.distance(q) - med).abs() <= cut)
-                    .collect();
-                let Some((n, rho)) = fit_line_tls(&q, &line.n) else {
+                let q: Vec<Point2<f64>> = near.iter().map(|&i| pts[i]).collect();
+                let Some((n, rho, cut)) = trimmed_fit(&q, (line.n, line.rho), (0.02, WIDE_M))
+                else {
                     break;
                 };
+                band = cut.max(p.band_m);
                 line.n = n;
                 line.rho = rho;
             }
@@ -435,16 +442,32 @@ struct Seen {
     seen: Vec<bool>,
 }
 
+/// The index of the cell holding `q` on a raster of `w` × `h` cells of side `cell` from `origin`.
+fn cell_index(
+    q: &Point2<f64>,
+    origin: &Point2<f64>,
+    cell: f64,
+    w: usize,
+    h: usize,
+) -> Option<usize> {
+    let (x, y) = (
+        ((q.x - origin.x) / cell).floor(),
+        ((q.y - origin.y) / cell).floor(),
+    );
+    (x >= 0.0 && y >= 0.0 && (x as usize) < w && (y as usize) < h)
+        .then(|| y as usize * w + x as usize)
+}
+
 impl Seen {
     fn new(evidence: &[Point2<f64>], lo: Point2<f64>, hi: Point2<f64>, cell: f64) -> Self {
         let w = (((hi.x - lo.x) / cell).ceil() as usize).clamp(1, 4000);
         let h = (((hi.y - lo.y) / cell).ceil() as usize).clamp(1, 4000);
         let mut seen = vec![false; w * h];
-        for q in evidence {
-            let (x, y) = ((q.x - lo.x) / cell, (q.y - lo.y) / cell);
-            if x >= 0.0 && y >= 0.0 && (x as usize) < w && (y as usize) < h {
-                seen[y as usize * w + x as usize] = true;
-            }
+        for c in evidence
+            .iter()
+            .filter_map(|q| cell_index(q, &lo, cell, w, h))
+        {
+            seen[c] = true;
         }
         let grow = |s: &[bool], value: bool| {
             let mut out = s.to_vec();
@@ -476,14 +499,7 @@ impl Seen {
     /// The points of `evidence` in cells holding at least a quarter of the median non-empty cell's
     /// count.
     fn dense(&self, evidence: &[Point2<f64>]) -> Vec<Point2<f64>> {
-        let cell = |q: &Point2<f64>| {
-            let (x, y) = (
-                ((q.x - self.origin.x) / self.cell).floor(),
-                ((q.y - self.origin.y) / self.cell).floor(),
-            );
-            (x >= 0.0 && y >= 0.0 && (x as usize) < self.w && (y as usize) < self.h)
-                .then(|| y as usize * self.w + x as usize)
-        };
+        let cell = |q: &Point2<f64>| cell_index(q, &self.origin, self.cell, self.w, self.h);
         let mut count = vec![0usize; self.w * self.h];
         for q in evidence {
             if let Some(c) = cell(q) {
