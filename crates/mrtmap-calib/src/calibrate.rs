@@ -5,12 +5,19 @@
 //! first without distortion, then with it; views whose RMS error is far above the others' are
 //! rejected and the fit repeated.
 //!
-//! Two cameras: each is first calibrated alone. The thermal corners' numbering is then tied to the
-//! colour image's (a plain checkerboard is numbered from what each camera sees: a quarter turn
-//! apart, or shifted on a partly visible board): the quarter turn that makes the two cameras look
-//! the same way, the shift that puts the thermal camera where the pairs showing the whole board
-//! in both images put it. Last, the intrinsics of both cameras, the extrinsic and every board pose
-//! are refined together, and pairs whose error stands out are rejected and reported.
+//! Two cameras: each is first calibrated alone, from all of its own images. The thermal corners'
+//! numbering is then tied to the colour image's (a plain checkerboard is numbered from what each
+//! camera sees: a quarter turn apart, or shifted on a partly visible board): the quarter turn that
+//! makes the two cameras look the same way, then the shift whose corners lie nearest where the
+//! colour view of the board, carried through the extrinsic of the pairs that show the whole board
+//! in both images, puts them. Last, the extrinsic and every board pose are fitted with the
+//! intrinsics fixed (as OpenCV's `stereoCalibrate` with `CALIB_FIX_INTRINSIC`), pairs whose error
+//! stands out are rejected and reported, and the extrinsic's spread is bootstrapped over the pairs.
+//!
+//! Why not refine the intrinsics jointly: on a hand-made board, whose squares are irregular by a
+//! millimetre, both cameras' residuals are the board's, not pixel noise; a joint fit then lets
+//! the camera with more pixels drag the other's focal length (on the real foil-board pairs the
+//! thermal f went from 152 px alone to 163 px jointly, while OpenCV's is 152 px).
 
 use mrtmap_geometry::camera::{BrownConrady, PinholeCamera};
 use mrtmap_geometry::nalgebra::{
@@ -23,6 +30,7 @@ use crate::board::Board;
 use crate::detect::{Corner, Detection};
 use crate::lm::{Problem, solve};
 use crate::zhang::{fit_homography, init_focal, pose_from_homography};
+use rayon::prelude::*;
 
 /// Which distortion coefficients are estimated (the others stay zero).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -616,46 +624,71 @@ fn median_offset(
 /// The pairs tied: index, colour camera_from_board, thermal_from_colour.
 type Tied = Vec<(usize, Isometry3<f64>, Isometry3<f64>)>;
 
-/// Ties each candidate's thermal numbering by the board shift that puts the thermal camera
-/// nearest `t0` across the view (x, y); a pair for which no shift comes within 0.4 squares is
-/// rejected. A pair whose both images show the whole board needs no shift (its numbering is
-/// fixed once turned): it is kept unless it lies more than two squares away.
+/// The thermal camera's rotation relative to the colour camera: the mean over the pairs that show
+/// the whole board in both images.
+fn mean_whole_rotation(cands: &[Cand], whole: &dyn Fn(usize) -> bool) -> UnitQuaternion<f64> {
+    let q: Vec<UnitQuaternion<f64>> = cands
+        .iter()
+        .filter(|c| whole(c.k))
+        .map(|c| (c.tt * c.tc.inverse()).rotation)
+        .collect();
+    mean_rotation(&q)
+}
+
+/// RMS distance (px) between thermal corners and where the board seen by the colour camera
+/// (`tc`) lands in the thermal image through the extrinsic `e0`.
+fn predicted_rms(
+    cam: &PinholeCamera,
+    board: &Board,
+    pose: &Isometry3<f64>,
+    corners: &[Corner],
+) -> f64 {
+    view_error(cam, pose, board, corners).rms_px
+}
+
+/// The largest error (in squares of the board as the thermal camera sees it) at which a thermal
+/// numbering predicted from the colour view and the other pairs' extrinsic is accepted: a
+/// neighbouring numbering lies one square away.
+const TIE_SQUARES: f64 = 0.35;
+
+/// Ties each candidate's thermal numbering to the colour one: of every shift of the board's
+/// numbering, the one whose corners lie nearest where the colour camera's view of the board puts
+/// them in the thermal image (through `e0`, the extrinsic of the pairs showing the whole board).
+/// A pair whose best numbering is more than `TIE_SQUARES` of a square off, or not clearly better
+/// than the next, is rejected with both distances.
 fn tie_shifts(
     board: &Board,
     cands: &[Cand],
-    t0: &Vector3<f64>,
-    whole: &dyn Fn(usize) -> bool,
+    e0: &Isometry3<f64>,
+    thermal: &PinholeCamera,
     status: &mut [PairStatus],
 ) -> (Tied, Vec<Option<Vec<Corner>>>) {
     let mut used = Vec::new();
     let mut th_labels: Vec<Option<Vec<Corner>>> = vec![None; status.len()];
     let reach = (board.cols as i32).max(board.rows as i32);
     for cand in cands {
-        let mut best: Option<(f64, i32, i32)> = None;
+        let predicted = e0 * cand.tc;
+        let mut tries: Vec<(f64, i32, i32)> = Vec::new();
         for di in -reach..=reach {
             for dj in -reach..=reach {
-                let tt = cand.tt * board_shift(board, di, dj).inverse();
-                // Across the view only: a single small camera's board distance is its noisiest
-                // coordinate, while a board shift moves the thermal camera sideways.
-                let e = (tt * cand.tc.inverse()).translation.vector - t0;
-                let d = e.x.hypot(e.y);
-                if best.is_none_or(|b| d < b.0) {
-                    best = Some((d, di, dj));
-                }
+                // The colour numbering of a partly seen board starts where its view does, so
+                // the thermal labels may run beyond it either way.
+                let c = shift(&cand.th, di, dj);
+                tries.push((predicted_rms(thermal, board, &predicted, &c), di, dj));
             }
         }
-        let Some((mut d, mut di, mut dj)) = best else {
+        tries.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let Some(&(d, di, dj)) = tries.first() else {
             continue;
         };
-        if whole(cand.k) {
-            let e = (cand.tt * cand.tc.inverse()).translation.vector - t0;
-            (d, di, dj) = (e.x.hypot(e.y), 0, 0);
-        }
-        let limit = if whole(cand.k) { 2.0 } else { 0.4 };
-        if d > limit * board.square_m {
+        let next = tries.get(1).map_or(f64::INFINITY, |t| t.0);
+        // The board's square as the thermal camera sees it at this pair's distance.
+        let z = predicted.translation.vector.z.max(1e-3);
+        let square_px = thermal.fx * board.square_m / z;
+        if d > TIE_SQUARES * square_px || next < 2.0 * d {
             status[cand.k] = PairStatus::Rejected(format!(
-                "the thermal corners cannot be matched to the colour corners (the best numbering puts the thermal camera {:.0} mm from where the other pairs do)",
-                d * 1e3
+                "the thermal corners cannot be matched to the colour corners: the best numbering lies {d:.1} px from where the colour view and the other pairs put the board (the next {next:.1} px; accepted: under {:.1} px and half the next)",
+                TIE_SQUARES * square_px
             ));
             continue;
         }
@@ -666,7 +699,7 @@ fn tie_shifts(
     (used, th_labels)
 }
 
-/// The joint problem's global parameters, which are free, and each pair's errors.
+/// The extrinsic problem's global parameters and each pair's errors.
 struct Joint<'a> {
     prob: Stereo<'a>,
     free: Vec<bool>,
@@ -684,41 +717,6 @@ impl Joint<'_> {
             view_error(&cr, &pose, self.prob.board, self.prob.rgb[v]),
             view_error(&ct, &(e * pose), self.prob.board, &self.prob.th[v]),
         )
-    }
-
-    /// Two-fold held-out error: fitted on every other active pair, the other pairs' reprojection
-    /// error (their poses refitted with the intrinsics and extrinsic fixed), summed over both folds;
-    /// `None` with fewer than six active pairs.
-    fn held_out_error(&self, s: &crate::lm::Solved, free: &[bool], active: &[bool]) -> Option<f64> {
-        let act: Vec<usize> = (0..active.len()).filter(|v| active[*v]).collect();
-        if act.len() < 6 {
-            return None;
-        }
-        let none = vec![false; free.len()];
-        let mut total = 0.0;
-        for fold in 0..2 {
-            let train: Vec<bool> = (0..active.len())
-                .map(|v| {
-                    active[v]
-                        && act
-                            .iter()
-                            .position(|a| *a == v)
-                            .is_some_and(|i| i % 2 != fold)
-                })
-                .collect();
-            let test: Vec<bool> = (0..active.len()).map(|v| active[v] && !train[v]).collect();
-            let fit = solve(
-                &self.prob,
-                s.global.clone(),
-                s.views.clone(),
-                free,
-                &train,
-                100,
-            );
-            let posed = solve(&self.prob, fit.global.clone(), fit.views, &none, &test, 50);
-            total += posed.sum_sq;
-        }
-        Some(total)
     }
 
     /// Refits without the pairs whose error is far above the others', twice at most and keeping
@@ -751,7 +749,7 @@ impl Joint<'_> {
                 active[v] = false;
                 let (er, et) = errs[v].unwrap_or_default();
                 status[idx[v]] = PairStatus::Rejected(format!(
-                    "outlier: RMS error {:.2} px colour, {:.2} px thermal, far above the other pairs'",
+                    "outlier: RMS error {:.2} px colour, {:.2} px thermal, more than three times the pairs' median",
                     er.rms_px, et.rms_px
                 ));
             }
@@ -759,9 +757,74 @@ impl Joint<'_> {
         }
         s
     }
+
+    /// Standard deviations of the extrinsic (axis-angle, translation) from a bootstrap over the
+    /// used pairs: the spread of refits on pairs drawn with replacement, which carries what the
+    /// fit's own covariance does not (a hand-made board's irregular squares, detection bias).
+    fn bootstrap_std(&self, s: &crate::lm::Solved, active: &[bool]) -> Option<[f64; 6]> {
+        let act: Vec<usize> = (0..active.len()).filter(|v| active[*v]).collect();
+        if act.len() < 4 {
+            return None;
+        }
+        // A fixed seed: the same input gives the same report.
+        let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let base = s.global[18..24].to_vec();
+        let draws: Vec<Vec<usize>> = (0..BOOTSTRAP_DRAWS)
+            .map(|_| {
+                (0..act.len())
+                    .map(|_| act[(next() % act.len() as u64) as usize])
+                    .collect()
+            })
+            .collect();
+        let samples: Vec<[f64; 6]> = draws
+            .par_iter()
+            .filter_map(|draw| {
+                // Repeated pairs enter as copies of their view.
+                let prob = Stereo {
+                    board: self.prob.board,
+                    rgb_size: self.prob.rgb_size,
+                    th_size: self.prob.th_size,
+                    rgb: draw.iter().map(|&v| self.prob.rgb[v]).collect(),
+                    th: draw.iter().map(|&v| self.prob.th[v].clone()).collect(),
+                };
+                let views: Vec<[f64; 6]> = draw.iter().map(|&v| s.views[v]).collect();
+                let all = vec![true; draw.len()];
+                let fit = solve(&prob, s.global.clone(), views, &self.free, &all, 50);
+                let mut d = [0.0; 6];
+                for (k, x) in d.iter_mut().enumerate() {
+                    *x = fit.global[18 + k] - base[k];
+                }
+                d.iter().all(|x| x.is_finite()).then_some(d)
+            })
+            .collect();
+        if samples.len() < BOOTSTRAP_DRAWS / 2 {
+            return None;
+        }
+        let n = samples.len() as f64;
+        let mut std = [0.0; 6];
+        for (k, x) in std.iter_mut().enumerate() {
+            let m = samples.iter().map(|d| d[k]).sum::<f64>() / n;
+            *x = (samples.iter().map(|d| (d[k] - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+        }
+        Some(std)
+    }
 }
 
+/// Refits of the bootstrap over pairs.
+const BOOTSTRAP_DRAWS: usize = 64;
+
 /// Calibrates both cameras and the extrinsic between them.
+///
+/// Each camera's intrinsics come from all of its own images (many more views than complete
+/// pairs, and a small camera's focal length is not dragged by the other's), then the extrinsic
+/// and the board poses are fitted with the intrinsics fixed, as OpenCV's `stereoCalibrate` does
+/// with `CALIB_FIX_INTRINSIC`.
 pub fn calibrate_stereo(
     board: &Board,
     rgb_size: (u32, u32),
@@ -776,78 +839,48 @@ pub fn calibrate_stereo(
     let n = pairs.len();
     let mut status = initial_status(&rgb_dets, &th_dets);
     let cands = quarter_turns(board, &th_dets, &rgb_alone, &thermal_alone);
-    let t0 = median_offset(board, &cands, &rgb_dets, &th_dets)?;
     let whole = |k: usize| full(board, &rgb_dets[k]) && full(board, &th_dets[k]);
-    let (used, th_labels) = tie_shifts(board, &cands, &t0, &whole, &mut status);
-    let e0 = Isometry3::from_parts(
-        Translation3::from(t0),
-        mean_rotation(&used.iter().map(|u| u.2.rotation).collect::<Vec<_>>()),
-    );
+    let t0 = median_offset(board, &cands, &rgb_dets, &th_dets)?;
+    let e0 = Isometry3::from_parts(Translation3::from(t0), mean_whole_rotation(&cands, &whole));
+    let (used, th_labels) = tie_shifts(board, &cands, &e0, &thermal_alone.camera, &mut status);
     let idx: Vec<usize> = used.iter().map(|u| u.0).collect();
+    let common = |rgb: &[Corner], th: &[Corner]| -> (Vec<Corner>, Vec<Corner>) {
+        let has = |cs: &[Corner], c: &Corner| cs.iter().any(|d| d.i == c.i && d.j == c.j);
+        (
+            rgb.iter().filter(|c| has(th, c)).copied().collect(),
+            th.iter().filter(|c| has(rgb, c)).copied().collect(),
+        )
+    };
+    let (rgb_views, th_views): (Vec<Vec<Corner>>, Vec<Vec<Corner>>) = idx
+        .iter()
+        .map(|&k| {
+            let rgb = corners_of(&rgb_dets[k]).to_vec();
+            let th = th_labels[k].clone().unwrap_or_default();
+            if opts.common_corners {
+                common(&rgb, &th)
+            } else {
+                (rgb, th)
+            }
+        })
+        .unzip();
     let prob = Stereo {
         board,
         rgb_size,
         th_size: thermal_size,
-        rgb: idx.iter().map(|&k| corners_of(&rgb_dets[k])).collect(),
-        th: idx
-            .iter()
-            .map(|&k| th_labels[k].clone().unwrap_or_default())
-            .collect(),
+        rgb: rgb_views.iter().map(Vec::as_slice).collect(),
+        th: th_views,
     };
     let mut g: Vec<f64> = intrinsics(&rgb_alone.camera).to_vec();
     g.extend(intrinsics(&thermal_alone.camera));
     g.extend(vec6(&e0));
-    let mut free: Vec<bool> = opts.model_rgb.free().to_vec();
-    free.extend(opts.model_thermal.free());
+    let mut free = vec![false; 18];
     free.extend([true; 6]);
-    let mut joint = Joint { prob, free };
+    let joint = Joint { prob, free };
     let views: Vec<[f64; 6]> = used.iter().map(|u| vec6(&u.1)).collect();
     let mut active = vec![true; idx.len()];
     let first = solve(&joint.prob, g, views, &joint.free, &active, 100);
-    let mut s = joint.reject_outliers(first, &mut active, &idx, &mut status);
-    // The thermal principal point: free, or at the image centre, whichever predicts held-out pairs
-    // better (a small sensor's views may not constrain it, and a wrong one tilts the pose).
-    let centred = |g: &[f64]| {
-        let mut g = g.to_vec();
-        g[11] = (thermal_size.0 as f64 - 1.0) / 2.0;
-        g[12] = (thermal_size.1 as f64 - 1.0) / 2.0;
-        g
-    };
-    let mut fixed_free = joint.free.clone();
-    fixed_free[11] = false;
-    fixed_free[12] = false;
-    let free_err = joint.held_out_error(&s, &joint.free, &active);
-    let centre_err = joint.held_out_error(
-        &crate::lm::Solved {
-            global: centred(&s.global),
-            ..s.clone()
-        },
-        &fixed_free,
-        &active,
-    );
-    let principal_point_centred = matches!((free_err, centre_err), (Some(f), Some(c)) if c <= f);
-    let model_choice = match (free_err, centre_err) {
-        (Some(f), Some(c)) => format!(
-            "thermal principal point {} (held-out squared error {c:.1} px² at the centre, {f:.1} px² free)",
-            if principal_point_centred {
-                "at the image centre"
-            } else {
-                "fitted"
-            }
-        ),
-        _ => "thermal principal point fitted (too few pairs to compare on held-out ones)".into(),
-    };
-    if principal_point_centred {
-        joint.free = fixed_free;
-        s = solve(
-            &joint.prob,
-            centred(&s.global),
-            s.views,
-            &joint.free,
-            &active,
-            100,
-        );
-    }
+    let s = joint.reject_outliers(first, &mut active, &idx, &mut status);
+    let boot = joint.bootstrap_std(&s, &active);
     let mut results: Vec<PairResult> = (0..n)
         .map(|k| PairResult {
             status: status[k].clone(),
@@ -869,12 +902,33 @@ pub fn calibrate_stereo(
             et_all.push(et);
         }
     }
+    // The intrinsics' deviations are each camera's own; the extrinsic's the larger of the fit's
+    // and the bootstrap's.
+    let std = s.global_std.map(|fit| {
+        let mut v = rgb_alone.std.map_or(vec![0.0; 9], |a| a.to_vec());
+        v.extend(thermal_alone.std.map_or([0.0; 9], |a| a));
+        for k in 0..6 {
+            let b = boot.map_or(0.0, |b| b[k]);
+            v.push(fit[18 + k].max(b));
+        }
+        v
+    });
     let e = iso(&s.global[18..24]);
+    let model_choice = format!(
+        "intrinsics from each camera's own images ({} colour, {} thermal views), fixed in the extrinsic fit; extrinsic ± from {}",
+        rgb_alone.view_errors.iter().flatten().count(),
+        thermal_alone.view_errors.iter().flatten().count(),
+        if boot.is_some() {
+            "the fit and a bootstrap over pairs, whichever is larger"
+        } else {
+            "the fit (too few pairs for a bootstrap)"
+        }
+    );
     Ok(StereoResult {
         rgb: camera_from(rgb_size.0, rgb_size.1, &s.global[0..9]),
         thermal: camera_from(thermal_size.0, thermal_size.1, &s.global[9..18]),
         rgb_from_thermal: e.inverse(),
-        std: s.global_std,
+        std,
         pairs: results,
         rgb_error: pooled(&er_all),
         thermal_error: pooled(&et_all),

@@ -8,7 +8,7 @@
 //!  pairs/ (rgb + thermal images)  --pairs-->  Pair list (matched by name or timestamp)
 //!    each image   --detect-->  Detection (labelled inner corners, sub-pixel)
 //!    detections   --calibrate_mono-->  MonoResult per camera (Zhang + Brown–Conrady, LM)
-//!    both         --calibrate_stereo-->  StereoResult (joint LM, outlier pairs rejected)
+//!    both         --calibrate_stereo-->  StereoResult (extrinsic by LM, intrinsics fixed, outlier pairs rejected, bootstrap ±)
 //!    result       --rig / report-->  rig.toml [thermal] [rgb], report images, calibration.json
 //! ```
 
