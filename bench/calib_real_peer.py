@@ -6,8 +6,11 @@
 OpenCV's classic detector (findChessboardCorners with adaptive threshold and normalisation,
 cornerSubPix; the small thermal images upscaled ×4 first, grey from the false colours), then
 calibrateCamera for each camera and stereoCalibrate (intrinsics fixed) on the pairs found in
-both, k3 fixed as mrtmap. Prints one JSON line: detections, focal lengths, RMS, the thermal
-camera's position and rotation in the colour frame, and mrtmap's for the same images.
+both, k3 fixed as mrtmap; once as is, and once dropping views whose own error is more than twice
+the median (as OpenCV's tutorials advise: cornerSubPix can slide several pixels along foil
+glare). Prints one JSON line: detections, focal lengths, principal points, RMS, the thermal
+camera's position and rotation in the colour frame, mrtmap's for the same images, and the
+differences.
 """
 import glob
 import json
@@ -32,7 +35,60 @@ def detect(path, size, thermal):
         return None, grey.shape[::-1]
     c = cv2.cornerSubPix(grey, c, (5, 5), (-1, -1),
                          (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_MAX_ITER, 50, 1e-4))
-    return c / scale, (grey.shape[1] // scale, grey.shape[0] // scale)
+    # Pixel centres: x in the upscaled image is (x + 0.5) / scale - 0.5 in the original.
+    return (c + 0.5) / scale - 0.5, (grey.shape[1] // scale, grey.shape[0] // scale)
+
+
+def rotation_angle(R):
+    return float(np.degrees(np.arccos(np.clip((np.trace(R) - 1) / 2, -1, 1))))
+
+
+def opencv_rig(names, found, dims, obj, reject):
+    """calibrateCamera per camera, then stereoCalibrate with the intrinsics fixed, k3 fixed.
+    With `reject` (a factor), views whose own RMS error exceeds reject × the median are dropped
+    and the camera refitted until none is (as OpenCV's tutorials advise for bad detections)."""
+    flags = cv2.CALIB_FIX_K3
+    mono = {}
+    kept = {}
+    for cam in ("rgb", "thermal"):
+        keys = list(found[cam])
+        while True:
+            pts = [found[cam][n] for n in keys]
+            r = cv2.calibrateCameraExtended([obj] * len(pts), pts, dims[cam], None, None, flags=flags)
+            rms, K, D, per_view = r[0], r[1], r[2], r[7].ravel()
+            if reject is None:
+                break
+            limit = reject * float(np.median(per_view))
+            keep = [n for n, e in zip(keys, per_view) if e <= limit]
+            if len(keep) == len(keys):
+                break
+            keys = keep
+        mono[cam] = (rms, K, D)
+        kept[cam] = set(keys)
+    both = [n for n in names if n in kept["rgb"] and n in kept["thermal"]]
+    rms, _, _, _, _, R, T, _, _ = cv2.stereoCalibrate(
+        [obj] * len(both), [found["rgb"][n] for n in both], [found["thermal"][n] for n in both],
+        mono["rgb"][1], mono["rgb"][2], mono["thermal"][1], mono["thermal"][2], dims["rgb"],
+        flags=cv2.CALIB_FIX_INTRINSIC)
+    # R, T: p_thermal = R p_rgb + T; the thermal camera's centre in the colour frame is −Rᵀ T.
+    return {"mono": mono, "views": {c: len(kept[c]) for c in kept}, "pairs": len(both),
+            "rms": rms, "R": R, "centre": (-R.T @ T).ravel()}
+
+
+def summary(rig):
+    return {
+        "views": rig["views"],
+        "pairs": rig["pairs"],
+        "rgb_f": [round(rig["mono"]["rgb"][1][0, 0], 1), round(rig["mono"]["rgb"][1][1, 1], 1)],
+        "rgb_c": [round(rig["mono"]["rgb"][1][0, 2], 1), round(rig["mono"]["rgb"][1][1, 2], 1)],
+        "thermal_f": [round(rig["mono"]["thermal"][1][0, 0], 1), round(rig["mono"]["thermal"][1][1, 1], 1)],
+        "thermal_c": [round(rig["mono"]["thermal"][1][0, 2], 1), round(rig["mono"]["thermal"][1][1, 2], 1)],
+        "thermal_k1": round(float(rig["mono"]["thermal"][2].ravel()[0]), 3),
+        "rms_px": {"rgb": round(rig["mono"]["rgb"][0], 3), "thermal": round(rig["mono"]["thermal"][0], 3),
+                   "stereo": round(rig["rms"], 3)},
+        "thermal_centre_mm": [round(1000 * x, 1) for x in rig["centre"]],
+        "rotation_deg": round(rotation_angle(rig["R"]), 2),
+    }
 
 
 def main(pairs, calib_json, grid, square):
@@ -49,53 +105,56 @@ def main(pairs, calib_json, grid, square):
             dims[cam] = d
             if c is not None:
                 found[cam][n] = c
-    flags = cv2.CALIB_FIX_K3
-    mono = {}
-    for cam in ("rgb", "thermal"):
-        pts = list(found[cam].values())
-        rms, K, D, _, _ = cv2.calibrateCamera([obj] * len(pts), pts, dims[cam], None, None, flags=flags)
-        mono[cam] = (rms, K, D)
-    both = [n for n in names if n in found["rgb"] and n in found["thermal"]]
-    # Orientation: the classic detector may number a symmetric board either way; keep the
-    # thermal numbering whose per-pair relative rotation agrees with the majority.
-    rms, _, _, _, _, R, T, _, _ = cv2.stereoCalibrate(
-        [obj] * len(both), [found["rgb"][n] for n in both], [found["thermal"][n] for n in both],
-        mono["rgb"][1], mono["rgb"][2], mono["thermal"][1], mono["thermal"][2], dims["rgb"],
-        flags=cv2.CALIB_FIX_INTRINSIC)
-    # R, T: p_thermal = R p_rgb + T; the thermal camera's centre in the colour frame is −Rᵀ T.
-    centre = (-R.T @ T).ravel()
-    angle = float(np.degrees(np.arccos(np.clip((np.trace(R) - 1) / 2, -1, 1))))
+    plain = opencv_rig(names, found, dims, obj, None)
+    careful = opencv_rig(names, found, dims, obj, 2.0)
     ours = json.load(open(calib_json))
-    t = ours["rgb_from_thermal"]["translation"]
-    q = ours["rgb_from_thermal"]["rotation_xyzw"]
-    our_angle = float(np.degrees(2 * np.arccos(min(1.0, abs(q[3])))))
-    used = sum(1 for p in ours["pairs"] if p.get("result", {}).get("status") == "used")
-    x, y, z, w = q
+    t = np.array(ours["rgb_from_thermal"]["translation"])
+    x, y, z, w = ours["rgb_from_thermal"]["rotation_xyzw"]
+    used = [p for p in ours["pairs"] if p.get("result", {}).get("status") == "used"]
     R_ours = np.array([
         [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
         [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
         [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
     ])
-    # rgb_from_thermal (ours) · thermal_from_rgb (OpenCV's R) is the identity when they agree.
-    d = R_ours @ R
-    rotation_difference = float(np.degrees(np.arccos(np.clip((np.trace(d) - 1) / 2, -1, 1))))
-    print(json.dumps({
+    # The stereo RMS as OpenCV's: over every corner distance of both cameras in the used pairs.
+    sq, n = 0.0, 0
+    for p in used:
+        for cam in ("rgb_error", "thermal_error"):
+            e = p["result"][cam]
+            sq += e["rms_px"] ** 2 * e["corners"]
+            n += e["corners"]
+    ours_found = {
+        "rgb": sum(1 for p in ours["pairs"] if p.get("rgb_corners")),
+        "thermal": sum(1 for p in ours["pairs"] if p.get("thermal_corners")),
+    }
+    out = {
         "images": len(names),
-        "opencv_found": {"rgb": len(found["rgb"]), "thermal": len(found["thermal"]), "both": len(both)},
-        "opencv_rgb_f": [round(mono["rgb"][1][0, 0], 1), round(mono["rgb"][1][1, 1], 1)],
-        "opencv_thermal_f": [round(mono["thermal"][1][0, 0], 1), round(mono["thermal"][1][1, 1], 1)],
-        "opencv_thermal_k1": round(float(mono["thermal"][2].ravel()[0]), 3),
-        "opencv_rms_px": {"rgb": round(mono["rgb"][0], 3), "thermal": round(mono["thermal"][0], 3), "stereo": round(rms, 3)},
-        "opencv_thermal_centre_mm": [round(1000 * x, 1) for x in centre],
-        "opencv_rotation_deg": round(angle, 2),
-        "mrtmap_pairs_used": used,
-        "mrtmap_rgb_f": [round(ours["rgb"]["fx"], 1), round(ours["rgb"]["fy"], 1)],
-        "mrtmap_thermal_f": [round(ours["thermal"]["fx"], 1), round(ours["thermal"]["fy"], 1)],
-        "mrtmap_thermal_centre_mm": [round(1000 * x, 1) for x in t],
-        "mrtmap_rotation_deg": round(our_angle, 2),
-        "centre_difference_mm": round(float(np.linalg.norm(np.array(t) * 1000 - centre * 1000)), 1),
-        "rotation_difference_deg": round(rotation_difference, 2),
-    }))
+        "opencv_found": {"rgb": len(found["rgb"]), "thermal": len(found["thermal"]),
+                         "both": sum(1 for n in names if n in found["rgb"] and n in found["thermal"])},
+        "mrtmap_found": ours_found,
+        "mrtmap": {
+            "pairs": len(used),
+            "rgb_f": [round(ours["rgb"]["fx"], 1), round(ours["rgb"]["fy"], 1)],
+            "rgb_c": [round(ours["rgb"]["cx"], 1), round(ours["rgb"]["cy"], 1)],
+            "thermal_f": [round(ours["thermal"]["fx"], 1), round(ours["thermal"]["fy"], 1)],
+            "thermal_c": [round(ours["thermal"]["cx"], 1), round(ours["thermal"]["cy"], 1)],
+            "thermal_k1": round(ours["thermal"]["distortion"]["k1"], 3),
+            "stereo_rms_px": round((sq / max(n, 1)) ** 0.5, 3),
+            "thermal_centre_mm": [round(1000 * v, 1) for v in t],
+            "rotation_deg": round(rotation_angle(R_ours), 2),
+        },
+    }
+    for name, rig in (("opencv", plain), ("opencv_view_rejection", careful)):
+        s = summary(rig)
+        # rgb_from_thermal (ours) · thermal_from_rgb (OpenCV's R) is the identity when they agree.
+        s["vs_mrtmap"] = {
+            "thermal_f_pct": [round(100 * (a / b - 1), 1) for a, b in zip(out["mrtmap"]["thermal_f"], s["thermal_f"])],
+            "centre_difference_mm": round(float(np.linalg.norm(t * 1000 - rig["centre"] * 1000)), 1),
+            "rotation_difference_deg": round(rotation_angle(R_ours @ rig["R"]), 2),
+            "stereo_rms_ratio": round(out["mrtmap"]["stereo_rms_px"] / rig["rms"], 3),
+        }
+        out[name] = s
+    print(json.dumps(out))
 
 
 if __name__ == "__main__":

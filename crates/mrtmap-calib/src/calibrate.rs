@@ -757,12 +757,28 @@ impl Joint<'_> {
         }
         s
     }
+}
 
+/// What a bootstrap over the image pairs refits from.
+struct Resample<'a> {
+    board: &'a Board,
+    sizes: ((u32, u32), (u32, u32)),
+    dets: (&'a [Option<Detection>], &'a [Option<Detection>]),
+    opts: &'a StereoOptions,
+    /// Per pair of the extrinsic fit: its input index, whether it is used.
+    idx: &'a [usize],
+    active: &'a [bool],
+}
+
+impl Resample<'_> {
     /// Standard deviations of the extrinsic (axis-angle, translation) from a bootstrap over the
-    /// used pairs: the spread of refits on pairs drawn with replacement, which carries what the
-    /// fit's own covariance does not (a hand-made board's irregular squares, detection bias).
-    fn bootstrap_std(&self, s: &crate::lm::Solved, active: &[bool]) -> Option<[f64; 6]> {
-        let act: Vec<usize> = (0..active.len()).filter(|v| active[*v]).collect();
+    /// image pairs: each draw recalibrates both cameras from the drawn images and refits the
+    /// extrinsic from the drawn used pairs. The spread carries what the fit's covariance with
+    /// fixed intrinsics does not: the intrinsics' own uncertainty (a small camera's principal
+    /// point trades with the rotation) and a hand-made board's irregular squares.
+    fn std(&self, joint: &Joint<'_>, s: &crate::lm::Solved) -> Option<[f64; 6]> {
+        let n = self.dets.0.len();
+        let act: Vec<usize> = (0..self.active.len()).filter(|v| self.active[*v]).collect();
         if act.len() < 4 {
             return None;
         }
@@ -774,45 +790,62 @@ impl Joint<'_> {
             state ^= state << 17;
             state
         };
-        let base = s.global[18..24].to_vec();
         let draws: Vec<Vec<usize>> = (0..BOOTSTRAP_DRAWS)
-            .map(|_| {
-                (0..act.len())
-                    .map(|_| act[(next() % act.len() as u64) as usize])
-                    .collect()
-            })
+            .map(|_| (0..n).map(|_| (next() % n as u64) as usize).collect())
             .collect();
+        let base = &s.global[18..24];
         let samples: Vec<[f64; 6]> = draws
             .par_iter()
-            .filter_map(|draw| {
-                // Repeated pairs enter as copies of their view.
-                let prob = Stereo {
-                    board: self.prob.board,
-                    rgb_size: self.prob.rgb_size,
-                    th_size: self.prob.th_size,
-                    rgb: draw.iter().map(|&v| self.prob.rgb[v]).collect(),
-                    th: draw.iter().map(|&v| self.prob.th[v].clone()).collect(),
-                };
-                let views: Vec<[f64; 6]> = draw.iter().map(|&v| s.views[v]).collect();
-                let all = vec![true; draw.len()];
-                let fit = solve(&prob, s.global.clone(), views, &self.free, &all, 50);
-                let mut d = [0.0; 6];
-                for (k, x) in d.iter_mut().enumerate() {
-                    *x = fit.global[18 + k] - base[k];
-                }
-                d.iter().all(|x| x.is_finite()).then_some(d)
-            })
+            .filter_map(|draw| self.one(joint, s, draw))
+            .map(|g| std::array::from_fn(|k| g[k] - base[k]))
             .collect();
         if samples.len() < BOOTSTRAP_DRAWS / 2 {
             return None;
         }
-        let n = samples.len() as f64;
-        let mut std = [0.0; 6];
-        for (k, x) in std.iter_mut().enumerate() {
-            let m = samples.iter().map(|d| d[k]).sum::<f64>() / n;
-            *x = (samples.iter().map(|d| (d[k] - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+        let m = samples.len() as f64;
+        Some(std::array::from_fn(|k| {
+            let mean = samples.iter().map(|d| d[k]).sum::<f64>() / m;
+            (samples.iter().map(|d| (d[k] - mean).powi(2)).sum::<f64>() / (m - 1.0)).sqrt()
+        }))
+    }
+
+    /// One draw: the extrinsic refitted with both cameras recalibrated from the drawn images.
+    fn one(&self, joint: &Joint<'_>, s: &crate::lm::Solved, draw: &[usize]) -> Option<Vec<f64>> {
+        let pick = |d: &[Option<Detection>]| -> Vec<Option<Detection>> {
+            draw.iter().map(|&k| d[k].clone()).collect()
+        };
+        let (rgb, th) = both_alone(
+            self.board,
+            self.sizes.0,
+            self.sizes.1,
+            (&pick(self.dets.0), &pick(self.dets.1)),
+            self.opts,
+        )
+        .ok()?;
+        // The drawn pairs that the extrinsic fit used, each as often as drawn.
+        let views: Vec<usize> = draw
+            .iter()
+            .filter_map(|k| self.idx.iter().position(|i| i == k))
+            .filter(|&v| self.active[v])
+            .collect();
+        if views.len() < 3 {
+            return None;
         }
-        Some(std)
+        let prob = Stereo {
+            board: joint.prob.board,
+            rgb_size: joint.prob.rgb_size,
+            th_size: joint.prob.th_size,
+            rgb: views.iter().map(|&v| joint.prob.rgb[v]).collect(),
+            th: views.iter().map(|&v| joint.prob.th[v].clone()).collect(),
+        };
+        let mut g: Vec<f64> = intrinsics(&rgb.camera).to_vec();
+        g.extend(intrinsics(&th.camera));
+        g.extend(&s.global[18..24]);
+        let poses: Vec<[f64; 6]> = views.iter().map(|&v| s.views[v]).collect();
+        let all = vec![true; views.len()];
+        let fit = solve(&prob, g, poses, &joint.free, &all, 50);
+        let e = fit.global[18..24].to_vec();
+        e.iter().all(|x| x.is_finite()).then_some(e)
     }
 }
 
@@ -880,7 +913,15 @@ pub fn calibrate_stereo(
     let mut active = vec![true; idx.len()];
     let first = solve(&joint.prob, g, views, &joint.free, &active, 100);
     let s = joint.reject_outliers(first, &mut active, &idx, &mut status);
-    let boot = joint.bootstrap_std(&s, &active);
+    let boot = Resample {
+        board,
+        sizes: (rgb_size, thermal_size),
+        dets: (&rgb_dets, &th_dets),
+        opts,
+        idx: &idx,
+        active: &active,
+    }
+    .std(&joint, &s);
     let mut results: Vec<PairResult> = (0..n)
         .map(|k| PairResult {
             status: status[k].clone(),
@@ -919,7 +960,7 @@ pub fn calibrate_stereo(
         rgb_alone.view_errors.iter().flatten().count(),
         thermal_alone.view_errors.iter().flatten().count(),
         if boot.is_some() {
-            "the fit and a bootstrap over pairs, whichever is larger"
+            "the fit and a bootstrap over the image pairs (both cameras recalibrated in each draw), whichever is larger"
         } else {
             "the fit (too few pairs for a bootstrap)"
         }

@@ -2,8 +2,9 @@
 //!
 //! The ChESS corner detector and grid labelling of `calib-targets` find the corners; small images
 //! (a 160×120 thermal camera) are first upsampled so that a square spans enough pixels for the
-//! detector's ring; large ones are also tried at half and a third of their size, and the scale
-//! with the most corners wins. Saddle points do not care which squares are bright, so thermal images with
+//! detector's ring, then tried at smaller factors; large ones are also tried at a half … a fifth
+//! of their size; a histogram-equalised copy when no scale finds the whole board; the try with
+//! the most corners wins. Saddle points do not care which squares are bright, so thermal images with
 //! inverted contrast need no special case. On images that were not upsampled each corner is
 //! refined by the gradient-orthogonality method (as OpenCV's `cornerSubPix`); corners that
 //! disagree with a homography fitted to the rest are dropped.
@@ -86,39 +87,106 @@ fn scale_for(img: &Gray) -> u32 {
     480u32.div_ceil(short).clamp(1, 4)
 }
 
+/// The image scales the detector tries: the preferred ones, and those tried when the preferred
+/// do not find the whole board. A small image is upsampled to about 480 pixels, then by every
+/// smaller whole factor down to its own size; an image of 480 pixels or more is tried at its
+/// size, a half and a third, then a quarter and a fifth.
+fn search_factors(img: &Gray) -> (Vec<f64>, Vec<f64>) {
+    let up = scale_for(img);
+    if up > 1 {
+        (vec![f64::from(up)], (1..up).rev().map(f64::from).collect())
+    } else if img.width.min(img.height) >= 480 {
+        (vec![1.0, 0.5, 1.0 / 3.0], vec![0.25, 0.2])
+    } else {
+        (vec![1.0], Vec::new())
+    }
+}
+
+/// `base` (the image at its own size) resized by `f`: bicubic up, triangle-filtered down.
+fn resized(base: &image::GrayImage, img: &Gray, f: f64) -> image::GrayImage {
+    if f == 1.0 {
+        return base.clone();
+    }
+    let (w, h) = (
+        ((img.width as f64 * f).round() as u32).max(1),
+        ((img.height as f64 * f).round() as u32).max(1),
+    );
+    let filter = if f > 1.0 {
+        image::imageops::FilterType::CatmullRom
+    } else {
+        image::imageops::FilterType::Triangle
+    };
+    image::imageops::resize(base, w, h, filter)
+}
+
+/// Histogram equalisation of an 8-bit image.
+fn equalise(img: &image::GrayImage) -> image::GrayImage {
+    let mut hist = [0u64; 256];
+    for p in img.pixels() {
+        hist[p.0[0] as usize] += 1;
+    }
+    let n = (img.width() as u64 * img.height() as u64).max(1) as f64;
+    let mut map = [0u8; 256];
+    let mut acc = 0u64;
+    for (k, m) in map.iter_mut().enumerate() {
+        acc += hist[k];
+        *m = (255.0 * acc as f64 / n).round().clamp(0.0, 255.0) as u8;
+    }
+    let mut out = img.clone();
+    for p in out.pixels_mut() {
+        p.0[0] = map[p.0[0] as usize];
+    }
+    out
+}
+
 /// Finds the board's inner corners, or `None` when fewer than `opts.min_corners` are found.
 /// `max_grid` (cols, rows) bounds the labels: a detection spanning more columns or rows than the
 /// board has (in either orientation) keeps the window of the board's size holding most corners.
 pub fn detect(img: &Gray, max_grid: (u32, u32), opts: &DetectOptions) -> Option<Detection> {
-    let scale = scale_for(img);
-    let up = img.to_luma8_scaled(scale);
+    let full = (max_grid.0 * max_grid.1) as usize;
+    let base = img.to_luma8_scaled(1);
     let mut params = ChessboardParams::default();
     params.min_corner_strength = 0.0;
-    // Large images are also tried at half and a third of their size: the detector's ring is a few
-    // pixels wide, and on large squares of crumpled foil it meets the foil's own texture first.
-    let mut tries: Vec<(image::GrayImage, f64)> = vec![(up, scale as f64)];
-    if scale == 1 && img.width.min(img.height) >= 480 {
-        for k in [2u32, 3] {
-            let small = image::imageops::resize(
-                &tries[0].0,
-                img.width / k,
-                img.height / k,
-                image::imageops::FilterType::Triangle,
-            );
-            tries.push((small, 1.0 / k as f64));
+    // The detector's ring is a few pixels wide: a small image is upsampled so that a square spans
+    // enough pixels for it; a large image is tried at its size, a half and a third (on large
+    // squares of crumpled foil the ring meets the foil's own texture first). When none of these
+    // finds the whole board, the search goes on: a small image at smaller factors (on a blurred
+    // or noisy one a coarser factor can see the board where the finest does not), a large one at
+    // a quarter and a fifth, then all of them on a histogram-equalised copy (OpenCV's
+    // `CALIB_CB_NORMALIZE_IMAGE`: a board in a dim corner of a glaring scene). A later try is
+    // taken only when it finds clearly more corners; a whole board ends the search.
+    let (preferred, more) = search_factors(img);
+    let mut found: Vec<(calib_targets::chessboard::ChessboardDetection, f64)> = Vec::new();
+    let mut found_at: Vec<usize> = Vec::new();
+    let equalised = equalise(&base);
+    let tries = preferred
+        .iter()
+        .map(|f| (&base, *f))
+        .chain(more.iter().map(|f| (&base, *f)))
+        .chain(preferred.iter().chain(&more).map(|f| (&equalised, *f)));
+    for (k, (source, f)) in tries.enumerate() {
+        if k >= preferred.len() && found.iter().any(|d| d.0.corners.len() >= full) {
+            break;
         }
-    }
-    let mut found = Vec::new();
-    for (im, f) in &tries {
-        let all = detect_chessboard_all(im, &default_chess_config(), &params);
+        let im = resized(source, img, f);
+        let all = detect_chessboard_all(&im, &default_chess_config(), &params);
         if let Some(d) = all.into_iter().max_by_key(|d| d.corners.len()) {
-            found.push((d, *f));
+            found.push((d, f));
+            found_at.push(k);
         }
     }
-    // Most corners; on a tie the finest scale (it comes first).
+    // Of the preferred tries, the most corners (on a tie the one tried first); a later try only
+    // when it finds a quarter of the board more (its coarser or equalised corners are less
+    // precise: one more corner at a coarser factor cost a simulated rig 3 mm).
     let mut pick = 0;
     for k in 1..found.len() {
-        if found[k].0.corners.len() > found[pick].0.corners.len() {
+        let (n, best) = (found[k].0.corners.len(), found[pick].0.corners.len());
+        let margin = if found_at[k] < preferred.len() {
+            0
+        } else {
+            full.div_ceil(4)
+        };
+        if n > best + margin {
             pick = k;
         }
     }
