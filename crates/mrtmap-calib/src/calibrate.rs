@@ -171,6 +171,56 @@ pub struct MonoResult {
     pub rejected: Vec<usize>,
     /// Pooled error over the used views.
     pub error: ViewError,
+    /// Whether the principal point was fixed at the image centre (the views did not predict
+    /// held-out views better with it free).
+    #[serde(default)]
+    pub principal_point_centred: bool,
+    /// Held-out RMS error (px) with the principal point free and at the centre, when compared.
+    #[serde(default)]
+    pub held_out_rms_px: Option<(f64, f64)>,
+}
+
+/// Where a camera's principal point comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PrincipalPoint {
+    /// Free or at the image centre, whichever predicts held-out views better (five folds).
+    Choose,
+    /// Fitted.
+    Free,
+    /// At the image centre.
+    Centre,
+}
+
+/// Held-out RMS error (px) of a model: fitted on four fifths of the active views, the others'
+/// poses fitted with the intrinsics fixed, over five folds; `None` with fewer than ten views.
+fn held_out_rms(
+    prob: &Mono<'_>,
+    s: &crate::lm::Solved,
+    free: &[bool],
+    active: &[bool],
+) -> Option<f64> {
+    let act: Vec<usize> = (0..active.len()).filter(|v| active[*v]).collect();
+    if act.len() < 10 {
+        return None;
+    }
+    let none = vec![false; free.len()];
+    let (mut sum, mut count) = (0.0, 0usize);
+    for fold in 0..5 {
+        let in_test = |v: usize| {
+            act.iter()
+                .position(|a| *a == v)
+                .is_some_and(|i| i % 5 == fold)
+        };
+        let train: Vec<bool> = (0..active.len())
+            .map(|v| active[v] && !in_test(v))
+            .collect();
+        let test: Vec<bool> = (0..active.len()).map(|v| active[v] && in_test(v)).collect();
+        let fit = solve(prob, s.global.clone(), s.views.clone(), free, &train, 100);
+        let posed = solve(prob, fit.global, fit.views, &none, &test, 50);
+        sum += posed.sum_sq;
+        count += posed.residuals / 2;
+    }
+    Some((sum / count.max(1) as f64).sqrt())
 }
 
 struct Mono<'a> {
@@ -282,13 +332,26 @@ fn drop_outlier_views(
     (s, rejected)
 }
 
-/// Calibrates one camera from its detections (`None` where the board was not found).
+/// Calibrates one camera from its detections (`None` where the board was not found); the
+/// principal point free or at the centre, whichever predicts held-out views better.
 pub fn calibrate_mono(
     board: &Board,
     width: u32,
     height: u32,
     dets: &[Option<Detection>],
     model: DistortionModel,
+) -> Result<MonoResult, CalibError> {
+    calibrate_mono_with(board, width, height, dets, model, PrincipalPoint::Choose)
+}
+
+/// `calibrate_mono` with the principal point's treatment given.
+pub fn calibrate_mono_with(
+    board: &Board,
+    width: u32,
+    height: u32,
+    dets: &[Option<Detection>],
+    model: DistortionModel,
+    principal: PrincipalPoint,
 ) -> Result<MonoResult, CalibError> {
     let usable: Vec<usize> = (0..dets.len())
         .filter(|&k| dets[k].as_ref().is_some_and(|d| d.corners.len() >= 6))
@@ -313,7 +376,33 @@ pub fn calibrate_mono(
     let poses = posed.iter().map(|p| p.1).collect();
     let s0 = solve(&prob, g0, poses, &DistortionModel::None.free(), &active, 50);
     let s1 = solve(&prob, s0.global, s0.views, &model.free(), &active, 100);
-    let (s, rejected) = drop_outlier_views(&prob, s1, model, &mut active, &index);
+    let (mut s, rejected) = drop_outlier_views(&prob, s1, model, &mut active, &index);
+    let mut centre_free = model.free();
+    centre_free[2] = false;
+    centre_free[3] = false;
+    let centred = |s: &crate::lm::Solved| crate::lm::Solved {
+        global: {
+            let mut g = s.global.clone();
+            g[2] = cx;
+            g[3] = cy;
+            g
+        },
+        ..s.clone()
+    };
+    let held_out_rms_px = match principal {
+        PrincipalPoint::Choose => held_out_rms(&prob, &s, &model.free(), &active)
+            .zip(held_out_rms(&prob, &centred(&s), &centre_free, &active)),
+        _ => None,
+    };
+    let principal_point_centred = match principal {
+        PrincipalPoint::Centre => true,
+        PrincipalPoint::Free => false,
+        PrincipalPoint::Choose => held_out_rms_px.is_some_and(|(free, centre)| centre <= free),
+    };
+    if principal_point_centred {
+        let c = centred(&s);
+        s = solve(&prob, c.global, c.views, &centre_free, &active, 100);
+    }
     let cam = camera_from(width, height, &s.global);
     let mut pose_out = vec![None; dets.len()];
     let mut errs = vec![None; dets.len()];
@@ -336,6 +425,8 @@ pub fn calibrate_mono(
         view_errors: errs,
         rejected,
         error,
+        principal_point_centred,
+        held_out_rms_px,
     })
 }
 
@@ -505,24 +596,41 @@ pub struct StereoOptions {
     pub common_corners: bool,
 }
 
-/// Each camera alone, from every image of it.
+/// Each camera alone, from every image of it; `principal` (colour, thermal) says how each
+/// principal point is found.
 fn both_alone(
     board: &Board,
     rgb_size: (u32, u32),
     thermal_size: (u32, u32),
     dets: (&[Option<Detection>], &[Option<Detection>]),
     opts: &StereoOptions,
+    principal: (PrincipalPoint, PrincipalPoint),
 ) -> Result<(MonoResult, MonoResult), CalibError> {
-    let alone = |camera: &'static str, (w, h): (u32, u32), d, model| {
-        calibrate_mono(board, w, h, d, model).map_err(|e| CalibError::Camera {
+    let alone = |camera: &'static str, (w, h): (u32, u32), d, model, pp| {
+        calibrate_mono_with(board, w, h, d, model, pp).map_err(|e| CalibError::Camera {
             camera,
             source: Box::new(e),
         })
     };
     Ok((
-        alone("colour", rgb_size, dets.0, opts.model_rgb)?,
-        alone("thermal", thermal_size, dets.1, opts.model_thermal)?,
+        alone("colour", rgb_size, dets.0, opts.model_rgb, principal.0)?,
+        alone(
+            "thermal",
+            thermal_size,
+            dets.1,
+            opts.model_thermal,
+            principal.1,
+        )?,
     ))
+}
+
+/// How a recalibration keeps a camera's principal point: as the full calibration chose it.
+fn as_chosen(m: &MonoResult) -> PrincipalPoint {
+    if m.principal_point_centred {
+        PrincipalPoint::Centre
+    } else {
+        PrincipalPoint::Free
+    }
 }
 
 /// Why each pair is not used, until the joint fit uses it.
@@ -765,6 +873,8 @@ struct Resample<'a> {
     sizes: ((u32, u32), (u32, u32)),
     dets: (&'a [Option<Detection>], &'a [Option<Detection>]),
     opts: &'a StereoOptions,
+    /// How each camera's principal point was found (kept in every draw).
+    principal: (PrincipalPoint, PrincipalPoint),
     /// Per pair of the extrinsic fit: its input index, whether it is used.
     idx: &'a [usize],
     active: &'a [bool],
@@ -820,6 +930,7 @@ impl Resample<'_> {
             self.sizes.1,
             (&pick(self.dets.0), &pick(self.dets.1)),
             self.opts,
+            self.principal,
         )
         .ok()?;
         // The drawn pairs that the extrinsic fit used, each as often as drawn.
@@ -867,8 +978,14 @@ pub fn calibrate_stereo(
 ) -> Result<StereoResult, CalibError> {
     let rgb_dets: Vec<Option<Detection>> = pairs.iter().map(|p| p.rgb.cloned()).collect();
     let th_dets: Vec<Option<Detection>> = pairs.iter().map(|p| p.thermal.cloned()).collect();
-    let (rgb_alone, thermal_alone) =
-        both_alone(board, rgb_size, thermal_size, (&rgb_dets, &th_dets), opts)?;
+    let (rgb_alone, thermal_alone) = both_alone(
+        board,
+        rgb_size,
+        thermal_size,
+        (&rgb_dets, &th_dets),
+        opts,
+        (PrincipalPoint::Choose, PrincipalPoint::Choose),
+    )?;
     let n = pairs.len();
     let mut status = initial_status(&rgb_dets, &th_dets);
     let cands = quarter_turns(board, &th_dets, &rgb_alone, &thermal_alone);
@@ -918,6 +1035,7 @@ pub fn calibrate_stereo(
         sizes: (rgb_size, thermal_size),
         dets: (&rgb_dets, &th_dets),
         opts,
+        principal: (as_chosen(&rgb_alone), as_chosen(&thermal_alone)),
         idx: &idx,
         active: &active,
     }
@@ -955,10 +1073,23 @@ pub fn calibrate_stereo(
         v
     });
     let e = iso(&s.global[18..24]);
+    let pp = |m: &MonoResult| match m.held_out_rms_px {
+        Some((free, centre)) => format!(
+            "principal point {} (held-out RMS {free:.3} px free, {centre:.3} px at the centre)",
+            if m.principal_point_centred {
+                "at the image centre"
+            } else {
+                "fitted"
+            }
+        ),
+        None => "principal point fitted (too few views to compare on held-out ones)".into(),
+    };
     let model_choice = format!(
-        "intrinsics from each camera's own images ({} colour, {} thermal views), fixed in the extrinsic fit; extrinsic ± from {}",
+        "intrinsics from each camera's own images ({} colour, {} thermal views), fixed in the extrinsic fit; colour {}; thermal {}; extrinsic ± from {}",
         rgb_alone.view_errors.iter().flatten().count(),
         thermal_alone.view_errors.iter().flatten().count(),
+        pp(&rgb_alone),
+        pp(&thermal_alone),
         if boot.is_some() {
             "the fit and a bootstrap over the image pairs (both cameras recalibrated in each draw), whichever is larger"
         } else {

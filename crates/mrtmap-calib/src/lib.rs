@@ -28,8 +28,8 @@ use std::path::{Path, PathBuf};
 
 pub use board::{Board, GridSize};
 pub use calibrate::{
-    DistortionModel, MonoResult, PairInput, PairResult, PairStatus, StereoOptions, StereoResult,
-    ViewError, calibrate_mono, calibrate_stereo,
+    DistortionModel, MonoResult, PairInput, PairResult, PairStatus, PrincipalPoint, StereoOptions,
+    StereoResult, ViewError, calibrate_mono, calibrate_mono_with, calibrate_stereo,
 };
 pub use detect::{Corner, DetectOptions, Detection, detect};
 pub use gray::Gray;
