@@ -732,15 +732,25 @@ fn median_offset(
 /// The pairs tied: index, colour camera_from_board, thermal_from_colour.
 type Tied = Vec<(usize, Isometry3<f64>, Isometry3<f64>)>;
 
-/// The thermal camera's rotation relative to the colour camera: the mean over the pairs that show
-/// the whole board in both images.
+/// The thermal camera's rotation relative to the colour camera from the pairs that show the whole
+/// board in both images: the mean of those within 3° of their medoid (the one nearest all
+/// others), so that a mismatched pair does not turn it.
 fn mean_whole_rotation(cands: &[Cand], whole: &dyn Fn(usize) -> bool) -> UnitQuaternion<f64> {
     let q: Vec<UnitQuaternion<f64>> = cands
         .iter()
         .filter(|c| whole(c.k))
         .map(|c| (c.tt * c.tc.inverse()).rotation)
         .collect();
-    mean_rotation(&q)
+    let spread = |a: &UnitQuaternion<f64>| q.iter().map(|b| a.angle_to(b)).sum::<f64>();
+    let Some(medoid) = q.iter().min_by(|a, b| spread(a).total_cmp(&spread(b))) else {
+        return UnitQuaternion::identity();
+    };
+    let near: Vec<UnitQuaternion<f64>> = q
+        .iter()
+        .filter(|r| r.angle_to(medoid) < 3f64.to_radians())
+        .copied()
+        .collect();
+    mean_rotation(&near)
 }
 
 /// RMS distance (px) between thermal corners and where the board seen by the colour camera
@@ -769,6 +779,7 @@ fn tie_shifts(
     cands: &[Cand],
     e0: &Isometry3<f64>,
     thermal: &PinholeCamera,
+    whole: &dyn Fn(usize) -> bool,
     status: &mut [PairStatus],
 ) -> (Tied, Vec<Option<Vec<Corner>>>) {
     let mut used = Vec::new();
@@ -786,17 +797,25 @@ fn tie_shifts(
             }
         }
         tries.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let Some(&(d, di, dj)) = tries.first() else {
+        let Some(&(mut d, mut di, mut dj)) = tries.first() else {
             continue;
         };
-        let next = tries.get(1).map_or(f64::INFINITY, |t| t.0);
+        let mut next = tries.get(1).map_or(f64::INFINITY, |t| t.0);
         // The board's square as the thermal camera sees it at this pair's distance.
         let z = predicted.translation.vector.z.max(1e-3);
         let square_px = thermal.fx * board.square_m / z;
-        if d > TIE_SQUARES * square_px || next < 2.0 * d {
+        // A pair whose both images show the whole board needs no shift (its numbering is fixed
+        // once turned): kept unless it lies two squares off, for the fit's outlier test to judge.
+        let (limit, ratio) = if whole(cand.k) {
+            d = predicted_rms(thermal, board, &predicted, &cand.th);
+            (di, dj, next) = (0, 0, f64::INFINITY);
+            (2.0 * square_px, 0.0)
+        } else {
+            (TIE_SQUARES * square_px, 2.0)
+        };
+        if d > limit || next < ratio * d {
             status[cand.k] = PairStatus::Rejected(format!(
-                "the thermal corners cannot be matched to the colour corners: the best numbering lies {d:.1} px from where the colour view and the other pairs put the board (the next {next:.1} px; accepted: under {:.1} px and half the next)",
-                TIE_SQUARES * square_px
+                "the thermal corners cannot be matched to the colour corners: the best numbering lies {d:.1} px from where the colour view and the other pairs put the board (the next {next:.1} px; accepted: under {limit:.1} px and half the next)"
             ));
             continue;
         }
@@ -919,6 +938,87 @@ impl Resample<'_> {
         }))
     }
 
+    /// Two-fold held-out error over the used pairs of predicting the thermal corners from the
+    /// colour view: both cameras calibrated from the images of every other used pair (and the
+    /// images in no used pair), the extrinsic fitted on those pairs (with `free`: the intrinsics
+    /// fixed, or refined jointly), then for each held-out pair the board posed from its colour
+    /// corners alone and carried into the thermal image. RMS (px) over the held-out thermal
+    /// corners; `None` with fewer than six used pairs.
+    fn held_out(&self, joint: &Joint<'_>, s: &crate::lm::Solved, free: &[bool]) -> Option<f64> {
+        let act: Vec<usize> = (0..self.active.len()).filter(|v| self.active[*v]).collect();
+        if act.len() < 6 {
+            return None;
+        }
+        let (mut sum, mut count) = (0.0, 0usize);
+        for fold in 0..2 {
+            let test: Vec<usize> = act.iter().copied().skip(fold).step_by(2).collect();
+            let train: Vec<usize> = act.iter().copied().filter(|v| !test.contains(v)).collect();
+            // Both cameras without the held-out pairs' images.
+            let held: Vec<usize> = test.iter().map(|&v| self.idx[v]).collect();
+            let without = |d: &[Option<Detection>]| -> Vec<Option<Detection>> {
+                (0..d.len())
+                    .map(|k| {
+                        if held.contains(&k) {
+                            None
+                        } else {
+                            d[k].clone()
+                        }
+                    })
+                    .collect()
+            };
+            let (rgb, th) = both_alone(
+                self.board,
+                self.sizes.0,
+                self.sizes.1,
+                (&without(self.dets.0), &without(self.dets.1)),
+                self.opts,
+                self.principal,
+            )
+            .ok()?;
+            let prob = Stereo {
+                board: joint.prob.board,
+                rgb_size: joint.prob.rgb_size,
+                th_size: joint.prob.th_size,
+                rgb: train.iter().map(|&v| joint.prob.rgb[v]).collect(),
+                th: train.iter().map(|&v| joint.prob.th[v].clone()).collect(),
+            };
+            let mut g: Vec<f64> = intrinsics(&rgb.camera).to_vec();
+            g.extend(intrinsics(&th.camera));
+            g.extend(&s.global[18..24]);
+            let poses: Vec<[f64; 6]> = train.iter().map(|&v| s.views[v]).collect();
+            let fit = solve(&prob, g, poses, free, &vec![true; train.len()], 100);
+            let cr = camera_from(self.sizes.0.0, self.sizes.0.1, &fit.global[0..9]);
+            let ct = camera_from(self.sizes.1.0, self.sizes.1.1, &fit.global[9..18]);
+            let e = iso(&fit.global[18..24]);
+            for &v in &test {
+                let colour = Mono {
+                    board: self.board,
+                    size: self.sizes.0,
+                    views: vec![joint.prob.rgb[v]],
+                };
+                let posed = solve(
+                    &colour,
+                    intrinsics(&cr).to_vec(),
+                    vec![s.views[v]],
+                    &[false; 9],
+                    &[true],
+                    50,
+                );
+                let mut r = Vec::new();
+                push_residuals(
+                    &ct,
+                    &(e * iso(&posed.views[0])),
+                    self.board,
+                    &joint.prob.th[v],
+                    &mut r,
+                );
+                sum += r.iter().map(|x| x * x).sum::<f64>();
+                count += r.len() / 2;
+            }
+        }
+        Some((sum / count.max(1) as f64).sqrt())
+    }
+
     /// One draw: the extrinsic refitted with both cameras recalibrated from the drawn images.
     fn one(&self, joint: &Joint<'_>, s: &crate::lm::Solved, draw: &[usize]) -> Option<Vec<f64>> {
         let pick = |d: &[Option<Detection>]| -> Vec<Option<Detection>> {
@@ -992,7 +1092,14 @@ pub fn calibrate_stereo(
     let whole = |k: usize| full(board, &rgb_dets[k]) && full(board, &th_dets[k]);
     let t0 = median_offset(board, &cands, &rgb_dets, &th_dets)?;
     let e0 = Isometry3::from_parts(Translation3::from(t0), mean_whole_rotation(&cands, &whole));
-    let (used, th_labels) = tie_shifts(board, &cands, &e0, &thermal_alone.camera, &mut status);
+    let (used, th_labels) = tie_shifts(
+        board,
+        &cands,
+        &e0,
+        &thermal_alone.camera,
+        &whole,
+        &mut status,
+    );
     let idx: Vec<usize> = used.iter().map(|u| u.0).collect();
     let common = |rgb: &[Corner], th: &[Corner]| -> (Vec<Corner>, Vec<Corner>) {
         let has = |cs: &[Corner], c: &Corner| cs.iter().any(|d| d.i == c.i && d.j == c.j);
@@ -1025,12 +1132,25 @@ pub fn calibrate_stereo(
     g.extend(vec6(&e0));
     let mut free = vec![false; 18];
     free.extend([true; 6]);
-    let joint = Joint { prob, free };
+    let mut joint = Joint { prob, free };
     let views: Vec<[f64; 6]> = used.iter().map(|u| vec6(&u.1)).collect();
     let mut active = vec![true; idx.len()];
     let first = solve(&joint.prob, g, views, &joint.free, &active, 100);
-    let s = joint.reject_outliers(first, &mut active, &idx, &mut status);
-    let boot = Resample {
+    let mut s = joint.reject_outliers(first, &mut active, &idx, &mut status);
+    // Intrinsics fixed, or refined with the extrinsic in one fit: whichever predicts held-out
+    // pairs' thermal corners from their colour view better. A joint fit is the better estimator
+    // when the residuals are pixel noise; on a hand-made board they are the board's own
+    // irregularity, and a joint fit lets the camera with more pixels drag the other's focal
+    // length (the real foil-board pairs' thermal f: 152 px alone, 163 px jointly).
+    let mut refined = [opts.model_rgb.free(), opts.model_thermal.free()].concat();
+    for (k, m) in [(2, &rgb_alone), (11, &thermal_alone)] {
+        if m.principal_point_centred {
+            refined[k] = false;
+            refined[k + 1] = false;
+        }
+    }
+    refined.extend([true; 6]);
+    let resample = Resample {
         board,
         sizes: (rgb_size, thermal_size),
         dets: (&rgb_dets, &th_dets),
@@ -1038,8 +1158,15 @@ pub fn calibrate_stereo(
         principal: (as_chosen(&rgb_alone), as_chosen(&thermal_alone)),
         idx: &idx,
         active: &active,
+    };
+    let fixed_err = resample.held_out(&joint, &s, &joint.free);
+    let joint_err = resample.held_out(&joint, &s, &refined);
+    let jointly = matches!((fixed_err, joint_err), (Some(f), Some(j)) if j < f);
+    if jointly {
+        s = solve(&joint.prob, s.global, s.views, &refined, &active, 100);
+        joint.free = refined;
     }
-    .std(&joint, &s);
+    let boot = resample.std(&joint, &s);
     let mut results: Vec<PairResult> = (0..n)
         .map(|k| PairResult {
             status: status[k].clone(),
@@ -1061,11 +1188,16 @@ pub fn calibrate_stereo(
             et_all.push(et);
         }
     }
-    // The intrinsics' deviations are each camera's own; the extrinsic's the larger of the fit's
-    // and the bootstrap's.
+    // The intrinsics' deviations are each camera's own (or the joint fit's); the extrinsic's the
+    // larger of the fit's and the bootstrap's.
     let std = s.global_std.map(|fit| {
-        let mut v = rgb_alone.std.map_or(vec![0.0; 9], |a| a.to_vec());
-        v.extend(thermal_alone.std.map_or([0.0; 9], |a| a));
+        let mut v = if jointly {
+            fit[..18].to_vec()
+        } else {
+            let mut v = rgb_alone.std.map_or(vec![0.0; 9], |a| a.to_vec());
+            v.extend(thermal_alone.std.map_or([0.0; 9], |a| a));
+            v
+        };
         for k in 0..6 {
             let b = boot.map_or(0.0, |b| b[k]);
             v.push(fit[18 + k].max(b));
@@ -1084,8 +1216,19 @@ pub fn calibrate_stereo(
         ),
         None => "principal point fitted (too few views to compare on held-out ones)".into(),
     };
+    let how = match (fixed_err, joint_err) {
+        (Some(f), Some(j)) => format!(
+            "{} (held-out pairs' thermal corners predicted from their colour view: RMS {f:.3} px fixed, {j:.3} px refined)",
+            if jointly {
+                "refined with the extrinsic"
+            } else {
+                "fixed in the extrinsic fit"
+            }
+        ),
+        _ => "fixed in the extrinsic fit (too few pairs to compare on held-out ones)".into(),
+    };
     let model_choice = format!(
-        "intrinsics from each camera's own images ({} colour, {} thermal views), fixed in the extrinsic fit; colour {}; thermal {}; extrinsic ± from {}",
+        "intrinsics from each camera's own images ({} colour, {} thermal views), {how}; colour {}; thermal {}; extrinsic ± from {}",
         rgb_alone.view_errors.iter().flatten().count(),
         thermal_alone.view_errors.iter().flatten().count(),
         pp(&rgb_alone),
