@@ -482,7 +482,9 @@ fn furniture_of(
         wall_planes: &wall_planes,
         floor_seen: &floor_seen,
     };
-    furniture::find_furniture(&pts.pos, &pts.temp, &pts.obs, surface_id, &room, p)
+    furniture::find_furniture(
+        &pts.pos, &pts.nrm, &pts.temp, &pts.obs, surface_id, &room, p,
+    )
 }
 
 /// A label's vote, if masks gave one.
