@@ -204,6 +204,9 @@ fn grow_over_hidden_floor(
     (a0, a1, b0, b1)
 }
 
+/// The cloud's positions, normals, radiant temperatures (K) and observation counts.
+type CloudView<'a> = (&'a [Point3<f64>], &'a [Vector3<f64>], &'a [f64], &'a [u32]);
+
 /// A side of a box at the middle of its face: the median of the points whose normals point out
 /// of that side (within 37° of the axis) in the outer 30 cm, when there are enough of them. A
 /// face is fused as thick as the depth noise at the distance it was seen from (±12 cm on the
@@ -232,7 +235,7 @@ fn face_side(coord: &[f64], normal: &[f64], outward: f64, edge: f64) -> f64 {
 /// floor when within 15 cm of it), unless it is the remainder of a wall, the floor or a picture.
 fn furniture_box(
     comp: Vec<usize>,
-    cloud: (&[Point3<f64>], &[Vector3<f64>], &[f64], &[u32]),
+    cloud: CloudView<'_>,
     room: &Room<'_>,
     wall_reach_m: f64,
 ) -> Option<FoundFurniture> {
