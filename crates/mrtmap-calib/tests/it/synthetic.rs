@@ -109,6 +109,46 @@ fn stereo_calibration_recovers_the_synthetic_rig() {
     }
     assert!(mrtmap_calib::plausibility(&loose)[0].contains("poorly constrained"));
     assert!(used >= 15, "only {used} pairs used");
+    // The convention: rgb_from_thermal carries thermal-frame points into the colour frame, so its
+    // translation is the thermal camera's centre seen from the colour camera. The board seen by
+    // the colour camera, carried into the thermal frame by its inverse, lands on the thermal
+    // corners; the transform the other way round would miss them by the baseline (45 mm, about
+    // 8 px at these distances).
+    let thermal_from_rgb = r.rgb_from_thermal.inverse();
+    let centre = r.rgb_from_thermal * mrtmap_geometry::nalgebra::Point3::origin();
+    assert!(
+        (centre - rig.rgb_from_thermal * mrtmap_geometry::nalgebra::Point3::origin()).norm()
+            < 0.002
+    );
+    let (mut sum, mut wrong, mut n) = (0.0, 0.0, 0usize);
+    for (k, p) in r.pairs.iter().enumerate() {
+        let (Some(pose), Some(th)) = (r.rgb_alone.poses[k], r.thermal_labels[k].as_ref()) else {
+            continue;
+        };
+        if p.status != PairStatus::Used {
+            continue;
+        }
+        for c in th {
+            let q = pose * o.board.point(c.i, c.j);
+            if let (Some(a), Some(b)) = (
+                r.thermal.project(&(thermal_from_rgb * q)),
+                r.thermal.project(&(r.rgb_from_thermal * q)),
+            ) {
+                sum += (a.x - c.x).hypot(a.y - c.y);
+                wrong += (b.x - c.x).hypot(b.y - c.y);
+                n += 1;
+            }
+        }
+    }
+    let (mean, mean_wrong) = (sum / n as f64, wrong / n as f64);
+    println!(
+        "colour board into the thermal image: {mean:.3} px (the inverse convention: {mean_wrong:.1} px)"
+    );
+    assert!(n > 500 && mean < 0.5, "{n} corners, mean {mean:.3} px");
+    assert!(
+        mean_wrong > 3.0,
+        "the inverse convention fits too: {mean_wrong:.2} px"
+    );
     assert!(rel(r.rgb.fx, rig.rgb.fx) < 0.005);
     assert!(rel(r.rgb.fy, rig.rgb.fy) < 0.005);
     assert!(rel(r.thermal.fx, rig.thermal.fx) < 0.005);
