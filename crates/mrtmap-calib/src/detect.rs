@@ -139,6 +139,34 @@ fn equalise(img: &image::GrayImage) -> image::GrayImage {
     out
 }
 
+/// Finds the board in the first of an image's grey `variants` (see [`Gray::variants`]), or, when
+/// that misses the whole board, in a later one that finds a quarter of the board more corners;
+/// returns the variant's index too.
+pub fn detect_variants(
+    variants: &[Gray],
+    max_grid: (u32, u32),
+    opts: &DetectOptions,
+) -> Option<(usize, Detection)> {
+    let full = (max_grid.0 * max_grid.1) as usize;
+    let mut best: Option<(usize, Detection)> = None;
+    for (k, g) in variants.iter().enumerate() {
+        // A later reading only with a quarter of the board more (its corners are less precise
+        // where the first reading works at all: ironbow's hue is not monotonic).
+        if let Some(d) = detect(g, max_grid, opts)
+            && best
+                .as_ref()
+                .is_none_or(|b| d.corners.len() > b.1.corners.len() + full.div_ceil(4))
+        {
+            let whole = d.corners.len() >= full;
+            best = Some((k, d));
+            if whole {
+                break;
+            }
+        }
+    }
+    best
+}
+
 /// Finds the board's inner corners, or `None` when fewer than `opts.min_corners` are found.
 /// `max_grid` (cols, rows) bounds the labels: a detection spanning more columns or rows than the
 /// board has (in either orientation) keeps the window of the board's size holding most corners.

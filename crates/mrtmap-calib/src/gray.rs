@@ -88,8 +88,65 @@ impl Gray {
         }
     }
 
+    /// The grey readings of an image worth searching for a board: its luminance (or 16-bit
+    /// values), and for a colourful false-colour image also its hue. A palette whose luminance
+    /// is not monotonic in temperature (a rainbow: blue, green, yellow, red) can give two
+    /// temperatures the same luminance; its hue still runs one way.
+    pub fn variants(img: &DynamicImage) -> Vec<Self> {
+        let mut out = vec![Self::from_dynamic(img)];
+        if let Some(h) = Self::hue_of(img) {
+            out.push(h);
+        }
+        out
+    }
+
+    /// The hue (0…1 over 360°) of an 8-bit colour image whose mean saturation shows a palette
+    /// (above 0.25); `None` for grey or 16-bit images.
+    pub fn hue_of(img: &DynamicImage) -> Option<Self> {
+        if !matches!(
+            img,
+            DynamicImage::ImageRgb8(_) | DynamicImage::ImageRgba8(_)
+        ) {
+            return None;
+        }
+        let rgb = img.to_rgb8();
+        let (mut hue, mut sat) = (Vec::with_capacity(rgb.len() / 3), 0.0f64);
+        for p in rgb.pixels() {
+            let [r, g, b] = p.0.map(|c| c as f32 / 255.0);
+            let (max, min) = (r.max(g).max(b), r.min(g).min(b));
+            let c = max - min;
+            sat += if max > 0.0 { (c / max) as f64 } else { 0.0 };
+            let h = if c <= 1e-6 {
+                0.0
+            } else if max == r {
+                ((g - b) / c).rem_euclid(6.0)
+            } else if max == g {
+                (b - r) / c + 2.0
+            } else {
+                (r - g) / c + 4.0
+            };
+            hue.push(h / 6.0);
+        }
+        let n = (rgb.width() as f64 * rgb.height() as f64).max(1.0);
+        (sat / n > 0.25).then(|| Self {
+            width: rgb.width(),
+            height: rgb.height(),
+            data: hue,
+        })
+    }
+
+    /// Reads an image file (PNG, JPEG, TIFF; 8- or 16-bit, grey or colour) as its grey
+    /// [`variants`](Self::variants).
+    pub fn read_variants(path: &Path) -> Result<Vec<Self>, CalibError> {
+        Ok(Self::variants(&Self::decode(path)?))
+    }
+
     /// Reads an image file (PNG, JPEG, TIFF; 8- or 16-bit, grey or colour).
     pub fn read(path: &Path) -> Result<Self, CalibError> {
+        Ok(Self::from_dynamic(&Self::decode(path)?))
+    }
+
+    fn decode(path: &Path) -> Result<DynamicImage, CalibError> {
         let img = ImageReader::open(path)
             .map_err(|e| CalibError::file(path, e.to_string()))?
             .with_guessed_format()
@@ -106,7 +163,7 @@ impl Gray {
                 ),
             ));
         }
-        Ok(Self::from_dynamic(&img))
+        Ok(img)
     }
 
     /// 8-bit copy, upsampled by an integer factor (bicubic) for the corner detector.

@@ -31,7 +31,7 @@ pub use calibrate::{
     DistortionModel, MonoResult, PairInput, PairResult, PairStatus, PrincipalPoint, StereoOptions,
     StereoResult, ViewError, calibrate_mono, calibrate_mono_with, calibrate_stereo,
 };
-pub use detect::{Corner, DetectOptions, Detection, detect};
+pub use detect::{Corner, DetectOptions, Detection, detect, detect_variants};
 pub use gray::Gray;
 pub use pairs::{ImagePair, find_pairs, list_images};
 pub use quality::plausibility;

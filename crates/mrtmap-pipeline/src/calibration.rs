@@ -8,8 +8,8 @@ use mrtmap_calib::report::{draw_corners, overlay, png};
 use mrtmap_calib::rig::{rig_toml, updated_rig};
 use mrtmap_calib::{
     Board, DetectOptions, Detection, DistortionModel, Gray, ImagePair, MonoResult, PairInput,
-    PairStatus, StereoOptions, StereoResult, ViewError, calibrate_mono, calibrate_stereo, detect,
-    find_pairs, list_images,
+    PairStatus, StereoOptions, StereoResult, ViewError, calibrate_mono, calibrate_stereo,
+    detect_variants, find_pairs, list_images,
 };
 use mrtmap_io::{FileError, PoseFile, Rig, write_atomic};
 use rayon::prelude::*;
@@ -29,7 +29,7 @@ pub struct Seen {
 }
 
 fn see(path: &Path, board: &Board, size: Option<(u32, u32)>) -> Seen {
-    let g = match Gray::read(path) {
+    let variants = match Gray::read_variants(path) {
         Err(e) => {
             return Seen {
                 gray: None,
@@ -37,8 +37,9 @@ fn see(path: &Path, board: &Board, size: Option<(u32, u32)>) -> Seen {
                 problem: Some(e.to_string()),
             };
         }
-        Ok(g) => g,
+        Ok(v) => v,
     };
+    let g = variants[0].clone();
     if let Some((w, h)) = size
         && (g.width, g.height) != (w, h)
     {
@@ -53,7 +54,12 @@ fn see(path: &Path, board: &Board, size: Option<(u32, u32)>) -> Seen {
             det: None,
         };
     }
-    let det = detect(&g, (board.cols, board.rows), &DetectOptions::default());
+    let det = detect_variants(
+        &variants,
+        (board.cols, board.rows),
+        &DetectOptions::default(),
+    )
+    .map(|(_, d)| d);
     Seen {
         gray: Some(g),
         det,

@@ -192,3 +192,108 @@ fn colour_mapped_thermal_gives_the_same_corners() {
         }
     }
 }
+
+/// The false-colour and layout variants real thermal exports come in: a rainbow palette (found in
+/// its hue), grey inverted (white-cold), a portrait image (the camera mounted on its side) and a
+/// blurred one all give the whole board, at the 16-bit image's corners (portrait: transposed
+/// back).
+#[test]
+fn palettes_inversion_portrait_and_blur_give_the_same_corners() {
+    let rig = SynthRig::default();
+    let o = SynthOptions {
+        pairs: 3,
+        partial: 0,
+        ..SynthOptions::default()
+    };
+    let pairs = render_pairs(&rig, &o);
+    let max = (o.board.cols, o.board.rows);
+    let opts = DetectOptions::default();
+    // A rainbow: hue from blue (cold) through green to red (warm).
+    let rainbow = |v: f32| {
+        let h = (1.0 - v.clamp(0.0, 1.0)) * 240.0;
+        let x = 1.0 - ((h / 60.0) % 2.0 - 1.0).abs();
+        let (r, g, b) = match (h / 60.0) as u32 {
+            0 => (1.0, x, 0.0),
+            1 => (x, 1.0, 0.0),
+            2 => (0.0, 1.0, x),
+            _ => (0.0, x, 1.0),
+        };
+        image::Rgb([(r * 255.0) as u8, (g * 255.0) as u8, (b * 255.0) as u8])
+    };
+    for p in &pairs {
+        let (w, h) = (p.thermal.width, p.thermal.height);
+        let g16 = Gray::from_u16(w, h, &p.thermal.data);
+        let v = |x: u32, y: u32| g16.data[(y * w + x) as usize];
+        let a = detect(&g16, max, &opts).expect("16-bit board");
+        assert_eq!(a.corners.len(), 48);
+        let variants: Vec<(&str, Gray, bool)> = vec![
+            (
+                "grey inverted",
+                Gray::from_dynamic(&image::DynamicImage::ImageLuma8(image::GrayImage::from_fn(
+                    w,
+                    h,
+                    |x, y| image::Luma([255 - (v(x, y).clamp(0.0, 1.0) * 255.0) as u8]),
+                ))),
+                false,
+            ),
+            (
+                "portrait",
+                Gray::from_dynamic(&image::DynamicImage::ImageLuma8(image::GrayImage::from_fn(
+                    h,
+                    w,
+                    |x, y| image::Luma([(v(y, x).clamp(0.0, 1.0) * 255.0) as u8]),
+                ))),
+                true,
+            ),
+            (
+                "blurred",
+                Gray::from_dynamic(&image::DynamicImage::ImageLuma8(image::imageops::blur(
+                    &image::GrayImage::from_fn(w, h, |x, y| {
+                        image::Luma([(v(x, y).clamp(0.0, 1.0) * 255.0) as u8])
+                    }),
+                    1.0,
+                ))),
+                false,
+            ),
+        ];
+        // A rainbow's luminance is not monotonic in temperature: the board is found in its hue.
+        let rainbow_img =
+            image::DynamicImage::ImageRgb8(image::RgbImage::from_fn(w, h, |x, y| rainbow(v(x, y))));
+        let luminance_only =
+            detect(&Gray::from_dynamic(&rainbow_img), max, &opts).map_or(0, |d| d.corners.len());
+        let (k, b) = mrtmap_calib::detect_variants(&Gray::variants(&rainbow_img), max, &opts)
+            .expect("rainbow: no board");
+        println!(
+            "rainbow: {luminance_only} corners from its luminance, {} from variant {k}",
+            b.corners.len()
+        );
+        assert_eq!(b.corners.len(), 48, "rainbow");
+        let worst = a
+            .corners
+            .iter()
+            .map(|c| {
+                b.corners
+                    .iter()
+                    .map(|e| (e.x - c.x).hypot(e.y - c.y))
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .fold(0.0, f64::max);
+        assert!(worst < 0.25, "rainbow: a corner moved {worst:.3} px");
+        for (name, g, transposed) in variants {
+            let b = detect(&g, max, &opts).unwrap_or_else(|| panic!("{name}: no board"));
+            assert_eq!(b.corners.len(), 48, "{name}");
+            let mut worst: f64 = 0.0;
+            for c in &a.corners {
+                let (cx, cy) = if transposed { (c.y, c.x) } else { (c.x, c.y) };
+                let d = b
+                    .corners
+                    .iter()
+                    .map(|e| (e.x - cx).hypot(e.y - cy))
+                    .fold(f64::INFINITY, f64::min);
+                worst = worst.max(d);
+            }
+            println!("{name}: corners within {worst:.3} px of the 16-bit image's");
+            assert!(worst < 0.25, "{name}: a corner moved {worst:.3} px");
+        }
+    }
+}
