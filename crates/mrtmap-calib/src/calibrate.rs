@@ -41,10 +41,13 @@ pub enum DistortionModel {
     /// k1, k2.
     Radial,
     /// k1, k2, p1, p2 (OpenCV's model with k3 fixed, its advice for ordinary lenses).
-    #[default]
     RadialTangential,
     /// k1, k2, p1, p2, k3 (OpenCV's default).
     Full,
+    /// k1, k2, or k1, k2, p1, p2 when that predicts held-out views more than 1 % better: only as
+    /// many coefficients as the views constrain.
+    #[default]
+    Auto,
 }
 
 impl DistortionModel {
@@ -52,7 +55,7 @@ impl DistortionModel {
         let (r, t, k3) = match self {
             Self::None => (false, false, false),
             Self::Radial => (true, false, false),
-            Self::RadialTangential => (true, true, false),
+            Self::RadialTangential | Self::Auto => (true, true, false),
             Self::Full => (true, true, true),
         };
         [true, true, true, true, r, r, t, t, k3]
@@ -178,6 +181,12 @@ pub struct MonoResult {
     /// Held-out RMS error (px) with the principal point free and at the centre, when compared.
     #[serde(default)]
     pub held_out_rms_px: Option<(f64, f64)>,
+    /// The distortion model fitted (`Auto` resolved).
+    #[serde(default)]
+    pub model: DistortionModel,
+    /// With `Auto`: held-out RMS error (px) of k1 k2 and of k1 k2 p1 p2.
+    #[serde(default)]
+    pub model_held_out_px: Option<(f64, f64)>,
 }
 
 /// Where a camera's principal point comes from.
@@ -377,6 +386,43 @@ pub fn calibrate_mono_with(
     let s0 = solve(&prob, g0, poses, &DistortionModel::None.free(), &active, 50);
     let s1 = solve(&prob, s0.global, s0.views, &model.free(), &active, 100);
     let (mut s, rejected) = drop_outlier_views(&prob, s1, model, &mut active, &index);
+    // Only as many coefficients as the views constrain: the tangential pair must predict held-out
+    // views more than 1 % better than k1 k2 alone.
+    let mut model_held_out_px = None;
+    let model = if model == DistortionModel::Auto {
+        let radial = crate::lm::Solved {
+            global: {
+                let mut g = s.global.clone();
+                g[6] = 0.0;
+                g[7] = 0.0;
+                g
+            },
+            ..s.clone()
+        };
+        let r = held_out_rms(&prob, &radial, &DistortionModel::Radial.free(), &active);
+        let t = held_out_rms(
+            &prob,
+            &s,
+            &DistortionModel::RadialTangential.free(),
+            &active,
+        );
+        model_held_out_px = r.zip(t);
+        if matches!((r, t), (Some(r), Some(t)) if t >= 0.99 * r) {
+            s = solve(
+                &prob,
+                radial.global,
+                radial.views,
+                &DistortionModel::Radial.free(),
+                &active,
+                100,
+            );
+            DistortionModel::Radial
+        } else {
+            DistortionModel::RadialTangential
+        }
+    } else {
+        model
+    };
     let mut centre_free = model.free();
     centre_free[2] = false;
     centre_free[3] = false;
@@ -427,6 +473,8 @@ pub fn calibrate_mono_with(
         error,
         principal_point_centred,
         held_out_rms_px,
+        model,
+        model_held_out_px,
     })
 }
 
@@ -603,7 +651,7 @@ fn both_alone(
     rgb_size: (u32, u32),
     thermal_size: (u32, u32),
     dets: (&[Option<Detection>], &[Option<Detection>]),
-    opts: &StereoOptions,
+    models: (DistortionModel, DistortionModel),
     principal: (PrincipalPoint, PrincipalPoint),
 ) -> Result<(MonoResult, MonoResult), CalibError> {
     let alone = |camera: &'static str, (w, h): (u32, u32), d, model, pp| {
@@ -613,14 +661,8 @@ fn both_alone(
         })
     };
     Ok((
-        alone("colour", rgb_size, dets.0, opts.model_rgb, principal.0)?,
-        alone(
-            "thermal",
-            thermal_size,
-            dets.1,
-            opts.model_thermal,
-            principal.1,
-        )?,
+        alone("colour", rgb_size, dets.0, models.0, principal.0)?,
+        alone("thermal", thermal_size, dets.1, models.1, principal.1)?,
     ))
 }
 
@@ -891,7 +933,8 @@ struct Resample<'a> {
     board: &'a Board,
     sizes: ((u32, u32), (u32, u32)),
     dets: (&'a [Option<Detection>], &'a [Option<Detection>]),
-    opts: &'a StereoOptions,
+    /// The distortion models the full calibration chose (kept in every draw).
+    models: (DistortionModel, DistortionModel),
     /// How each camera's principal point was found (kept in every draw).
     principal: (PrincipalPoint, PrincipalPoint),
     /// Per pair of the extrinsic fit: its input index, whether it is used.
@@ -971,7 +1014,7 @@ impl Resample<'_> {
                 self.sizes.0,
                 self.sizes.1,
                 (&without(self.dets.0), &without(self.dets.1)),
-                self.opts,
+                self.models,
                 self.principal,
             )
             .ok()?;
@@ -1029,7 +1072,7 @@ impl Resample<'_> {
             self.sizes.0,
             self.sizes.1,
             (&pick(self.dets.0), &pick(self.dets.1)),
-            self.opts,
+            self.models,
             self.principal,
         )
         .ok()?;
@@ -1083,7 +1126,7 @@ pub fn calibrate_stereo(
         rgb_size,
         thermal_size,
         (&rgb_dets, &th_dets),
-        opts,
+        (opts.model_rgb, opts.model_thermal),
         (PrincipalPoint::Choose, PrincipalPoint::Choose),
     )?;
     let n = pairs.len();
@@ -1142,7 +1185,7 @@ pub fn calibrate_stereo(
     // when the residuals are pixel noise; on a hand-made board they are the board's own
     // irregularity, and a joint fit lets the camera with more pixels drag the other's focal
     // length (the real foil-board pairs' thermal f: 152 px alone, 163 px jointly).
-    let mut refined = [opts.model_rgb.free(), opts.model_thermal.free()].concat();
+    let mut refined = [rgb_alone.model.free(), thermal_alone.model.free()].concat();
     for (k, m) in [(2, &rgb_alone), (11, &thermal_alone)] {
         if m.principal_point_centred {
             refined[k] = false;
@@ -1154,7 +1197,7 @@ pub fn calibrate_stereo(
         board,
         sizes: (rgb_size, thermal_size),
         dets: (&rgb_dets, &th_dets),
-        opts,
+        models: (rgb_alone.model, thermal_alone.model),
         principal: (as_chosen(&rgb_alone), as_chosen(&thermal_alone)),
         idx: &idx,
         active: &active,
@@ -1205,16 +1248,28 @@ pub fn calibrate_stereo(
         v
     });
     let e = iso(&s.global[18..24]);
-    let pp = |m: &MonoResult| match m.held_out_rms_px {
-        Some((free, centre)) => format!(
-            "principal point {} (held-out RMS {free:.3} px free, {centre:.3} px at the centre)",
-            if m.principal_point_centred {
-                "at the image centre"
-            } else {
-                "fitted"
+    let pp = |m: &MonoResult| {
+        let model = match (m.model, m.model_held_out_px) {
+            (DistortionModel::Radial, Some((r, t))) => {
+                format!("k1 k2 (held-out RMS {r:.3} px; with p1 p2 {t:.3} px, not 1 % better), ")
             }
-        ),
-        None => "principal point fitted (too few views to compare on held-out ones)".into(),
+            (DistortionModel::RadialTangential, Some((r, t))) => {
+                format!("k1 k2 p1 p2 (held-out RMS {t:.3} px; k1 k2 alone {r:.3} px), ")
+            }
+            _ => String::new(),
+        };
+        let point = match m.held_out_rms_px {
+            Some((free, centre)) => format!(
+                "principal point {} (held-out RMS {free:.3} px free, {centre:.3} px at the centre)",
+                if m.principal_point_centred {
+                    "at the image centre"
+                } else {
+                    "fitted"
+                }
+            ),
+            None => "principal point fitted (too few views to compare on held-out ones)".into(),
+        };
+        model + &point
     };
     let how = match (fixed_err, joint_err) {
         (Some(f), Some(j)) => format!(

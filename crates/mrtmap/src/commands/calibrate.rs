@@ -19,6 +19,7 @@ fn model(d: DistortionArg) -> DistortionModel {
         DistortionArg::Radial => DistortionModel::Radial,
         DistortionArg::RadialTangential => DistortionModel::RadialTangential,
         DistortionArg::Full => DistortionModel::Full,
+        DistortionArg::Auto => DistortionModel::Auto,
     }
 }
 
