@@ -5,7 +5,8 @@
     calib_peer.py mono   REPORT/calibration.json
 
 Reads the corners mrtmap found (and the views or pairs it used), hands the same corners to
-OpenCV with the same distortion model (k1 k2 p1 p2, k3 fixed) and prints both reprojection
+OpenCV with the same distortion model (k1 k2 p1 p2, or k1 k2 where mrtmap's held-out choice left
+p1 p2 out; k3 fixed) and prints both reprojection
 errors: mean per-corner distance (MRE) and RMS (what OpenCV returns). With a truth.json from
 `mrtmap simulate-board`, also the focal-length and extrinsic errors of both.
 """
@@ -17,6 +18,13 @@ import cv2
 import numpy as np
 
 FLAGS = cv2.CALIB_FIX_K3
+
+
+def model_flags(camera):
+    """OpenCV's flags for the model mrtmap fitted: k3 fixed, and the tangential pair too when
+    mrtmap's held-out choice left it out (p1 = p2 = 0 exactly)."""
+    d = camera["distortion"]
+    return FLAGS | (cv2.CALIB_ZERO_TANGENT_DIST if d["p1"] == 0.0 and d["p2"] == 0.0 else 0)
 
 
 def points(corners, square):
@@ -36,9 +44,9 @@ def errors(obj, img, K, D, rvecs, tvecs):
     return d.mean(), np.sqrt((d ** 2).mean()), len(d)
 
 
-def mono_cv(obj, img, size):
+def mono_cv(obj, img, size, flags=FLAGS):
     t = time.perf_counter()
-    rms, K, D, rv, tv = cv2.calibrateCamera(obj, img, size, None, None, flags=FLAGS)
+    rms, K, D, rv, tv = cv2.calibrateCamera(obj, img, size, None, None, flags=flags)
     dt = time.perf_counter() - t
     mre, rms2, n = errors(obj, img, K, D, rv, tv)
     return K, D, mre, rms, n, dt
@@ -65,7 +73,7 @@ def mono(path):
     cam = cal["camera"]
     views = [v for v in cal["views"] if v["error"] is not None]
     obj, img = zip(*(points(v["corners"], sq) for v in views))
-    K, D, mre, rms, n, dt = mono_cv(list(obj), list(img), (cam["width"], cam["height"]))
+    K, D, mre, rms, n, dt = mono_cv(list(obj), list(img), (cam["width"], cam["height"]), model_flags(cam))
     print(f"one camera, {len(views)} views used by mrtmap (same corners to OpenCV {cv2.__version__}):")
     print(line("intrinsics", cal["error"]["mean_px"], cal["error"]["rms_px"], mre, rms, n))
     print(f"  fx mrtmap {cam['fx']:.2f} OpenCV {K[0,0]:.2f}; fy {cam['fy']:.2f} / {K[1,1]:.2f}; "
@@ -91,13 +99,13 @@ def stereo(path, truth_path=None):
     sq = cal["board"]["square_m"]
     pairs = cal["pairs"]
     out = {}
-    print(f"same detections to OpenCV {cv2.__version__} (k1 k2 p1 p2, k3 fixed):")
+    print(f"same detections to OpenCV {cv2.__version__} (the model mrtmap chose, k3 fixed):")
     for cam, key in (("rgb", "rgb_corners"), ("thermal", "thermal_corners")):
         alone = cal[f"{cam}_alone"]
         used = [k for k, e in enumerate(alone["view_errors"]) if e is not None]
         obj, img = zip(*(points(pairs[k][key], sq) for k in used))
         size = (cal[cam]["width"], cal[cam]["height"])
-        K, D, mre, rms, n, dt = mono_cv(list(obj), list(img), size)
+        K, D, mre, rms, n, dt = mono_cv(list(obj), list(img), size, model_flags(cal[cam]))
         out[cam] = (K, D, size)
         print(line(f"{cam} intrinsics alone", alone["error"]["mean_px"], alone["error"]["rms_px"], mre, rms, n))
     used = [p for p in pairs if p["result"]["status"] == "used"]
@@ -112,7 +120,8 @@ def stereo(path, truth_path=None):
     (K1, D1, s1), (K2, D2, s2) = out["rgb"], out["thermal"]
     tm = time.perf_counter()
     res = cv2.stereoCalibrate(objs, i1, i2, K1.copy(), D1.copy(), K2.copy(), D2.copy(), s1,
-                              flags=FLAGS | cv2.CALIB_USE_INTRINSIC_GUESS,
+                              flags=model_flags(cal["rgb"]) | model_flags(cal["thermal"])
+                              | cv2.CALIB_USE_INTRINSIC_GUESS,
                               criteria=(cv2.TERM_CRITERIA_COUNT + cv2.TERM_CRITERIA_EPS, 200, 1e-10))
     dt = time.perf_counter() - tm
     rms, K1, D1, K2, D2, R, T = res[:7]
