@@ -795,17 +795,6 @@ fn mean_whole_rotation(cands: &[Cand], whole: &dyn Fn(usize) -> bool) -> UnitQua
     mean_rotation(&near)
 }
 
-/// RMS distance (px) between thermal corners and where the board seen by the colour camera
-/// (`tc`) lands in the thermal image through the extrinsic `e0`.
-fn predicted_rms(
-    cam: &PinholeCamera,
-    board: &Board,
-    pose: &Isometry3<f64>,
-    corners: &[Corner],
-) -> f64 {
-    view_error(cam, pose, board, corners).rms_px
-}
-
 /// The largest error (in squares of the board as the thermal camera sees it) at which a thermal
 /// numbering predicted from the colour view and the other pairs' extrinsic is accepted: a
 /// neighbouring numbering lies one square away.
@@ -835,7 +824,7 @@ fn tie_shifts(
                 // The colour numbering of a partly seen board starts where its view does, so
                 // the thermal labels may run beyond it either way.
                 let c = shift(&cand.th, di, dj);
-                tries.push((predicted_rms(thermal, board, &predicted, &c), di, dj));
+                tries.push((view_error(thermal, &predicted, board, &c).rms_px, di, dj));
             }
         }
         tries.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -849,7 +838,7 @@ fn tie_shifts(
         // A pair whose both images show the whole board needs no shift (its numbering is fixed
         // once turned): kept unless it lies two squares off, for the fit's outlier test to judge.
         let (limit, ratio) = if whole(cand.k) {
-            d = predicted_rms(thermal, board, &predicted, &cand.th);
+            d = view_error(thermal, &predicted, board, &cand.th).rms_px;
             (di, dj, next) = (0, 0, f64::INFINITY);
             (2.0 * square_px, 0.0)
         } else {
@@ -1009,27 +998,8 @@ impl Resample<'_> {
                     })
                     .collect()
             };
-            let (rgb, th) = both_alone(
-                self.board,
-                self.sizes.0,
-                self.sizes.1,
-                (&without(self.dets.0), &without(self.dets.1)),
-                self.models,
-                self.principal,
-            )
-            .ok()?;
-            let prob = Stereo {
-                board: joint.prob.board,
-                rgb_size: joint.prob.rgb_size,
-                th_size: joint.prob.th_size,
-                rgb: train.iter().map(|&v| joint.prob.rgb[v]).collect(),
-                th: train.iter().map(|&v| joint.prob.th[v].clone()).collect(),
-            };
-            let mut g: Vec<f64> = intrinsics(&rgb.camera).to_vec();
-            g.extend(intrinsics(&th.camera));
-            g.extend(&s.global[18..24]);
-            let poses: Vec<[f64; 6]> = train.iter().map(|&v| s.views[v]).collect();
-            let fit = solve(&prob, g, poses, free, &vec![true; train.len()], 100);
+            let (r, t) = (without(self.dets.0), without(self.dets.1));
+            let fit = self.refit(joint, s, (&r, &t), &train, free, 100)?;
             let cr = camera_from(self.sizes.0.0, self.sizes.0.1, &fit.global[0..9]);
             let ct = camera_from(self.sizes.1.0, self.sizes.1.1, &fit.global[9..18]);
             let e = iso(&fit.global[18..24]);
@@ -1067,15 +1037,6 @@ impl Resample<'_> {
         let pick = |d: &[Option<Detection>]| -> Vec<Option<Detection>> {
             draw.iter().map(|&k| d[k].clone()).collect()
         };
-        let (rgb, th) = both_alone(
-            self.board,
-            self.sizes.0,
-            self.sizes.1,
-            (&pick(self.dets.0), &pick(self.dets.1)),
-            self.models,
-            self.principal,
-        )
-        .ok()?;
         // The drawn pairs that the extrinsic fit used, each as often as drawn.
         let views: Vec<usize> = draw
             .iter()
@@ -1085,6 +1046,33 @@ impl Resample<'_> {
         if views.len() < 3 {
             return None;
         }
+        let (r, t) = (pick(self.dets.0), pick(self.dets.1));
+        let fit = self.refit(joint, s, (&r, &t), &views, &joint.free, 50)?;
+        let e = fit.global[18..24].to_vec();
+        e.iter().all(|x| x.is_finite()).then_some(e)
+    }
+
+    /// Both cameras recalibrated from `dets` (with the models and principal points chosen), then
+    /// the extrinsic problem refitted with `free` on the pairs `views` (indices into the fit's
+    /// pairs, repeats allowed), starting from `s`.
+    fn refit(
+        &self,
+        joint: &Joint<'_>,
+        s: &crate::lm::Solved,
+        dets: (&[Option<Detection>], &[Option<Detection>]),
+        views: &[usize],
+        free: &[bool],
+        iterations: usize,
+    ) -> Option<crate::lm::Solved> {
+        let (rgb, th) = both_alone(
+            self.board,
+            self.sizes.0,
+            self.sizes.1,
+            dets,
+            self.models,
+            self.principal,
+        )
+        .ok()?;
         let prob = Stereo {
             board: joint.prob.board,
             rgb_size: joint.prob.rgb_size,
@@ -1097,9 +1085,7 @@ impl Resample<'_> {
         g.extend(&s.global[18..24]);
         let poses: Vec<[f64; 6]> = views.iter().map(|&v| s.views[v]).collect();
         let all = vec![true; views.len()];
-        let fit = solve(&prob, g, poses, &joint.free, &all, 50);
-        let e = fit.global[18..24].to_vec();
-        e.iter().all(|x| x.is_finite()).then_some(e)
+        Some(solve(&prob, g, poses, free, &all, iterations))
     }
 }
 

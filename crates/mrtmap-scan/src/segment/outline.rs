@@ -330,15 +330,19 @@ pub fn wall_lines(
             // the line is the middle of its points within 30 cm, found by trimming at 2.5 robust
             // standard deviations and refitting; its points lie within that spread.
             let cos_n = p.normal_deg.to_radians().cos();
-            let mut band = p.band_m;
-            for _ in 0..3 {
-                let near: Vec<usize> = (0..pts.len())
+            // The free points within `width` of a line whose normals agree with it.
+            let within = |line: &WallLine, width: f64| -> Vec<usize> {
+                (0..pts.len())
                     .filter(|&i| {
                         free[i]
-                            && line.distance(&pts[i]).abs() <= WIDE_M
+                            && line.distance(&pts[i]).abs() <= width
                             && normals[i].dot(&line.n) >= cos_n
                     })
-                    .collect();
+                    .collect()
+            };
+            let mut band = p.band_m;
+            for _ in 0..3 {
+                let near = within(&line, WIDE_M);
                 if near.len() < p.min_points {
                     break;
                 }
@@ -352,13 +356,7 @@ pub fn wall_lines(
                 line.rho = rho;
             }
             // Its points: near the line with agreeing normals, in runs along it.
-            let cand: Vec<usize> = (0..pts.len())
-                .filter(|&i| {
-                    free[i]
-                        && line.distance(&pts[i]).abs() <= band
-                        && normals[i].dot(&line.n) >= cos_n
-                })
-                .collect();
+            let cand = within(&line, band);
             let (length, kept) = runs_along(&line, pts, &cand, p.min_length_m);
             if kept.len() < p.min_points || length < p.min_length_m {
                 continue;
