@@ -97,6 +97,7 @@ impl Default for RansacParams {
 }
 
 /// The best plane among `candidates` (indices into `points`): RANSAC over three-point hypotheses
+/// (one point and its normal when no three-point hypothesis agrees with its points' normals)
 /// scored on a subsample (inliers within `distance_m` whose normal agrees within `normal_deg`),
 /// then refitted by least squares to all its inliers. Returns the plane and its inliers.
 pub fn ransac_plane<R: Rng>(
@@ -139,6 +140,24 @@ pub fn ransac_plane<R: Rng>(
             .count();
         if best.is_none_or(|b| score > b.1) {
             best = Some((pl, score));
+        }
+    }
+    if best.is_none() {
+        // No three points agreed with their normals (thick, noisy surfaces): hypotheses from one
+        // point and its own normal instead.
+        for _ in 0..params.iterations {
+            let a = candidates[rng.random_range(0..candidates.len())];
+            let Some(n) = Unit::try_new(normals[a], 1e-9) else {
+                continue;
+            };
+            let pl = Plane::from_point_normal(&points[a], n);
+            let score = sample
+                .iter()
+                .filter(|&&i| is_inlier(&pl, i, params.distance_m))
+                .count();
+            if best.is_none_or(|b| score > b.1) {
+                best = Some((pl, score));
+            }
         }
     }
     let (mut pl, _) = best?;

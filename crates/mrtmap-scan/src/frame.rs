@@ -21,7 +21,7 @@ pub struct DepthSampling {
 impl Default for DepthSampling {
     fn default() -> Self {
         Self {
-            stride: 2,
+            stride: 3,
             normal_radius_px: 6,
             min_m: 0.3,
             max_m: 5.0,

@@ -13,6 +13,7 @@
 use std::collections::BTreeMap;
 use std::time::Instant;
 
+use mrtmap_geometry::cloud::voxel_key;
 use mrtmap_geometry::icp::{IcpParams, IcpTarget, icp_point_to_plane};
 use mrtmap_geometry::nalgebra::{Isometry3, Point3, Vector3};
 use mrtmap_io::{InterpolationLimits, Recording, ThermalCloud};
@@ -25,7 +26,7 @@ use crate::radiometric::{
     Calibrator, FrameResiduals, RadiometricReport, SelfCalibration, frame_residuals,
 };
 use crate::sync::{SkipReason, pair_frames};
-use crate::voxels::{FrameVoxels, VoxelMap};
+use crate::voxels::{FrameVoxels, ShardedVoxels, VoxelMap};
 
 /// ICP refinement settings and the checks a refinement must pass.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -60,12 +61,18 @@ impl Default for IcpSettings {
         Self {
             enabled: true,
             source_points: 1500,
+            // The target is voxel centroids 6 cm apart and the depth is noisy: after a few
+            // iterations the updates wander by a few millimetres as correspondences switch, so a
+            // millimetre (a milliradian) is converged and ten iterations are plenty (15 at 10 µm
+            // took half again the time for the same maps).
             params: IcpParams {
-                max_iterations: 15,
+                max_iterations: 10,
+                converged_translation_m: 1e-3,
+                converged_rotation_rad: 1e-3,
                 ..IcpParams::default()
             },
             min_map_voxels: 3000,
-            rebuild_every: 10,
+            rebuild_every: 30,
             target_every: 2,
             correction_gain: 0.1,
             min_fitness: 0.7,
@@ -126,6 +133,9 @@ pub struct IcpReport {
     pub mean_fitness: f64,
     /// Mean point-to-point inlier RMSE of accepted refinements (m).
     pub mean_inlier_rmse_m: f64,
+    /// Mean number of iterations of the refinements run.
+    #[serde(default)]
+    pub mean_iterations: f64,
     /// Frames where some directions were unconstrained (left unchanged).
     pub degenerate_frames: usize,
     /// The final correction applied to the trajectory: translation (m) and rotation (degrees).
@@ -213,6 +223,38 @@ fn rotation_deg(p: &Isometry3<f64>) -> f64 {
     p.rotation.angle().to_degrees()
 }
 
+/// Reads and back-projects a chunk of (thermal, depth) frame pairs in parallel; also returns the
+/// CPU seconds spent (the frames' times summed).
+fn prepare(
+    rec: &Recording,
+    rays: &RayTable,
+    params: &FuseParams,
+    chunk: &[(usize, usize)],
+) -> (Vec<Result<Prepared, String>>, f64) {
+    let prepared: Vec<(Result<Prepared, String>, f64)> = chunk
+        .par_iter()
+        .map(|&(ti, di)| {
+            let t0 = Instant::now();
+            let th = &rec.thermal[ti];
+            let de = &rec.depth[di];
+            let read = || -> Result<Prepared, String> {
+                let depth = rec.read_depth(de).map_err(|e| e.to_string())?;
+                let thermal = rec.read_thermal(th).map_err(|e| e.to_string())?;
+                Ok(Prepared {
+                    thermal_t: th.t,
+                    depth_t: de.t,
+                    points: depth_points(&depth, rays, rec.rig.depth_scale, &params.depth),
+                    thermal: ThermalImage::from_raw(&thermal, rec.rig.thermal_encoding),
+                })
+            };
+            let r = read();
+            (r, t0.elapsed().as_secs_f64())
+        })
+        .collect();
+    let cpu = prepared.iter().map(|(_, t)| t).sum();
+    (prepared.into_iter().map(|(r, _)| r).collect(), cpu)
+}
+
 /// A prepared frame with its poses: world_from_depth and world_from_thermal-depth (before ICP),
 /// or after it world_from_depth and world_from_thermal.
 type Posed = (Prepared, Isometry3<f64>, Isometry3<f64>);
@@ -222,7 +264,6 @@ struct Fuser<'a> {
     rec: &'a Recording,
     params: &'a FuseParams,
     limits: InterpolationLimits,
-    rays: RayTable,
     report: FusionReport,
     map: VoxelMap,
     target: Option<IcpTarget>,
@@ -231,6 +272,7 @@ struct Fuser<'a> {
     correction: Isometry3<f64>,
     fit_sum: f64,
     rmse_sum: f64,
+    iterations_sum: usize,
     poses: Vec<(f64, Isometry3<f64>)>,
     timing: Timing,
     done: u64,
@@ -251,29 +293,6 @@ impl Fuser<'_> {
     fn drop_frame(&mut self, r: SkipReason) {
         self.skip(r);
         self.done += 1;
-    }
-
-    /// Reads and back-projects a chunk of (thermal, depth) frame pairs in parallel.
-    fn prepare(&mut self, chunk: &[(usize, usize)]) -> Vec<Result<Prepared, String>> {
-        let t0 = Instant::now();
-        let (rec, params) = (self.rec, self.params);
-        let prepared = chunk
-            .par_iter()
-            .map(|&(ti, di)| {
-                let th = &rec.thermal[ti];
-                let de = &rec.depth[di];
-                let depth = rec.read_depth(de).map_err(|e| e.to_string())?;
-                let thermal = rec.read_thermal(th).map_err(|e| e.to_string())?;
-                Ok(Prepared {
-                    thermal_t: th.t,
-                    depth_t: de.t,
-                    points: depth_points(&depth, &self.rays, rec.rig.depth_scale, &params.depth),
-                    thermal: ThermalImage::from_raw(&thermal, rec.rig.thermal_encoding),
-                })
-            })
-            .collect();
-        self.timing.read_cpu += t0.elapsed().as_secs_f64() * rayon::current_num_threads() as f64;
-        prepared
     }
 
     /// The frames that can be used, with their poses; the others skipped and counted.
@@ -313,7 +332,7 @@ impl Fuser<'_> {
         pr: &Prepared,
         wd: &Isometry3<f64>,
         start: &Isometry3<f64>,
-    ) -> Option<Result<Refinement, &'static str>> {
+    ) -> Option<(usize, Result<Refinement, &'static str>)> {
         let params = self.params;
         let tgt = self.target.as_ref().filter(|_| params.icp.enabled)?;
         let init = start * wd;
@@ -327,7 +346,7 @@ impl Fuser<'_> {
             .collect();
         let reg = icp_point_to_plane(&src, tgt, &Isometry3::identity(), &params.icp.params);
         let d = reg.target_from_source;
-        Some(if reg.fitness < params.icp.min_fitness {
+        let verdict = if reg.fitness < params.icp.min_fitness {
             Err("fitness below the limit")
         } else if reg.inlier_plane_rmse_m > params.icp.max_rmse_m {
             Err("residual above the limit")
@@ -342,7 +361,8 @@ impl Fuser<'_> {
                 rmse_m: reg.inlier_rmse_m,
                 degenerate_dofs: reg.degenerate_dofs,
             })
-        })
+        };
+        Some((reg.iterations, verdict))
     }
 
     /// ICP: every frame of the chunk is refined in parallel from the correction at the chunk's
@@ -360,11 +380,13 @@ impl Fuser<'_> {
             let mut frame_correction = start;
             match refinement {
                 None => {}
-                Some(Err(why)) => {
+                Some((iterations, Err(why))) => {
+                    self.iterations_sum += iterations;
                     self.report.icp.attempted += 1;
                     *self.report.icp.rejected.entry(why.to_string()).or_default() += 1;
                 }
-                Some(Ok(r)) => {
+                Some((iterations, Ok(r))) => {
+                    self.iterations_sum += iterations;
                     self.report.icp.attempted += 1;
                     self.report.icp.accepted += 1;
                     self.fit_sum += r.fitness;
@@ -409,14 +431,30 @@ impl Fuser<'_> {
                     &pr.thermal,
                     &params.observation,
                 );
+                let vm = params.voxel_m;
+                let keys: Vec<[i32; 3]> = pts.iter().map(|p| voxel_key(p, vm)).collect();
                 let (residuals, offset, a) = if cal.enabled {
-                    // Every third observation is plenty for a median and a slope.
+                    // Every third observation is plenty for a median and a slope. Neighbouring
+                    // observations mostly share a voxel: the last one looked up is kept.
+                    let mut last: Option<([i32; 3], Option<f64>)> = None;
                     let pairs: Vec<(f64, f64)> = obs
                         .iter()
                         .step_by(3)
                         .filter_map(|o| {
-                            map.reference_k(&o.p, cal.min_map_observations, cal.max_map_spread_k)
-                                .map(|t| (o.t_k - t, o.rho))
+                            let k = keys[o.index];
+                            let reference = match last {
+                                Some((lk, r)) if lk == k => r,
+                                _ => {
+                                    let r = map.reference_k(
+                                        k,
+                                        cal.min_map_observations,
+                                        cal.max_map_spread_k,
+                                    );
+                                    last = Some((k, r));
+                                    r
+                                }
+                            };
+                            reference.map(|t| (o.t_k - t, o.rho))
                         })
                         .collect();
                     let r = frame_residuals(&pairs, a, cal.outlier_k);
@@ -429,16 +467,16 @@ impl Fuser<'_> {
                 } else {
                     (FrameResiduals::default(), 0.0, 0.0)
                 };
-                let mut fv = FrameVoxels::default();
-                for (p, n) in pts.iter().zip(&nrm) {
-                    fv.add_point(params.voxel_m, p, n);
+                let mut fv = FrameVoxels::with_capacity(pts.len() / 8);
+                for ((k, p), n) in keys.iter().zip(&pts).zip(&nrm) {
+                    fv.add_point(*k, p, n);
                 }
                 for o in &obs {
                     let t = o.t_k - offset - a * o.rho;
-                    fv.add_temperature(params.voxel_m, &o.p, t, o.w);
+                    fv.add_temperature(keys[o.index], t, o.w);
                 }
                 Observed {
-                    voxels: fv,
+                    voxels: fv.into_shards(),
                     counts,
                     thermal_t: pr.thermal_t,
                     residuals,
@@ -453,6 +491,7 @@ impl Fuser<'_> {
     /// Merges the frames into the map in frame order, and rebuilds the ICP target when due.
     fn merge(&mut self, results: Vec<Observed>, total: u64, progress: &(dyn Fn(u64, u64) + Sync)) {
         let t3 = Instant::now();
+        let mut frames = Vec::with_capacity(results.len());
         for o in results {
             let (fv, counts) = (o.voxels, o.counts);
             if self.params.radiometric.enabled && counts.kept > 0 {
@@ -469,11 +508,12 @@ impl Fuser<'_> {
                 self.report.used_frames += 1;
             }
             self.report.observations.add(&counts);
-            self.map.merge(fv);
+            frames.push(fv);
             self.since_rebuild += 1;
             self.done += 1;
             progress(self.done, total);
         }
+        self.map.merge(&frames);
         let icp = &self.params.icp;
         if icp.enabled && (self.target.is_none() || self.since_rebuild >= icp.rebuild_every) {
             let (p, n) = self.map.surface(3, icp.target_every);
@@ -497,6 +537,9 @@ impl Fuser<'_> {
             report.icp.mean_fitness = self.fit_sum / report.icp.accepted as f64;
             report.icp.mean_inlier_rmse_m = self.rmse_sum / report.icp.accepted as f64;
         }
+        if report.icp.attempted > 0 {
+            report.icp.mean_iterations = self.iterations_sum as f64 / report.icp.attempted as f64;
+        }
         report.icp.final_correction_m = self.correction.translation.vector.norm();
         report.icp.final_correction_deg = rotation_deg(&self.correction);
         report.frames_per_second = report.thermal_frames as f64 / self.timing.total.max(1e-9);
@@ -516,7 +559,7 @@ type Vector3List = Vec<Vector3<f64>>;
 
 /// A frame observed: its voxels, counts, and its comparison with the map.
 struct Observed {
-    voxels: FrameVoxels,
+    voxels: ShardedVoxels,
     counts: ObservationCounts,
     thermal_t: f64,
     residuals: FrameResiduals,
@@ -540,7 +583,6 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
         rec,
         params,
         limits,
-        rays: RayTable::new(&rec.rig.depth),
         report,
         map: VoxelMap::new(params.voxel_m),
         target: None,
@@ -548,6 +590,7 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
         correction: Isometry3::identity(),
         fit_sum: 0.0,
         rmse_sum: 0.0,
+        iterations_sum: 0,
         poses: Vec::new(),
         timing: Timing::default(),
         done: 0,
@@ -561,12 +604,26 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
         }
     }
     let total = rec.thermal.len() as u64;
-    for chunk in usable.chunks(params.chunk.max(1)) {
-        let prepared = fuser.prepare(chunk);
-        let ready = fuser.posed(prepared);
-        let work = fuser.register(ready);
-        let results = fuser.observe(&work);
-        fuser.merge(results, total, progress);
+    // The next chunk is read while the current one is registered, observed and merged (ICP and
+    // merging are partly sequential, reading is not).
+    let rays = RayTable::new(&rec.rig.depth);
+    let chunks: Vec<&[(usize, usize)]> = usable.chunks(params.chunk.max(1)).collect();
+    let mut next = chunks.first().map(|c| prepare(rec, &rays, params, c));
+    for i in 0..chunks.len() {
+        let Some((prepared, cpu)) = next.take() else {
+            break;
+        };
+        fuser.timing.read_cpu += cpu;
+        let (following, ()) = rayon::join(
+            || chunks.get(i + 1).map(|c| prepare(rec, &rays, params, c)),
+            || {
+                let ready = fuser.posed(prepared);
+                let work = fuser.register(ready);
+                let results = fuser.observe(&work);
+                fuser.merge(results, total, progress);
+            },
+        );
+        next = following;
     }
     fuser.finish(t_start)
 }

@@ -58,6 +58,8 @@ impl Default for ObservationParams {
 /// One temperature observation of a world point.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Observation {
+    /// Index of the point observed in the points given.
+    pub index: usize,
     /// World position.
     pub p: Point3<f64>,
     /// World unit normal facing the camera.
@@ -229,6 +231,7 @@ pub fn observe(
         }
         counts.kept += 1;
         out.push(Observation {
+            index: i,
             p,
             n,
             t_k: t,

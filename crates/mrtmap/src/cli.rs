@@ -590,7 +590,7 @@ pub struct FuseArgs {
     #[arg(long = "sync-tolerance-ms", default_value_t = 20.0)]
     pub sync_tolerance_ms: f64,
     /// Use every N-th depth pixel in each direction.
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, default_value_t = 3)]
     pub depth_stride: u32,
     /// Radiometric self-calibration: estimate and remove each frame's offset (flat-field
     /// corrections, drift) and the vignetting from the frames' overlaps.

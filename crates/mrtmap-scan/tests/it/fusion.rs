@@ -106,3 +106,25 @@ fn corrupt_frames_are_skipped_and_reported() {
     );
     assert_eq!(r.used_frames, r.thermal_frames - 1);
 }
+
+/// Results do not depend on the number of threads: the next chunk is read while the current one
+/// is registered and observed, frames are observed in parallel, and the map's shards take them in
+/// frame order.
+#[test]
+fn fusion_gives_the_same_cloud_on_one_thread_as_on_several() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("scan");
+    scan("office", NoiseLevel::Realistic, Drift::NONE, 3.0, &rec);
+    let on = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| fuse_dir(&rec, &params(true)))
+    };
+    let (one, three) = (on(1), on(3));
+    assert!(one.cloud.len() > 1000, "{}", one.cloud.len());
+    assert!(one.report.icp.attempted > 0, "{:?}", one.report.icp);
+    assert!(one.cloud == three.cloud, "the clouds differ");
+    assert_eq!(one.poses, three.poses);
+}
