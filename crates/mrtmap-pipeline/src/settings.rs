@@ -49,7 +49,7 @@ clo = 0.7                 # clothing insulation
 voxel_m = 0.03
 icp = true                # refine poses by ICP against the map (as the seed paper)
 sync_tolerance_ms = 20.0  # thermal frame ↔ nearest depth frame
-depth_stride = 3          # every 3rd depth pixel
+depth_stride = 0          # every N-th depth pixel; 0: about one per thermal pixel
 self_calibrate = true     # remove each frame's offset (FFC, drift) and the vignetting, from overlaps
 
 [segment]
@@ -331,7 +331,7 @@ impl Default for FuseSection {
             voxel_m: 0.03,
             icp: true,
             sync_tolerance_ms: 20.0,
-            depth_stride: 3,
+            depth_stride: 0,
             self_calibrate: true,
         }
     }
@@ -361,7 +361,7 @@ impl FuseSection {
             ..FuseParams::default()
         };
         p.icp.enabled = self.icp;
-        p.depth.stride = self.depth_stride.max(1);
+        p.depth.stride = self.depth_stride;
         p.radiometric.enabled = self.self_calibrate;
         Ok(p)
     }

@@ -8,7 +8,8 @@ use mrtmap_io::{Image16, ThermalEncoding};
 /// Back-projection settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DepthSampling {
-    /// Use every `stride`-th pixel in each direction.
+    /// Use every `stride`-th pixel in each direction; 0: about one depth point per thermal pixel
+    /// (see `DepthSampling::auto_stride`).
     pub stride: u32,
     /// Normals from neighbours this many pixels away (robust to depth noise).
     pub normal_radius_px: u32,
@@ -21,11 +22,22 @@ pub struct DepthSampling {
 impl Default for DepthSampling {
     fn default() -> Self {
         Self {
-            stride: 3,
+            stride: 0,
             normal_radius_px: 6,
             min_m: 0.3,
             max_m: 5.0,
         }
+    }
+}
+
+impl DepthSampling {
+    /// The stride that gives about one depth point per thermal pixel: the ratio of the two
+    /// cameras' focal lengths in pixels, rounded (3 for a 640×480 D435 beside a Lepton 3.5, 1 for
+    /// a depth image no sharper than the thermal one). Sampling the depth more densely than the
+    /// thermal image adds time, not information, to the temperatures.
+    pub fn auto_stride(depth: &PinholeCamera, thermal: &PinholeCamera) -> u32 {
+        let ratio = depth.fx.max(depth.fy) / thermal.fx.max(thermal.fy).max(1e-9);
+        (ratio.round() as u32).clamp(1, 8)
     }
 }
 
@@ -160,5 +172,21 @@ impl ThermalImage {
         let t = (1.0 - fv) * ((1.0 - fu) * a + fu * b) + fv * ((1.0 - fu) * c + fu * d);
         let contrast = a.max(b).max(c).max(d) - a.min(b).min(c).min(d);
         Some((t, contrast))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_automatic_stride_gives_about_one_depth_point_per_thermal_pixel() {
+        let lepton = PinholeCamera::new(160, 120, 147.3, 147.3, 79.5, 59.5);
+        let d435 = PinholeCamera::new(640, 480, 385.0, 385.0, 319.5, 239.5);
+        assert_eq!(DepthSampling::auto_stride(&d435, &lepton), 3);
+        let small = PinholeCamera::new(160, 120, 96.25, 96.25, 79.5, 59.5);
+        assert_eq!(DepthSampling::auto_stride(&small, &lepton), 1);
+        let boson = PinholeCamera::new(640, 512, 800.0, 800.0, 319.5, 255.5);
+        assert_eq!(DepthSampling::auto_stride(&d435, &boson), 1);
     }
 }

@@ -172,6 +172,9 @@ pub struct FusionReport {
     pub depth_frames: usize,
     /// Thermal frames fused.
     pub used_frames: usize,
+    /// Every this many depth pixels were used, in each direction.
+    #[serde(default)]
+    pub depth_stride: u32,
     /// Frames skipped, by reason.
     pub skipped: BTreeMap<String, usize>,
     /// The first few problems, with file names.
@@ -568,6 +571,11 @@ struct Observed {
 
 /// Fuses a recording. `progress(done, total)` is called after each frame.
 pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) + Sync)) -> Fused {
+    let mut params = *params;
+    if params.depth.stride == 0 {
+        params.depth.stride = DepthSampling::auto_stride(&rec.rig.depth, &rec.rig.thermal);
+    }
+    let params = &params;
     let t_start = Instant::now();
     let limits = InterpolationLimits::default();
     let pairs = pair_frames(rec, params.sync_tolerance_s, &limits);
@@ -575,6 +583,7 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
         recording: rec.dir.display().to_string(),
         thermal_frames: rec.thermal.len(),
         depth_frames: rec.depth.len(),
+        depth_stride: params.depth.stride,
         parameters: *params,
         ..Default::default()
     };

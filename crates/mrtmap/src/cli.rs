@@ -589,8 +589,9 @@ pub struct FuseArgs {
     /// Largest time between a thermal frame and the depth frame it takes (ms).
     #[arg(long = "sync-tolerance-ms", default_value_t = 20.0)]
     pub sync_tolerance_ms: f64,
-    /// Use every N-th depth pixel in each direction.
-    #[arg(long, default_value_t = 3)]
+    /// Use every N-th depth pixel in each direction; 0: about one depth point per thermal pixel
+    /// (the cameras' focal lengths' ratio, rounded: 3 for a 640×480 D435 beside a Lepton).
+    #[arg(long, default_value_t = 0)]
     pub depth_stride: u32,
     /// Radiometric self-calibration: estimate and remove each frame's offset (flat-field
     /// corrections, drift) and the vignetting from the frames' overlaps.
