@@ -135,9 +135,6 @@ fn demo_project(truth: &Truth, s: &DemoSettings) -> Project {
     };
     project.air.temperature_c = Some(truth.air_temperature_c);
     project.air.speed_m_s = s.air_speed_m_s;
-    if s.depth_size.0 < 640 {
-        project.fuse.depth_stride = 1; // small frames: every pixel
-    }
     project
 }
 
