@@ -559,10 +559,14 @@ impl Occluder {
         }
     }
 
-    /// Whether `p` lies strictly inside (boxes only; meshes answer false).
+    /// Whether `p` lies inside or on a face, to a micrometre (boxes only; meshes answer false): a
+    /// point on a face has no radiant temperature (half its sphere is the furniture's inside).
     pub fn contains(&self, p: &Point3<f64>) -> bool {
+        const ON: f64 = 1e-6;
         match &self.shape {
-            OccluderShape::Box { min, max } => (0..3).all(|i| p[i] > min[i] && p[i] < max[i]),
+            OccluderShape::Box { min, max } => {
+                (0..3).all(|i| p[i] >= min[i] - ON && p[i] <= max[i] + ON)
+            }
             OccluderShape::Mesh { .. } => false,
         }
     }

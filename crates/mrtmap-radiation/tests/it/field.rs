@@ -94,6 +94,32 @@ fn nodes_inside_occluders_are_reported_not_computed() {
     assert_eq!(field.summary().unwrap().skipped, 16);
 }
 
+/// A point exactly on a furniture face has no radiant temperature (half its sphere is the
+/// furniture's inside): refused like a point inside; a millimetre off the face it is computed.
+#[test]
+fn a_point_on_a_furniture_face_is_refused_and_one_beside_it_is_not() {
+    let mut f = box_room(4.0, 4.0, 3.0, [20.0; 6]);
+    f.occluders.push(box_occluder(
+        "shelf",
+        [0.0, 0.0, 0.0],
+        [1.0, 4.0, 2.0],
+        21.0,
+    ));
+    let s = scene(&f);
+    let e = MrtEngine::new(
+        &s,
+        Method::MonteCarlo(MonteCarlo {
+            rays: 800,
+            ..MonteCarlo::default()
+        }),
+    )
+    .unwrap();
+    let on = e.at(&Point3::new(1.0, 2.0, 1.1), 1);
+    assert!(matches!(on, Err(MrtError::InsideOccluder { .. })), "{on:?}");
+    let beside = e.at(&Point3::new(1.001, 2.0, 1.1), 1).unwrap();
+    assert!(beside.mrt.celsius() > 20.0 && beside.mrt.celsius() < 21.0);
+}
+
 #[test]
 fn map_frame_without_up_uses_the_floor_and_world_axes() {
     let s = scene(&box_room(4.0, 3.0, 2.5, [20.0; 6]));

@@ -78,6 +78,8 @@ struct Grid {
     inside: Vec<bool>,
     temp: Vec<RadiantAverage>,
     points: Vec<Vec<usize>>,
+    /// Each texel's points in the frame and their temperatures (K).
+    samples: Vec<Vec<(Point2<f64>, f64)>>,
 }
 
 impl Grid {
@@ -108,6 +110,7 @@ impl Grid {
             inside: vec![false; nx * ny],
             temp: vec![RadiantAverage::new(); nx * ny],
             points: vec![Vec::new(); nx * ny],
+            samples: vec![Vec::new(); nx * ny],
         };
         for j in 0..ny {
             for i in 0..nx {
@@ -121,6 +124,7 @@ impl Grid {
                 let c = j as usize * nx + i as usize;
                 g.temp[c].add(Temperature::from_kelvin(temp_k[k]), 1.0);
                 g.points[c].push(k);
+                g.samples[c].push((q, temp_k[k]));
             }
         }
         g
@@ -380,6 +384,7 @@ fn outline(
     core: &[usize],
     host: &[Point2<f64>],
     area: f64,
+    step: Option<&Step<'_>>,
 ) -> Result<Vec<Point2<f64>>, String> {
     use mrtmap_geometry::nalgebra::Vector2;
     let t = g.t;
@@ -402,7 +407,9 @@ fn outline(
         return Err(String::new());
     };
     let mut poly = if area / rect_area >= 0.75 {
-        robust_rectangle(g, core, &rect).unwrap_or(rect).to_vec()
+        robust_rectangle(g, core, &rect, step)
+            .unwrap_or(rect)
+            .to_vec()
     } else {
         simplify_closed(&convex_hull(&corners), 0.5 * t)
     };
@@ -428,7 +435,8 @@ fn outline(
 }
 
 /// The texels of region `comp` at least half as far from the background as its plateau (the
-/// median of its interior texels, or its upper quartile when too few are interior). A blurred step
+/// median of its interior texels, or its upper quartile when too few are interior), and the
+/// plateau's contrast (K, signed by `sign`). A blurred step
 /// crosses half its height at the true edge, while the region's threshold, a fixed contrast, lies
 /// further out the hotter the feature: the L-shaped room's 45 °C radiator (1.80 × 0.60 m) came out
 /// 1.86 × 0.66 m from its thresholded region.
@@ -437,7 +445,7 @@ fn half_contrast_core(
     comp: &[usize],
     resid: &dyn Fn(usize) -> f64,
     sign: f64,
-) -> Vec<usize> {
+) -> (Vec<usize>, Option<f64>) {
     let mut in_comp = vec![false; g.nx * g.ny];
     for &c in comp {
         in_comp[c] = true;
@@ -465,20 +473,29 @@ fn half_contrast_core(
         contrast(&mut all, 0.75)
     };
     let Some(plateau) = plateau else {
-        return comp.to_vec();
+        return (comp.to_vec(), None);
     };
     let core: Vec<usize> = comp
         .iter()
         .copied()
         .filter(|&c| !g.observed(c) || resid(c) * sign >= 0.5 * plateau)
         .collect();
-    if core.len() < 4 { comp.to_vec() } else { core }
+    if core.len() < 4 {
+        (comp.to_vec(), Some(plateau))
+    } else {
+        (core, Some(plateau))
+    }
 }
 
 /// The rectangle `rect` of a region's texels, each side moved to where the region fills half of
 /// the texel rows along it: the extreme texels of a blurred, noisy edge (a 45 °C radiator's glow)
 /// stretch the smallest enclosing rectangle outwards, but not the rows' half-occupancy.
-fn robust_rectangle(g: &Grid, comp: &[usize], rect: &[Point2<f64>; 4]) -> Option<[Point2<f64>; 4]> {
+fn robust_rectangle(
+    g: &Grid,
+    comp: &[usize],
+    rect: &[Point2<f64>; 4],
+    step: Option<&Step<'_>>,
+) -> Option<[Point2<f64>; 4]> {
     let o = rect[0];
     let (ea, eb) = (rect[1] - rect[0], rect[3] - rect[0]);
     let (la, lb) = (ea.norm(), eb.norm());
@@ -502,12 +519,90 @@ fn robust_rectangle(g: &Grid, comp: &[usize], rect: &[Point2<f64>; 4]) -> Option
         Some((first as f64 * t, (last + 1) as f64 * t))
     };
     let ((a0, a1), (b0, b1)) = (extent(&rows_a)?, extent(&rows_b)?);
-    let (a0, a1, b0, b1) = (a0.max(0.0), a1.min(la), b0.max(0.0), b1.min(lb));
+    let (mut a0, mut a1, mut b0, mut b1) = (a0.max(0.0), a1.min(la), b0.max(0.0), b1.min(lb));
     if a1 - a0 < t || b1 - b0 < t {
         return None;
     }
+    if let Some(step) = step {
+        // Each side to a fraction of a texel, from the points' temperatures across it.
+        let local = |q: &Point2<f64>| {
+            let d = q - o;
+            (d.dot(&ua), d.dot(&ub))
+        };
+        let samples: Vec<(f64, f64, f64)> = g
+            .samples
+            .iter()
+            .flatten()
+            .map(|(q, tk)| {
+                let (a, b) = local(q);
+                (a, b, step.filled(q, *tk))
+            })
+            .collect();
+        let across_b: Vec<(f64, f64, f64)> = samples.iter().map(|&(a, b, f)| (b, a, f)).collect();
+        let (ra0, ra1) = (
+            refine_side(&samples, a0, (b0, b1), true, t),
+            refine_side(&samples, a1, (b0, b1), false, t),
+        );
+        let (rb0, rb1) = (
+            refine_side(&across_b, b0, (a0, a1), true, t),
+            refine_side(&across_b, b1, (a0, a1), false, t),
+        );
+        (a0, a1, b0, b1) = (ra0, ra1, rb0, rb1);
+        if a1 - a0 < t || b1 - b0 < t {
+            return None;
+        }
+    }
     let at = |a: f64, b: f64| o + ua * a + ub * b;
     Some([at(a0, b0), at(a1, b0), at(a1, b1), at(a0, b1)])
+}
+
+/// A feature's step above (or below) its surface's background: where a point lies on it.
+struct Step<'a> {
+    background: &'a Background,
+    sign: f64,
+    plateau: f64,
+}
+
+impl Step<'_> {
+    /// How much of the step a point at `q` with temperature `t_k` shows: 0 on the background, 1 on
+    /// the feature's plateau, clamped.
+    fn filled(&self, q: &Point2<f64>, t_k: f64) -> f64 {
+        let r = t_k - self.background.a - self.background.b * q.y;
+        (self.sign * r / self.plateau.max(1e-9)).clamp(0.0, 1.0)
+    }
+}
+
+/// One side of a feature's rectangle to a fraction of a texel: `samples` are (across, along,
+/// filled) with `across` the coordinate perpendicular to the side, at `edge` from the texels; the
+/// feature lies beyond it (`rising`: at larger `across`). Over a band of ± two texels across the
+/// side (away from the side's ends) a blurred step keeps its integral, so the mean fill f of the
+/// band's points puts the edge at the band's far end minus 4 texels × f. Unchanged with fewer than
+/// 12 points in the band, and never moved by more than a texel.
+fn refine_side(
+    samples: &[(f64, f64, f64)],
+    edge: f64,
+    (lo, hi): (f64, f64),
+    rising: bool,
+    t: f64,
+) -> f64 {
+    let w = 2.0 * t;
+    let (mut n, mut sum) = (0usize, 0.0);
+    for &(a, b, f) in samples {
+        if (a - edge).abs() <= w && b > lo + t && b < hi - t {
+            n += 1;
+            sum += f;
+        }
+    }
+    if n < 12 {
+        return edge;
+    }
+    let fill = sum / n as f64;
+    let refined = if rising {
+        edge + w - 2.0 * w * fill
+    } else {
+        edge - w + 2.0 * w * fill
+    };
+    refined.clamp(edge - t, edge + t)
 }
 
 /// A feature of region `comp` with outline `poly`: its temperature from interior texels (all four
@@ -660,8 +755,13 @@ pub fn analyse_surface(
                 ));
                 continue;
             }
-            let core = half_contrast_core(&g, &comp, &resid, sign);
-            let poly = match outline(&g, &comp, &core, host, area) {
+            let (core, plateau) = half_contrast_core(&g, &comp, &resid, sign);
+            let step = plateau.map(|plateau| Step {
+                background: &bg,
+                sign,
+                plateau,
+            });
+            let poly = match outline(&g, &comp, &core, host, area, step.as_ref()) {
                 Ok(poly) => poly,
                 Err(why) => {
                     if !why.is_empty() {
@@ -822,6 +922,33 @@ fn background_raster(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A blurred step at 0.913 m, sampled every centimetre with noise: the texel grid says 0.90 (a
+    /// 3 cm texel's boundary); the band's mean fill puts the side within 3 mm, on either side.
+    #[test]
+    fn a_feature_side_is_placed_between_texel_boundaries() {
+        let (edge, blur) = (0.913, 0.015);
+        let fill = |a: f64| 0.5 * (1.0 + ((a - edge) / blur).tanh());
+        let mut rising = Vec::new();
+        let mut falling = Vec::new();
+        for i in 0..200 {
+            for j in 0..20 {
+                let (a, b) = (0.5 + i as f64 * 0.005, j as f64 * 0.05);
+                let noise = 0.05 * (((i * 7 + j * 13) % 11) as f64 / 11.0 - 0.5);
+                rising.push((a, b, (fill(a) + noise).clamp(0.0, 1.0)));
+                falling.push((-a, b, (fill(a) + noise).clamp(0.0, 1.0)));
+            }
+        }
+        let r = refine_side(&rising, 0.90, (0.0, 1.0), true, 0.03);
+        assert!((r - edge).abs() < 0.003, "{r}");
+        let f = refine_side(&falling, -0.90, (0.0, 1.0), false, 0.03);
+        assert!((f + edge).abs() < 0.003, "{f}");
+        // Too few points in the band: the texel's side stays.
+        assert_eq!(
+            refine_side(&rising[..5], 0.90, (0.0, 1.0), true, 0.03),
+            0.90
+        );
+    }
 
     /// A stratified wall (18 °C at mid-height, 0.8 K/m) with a 14 °C window over a quarter of it.
     #[test]
