@@ -115,21 +115,6 @@ impl IcpTarget {
             .map_or(f64::INFINITY, |r| (r.distance as f64).sqrt());
         Some((k, (p - self.points[k]).norm(), second))
     }
-
-    /// The nearest target point to `p` within `max_m`: (index, distance).
-    pub fn nearest(&self, p: &Point3<f64>, max_m: f64) -> Option<(usize, f64)> {
-        if self.points.is_empty() {
-            return None;
-        }
-        let r = self
-            .tree
-            .query(&[p.x as f32, p.y as f32, p.z as f32])
-            .nearest_one::<SquaredEuclidean<f32>>()
-            .execute();
-        let k = r.item as usize;
-        let d = (p - self.points[k]).norm();
-        (d <= max_m).then_some((k, d))
-    }
 }
 
 /// A source point's last nearest-neighbour query: where it was asked, the nearest target point,

@@ -116,6 +116,12 @@ pub fn ransac_plane<R: Rng>(
     let is_inlier = |pl: &Plane, i: usize, tol: f64| {
         pl.distance(&points[i]).abs() <= tol && pl.normal.dot(&normals[i]).abs() >= cos
     };
+    let score = |pl: &Plane| {
+        sample
+            .iter()
+            .filter(|&&i| is_inlier(pl, i, params.distance_m))
+            .count()
+    };
     let mut best: Option<(Plane, usize)> = None;
     for _ in 0..params.iterations {
         let (a, b, c) = (
@@ -134,12 +140,9 @@ pub fn ransac_plane<R: Rng>(
         {
             continue;
         }
-        let score = sample
-            .iter()
-            .filter(|&&i| is_inlier(&pl, i, params.distance_m))
-            .count();
-        if best.is_none_or(|b| score > b.1) {
-            best = Some((pl, score));
+        let s = score(&pl);
+        if best.is_none_or(|b| s > b.1) {
+            best = Some((pl, s));
         }
     }
     if best.is_none() {
@@ -151,12 +154,9 @@ pub fn ransac_plane<R: Rng>(
                 continue;
             };
             let pl = Plane::from_point_normal(&points[a], n);
-            let score = sample
-                .iter()
-                .filter(|&&i| is_inlier(&pl, i, params.distance_m))
-                .count();
-            if best.is_none_or(|b| score > b.1) {
-                best = Some((pl, score));
+            let s = score(&pl);
+            if best.is_none_or(|b| s > b.1) {
+                best = Some((pl, s));
             }
         }
     }

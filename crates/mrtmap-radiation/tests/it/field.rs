@@ -1,6 +1,7 @@
 use mrtmap_geometry::nalgebra::Point3;
 use mrtmap_radiation::{
-    GridSpec, MapFrame, Method, MonteCarlo, MrtEngine, MrtError, MrtField, example_office,
+    GridSpec, MapFrame, Method, MonteCarlo, MrtEngine, MrtError, MrtField, RadiantScene,
+    example_office,
 };
 
 use crate::common::*;
@@ -56,8 +57,8 @@ fn l_shaped_floor_leaves_out_the_missing_quadrant() {
     assert!(field.nodes.iter().all(|n| n.result.is_ok()));
 }
 
-#[test]
-fn nodes_inside_occluders_are_reported_not_computed() {
+/// A 4 × 4 × 3 m room with a 21 °C shelf along one wall, x < 1 m up to 2 m.
+fn room_with_a_shelf() -> RadiantScene {
     let mut f = box_room(4.0, 4.0, 3.0, [20.0; 6]);
     f.occluders.push(box_occluder(
         "shelf",
@@ -65,15 +66,25 @@ fn nodes_inside_occluders_are_reported_not_computed() {
         [1.0, 4.0, 2.0],
         21.0,
     ));
-    let s = scene(&f);
-    let e = MrtEngine::new(
-        &s,
+    scene(&f)
+}
+
+/// Monte Carlo with 800 rays.
+fn monte_carlo(s: &RadiantScene) -> MrtEngine<'_> {
+    MrtEngine::new(
+        s,
         Method::MonteCarlo(MonteCarlo {
             rays: 800,
             ..MonteCarlo::default()
         }),
     )
-    .unwrap();
+    .unwrap()
+}
+
+#[test]
+fn nodes_inside_occluders_are_reported_not_computed() {
+    let s = room_with_a_shelf();
+    let e = monte_carlo(&s);
     let field = MrtField::compute(
         &e,
         MapFrame::of_scene(&s).unwrap(),
@@ -98,22 +109,8 @@ fn nodes_inside_occluders_are_reported_not_computed() {
 /// furniture's inside): refused like a point inside; a millimetre off the face it is computed.
 #[test]
 fn a_point_on_a_furniture_face_is_refused_and_one_beside_it_is_not() {
-    let mut f = box_room(4.0, 4.0, 3.0, [20.0; 6]);
-    f.occluders.push(box_occluder(
-        "shelf",
-        [0.0, 0.0, 0.0],
-        [1.0, 4.0, 2.0],
-        21.0,
-    ));
-    let s = scene(&f);
-    let e = MrtEngine::new(
-        &s,
-        Method::MonteCarlo(MonteCarlo {
-            rays: 800,
-            ..MonteCarlo::default()
-        }),
-    )
-    .unwrap();
+    let s = room_with_a_shelf();
+    let e = monte_carlo(&s);
     let on = e.at(&Point3::new(1.0, 2.0, 1.1), 1);
     assert!(matches!(on, Err(MrtError::InsideOccluder { .. })), "{on:?}");
     let beside = e.at(&Point3::new(1.001, 2.0, 1.1), 1).unwrap();
