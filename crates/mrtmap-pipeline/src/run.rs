@@ -16,6 +16,7 @@ use mrtmap_geometry::nalgebra::{Isometry3, Point3};
 use mrtmap_io::{Recording, Trajectory, read_cloud_ply, write_atomic, write_cloud_ply};
 use mrtmap_radiation::{GridSpec, RadiantScene};
 use mrtmap_scan::segment::{MaskInput, SegmentParams, SegmentReport, refined_poses, segment};
+use mrtmap_scan::track::{TrackParams, TrackReport, track};
 use mrtmap_scan::{FuseParams, FusionReport, fuse};
 
 use crate::cache::{Fingerprint, Stage, StageOutcome, read_json, run_or_reuse, write_json};
@@ -25,6 +26,30 @@ use crate::level::{DEFAULT_CAMERA_ACCURACY_K, Level, Reference, find_level, read
 use crate::maps::{Mark, MarkAt, Summary, make_map};
 use crate::progress::Progress;
 use crate::settings::{PointEntry, PointFrame, Project, Quantity};
+
+/// Tracks `rec`'s colour and depth frames into `out`: trajectory.txt (world_from_depth, TUM) and
+/// track.json (what was done; with the recording's groundtruth.txt, the trajectory error).
+pub fn track_into(
+    rec: &Recording,
+    params: &TrackParams,
+    out: &Path,
+    progress: &dyn Progress,
+) -> Result<(Trajectory, TrackReport)> {
+    progress.begin("tracking the camera (colour + depth)");
+    let (traj, report) = track(rec, params, &|d, t| progress.advance(d as u64, t as u64))
+        .map_err(|e| Error::source(&rec.dir, e.to_string()))?;
+    std::fs::create_dir_all(out).map_err(|e| mrtmap_io::FileError::io(out, e))?;
+    write_atomic(
+        &out.join("trajectory.txt"),
+        traj.to_tum(&format!(
+            "mrtmap track of {}: world_from_depth at the colour frames' times (the first frame's depth camera is the world)",
+            rec.dir.display()
+        ))
+        .as_bytes(),
+    )?;
+    write_json(&out.join("track.json"), &report)?;
+    Ok((traj, report))
+}
 
 /// Fuses `rec` into `out`: cloud.ply, fusion.json and poses.txt (the refined trajectory).
 pub fn fuse_into(

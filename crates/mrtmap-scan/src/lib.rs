@@ -16,6 +16,7 @@ pub mod pose_graph;
 pub mod radiometric;
 pub mod segment;
 mod sync;
+pub mod track;
 pub mod voxels;
 
 pub use fuse::{FuseParams, Fused, FusionReport, IcpReport, IcpSettings, Timing, fuse};

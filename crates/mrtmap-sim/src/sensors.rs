@@ -2,7 +2,7 @@
 //! instance masks with labels. Each renders one frame from a camera pose in the room frame.
 
 use mrtmap_geometry::camera::PinholeCamera;
-use mrtmap_geometry::nalgebra::{Isometry3, Point2, Vector3};
+use mrtmap_geometry::nalgebra::{Isometry3, Point2, Point3, Vector3};
 use mrtmap_io::masks::{InstanceInfo, MaskLabels};
 use mrtmap_io::{Image16, ThermalEncoding, gaussian_blur};
 use mrtmap_physics::ZERO_CELSIUS_K;
@@ -239,7 +239,7 @@ pub fn render_thermal<R: Rng>(
 ) -> Image16 {
     let (w, h) = (cam.width as usize, cam.height as usize);
     let ss = (noise.supersample.max(1) * noise.supersample.max(1)) as usize;
-    let o: mrtmap_geometry::nalgebra::Point3<f64> = room_from_cam.translation.vector.into();
+    let o: Point3<f64> = room_from_cam.translation.vector.into();
     let view = renderer.view(room_from_cam);
     let rot = room_from_cam.rotation.to_rotation_matrix();
     let t_refl4 = (room.file.air_temperature_c + ZERO_CELSIUS_K).powi(4);
@@ -347,6 +347,59 @@ fn colour(room: &Room, hit: &Hit) -> [f64; 3] {
     }
 }
 
+/// A seed per element, so that every surface, feature and piece of furniture has its own pattern.
+fn element_seed(e: &Element) -> u64 {
+    match *e {
+        Element::Surface { surface, feature } => {
+            0x9e37_79b9 + surface as u64 * 7919 + feature.map_or(0, |f| 104_729 * (f as u64 + 1))
+        }
+        Element::Furniture(i) => 0x85eb_ca6b + i as u64 * 15_485_863,
+    }
+}
+
+/// A hash of a lattice point to [0, 1).
+fn lattice(i: i64, j: i64, k: i64, seed: u64) -> f64 {
+    let mut h = seed
+        ^ (i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+        ^ (j as u64).wrapping_mul(0xc2b2_ae3d_27d4_eb4f)
+        ^ (k as u64).wrapping_mul(0x1656_67b1_9e37_79f9);
+    h ^= h >> 33;
+    h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
+    h ^= h >> 33;
+    h = h.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+    h ^= h >> 33;
+    (h >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// Value noise in [0, 1): hashed lattice values, smoothly interpolated (no period).
+fn value_noise(p: &Vector3<f64>, seed: u64) -> f64 {
+    let f = p.map(f64::floor);
+    let r = p - f;
+    let s = r.map(|x| x * x * (3.0 - 2.0 * x));
+    let (i, j, k) = (f.x as i64, f.y as i64, f.z as i64);
+    let mut acc = 0.0;
+    for (di, wx) in [(0, 1.0 - s.x), (1, s.x)] {
+        for (dj, wy) in [(0, 1.0 - s.y), (1, s.y)] {
+            for (dk, wz) in [(0, 1.0 - s.z), (1, s.z)] {
+                acc += wx * wy * wz * lattice(i + di, j + dj, k + dk, seed);
+            }
+        }
+    }
+    acc
+}
+
+/// The pattern painted on a surface at room point `p` (m), in [0, 1]: blotches with sharp edges
+/// at three scales (50, 13 and 4 cm) over a fine grain (1.2 cm), fixed to the surface and never
+/// repeating, so that a visual tracker finds corners to follow everywhere.
+pub fn texture(p: &Vector3<f64>, seed: u64) -> f64 {
+    let n = 0.5 * value_noise(&(p / 0.5), seed)
+        + 0.3 * value_noise(&(p / 0.13), seed ^ 0x51)
+        + 0.2 * value_noise(&(p / 0.04), seed ^ 0xa7);
+    let blotch = 0.5 + 0.5 * ((n - 0.5) * 14.0).tanh();
+    let grain = value_noise(&(p / 0.012), seed ^ 0x3c);
+    (0.6 * blotch + 0.25 * n + 0.15 * grain).clamp(0.0, 1.0)
+}
+
 /// A label a detector might confuse with `label`.
 fn confusable(label: &str) -> &'static str {
     let l = label.to_lowercase();
@@ -367,8 +420,9 @@ fn confusable(label: &str) -> &'static str {
     }
 }
 
-/// Renders a colour image (RGB8, shaded by incidence) and an instance mask with labels. With
-/// `noisy_labels`, a detector's mistakes are imitated: each instance is missed with probability
+/// Renders a colour image (RGB8: each element's colour painted with its own procedural
+/// [`texture`], shaded by incidence; with `noisy_labels` also ±2 levels of sensor noise) and an
+/// instance mask with labels. With `noisy_labels`, a detector's mistakes are imitated: each instance is missed with probability
 /// 0.05 and mislabelled with probability 0.1, scores vary.
 pub fn render_rgb_and_mask<R: Rng>(
     room: &Room,
@@ -383,13 +437,24 @@ pub fn render_rgb_and_mask<R: Rng>(
     let rot = room_from_cam.rotation.to_rotation_matrix();
     let mut rgb = vec![0u8; rays.len() * 3];
     let mut mask = Image16::zeros(cam.width, cam.height);
+    // The sensor noise comes from the pose, not from `rng`, which draws the labels' mistakes.
+    let tr = room_from_cam.translation.vector;
+    let frame_seed =
+        tr.x.to_bits() ^ tr.y.to_bits().rotate_left(21) ^ tr.z.to_bits().rotate_left(42);
     for (k, d) in rays.iter().enumerate() {
         let dw = rot * d;
         if let Some(hit) = view.cast(d) {
             let shade = 0.55 + 0.45 * (hit.normal.dot(&dw) / dw.norm()).abs();
             let c = colour(room, &hit);
+            let at = room_from_cam * Point3::from(d * hit.t);
+            let tex = 0.55 + 0.45 * texture(&at.coords, element_seed(&hit.element));
             for i in 0..3 {
-                rgb[3 * k + i] = (c[i] * shade).round().clamp(0.0, 255.0) as u8;
+                let grain = if noisy_labels {
+                    4.0 * lattice(k as i64, i as i64, 0, frame_seed) - 2.0
+                } else {
+                    0.0
+                };
+                rgb[3 * k + i] = (c[i] * shade * tex + grain).round().clamp(0.0, 255.0) as u8;
             }
             mask.data[k] = instance_of(room, &hit);
         }

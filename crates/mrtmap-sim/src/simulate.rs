@@ -108,6 +108,9 @@ pub struct SimConfig {
     pub references: usize,
     /// Their standard uncertainty (K).
     pub reference_std_k: f64,
+    /// Write trajectory.txt (the pose source's estimate); without it the recording has no poses
+    /// and a tracker must find them (groundtruth.txt keeps the truth either way).
+    pub poses_in_recording: bool,
 }
 
 impl Default for SimConfig {
@@ -140,6 +143,7 @@ impl Default for SimConfig {
             radiometric: RadiometricModel::NONE,
             references: 0,
             reference_std_k: 0.1,
+            poses_in_recording: true,
         }
     }
 }
@@ -260,7 +264,8 @@ fn drifting(
         .collect()
 }
 
-/// Writes groundtruth.txt and trajectory.txt (with the configured drift); returns the pose count.
+/// Writes groundtruth.txt and, unless the recording is to have no poses, trajectory.txt (with the
+/// configured drift); returns the pose count.
 fn write_poses(
     out: &Out,
     walk: &Walk,
@@ -292,6 +297,9 @@ fn write_poses(
         ))
         .as_bytes(),
     )?;
+    if !cfg.poses_in_recording {
+        return Ok(n_poses);
+    }
     out.write(
         "trajectory.txt",
         slam.to_tum(&format!("{header}\nSLAM poses (drift {:?})", cfg.drift))

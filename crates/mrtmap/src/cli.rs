@@ -37,6 +37,9 @@ pub enum Command {
     Simulate(SimulateArgs),
     /// List the preset rooms, or print one as TOML to start your own.
     Rooms(RoomsArgs),
+    /// Track the camera of a recording that has colour and depth but no poses (trajectory.txt,
+    /// track.json; with groundtruth.txt, the trajectory error).
+    Track(TrackArgs),
     /// Fuse a recording into a 3D thermal point cloud (cloud.ply, fusion.json).
     Fuse(FuseArgs),
     /// Segment a fused cloud into the room's surfaces and thermal features: scene.json.
@@ -619,6 +622,22 @@ pub enum DriftArg {
     Odometry,
 }
 
+/// `mrtmap track`.
+#[derive(Debug, Args)]
+pub struct TrackArgs {
+    /// The recording folder (docs/recording.md) with colour frames (rgb.txt) and depth.
+    pub recording: PathBuf,
+    /// Output folder for trajectory.txt and track.json.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Do not look for loop closures.
+    #[arg(long)]
+    pub no_loops: bool,
+    /// FAST corner threshold (grey levels); lower finds more corners on weak texture.
+    #[arg(long, default_value_t = 12)]
+    pub fast_threshold: u8,
+}
+
 /// `mrtmap simulate`.
 #[derive(Debug, Args)]
 pub struct SimulateArgs {
@@ -658,6 +677,10 @@ pub struct SimulateArgs {
     /// Colour and instance-mask frame rate (Hz).
     #[arg(long, default_value_t = 5.0)]
     pub rgb_hz: f64,
+    /// Leave trajectory.txt out: a recording without a pose source (colour, depth and thermal
+    /// only), for `mrtmap track`; groundtruth.txt still has the true poses.
+    #[arg(long)]
+    pub no_poses: bool,
     /// Monte Carlo rays per truth point (rooms with furniture or not convex).
     #[arg(long, default_value_t = 100_000)]
     pub truth_rays: usize,

@@ -86,28 +86,38 @@ impl Recording {
         let rgb = list(dir, "rgb.txt", false)?;
         let masks = list(dir, "masks.txt", false)?;
         let traj_path = dir.join("trajectory.txt");
-        if !traj_path.exists() {
+        let mut warnings = Vec::new();
+        // Without poses, a recording with colour can still be tracked (`mrtmap track`).
+        let trajectory = if traj_path.exists() {
+            Trajectory::read(&traj_path)?
+        } else if !rgb.is_empty() {
+            warnings.push(
+                "no trajectory.txt: the poses must come from the built-in tracker".to_string(),
+            );
+            Trajectory::default()
+        } else {
             return Err(FileError::new(
                 &traj_path,
                 None,
-                FileErrorKind::Missing("trajectory.txt (a recording needs it)".into()),
+                FileErrorKind::Missing(
+                    "trajectory.txt (a recording needs it, or colour frames in rgb.txt to track)"
+                        .into(),
+                ),
             ));
-        }
-        let trajectory = Trajectory::read(&traj_path)?;
+        };
         let gt_path = dir.join("groundtruth.txt");
         let groundtruth = if gt_path.exists() {
             Some(Trajectory::read(&gt_path)?)
         } else {
             None
         };
-        let mut warnings = Vec::new();
         if depth.is_empty() {
             warnings.push("depth.txt lists no frames".to_string());
         }
         if thermal.is_empty() {
             warnings.push("thermal.txt lists no frames".to_string());
         }
-        if trajectory.is_empty() {
+        if trajectory.is_empty() && traj_path.exists() {
             warnings.push("trajectory.txt has no poses".to_string());
         }
         let limits = InterpolationLimits::default();

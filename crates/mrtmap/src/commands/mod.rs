@@ -17,6 +17,7 @@ mod segment;
 mod simulate;
 mod simulate_board;
 mod thermal;
+mod track;
 mod validate;
 
 use crate::cli::{Cli, Command};
@@ -31,6 +32,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::ExampleScene(a) => example_scene::run(&a),
         Command::Simulate(a) => simulate::run(&a),
         Command::Rooms(a) => rooms::run(&a),
+        Command::Track(a) => track::run(&a),
         Command::Fuse(a) => fuse::run(&a),
         Command::Segment(a) => segment::run(&a),
         Command::Run(a) => run::run(&a),

@@ -34,6 +34,7 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<()> {
     cfg.depth_hz = a.depth_hz;
     cfg.thermal_hz = a.thermal_hz;
     cfg.rgb_hz = a.rgb_hz;
+    cfg.poses_in_recording = !a.no_poses;
     cfg.truth_rays = a.truth_rays;
     cfg.radiometric = a.camera.model(a.noise);
     cfg.references = a.camera.references(a.noise);

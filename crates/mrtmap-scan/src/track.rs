@@ -1,0 +1,1024 @@
+//! Built-in RGB-D tracking: poses for a recording that has colour and depth but no pose source.
+//!
+//! ```text
+//!  colour frame ─ FAST-9 corners (imageproc), spread over a grid ─ BRIEF-256 (fixed test pairs)
+//!      │ depth frame nearest in time → z-buffer in the colour image → 3D of each corner
+//!      │ match to the reference keyframe: guided by the constant-velocity prediction
+//!      │   (or, failing that, over the whole image), mutual best with a ratio test
+//!      │ RANSAC on 3D–3D triples (Kabsch), inliers by reprojection → Gauss–Newton on the
+//!      │   reprojection error (Huber)                           = the frame's pose
+//!      │ keyframe when the inliers thin out or the camera moved / turned enough
+//!      └ loop closure: each new keyframe against older ones nearby (descriptors + RANSAC),
+//!        pose graph over keyframes (tiny-solver), frames follow their keyframes
+//! ```
+//!
+//! The depth frame was taken at its own time: its points are moved to the colour frame's time with
+//! the camera's current velocity. Results are deterministic (fixed BRIEF pairs, RANSAC seeded per
+//! frame) and do not depend on the number of threads (features are computed in parallel, tracking
+//! is sequential).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::time::Instant;
+
+use imageproc::binary_descriptors::brief::{TestPair, brief};
+use imageproc::corners::corners_fast9;
+use imageproc::point::Point;
+use mrtmap_geometry::camera::PinholeCamera;
+use mrtmap_geometry::nalgebra::{
+    Isometry3, Matrix3, Matrix6, Point2, Point3, Rotation3, Translation3, UnitQuaternion, Vector3,
+    Vector6,
+};
+use mrtmap_io::{Recording, Trajectory, read_image16};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::pose_graph::{Edge, optimise};
+
+/// Tracking settings.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct TrackParams {
+    /// FAST-9 threshold (grey levels).
+    pub fast_threshold: u8,
+    /// Corners are spread over cells of this size (px)…
+    pub cell_px: u32,
+    /// …keeping at most this many (the strongest) per cell.
+    pub per_cell: usize,
+    /// A match's Hamming distance (of 256 bits) at most this.
+    pub max_hamming: u32,
+    /// Lowe's ratio: best distance below this fraction of the second best.
+    pub ratio: f64,
+    /// Guided matching: search radius around the predicted pixel (px).
+    pub search_radius_px: f64,
+    /// Reprojection error of an inlier (px).
+    pub inlier_px: f64,
+    /// A pose needs this many inliers.
+    pub min_inliers: usize,
+    /// RANSAC hypotheses.
+    pub ransac_iterations: usize,
+    /// A new keyframe when the inliers fall below this fraction of the keyframe's corners with depth…
+    pub keyframe_inlier_ratio: f64,
+    /// …or the camera moved this far from it (m)…
+    pub keyframe_move_m: f64,
+    /// …or turned this much (degrees).
+    pub keyframe_turn_deg: f64,
+    /// Corners farther than this have no 3D point (the depth noise grows with z²).
+    pub max_depth_m: f64,
+    /// Largest time between a colour frame and its depth frame (s).
+    pub sync_tolerance_s: f64,
+    /// Look for loop closures.
+    pub loop_closure: bool,
+    /// A loop joins keyframes at least this many keyframes apart…
+    pub loop_min_separation: usize,
+    /// …whose estimated positions lie within this distance (m)…
+    pub loop_radius_m: f64,
+    /// …with at least this many inliers.
+    pub loop_min_inliers: usize,
+}
+
+impl Default for TrackParams {
+    fn default() -> Self {
+        Self {
+            fast_threshold: 12,
+            cell_px: 32,
+            per_cell: 6,
+            max_hamming: 70,
+            ratio: 0.85,
+            search_radius_px: 40.0,
+            inlier_px: 2.5,
+            min_inliers: 25,
+            ransac_iterations: 200,
+            keyframe_inlier_ratio: 0.35,
+            keyframe_move_m: 0.4,
+            keyframe_turn_deg: 20.0,
+            max_depth_m: 3.5,
+            sync_tolerance_s: 0.02,
+            loop_closure: true,
+            loop_min_separation: 12,
+            loop_radius_m: 1.5,
+            loop_min_inliers: 40,
+        }
+    }
+}
+
+/// What tracking did.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TrackReport {
+    /// Colour frames.
+    pub frames: usize,
+    /// Frames with a pose.
+    pub tracked: usize,
+    /// Frames without a depth frame near enough in time.
+    pub unsynced: usize,
+    /// Frames whose pose could not be found (lost).
+    pub lost: usize,
+    /// Frames found again against an older keyframe after being lost or off the reference.
+    pub relocalised: usize,
+    /// Keyframes.
+    pub keyframes: usize,
+    /// Loop closures tried (candidate keyframe pairs) and accepted.
+    pub loops_tried: usize,
+    /// Accepted loop closures.
+    pub loops_accepted: usize,
+    /// Mean corners per frame.
+    pub mean_corners: f64,
+    /// Mean inliers per tracked frame.
+    pub mean_inliers: f64,
+    /// Mean inlier reprojection error (px).
+    pub mean_reprojection_px: f64,
+    /// Pose graph: weighted squared error before and after (0 without loops).
+    pub graph_cost_before: f64,
+    /// After.
+    pub graph_cost_after: f64,
+    /// Wall time (s).
+    pub seconds: f64,
+    /// Against the recording's true poses (groundtruth.txt), when it has them.
+    pub accuracy: Option<TrajectoryError>,
+}
+
+/// Absolute trajectory error (TUM's definition: poses associated by time, rigidly aligned).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TrajectoryError {
+    /// Poses compared.
+    pub poses: usize,
+    /// RMSE of the positions after alignment (m).
+    pub ate_rmse_m: f64,
+    /// Largest position error (m).
+    pub ate_max_m: f64,
+    /// RMSE of the orientations after alignment (degrees).
+    pub rotation_rmse_deg: f64,
+}
+
+/// Why tracking could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum TrackError {
+    /// The recording has no colour stream or no colour camera in its rig.
+    #[error("{0}")]
+    NoColour(String),
+    /// A frame could not be read.
+    #[error(transparent)]
+    File(#[from] mrtmap_io::FileError),
+    /// A colour image could not be decoded.
+    #[error("{path}: cannot read the colour image ({why}); re-export the frame as PNG or JPEG")]
+    Colour {
+        /// The file.
+        path: String,
+        /// Why.
+        why: String,
+    },
+    /// Too few frames could be tracked.
+    #[error("tracking found a pose for only {tracked} of {frames} colour frames: {why}")]
+    Failed {
+        /// Tracked frames.
+        tracked: usize,
+        /// Frames.
+        frames: usize,
+        /// Advice.
+        why: String,
+    },
+}
+
+/// Corners of one frame with descriptors and, where the depth has them, 3D points in the colour
+/// camera's frame (see [`Features::moved`]).
+#[derive(Clone, Debug, Default)]
+struct Features {
+    px: Vec<Point2<f64>>,
+    /// Normalised image coordinates (distortion removed).
+    norm: Vec<Point2<f64>>,
+    desc: Vec<[u64; 4]>,
+    /// 3D points as the depth frame gives them at the corners' pixels (no motion).
+    xyz: Vec<Option<Point3<f64>>>,
+    /// The depth frame's z in the colour image (row-major), kept until the points are moved.
+    zmap: Option<std::sync::Arc<Vec<f32>>>,
+    /// Depth frame time minus colour frame time (s).
+    dt: f64,
+}
+
+impl Features {
+    /// The 3D points at the colour frame's time: `motion` is colour(t)_from_colour(t + dt), the
+    /// camera's motion over the depth frame's offset. The depth image saw each surface point at
+    /// another pixel than the colour image: a corner's depth is looked up where its point was
+    /// at the depth frame's time (two fixed-point steps), then moved.
+    fn moved(
+        &self,
+        motion: &Isometry3<f64>,
+        cam: &PinholeCamera,
+        max_depth_m: f64,
+    ) -> Vec<Option<Point3<f64>>> {
+        let Some(z) = self.zmap.as_deref() else {
+            return self.xyz.clone();
+        };
+        let (w, h) = (cam.width as i64, cam.height as i64);
+        let at = |px: &Point2<f64>| -> Option<f64> {
+            let (x, y) = (px.x.round() as i64, px.y.round() as i64);
+            (x >= 0 && y >= 0 && x < w && y < h)
+                .then(|| z[(y * w + x) as usize])
+                .filter(|v| v.is_finite())
+                .map(f64::from)
+        };
+        let back = motion.inverse();
+        self.xyz
+            .iter()
+            .zip(&self.norm)
+            .map(|(p0, n)| {
+                let mut p = (*p0)?;
+                let ray = Vector3::new(n.x, n.y, 1.0);
+                for _ in 0..2 {
+                    let then = back * p;
+                    let px = cam.project(&then)?;
+                    let zz = at(&px)?;
+                    let seen = motion * Point3::from(cam.unproject(&px) * zz);
+                    p = Point3::from(ray * seen.z);
+                }
+                (p.z <= max_depth_m).then_some(p)
+            })
+            .collect()
+    }
+}
+
+fn hamming(a: &[u64; 4], b: &[u64; 4]) -> u32 {
+    (a[0] ^ b[0]).count_ones()
+        + (a[1] ^ b[1]).count_ones()
+        + (a[2] ^ b[2]).count_ones()
+        + (a[3] ^ b[3]).count_ones()
+}
+
+/// BRIEF test pairs, fixed (imageproc draws them from the OS's randomness unless given).
+fn test_pairs() -> Vec<TestPair> {
+    let mut rng = ChaCha8Rng::seed_from_u64(0x0b71_ef00);
+    let mut out = Vec::with_capacity(256);
+    while out.len() < 256 {
+        // Gaussian around the 31 × 31 patch's centre, σ 6.6 (Calonder et al.'s G II).
+        let mut g = || {
+            let (u1, u2): (f64, f64) = (rng.random_range(1e-12..1.0), rng.random::<f64>());
+            16.0 + 6.6 * (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+        };
+        let (x0, y0, x1, y1) = (g(), g(), g(), g());
+        if [x0, y0, x1, y1].iter().all(|v| (0.0..31.0).contains(v)) {
+            out.push(TestPair {
+                p0: Point::new(x0 as u32, y0 as u32),
+                p1: Point::new(x1 as u32, y1 as u32),
+            });
+        }
+    }
+    out
+}
+
+/// The cameras tracking uses.
+struct Cameras {
+    colour: PinholeCamera,
+    depth: PinholeCamera,
+    depth_scale: f64,
+    /// p_colour = colour_from_depth · p_depth.
+    colour_from_depth: Isometry3<f64>,
+}
+
+/// Depth of the colour image's pixels: the depth frame's points moved into the colour camera and
+/// z-buffered (nearest wins).
+fn depth_in_colour(depth: &mrtmap_io::Image16, cams: &Cameras) -> Vec<f32> {
+    let (cw, ch) = (cams.colour.width as usize, cams.colour.height as usize);
+    let mut z = vec![f32::INFINITY; cw * ch];
+    let same = cams.colour == cams.depth
+        && cams.colour_from_depth.translation.vector.norm() < 1e-9
+        && cams.colour_from_depth.rotation.angle() < 1e-9;
+    for v in 0..depth.height {
+        for u in 0..depth.width {
+            let raw = depth.data[(v * depth.width + u) as usize];
+            if raw == 0 {
+                continue;
+            }
+            let d = raw as f64 / cams.depth_scale;
+            if same {
+                z[v as usize * cw + u as usize] = d as f32;
+                continue;
+            }
+            let p = Point3::from(cams.depth.unproject(&Point2::new(u as f64, v as f64)) * d);
+            let q = cams.colour_from_depth * p;
+            if let Some(px) = cams.colour.project(&q) {
+                let (x, y) = (px.x.round(), px.y.round());
+                if x >= 0.0 && y >= 0.0 && (x as usize) < cw && (y as usize) < ch {
+                    let k = y as usize * cw + x as usize;
+                    z[k] = z[k].min(q.z as f32);
+                }
+            }
+        }
+    }
+    z
+}
+
+fn features(
+    grey: &image::GrayImage,
+    depth: Option<(std::sync::Arc<Vec<f32>>, f64)>,
+    cams: &Cameras,
+    pairs: &[TestPair],
+    p: &TrackParams,
+) -> Features {
+    let (w, h) = grey.dimensions();
+    const BORDER: u32 = 17;
+    let mut corners = corners_fast9(grey, p.fast_threshold);
+    corners.retain(|c| c.x >= BORDER && c.y >= BORDER && c.x + BORDER < w && c.y + BORDER < h);
+    // Non-maximum suppression (3 × 3) and the strongest few per cell.
+    let mut score = vec![0f32; (w * h) as usize];
+    for c in &corners {
+        score[(c.y * w + c.x) as usize] = c.score;
+    }
+    corners.retain(|c| {
+        let s = c.score;
+        (-1i32..=1).all(|dy| {
+            (-1i32..=1).all(|dx| {
+                let (x, y) = ((c.x as i32 + dx) as u32, (c.y as i32 + dy) as u32);
+                let o = score[(y * w + x) as usize];
+                o < s || (o == s && (dy, dx) >= (0, 0))
+            })
+        })
+    });
+    let cells_x = w.div_ceil(p.cell_px);
+    let mut cells: BTreeMap<u32, Vec<(f32, u32, u32)>> = BTreeMap::new();
+    for c in &corners {
+        cells
+            .entry((c.y / p.cell_px) * cells_x + c.x / p.cell_px)
+            .or_default()
+            .push((c.score, c.y, c.x));
+    }
+    let mut kept: Vec<Point<u32>> = Vec::new();
+    for list in cells.values_mut() {
+        list.sort_by(|a, b| b.0.total_cmp(&a.0).then((a.1, a.2).cmp(&(b.1, b.2))));
+        kept.extend(
+            list.iter()
+                .take(p.per_cell)
+                .map(|&(_, y, x)| Point::new(x, y)),
+        );
+    }
+    let Ok((desc, _)) = brief(grey, &kept, 256, Some(&pairs.to_vec())) else {
+        return Features::default();
+    };
+    let mut f = Features {
+        dt: depth.as_ref().map_or(0.0, |d| d.1),
+        ..Features::default()
+    };
+    for d in desc {
+        let (x, y) = (d.corner.x, d.corner.y);
+        let px = Point2::new(x as f64, y as f64);
+        let ray = cams.colour.unproject(&px);
+        let xyz = depth.as_ref().and_then(|(z, _)| {
+            // The nearest valid depth in the 3 × 3 neighbourhood: a corner often sits on an edge.
+            let mut best = f32::INFINITY;
+            for dy in -1i32..=1 {
+                for dx in -1i32..=1 {
+                    let k = ((y as i32 + dy) as u32 * w + (x as i32 + dx) as u32) as usize;
+                    best = best.min(z[k]);
+                }
+            }
+            let zc = z[(y * w + x) as usize];
+            // Prefer the pixel's own depth; a neighbour's only when the pixel has none.
+            let zz = if zc.is_finite() { zc } else { best };
+            (zz.is_finite() && (zz as f64) <= p.max_depth_m).then(|| Point3::from(ray * zz as f64))
+        });
+        let b = &d.bits;
+        f.desc.push([
+            b[0] as u64,
+            (b[0] >> 64) as u64,
+            b.get(1).map_or(0, |v| *v as u64),
+            b.get(1).map_or(0, |v| (*v >> 64) as u64),
+        ]);
+        f.px.push(px);
+        f.norm.push(Point2::new(ray.x, ray.y));
+        f.xyz.push(xyz);
+    }
+    f.zmap = depth.map(|d| d.0);
+    f
+}
+
+/// Matches (reference index, current index): guided by `predicted` (current_from_reference) when
+/// given, otherwise over the whole image; mutual best with a ratio test.
+fn match_features(
+    r: &Features,
+    r_xyz: &[Option<Point3<f64>>],
+    c: &Features,
+    predicted: Option<&Isometry3<f64>>,
+    cam: &PinholeCamera,
+    p: &TrackParams,
+) -> Vec<(usize, usize)> {
+    let best_for = |i: usize, cands: &mut dyn Iterator<Item = usize>| -> Option<usize> {
+        let (mut b, mut bd, mut sd) = (usize::MAX, u32::MAX, u32::MAX);
+        for j in cands {
+            let d = hamming(&r.desc[i], &c.desc[j]);
+            if d < bd {
+                (sd, bd, b) = (bd, d, j);
+            } else if d < sd {
+                sd = d;
+            }
+        }
+        (bd <= p.max_hamming && (bd as f64) < p.ratio * sd as f64).then_some(b)
+    };
+    let r2 = p.search_radius_px * p.search_radius_px;
+    let forward: Vec<Option<usize>> = (0..r.desc.len())
+        .map(|i| match predicted {
+            Some(t) => {
+                let x = r_xyz[i]?;
+                let px = cam.project(&(t * x))?;
+                let mut near = (0..c.px.len()).filter(|&j| (c.px[j] - px).norm_squared() < r2);
+                best_for(i, &mut near)
+            }
+            None => best_for(i, &mut (0..c.desc.len())),
+        })
+        .collect();
+    // Mutual: the current corner's best among the reference corners that chose it.
+    let mut chosen: BTreeMap<usize, (u32, usize)> = BTreeMap::new();
+    for (i, j) in forward.iter().enumerate() {
+        if let Some(j) = *j {
+            let d = hamming(&r.desc[i], &c.desc[j]);
+            let e = chosen.entry(j).or_insert((d, i));
+            if d < e.0 {
+                *e = (d, i);
+            }
+        }
+    }
+    chosen.into_iter().map(|(j, (_, i))| (i, j)).collect()
+}
+
+/// The rigid transform b = T · a of three or more pairs (Kabsch).
+fn kabsch(a: &[Point3<f64>], b: &[Point3<f64>]) -> Option<Isometry3<f64>> {
+    let n = a.len() as f64;
+    let ca = a.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / n;
+    let cb = b.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / n;
+    let mut h = Matrix3::zeros();
+    for (p, q) in a.iter().zip(b) {
+        h += (p.coords - ca) * (q.coords - cb).transpose();
+    }
+    let svd = h.svd(true, true);
+    let (u, vt) = (svd.u?, svd.v_t?);
+    let mut d = Matrix3::identity();
+    if (vt.transpose() * u.transpose()).determinant() < 0.0 {
+        d[(2, 2)] = -1.0;
+    }
+    let r = vt.transpose() * d * u.transpose();
+    let rot = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(r));
+    let t = cb - rot * ca;
+    Some(Isometry3::from_parts(Translation3::from(t), rot))
+}
+
+/// Reprojection residual (normalised coordinates) of reference point `x` seen at `obs` through
+/// current_from_reference `t`.
+fn residual(t: &Isometry3<f64>, x: &Point3<f64>, obs: &Point2<f64>) -> Option<(f64, f64)> {
+    let y = t * x;
+    (y.z > 1e-3).then(|| (y.x / y.z - obs.x, y.y / y.z - obs.y))
+}
+
+/// Gauss–Newton on the reprojection error (Huber at `huber` in normalised units).
+fn refine(mut t: Isometry3<f64>, pts: &[(Point3<f64>, Point2<f64>)], huber: f64) -> Isometry3<f64> {
+    for _ in 0..10 {
+        let mut hmat = Matrix6::<f64>::zeros();
+        let mut g = Vector6::<f64>::zeros();
+        for (x, obs) in pts {
+            let y = t * x;
+            if y.z < 1e-3 {
+                continue;
+            }
+            let (iz, iz2) = (1.0 / y.z, 1.0 / (y.z * y.z));
+            let e = [y.x * iz - obs.x, y.y * iz - obs.y];
+            let norm = (e[0] * e[0] + e[1] * e[1]).sqrt();
+            let w = if norm <= huber { 1.0 } else { huber / norm };
+            // d(x/z, y/z)/dY, and dY/d(ω, v) = [−[Y]×, I].
+            let jp = [[iz, 0.0, -y.x * iz2], [0.0, iz, -y.y * iz2]];
+            for (k, row) in jp.iter().enumerate() {
+                let jy = Vector3::new(row[0], row[1], row[2]);
+                let jw = y.coords.cross(&jy); // row of jy · (−[Y]×) = (Y × jy)ᵀ
+                let j = Vector6::new(jw.x, jw.y, jw.z, jy.x, jy.y, jy.z);
+                hmat += w * j * j.transpose();
+                g += w * j * e[k];
+            }
+        }
+        let Some(step) = hmat.cholesky().map(|c| c.solve(&(-g))) else {
+            break;
+        };
+        let dw = Vector3::new(step[0], step[1], step[2]);
+        let dv = Vector3::new(step[3], step[4], step[5]);
+        let delta =
+            Isometry3::from_parts(Translation3::from(dv), UnitQuaternion::from_scaled_axis(dw));
+        t = delta * t;
+        if dv.norm() < 1e-6 && dw.norm() < 1e-7 {
+            break;
+        }
+    }
+    t
+}
+
+/// A pose found from matches.
+struct Found {
+    /// current_from_reference.
+    pose: Isometry3<f64>,
+    inliers: usize,
+    reprojection_px: f64,
+}
+
+/// current_from_reference from matched corners: RANSAC on 3D–3D triples, scored by reprojection,
+/// then Gauss–Newton on the inliers' reprojection errors.
+/// A frame's corners as pose estimation sees them: normalised coordinates and 3D points.
+#[derive(Clone, Copy)]
+struct Seen<'a> {
+    norm: &'a [Point2<f64>],
+    xyz: &'a [Option<Point3<f64>>],
+}
+
+/// A match: the reference's 3D point, the current corner and its own 3D point.
+type Observation = (Point3<f64>, Point2<f64>, Option<Point3<f64>>);
+
+fn estimate(
+    r_xyz: &[Option<Point3<f64>>],
+    c: Seen<'_>,
+    matches: &[(usize, usize)],
+    prior: Option<&Isometry3<f64>>,
+    fx: f64,
+    p: &TrackParams,
+    seed: u64,
+) -> Option<Found> {
+    let obs: Vec<Observation> = matches
+        .iter()
+        .filter_map(|&(i, j)| Some((r_xyz[i]?, c.norm[j], c.xyz[j])))
+        .collect();
+    if obs.len() < p.min_inliers {
+        return None;
+    }
+    let tol = p.inlier_px / fx;
+    let count = |t: &Isometry3<f64>| -> usize {
+        obs.iter()
+            .filter(|(x, o, _)| residual(t, x, o).is_some_and(|(a, b)| a * a + b * b < tol * tol))
+            .count()
+    };
+    let both: Vec<usize> = (0..obs.len()).filter(|&k| obs[k].2.is_some()).collect();
+    let mut best: Option<(usize, Isometry3<f64>)> = prior.map(|t| (count(t), *t));
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    if both.len() >= 3 {
+        for _ in 0..p.ransac_iterations {
+            let k: [usize; 3] = std::array::from_fn(|_| both[rng.random_range(0..both.len())]);
+            if k[0] == k[1] || k[1] == k[2] || k[0] == k[2] {
+                continue;
+            }
+            let a: Vec<Point3<f64>> = k.iter().map(|&i| obs[i].0).collect();
+            let b: Vec<Point3<f64>> = k.iter().filter_map(|&i| obs[i].2).collect();
+            // A degenerate triple (nearly collinear or tiny) gives no pose.
+            let area = (a[1] - a[0]).cross(&(a[2] - a[0])).norm();
+            if area < 1e-3 {
+                continue;
+            }
+            let Some(t) = kabsch(&a, &b) else { continue };
+            let n = count(&t);
+            if best.as_ref().is_none_or(|(m, _)| n > *m) {
+                best = Some((n, t));
+            }
+        }
+    }
+    let (_, mut t) = best?;
+    for round in 0..2 {
+        let huber = if round == 0 { 2.0 * tol } else { tol };
+        let inl: Vec<(Point3<f64>, Point2<f64>)> = obs
+            .iter()
+            .filter(|(x, o, _)| {
+                residual(&t, x, o).is_some_and(|(a, b)| a * a + b * b < 4.0 * tol * tol)
+            })
+            .map(|(x, o, _)| (*x, *o))
+            .collect();
+        if inl.len() < p.min_inliers {
+            return None;
+        }
+        t = refine(t, &inl, huber);
+    }
+    let errs: Vec<f64> = obs
+        .iter()
+        .filter_map(|(x, o, _)| residual(&t, x, o))
+        .map(|(a, b)| (a * a + b * b).sqrt())
+        .filter(|e| *e < tol)
+        .collect();
+    (errs.len() >= p.min_inliers).then(|| Found {
+        pose: t,
+        inliers: errs.len(),
+        reprojection_px: fx * errs.iter().sum::<f64>() / errs.len() as f64,
+    })
+}
+
+/// A keyframe: its corners (3D at the colour frame's time) and world_from_colour.
+struct Keyframe {
+    feats: Features,
+    xyz: Vec<Option<Point3<f64>>>,
+    with_depth: usize,
+    pose: Isometry3<f64>,
+}
+
+/// The camera's velocity in its own frame: translation (m/s) and rotation (rad/s, scaled axis).
+#[derive(Clone, Copy, Debug, Default)]
+struct Twist {
+    v: Vector3<f64>,
+    w: Vector3<f64>,
+}
+
+impl Twist {
+    /// From the motion `rel` (earlier_from_later) over `dt` seconds.
+    fn from_motion(rel: &Isometry3<f64>, dt: f64) -> Self {
+        Self {
+            v: rel.translation.vector / dt,
+            w: rel.rotation.scaled_axis() / dt,
+        }
+    }
+
+    /// The motion over `dt` seconds (now_from_later; negative `dt`: now_from_earlier).
+    fn over(&self, dt: f64) -> Isometry3<f64> {
+        Isometry3::from_parts(
+            Translation3::from(self.v * dt),
+            UnitQuaternion::from_scaled_axis(self.w * dt),
+        )
+    }
+}
+
+fn rotation_deg(t: &Isometry3<f64>) -> f64 {
+    t.rotation.angle().to_degrees()
+}
+
+/// Tracks the recording's colour frames; returns world_from_depth at the colour frames' times (the
+/// first frame's depth camera is the world) and what was done.
+pub fn track(
+    rec: &Recording,
+    params: &TrackParams,
+    progress: &dyn Fn(usize, usize),
+) -> Result<(Trajectory, TrackReport), TrackError> {
+    let t0 = Instant::now();
+    let rig = &rec.rig;
+    let Some(rgb) = rig.rgb else {
+        return Err(TrackError::NoColour(format!(
+            "{}: the rig has no [rgb] camera; tracking needs the colour camera's intrinsics and its pose in the depth camera",
+            rec.dir.join("rig.toml").display()
+        )));
+    };
+    if rec.rgb.is_empty() {
+        return Err(TrackError::NoColour(format!(
+            "{}: no colour frames (rgb.txt); tracking needs them",
+            rec.dir.display()
+        )));
+    }
+    let cams = Cameras {
+        colour: rgb.camera,
+        depth: rig.depth,
+        depth_scale: rig.depth_scale,
+        colour_from_depth: rgb.depth_from_rgb.inverse(),
+    };
+    let pairs = test_pairs();
+    let n = rec.rgb.len();
+    let mut report = TrackReport {
+        frames: n,
+        ..TrackReport::default()
+    };
+    let depth_t: Vec<f64> = rec.depth.iter().map(|e| e.t).collect();
+    let nearest_depth = |t: f64| -> Option<usize> {
+        let k = depth_t.partition_point(|&x| x < t);
+        [k.checked_sub(1), (k < depth_t.len()).then_some(k)]
+            .into_iter()
+            .flatten()
+            .min_by(|&a, &b| (depth_t[a] - t).abs().total_cmp(&(depth_t[b] - t).abs()))
+            .filter(|&k| (depth_t[k] - t).abs() <= params.sync_tolerance_s)
+    };
+    let read = |i: usize| -> Result<Features, TrackError> {
+        let e = &rec.rgb[i];
+        let path = rec.path_of(e);
+        let grey = image::ImageReader::open(&path)
+            .map_err(|e| mrtmap_io::FileError::io(&path, e))?
+            .with_guessed_format()
+            .map_err(|e| mrtmap_io::FileError::io(&path, e))?
+            .decode()
+            .map_err(|why| TrackError::Colour {
+                path: path.display().to_string(),
+                why: why.to_string(),
+            })?
+            .to_luma8();
+        let depth = match nearest_depth(e.t) {
+            Some(k) => {
+                let img = read_image16(&rec.path_of(&rec.depth[k]))?;
+                Some((
+                    std::sync::Arc::new(depth_in_colour(&img, &cams)),
+                    depth_t[k] - e.t,
+                ))
+            }
+            None => None,
+        };
+        Ok(features(&grey, depth, &cams, &pairs, params))
+    };
+
+    let fx = cams.colour.fx;
+    let mut poses: Vec<Option<Isometry3<f64>>> = vec![None; n];
+    // Each tracked frame's keyframe and keyframe_from_frame, for the pose graph's correction.
+    let mut anchor: Vec<Option<(usize, Isometry3<f64>)>> = vec![None; n];
+    let mut kfs: Vec<Keyframe> = Vec::new();
+    let mut edges: Vec<Edge> = Vec::new();
+    // Motion per second (earlier_from_later over 1 s, body frame) and the last tracked frame.
+    let mut velocity = Twist::default();
+    let mut last: Option<(usize, Isometry3<f64>)> = None;
+    let (mut corners_sum, mut inliers_sum, mut reproj_sum) = (0usize, 0usize, 0.0);
+    let chunk = 16;
+    let mut start = 0;
+    while start < n {
+        let end = (start + chunk).min(n);
+        let feats: Vec<Features> = (start..end)
+            .into_par_iter()
+            .map(read)
+            .collect::<Result<_, _>>()?;
+        for (i, f) in (start..end).zip(feats) {
+            progress(i + 1, n);
+            corners_sum += f.px.len();
+            if f.xyz.iter().all(Option::is_none) && kfs.is_empty() {
+                report.unsynced += 1;
+                continue;
+            }
+            let t_now = rec.rgb[i].t;
+            // The depth's points at the colour frame's time: colour(t) from colour(t + dt).
+            let motion = velocity.over(f.dt);
+            let xyz_now = f.moved(&motion, &cams.colour, params.max_depth_m);
+            let Some(kf) = kfs.last() else {
+                let with_depth = xyz_now.iter().flatten().count();
+                if with_depth < params.min_inliers {
+                    report.unsynced += 1;
+                    continue;
+                }
+                poses[i] = Some(Isometry3::identity());
+                anchor[i] = Some((0, Isometry3::identity()));
+                kfs.push(Keyframe {
+                    feats: Features { zmap: None, ..f },
+                    xyz: xyz_now,
+                    with_depth,
+                    pose: Isometry3::identity(),
+                });
+                last = Some((i, Isometry3::identity()));
+                report.tracked += 1;
+                continue;
+            };
+            let predicted_world = last.map(|(k, p)| p * velocity.over(t_now - rec.rgb[k].t));
+            let predicted = predicted_world.map(|w| w.inverse() * kf.pose);
+            let seed = i as u64;
+            let mut found = None;
+            if let Some(pr) = predicted.as_ref() {
+                let m = match_features(&kf.feats, &kf.xyz, &f, Some(pr), &cams.colour, params);
+                found = estimate(
+                    &kf.xyz,
+                    Seen {
+                        norm: &f.norm,
+                        xyz: &xyz_now,
+                    },
+                    &m,
+                    Some(pr),
+                    fx,
+                    params,
+                    seed,
+                );
+            }
+            if found.is_none() {
+                let m = match_features(&kf.feats, &kf.xyz, &f, None, &cams.colour, params);
+                found = estimate(
+                    &kf.xyz,
+                    Seen {
+                        norm: &f.norm,
+                        xyz: &xyz_now,
+                    },
+                    &m,
+                    None,
+                    fx,
+                    params,
+                    seed,
+                );
+            }
+            let mut reference = kfs.len() - 1;
+            if found.is_none() {
+                // Lost against the reference: try the other keyframes, newest first.
+                for (k, other) in kfs.iter().enumerate().rev().skip(1) {
+                    let m =
+                        match_features(&other.feats, &other.xyz, &f, None, &cams.colour, params);
+                    if let Some(fd) = estimate(
+                        &other.xyz,
+                        Seen {
+                            norm: &f.norm,
+                            xyz: &xyz_now,
+                        },
+                        &m,
+                        None,
+                        fx,
+                        params,
+                        seed,
+                    ) {
+                        found = Some(fd);
+                        reference = k;
+                        report.relocalised += 1;
+                        break;
+                    }
+                }
+            }
+            let Some(fd) = found else {
+                report.lost += 1;
+                continue;
+            };
+            let kref = &kfs[reference];
+            let kf_from_frame = fd.pose.inverse();
+            let world = kref.pose * kf_from_frame;
+            if let Some((k, p)) = last {
+                let dt = t_now - rec.rgb[k].t;
+                if dt > 1e-6 {
+                    velocity = Twist::from_motion(&(p.inverse() * world), dt);
+                }
+            }
+            poses[i] = Some(world);
+            anchor[i] = Some((reference, kf_from_frame));
+            last = Some((i, world));
+            report.tracked += 1;
+            inliers_sum += fd.inliers;
+            reproj_sum += fd.reprojection_px;
+            let new_kf = (fd.inliers as f64)
+                < params.keyframe_inlier_ratio * kref.with_depth as f64
+                || kf_from_frame.translation.vector.norm() > params.keyframe_move_m
+                || rotation_deg(&kf_from_frame) > params.keyframe_turn_deg
+                || reference != kfs.len() - 1;
+            if !new_kf {
+                continue;
+            }
+            // The motion model now holds this frame's velocity: move its depth again.
+            let motion = velocity.over(f.dt);
+            let xyz = f.moved(&motion, &cams.colour, params.max_depth_m);
+            let with_depth = xyz.iter().flatten().count();
+            if with_depth < params.min_inliers {
+                continue;
+            }
+            let info = Matrix6::identity() * (fd.inliers as f64).max(1.0);
+            edges.push(Edge {
+                from: reference as i64,
+                to: kfs.len() as i64,
+                measured: kf_from_frame,
+                information: info,
+            });
+            let id = kfs.len();
+            anchor[i] = Some((id, Isometry3::identity()));
+            kfs.push(Keyframe {
+                feats: Features { zmap: None, ..f },
+                xyz,
+                with_depth,
+                pose: world,
+            });
+            if params.loop_closure {
+                close_loops(&mut kfs, &mut edges, &cams, params, &mut report);
+            }
+        }
+        start = end;
+    }
+    report.keyframes = kfs.len();
+    report.mean_corners = corners_sum as f64 / n.max(1) as f64;
+    report.mean_inliers = inliers_sum as f64 / report.tracked.max(1) as f64;
+    report.mean_reprojection_px = reproj_sum / report.tracked.max(1) as f64;
+    // The pose graph over keyframes, when loops were closed.
+    if report.loops_accepted > 0 {
+        let initial: BTreeMap<i64, Isometry3<f64>> = kfs
+            .iter()
+            .enumerate()
+            .map(|(k, kf)| (k as i64, kf.pose))
+            .collect();
+        if let Ok(opt) = optimise(&initial, &edges) {
+            report.graph_cost_before = opt.cost_before;
+            report.graph_cost_after = opt.cost_after;
+            for (k, kf) in kfs.iter_mut().enumerate() {
+                if let Some(p) = opt.poses.get(&(k as i64)) {
+                    kf.pose = *p;
+                }
+            }
+            for (pose, a) in poses.iter_mut().zip(&anchor) {
+                if let (Some(p), Some((k, rel))) = (pose.as_mut(), a) {
+                    *p = kfs[*k].pose * rel;
+                }
+            }
+        }
+    }
+    let mut traj = Trajectory::default();
+    for (i, p) in poses.iter().enumerate() {
+        if let Some(p) = p {
+            traj.stamps.push(rec.rgb[i].t);
+            // world_from_depth = world_from_colour · colour_from_depth.
+            traj.poses.push(p * cams.colour_from_depth);
+        }
+    }
+    // The first tracked frame's depth camera is the world.
+    if let Some(first) = traj.poses.first().copied() {
+        let inv = first.inverse();
+        for p in &mut traj.poses {
+            *p = inv * *p;
+        }
+    }
+    report.seconds = t0.elapsed().as_secs_f64();
+    if let Some(gt) = &rec.groundtruth {
+        report.accuracy = trajectory_error(&traj, gt);
+    }
+    if report.tracked < 2 || report.tracked * 2 < n {
+        return Err(TrackError::Failed {
+            tracked: report.tracked,
+            frames: n,
+            why: "too few corners or matches (a textureless view, motion blur, or colour and depth out of step); scan more slowly over textured surfaces, or record poses".into(),
+        });
+    }
+    Ok((traj, report))
+}
+
+/// Tries to join the newest keyframe to older ones nearby; adds accepted loops as edges.
+fn close_loops(
+    kfs: &mut [Keyframe],
+    edges: &mut Vec<Edge>,
+    cams: &Cameras,
+    p: &TrackParams,
+    report: &mut TrackReport,
+) {
+    let Some((new, older)) = kfs.split_last() else {
+        return;
+    };
+    let id = older.len();
+    if id < p.loop_min_separation {
+        return;
+    }
+    // Candidates: far enough back in the sequence, near in space and looking the same way.
+    let mut cands: Vec<(f64, usize)> = older[..id - p.loop_min_separation]
+        .iter()
+        .enumerate()
+        .filter_map(|(k, o)| {
+            let rel = o.pose.inverse() * new.pose;
+            let d = rel.translation.vector.norm();
+            (d < p.loop_radius_m && rotation_deg(&rel) < 35.0).then_some((d, k))
+        })
+        .collect();
+    cands.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for &(_, k) in cands.iter().take(2) {
+        report.loops_tried += 1;
+        let o = &older[k];
+        let m = match_features(&o.feats, &o.xyz, &new.feats, None, &cams.colour, p);
+        let Some(fd) = estimate(
+            &o.xyz,
+            Seen {
+                norm: &new.feats.norm,
+                xyz: &new.xyz,
+            },
+            &m,
+            None,
+            cams.colour.fx,
+            p,
+            0x100 + id as u64,
+        ) else {
+            continue;
+        };
+        if fd.inliers < p.loop_min_inliers {
+            continue;
+        }
+        report.loops_accepted += 1;
+        edges.push(Edge {
+            from: k as i64,
+            to: id as i64,
+            measured: fd.pose.inverse(),
+            information: Matrix6::identity() * fd.inliers as f64,
+        });
+    }
+}
+
+/// TUM's absolute trajectory error: each estimated pose against the true pose interpolated at its
+/// time, after the rigid alignment (Horn) that minimises the position errors.
+pub fn trajectory_error(est: &Trajectory, truth: &Trajectory) -> Option<TrajectoryError> {
+    let limits = mrtmap_io::InterpolationLimits::default();
+    let pairs: Vec<(Isometry3<f64>, Isometry3<f64>)> = est
+        .stamps
+        .iter()
+        .zip(&est.poses)
+        .filter_map(|(&t, p)| Some((*p, truth.interpolate(t, &limits)?)))
+        .collect();
+    if pairs.len() < 3 {
+        return None;
+    }
+    let a: Vec<Point3<f64>> = pairs
+        .iter()
+        .map(|(p, _)| Point3::from(p.translation.vector))
+        .collect();
+    let b: Vec<Point3<f64>> = pairs
+        .iter()
+        .map(|(_, q)| Point3::from(q.translation.vector))
+        .collect();
+    let align = kabsch(&a, &b)?;
+    let (mut se, mut max, mut re) = (0.0, 0.0f64, 0.0);
+    for (p, q) in &pairs {
+        let al = align * p;
+        let e = (al.translation.vector - q.translation.vector).norm();
+        se += e * e;
+        max = max.max(e);
+        let r = (al.rotation.inverse() * q.rotation).angle().to_degrees();
+        re += r * r;
+    }
+    let n = pairs.len() as f64;
+    Some(TrajectoryError {
+        poses: pairs.len(),
+        ate_rmse_m: (se / n).sqrt(),
+        ate_max_m: max,
+        rotation_rmse_deg: (re / n).sqrt(),
+    })
+}
+
+/// Writes a trajectory as TUM text.
+pub fn write_trajectory(traj: &Trajectory, path: &Path, header: &str) -> std::io::Result<()> {
+    std::fs::write(path, traj.to_tum(header))
+}

@@ -1,0 +1,56 @@
+//! `mrtmap track`: poses for a recording without a pose source.
+
+use mrtmap_io::Recording;
+use mrtmap_pipeline::run::track_into;
+use mrtmap_scan::track::TrackParams;
+
+use crate::cli::TrackArgs;
+use crate::output::Bar;
+
+pub fn run(a: &TrackArgs) -> anyhow::Result<()> {
+    let rec = Recording::open(&a.recording)?;
+    for w in &rec.warnings {
+        eprintln!("warning: {w}");
+    }
+    let params = TrackParams {
+        loop_closure: !a.no_loops,
+        fast_threshold: a.fast_threshold,
+        ..TrackParams::default()
+    };
+    let bar = Bar::new(" frames");
+    let (traj, r) = track_into(&rec, &params, &a.out, &bar)?;
+    bar.finish();
+    outln!(
+        "tracked {} of {} colour frames in {:.1} s: {} keyframes, {} loop closures accepted of {} tried, {} frames lost, {} found again",
+        r.tracked,
+        r.frames,
+        r.seconds,
+        r.keyframes,
+        r.loops_accepted,
+        r.loops_tried,
+        r.lost,
+        r.relocalised
+    );
+    outln!(
+        "  {:.0} corners per frame, {:.0} inliers per tracked frame, reprojection {:.2} px; {} frames without depth near in time",
+        r.mean_corners,
+        r.mean_inliers,
+        r.mean_reprojection_px,
+        r.unsynced
+    );
+    if let Some(e) = r.accuracy {
+        outln!(
+            "  against groundtruth.txt ({} poses): ATE RMSE {:.1} mm (max {:.1} mm), rotation RMSE {:.2}°",
+            e.poses,
+            e.ate_rmse_m * 1000.0,
+            e.ate_max_m * 1000.0,
+            e.rotation_rmse_deg
+        );
+    }
+    outln!(
+        "wrote {} poses to {}",
+        traj.len(),
+        a.out.join("trajectory.txt").display()
+    );
+    Ok(())
+}
