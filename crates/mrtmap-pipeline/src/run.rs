@@ -25,7 +25,7 @@ use crate::error::{Error, Result};
 use crate::level::{DEFAULT_CAMERA_ACCURACY_K, Level, Reference, find_level, read_references};
 use crate::maps::{Mark, MarkAt, Summary, make_map};
 use crate::progress::Progress;
-use crate::settings::{PointEntry, PointFrame, Project, Quantity};
+use crate::settings::{PointEntry, PointFrame, Project, Quantity, TrackMode};
 
 /// Tracks `rec`'s colour and depth frames into `out`: trajectory.txt (world_from_depth, TUM) and
 /// track.json (what was done; with the recording's groundtruth.txt, the trajectory error).
@@ -302,6 +302,9 @@ fn comfort_stage(
 pub struct RunOutcome {
     /// What each stage did.
     pub stages: Vec<StageOutcome>,
+    /// The built-in tracker's report, when it ran (the recording had no poses, or
+    /// `[track] mode = "always"`).
+    pub track: Option<TrackReport>,
     /// The segmented scene.
     pub scene: RadiantScene,
     /// Fusion's report.
@@ -318,6 +321,46 @@ pub struct RunOutcome {
     pub warnings: Vec<String>,
 }
 
+/// The track stage: `out/track`, when the recording has no poses or `[track] mode = "always"`;
+/// the recording's trajectory becomes the tracked one.
+fn track_stage(
+    rec: &mut Recording,
+    out: &Path,
+    p: &Project,
+    force: bool,
+    progress: &dyn Progress,
+) -> Result<Option<(StageOutcome, TrackReport)>> {
+    let has_poses = !rec.trajectory.is_empty();
+    let needed = match p.track.mode {
+        TrackMode::Auto => !has_poses,
+        TrackMode::Always => true,
+        TrackMode::Never => {
+            if !has_poses {
+                return Err(Error::source(
+                    &rec.dir.join("trajectory.txt"),
+                    "the recording has no poses and [track] mode = \"never\": record poses, or set mode = \"auto\" to track the colour and depth frames",
+                ));
+            }
+            false
+        }
+    };
+    if !needed {
+        return Ok(None);
+    }
+    let dir = out.join("track");
+    let fingerprint = ["rig.toml", "depth.txt", "rgb.txt"]
+        .iter()
+        .fold(Fingerprint::new(), |f, n| f.file(&rec.dir.join(n)))
+        .setting("track", &p.track);
+    let stage = Stage::in_dir("track", &dir, &["trajectory.txt", "track.json"]);
+    let params = p.track.params();
+    let outcome = run_or_reuse(&stage, fingerprint, force, || {
+        track_into(rec, &params, &dir, progress).map(|_| ())
+    })?;
+    rec.trajectory = Trajectory::read(&dir.join("trajectory.txt"))?;
+    Ok(Some((outcome, read_json(&dir.join("track.json"))?)))
+}
+
 /// The fuse stage: `out/fuse`.
 fn fuse_stage(
     rec: &Recording,
@@ -328,9 +371,11 @@ fn fuse_stage(
 ) -> Result<(StageOutcome, FusionReport)> {
     let dir = out.join("fuse");
     let params = p.fuse.params()?;
+    let tracked = out.join("track").join("trajectory.txt");
     let fingerprint = ["rig.toml", "depth.txt", "thermal.txt", "trajectory.txt"]
         .iter()
         .fold(Fingerprint::new(), |f, n| f.file(&rec.dir.join(n)))
+        .maybe_file(tracked.exists().then_some(tracked.as_path()))
         .setting("fuse", &p.fuse);
     let stage = Stage::in_dir("fuse", &dir, &["cloud.ply", "fusion.json", "poses.txt"]);
     let outcome = run_or_reuse(&stage, fingerprint, force, || {
@@ -514,12 +559,22 @@ pub fn run(
 ) -> Result<RunOutcome> {
     p.check()?;
     check_out_dir(out)?;
-    let rec = Recording::open(recording)?;
+    let mut rec = Recording::open(recording)?;
     let mut warnings: Vec<String> = rec
         .warnings
         .iter()
+        .filter(|w| !w.starts_with("no trajectory.txt"))
         .map(|w| format!("recording: {w}"))
         .collect();
+    let tracked = track_stage(&mut rec, out, p, force, progress)?;
+    if let Some((_, t)) = &tracked
+        && t.lost > 0
+    {
+        warnings.push(format!(
+            "tracking lost {} of {} colour frames",
+            t.lost, t.frames
+        ));
+    }
     let (fused, fusion) = fuse_stage(&rec, out, p, force, progress)?;
     for (why, n) in &fusion.skipped {
         warnings.push(format!("fusion skipped {n} thermal frames: {why}"));
@@ -534,7 +589,9 @@ pub fn run(
     let scene_path = out.join("segment").join("scene.json");
     let scene = RadiantScene::load(&scene_path)?;
     check_requests(&scene, &scene_path, p)?;
-    let mut stages = vec![fused, segmented];
+    let (track_outcome, track) = tracked.unzip();
+    let mut stages: Vec<StageOutcome> = track_outcome.into_iter().collect();
+    stages.extend([fused, segmented]);
     let mut maps = Vec::new();
     for &h in &p.map.heights_m {
         let (st, m) = map_stage(&scene, out, p, h, force, progress)?;
@@ -551,6 +608,7 @@ pub fn run(
     };
     Ok(RunOutcome {
         stages,
+        track,
         scene,
         fusion,
         segment,

@@ -52,6 +52,11 @@ sync_tolerance_ms = 20.0  # thermal frame ↔ nearest depth frame
 depth_stride = 0          # every N-th depth pixel; 0: about one per thermal pixel
 self_calibrate = true     # remove each frame's offset (FFC, drift) and the vignetting, from overlaps
 
+[track]
+mode = "auto"             # the built-in RGB-D tracker: auto (when the recording has no poses),
+                          # always (re-track even when it has them), never
+loop_closure = true
+
 [segment]
 feature_threshold_k = 0.3 # a texel differing from its surface's background by more is a feature
 feature_min_area_m2 = 0.04
@@ -308,6 +313,48 @@ impl Default for AirSection {
     }
 }
 
+/// When the built-in tracker runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TrackMode {
+    /// When the recording has no trajectory.txt.
+    #[default]
+    Auto,
+    /// Always, replacing the recording's poses.
+    Always,
+    /// Never (a recording without poses is refused).
+    Never,
+}
+
+/// `[track]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TrackSection {
+    /// When the tracker runs.
+    pub mode: TrackMode,
+    /// Look for loop closures.
+    pub loop_closure: bool,
+}
+
+impl Default for TrackSection {
+    fn default() -> Self {
+        Self {
+            mode: TrackMode::Auto,
+            loop_closure: true,
+        }
+    }
+}
+
+impl TrackSection {
+    /// The tracker's parameters.
+    pub fn params(&self) -> mrtmap_scan::track::TrackParams {
+        mrtmap_scan::track::TrackParams {
+            loop_closure: self.loop_closure,
+            ..Default::default()
+        }
+    }
+}
+
 /// `[fuse]`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -521,6 +568,8 @@ pub struct Project {
     pub air: AirSection,
     /// Fusion.
     pub fuse: FuseSection,
+    /// The built-in tracker.
+    pub track: TrackSection,
     /// Segmentation.
     pub segment: SegmentSection,
     /// The room frame.

@@ -148,8 +148,16 @@ pub struct TrajectoryError {
     pub ate_rmse_m: f64,
     /// Largest position error (m).
     pub ate_max_m: f64,
-    /// RMSE of the orientations after alignment (degrees).
-    pub rotation_rmse_deg: f64,
+    /// Relative pose error between consecutive poses (TUM's RPE at one frame): translation RMSE (m)…
+    pub rpe_translation_rmse_m: f64,
+    /// …and rotation RMSE (degrees).
+    pub rpe_rotation_rmse_deg: f64,
+    /// The span of the drift figures (s): 1 s, or the whole trajectory if shorter.
+    pub drift_span_s: f64,
+    /// Drift: the relative pose error over `drift_span_s`, translation RMSE (m)…
+    pub drift_translation_rmse_m: f64,
+    /// …and rotation RMSE (degrees).
+    pub drift_rotation_rmse_deg: f64,
 }
 
 /// Why tracking could not run.
@@ -499,7 +507,7 @@ fn refine(mut t: Isometry3<f64>, pts: &[(Point3<f64>, Point2<f64>)], huber: f64)
         let dv = Vector3::new(step[3], step[4], step[5]);
         let delta =
             Isometry3::from_parts(Translation3::from(dv), UnitQuaternion::from_scaled_axis(dw));
-        t = delta * t;
+        t = renormalised(&(delta * t));
         if dv.norm() < 1e-6 && dw.norm() < 1e-7 {
             break;
         }
@@ -631,6 +639,14 @@ impl Twist {
             UnitQuaternion::from_scaled_axis(self.w * dt),
         )
     }
+}
+
+/// The pose with its quaternion's norm restored (products of many poses drift from 1).
+fn renormalised(t: &Isometry3<f64>) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        t.translation,
+        UnitQuaternion::new_normalize(t.rotation.into_inner()),
+    )
 }
 
 fn rotation_deg(t: &Isometry3<f64>) -> f64 {
@@ -897,14 +913,14 @@ pub fn track(
         if let Some(p) = p {
             traj.stamps.push(rec.rgb[i].t);
             // world_from_depth = world_from_colour · colour_from_depth.
-            traj.poses.push(p * cams.colour_from_depth);
+            traj.poses.push(renormalised(&(p * cams.colour_from_depth)));
         }
     }
     // The first tracked frame's depth camera is the world.
     if let Some(first) = traj.poses.first().copied() {
         let inv = first.inverse();
         for p in &mut traj.poses {
-            *p = inv * *p;
+            *p = renormalised(&(inv * *p));
         }
     }
     report.seconds = t0.elapsed().as_secs_f64();
@@ -978,6 +994,25 @@ fn close_loops(
     }
 }
 
+/// truth_world_from_est_world: the rigid transform (Horn/Kabsch on the positions, poses paired by
+/// time) that carries an estimated trajectory onto the true one; `None` below three pairs.
+pub fn align(est: &Trajectory, truth: &Trajectory) -> Option<Isometry3<f64>> {
+    let limits = mrtmap_io::InterpolationLimits::default();
+    let (a, b): (Vec<Point3<f64>>, Vec<Point3<f64>>) = est
+        .stamps
+        .iter()
+        .zip(&est.poses)
+        .filter_map(|(&t, p)| {
+            let q = truth.interpolate(t, &limits)?;
+            Some((
+                Point3::from(p.translation.vector),
+                Point3::from(q.translation.vector),
+            ))
+        })
+        .unzip();
+    (a.len() >= 3).then(|| kabsch(&a, &b)).flatten()
+}
+
 /// TUM's absolute trajectory error: each estimated pose against the true pose interpolated at its
 /// time, after the rigid alignment (Horn) that minimises the position errors.
 pub fn trajectory_error(est: &Trajectory, truth: &Trajectory) -> Option<TrajectoryError> {
@@ -1000,25 +1035,154 @@ pub fn trajectory_error(est: &Trajectory, truth: &Trajectory) -> Option<Trajecto
         .map(|(_, q)| Point3::from(q.translation.vector))
         .collect();
     let align = kabsch(&a, &b)?;
-    let (mut se, mut max, mut re) = (0.0, 0.0f64, 0.0);
+    let (mut se, mut max) = (0.0, 0.0f64);
     for (p, q) in &pairs {
-        let al = align * p;
-        let e = (al.translation.vector - q.translation.vector).norm();
+        let e = ((align * p).translation.vector - q.translation.vector).norm();
         se += e * e;
         max = max.max(e);
-        let r = (al.rotation.inverse() * q.rotation).angle().to_degrees();
-        re += r * r;
     }
     let n = pairs.len() as f64;
+    let stamps: Vec<f64> = est
+        .stamps
+        .iter()
+        .zip(&est.poses)
+        .filter(|(t, _)| truth.interpolate(**t, &limits).is_some())
+        .map(|(t, _)| *t)
+        .collect();
+    // Relative pose errors between pose k and the first pose at least `span` seconds later.
+    let rpe = |span: f64| -> (f64, f64) {
+        let (mut st, mut sr, mut m) = (0.0, 0.0, 0usize);
+        let mut j = 0;
+        for k in 0..pairs.len() {
+            j = j.max(k + 1);
+            while j < pairs.len() && stamps[j] - stamps[k] < span - 1e-9 {
+                j += 1;
+            }
+            if j >= pairs.len() {
+                break;
+            }
+            let de = pairs[k].0.inverse() * pairs[j].0;
+            let dg = pairs[k].1.inverse() * pairs[j].1;
+            let e = dg.inverse() * de;
+            st += e.translation.vector.norm_squared();
+            sr += e.rotation.angle().to_degrees().powi(2);
+            m += 1;
+        }
+        let m = m.max(1) as f64;
+        ((st / m).sqrt(), (sr / m).sqrt())
+    };
+    let (rt, rr) = rpe(0.0);
+    let span = (stamps[stamps.len() - 1] - stamps[0]).min(1.0);
+    let (dt, dr) = rpe(span);
     Some(TrajectoryError {
         poses: pairs.len(),
         ate_rmse_m: (se / n).sqrt(),
         ate_max_m: max,
-        rotation_rmse_deg: (re / n).sqrt(),
+        rpe_translation_rmse_m: rt,
+        rpe_rotation_rmse_deg: rr,
+        drift_span_s: span,
+        drift_translation_rmse_m: dt,
+        drift_rotation_rmse_deg: dr,
     })
 }
 
 /// Writes a trajectory as TUM text.
 pub fn write_trajectory(traj: &Trajectory, path: &Path, header: &str) -> std::io::Result<()> {
     std::fs::write(path, traj.to_tum(header))
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    fn pose(t: [f64; 3], axis_angle: [f64; 3]) -> Isometry3<f64> {
+        Isometry3::from_parts(
+            Translation3::new(t[0], t[1], t[2]),
+            UnitQuaternion::from_scaled_axis(Vector3::from(axis_angle)),
+        )
+    }
+
+    #[test]
+    fn kabsch_recovers_a_rigid_transform() {
+        let t = pose([0.3, -0.2, 1.1], [0.1, -0.4, 0.25]);
+        let a: Vec<Point3<f64>> = (0..7)
+            .map(|k| {
+                Point3::new(
+                    k as f64 * 0.3,
+                    (k * k) as f64 * 0.1 - 1.0,
+                    2.0 - k as f64 * 0.2,
+                )
+            })
+            .collect();
+        let b: Vec<Point3<f64>> = a.iter().map(|p| t * p).collect();
+        let got = kabsch(&a, &b).unwrap();
+        assert!((got.translation.vector - t.translation.vector).norm() < 1e-9);
+        assert!((got.rotation.inverse() * t.rotation).angle() < 1e-9);
+    }
+
+    #[test]
+    fn a_twist_gives_back_the_motion_it_came_from_and_scales_with_time() {
+        let rel = pose([0.02, 0.0, -0.01], [0.0, 0.012, 0.003]);
+        let v = Twist::from_motion(&rel, 1.0 / 30.0);
+        let back = v.over(1.0 / 30.0);
+        assert!((back.translation.vector - rel.translation.vector).norm() < 1e-12);
+        assert!((back.rotation.inverse() * rel.rotation).angle() < 1e-12);
+        let half = v.over(0.5 / 30.0);
+        assert!((half.rotation.angle() - rel.rotation.angle() / 2.0).abs() < 1e-12);
+        // Backwards in time: the inverse motion (to first order in the rotation: 0.3 mm here).
+        let before = v.over(-1.0 / 30.0) * back;
+        assert!(before.translation.vector.norm() < 5e-4 && before.rotation.angle() < 1e-9);
+    }
+
+    #[test]
+    fn the_trajectory_error_ignores_the_world_frame_and_sees_a_bent_path() {
+        let truth = Trajectory {
+            stamps: (0..40).map(|k| k as f64 * 0.1).collect(),
+            poses: (0..40)
+                .map(|k| {
+                    let s = k as f64 * 0.1;
+                    pose([s, (s * 2.0).sin(), 0.3 * s], [0.0, 0.0, 0.2 * s])
+                })
+                .collect(),
+        };
+        // The same path in another world frame: no error.
+        let w = pose([1.0, 2.0, -0.5], [0.2, 0.1, 1.0]);
+        let moved = Trajectory {
+            stamps: truth.stamps.clone(),
+            poses: truth.poses.iter().map(|p| w * p).collect(),
+        };
+        let e = trajectory_error(&moved, &truth).unwrap();
+        assert_eq!(e.poses, 40);
+        assert!(
+            e.ate_rmse_m < 1e-9 && e.rpe_translation_rmse_m < 1e-9,
+            "{e:?}"
+        );
+        assert!(e.drift_rotation_rmse_deg < 1e-6, "{e:?}");
+        assert!((e.drift_span_s - 1.0).abs() < 1e-9);
+        // A path that drifts 1 cm per pose along x: seen by the ATE and by the relative errors.
+        let drifted = Trajectory {
+            stamps: truth.stamps.clone(),
+            poses: truth
+                .poses
+                .iter()
+                .enumerate()
+                .map(|(k, p)| pose([0.01 * k as f64, 0.0, 0.0], [0.0, 0.0, 0.0]) * p)
+                .collect(),
+        };
+        let e = trajectory_error(&drifted, &truth).unwrap();
+        assert!(e.ate_rmse_m > 0.005, "{e:?}");
+        assert!((e.drift_translation_rmse_m - 0.1).abs() < 0.02, "{e:?}");
+    }
+
+    #[test]
+    fn brief_pairs_are_fixed_and_inside_the_patch() {
+        let a = test_pairs();
+        assert_eq!(a.len(), 256);
+        assert!(a == test_pairs());
+        assert!(
+            a.iter()
+                .all(|p| p.p0.x < 31 && p.p0.y < 31 && p.p1.x < 31 && p.p1.y < 31)
+        );
+    }
 }

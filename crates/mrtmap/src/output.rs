@@ -133,6 +133,24 @@ pub fn print_stages(stages: &[StageOutcome]) {
 
 /// Prints a run's stages, maps and warnings, and where the report is.
 pub fn print_run(o: &mrtmap_pipeline::run::RunOutcome, out: &std::path::Path, secs: f64) {
+    if let Some(t) = &o.track {
+        outln!(
+            "poses from the built-in tracker (track/trajectory.txt): {} of {} colour frames, {} keyframes, {} loop closures{}",
+            t.tracked,
+            t.frames,
+            t.keyframes,
+            t.loops_accepted,
+            t.accuracy
+                .map(|e| format!(
+                    "; against groundtruth.txt ATE {:.1} mm, drift over {:.1} s {:.1} mm, {:.2}°",
+                    e.ate_rmse_m * 1000.0,
+                    e.drift_span_s,
+                    e.drift_translation_rmse_m * 1000.0,
+                    e.drift_rotation_rmse_deg
+                ))
+                .unwrap_or_default()
+        );
+    }
     print_stages(&o.stages);
     for m in &o.maps {
         print_map(&m.summary);

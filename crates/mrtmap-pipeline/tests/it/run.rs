@@ -94,3 +94,74 @@ fn settings_are_checked_before_any_stage_runs() {
     );
     assert!(!dir.path().join("out").exists());
 }
+
+#[test]
+fn a_recording_without_poses_is_tracked_then_mapped() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("scan");
+    let room = preset("office").unwrap().unwrap();
+    let mut cfg = SimConfig {
+        seconds: 20.0,
+        noise: NoiseLevel::None,
+        truth_rays: 1000,
+        rgb_hz: 15.0,
+        poses_in_recording: false,
+        ..SimConfig::default()
+    };
+    cfg.depth_camera = cfg.depth_camera.scaled(0.5);
+    simulate(&room, &cfg, &rec, &|_, _| {}).unwrap();
+    let out = dir.path().join("out");
+    let mut p = Project::default();
+    // Refused when tracking is switched off: the recording has no poses.
+    p.track.mode = mrtmap_pipeline::settings::TrackMode::Never;
+    let err = run(&rec, &out, &p, false, &mrtmap_pipeline::Silent)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("trajectory.txt") && err.contains("never"),
+        "{err}"
+    );
+    p.track.mode = mrtmap_pipeline::settings::TrackMode::Auto;
+    p.fuse.depth_stride = 1;
+    p.map.grid = [6, 5];
+    let log = Log::default();
+    let first = run(&rec, &out, &p, false, &log).unwrap();
+    assert_eq!(first.stages[0].stage, "track");
+    assert_eq!(
+        log.0.lock().unwrap()[0],
+        "tracking the camera (colour + depth)"
+    );
+    let t = first.track.as_ref().unwrap();
+    let e = t.accuracy.unwrap();
+    assert!(e.ate_rmse_m < 0.02, "{t:?}");
+    assert!(out.join("track").join("trajectory.txt").is_file());
+    // The truth's validation points, carried into the tracked world, against the map.
+    let tracked = mrtmap_io::Trajectory::read(&out.join("track").join("trajectory.txt")).unwrap();
+    let truth_poses = mrtmap_io::Trajectory::read(&rec.join("groundtruth.txt")).unwrap();
+    let truth_from_est = mrtmap_scan::track::align(&tracked, &truth_poses).unwrap();
+    let truth: mrtmap_sim::Truth =
+        serde_json::from_str(&std::fs::read_to_string(rec.join("truth.json")).unwrap()).unwrap();
+    for pt in &truth.points {
+        let w = truth_from_est.inverse() * mrtmap_geometry::nalgebra::Point3::from(pt.xyz_world);
+        p.points.push(PointEntry {
+            name: pt.name.clone(),
+            xyz: [w.x, w.y, w.z],
+            frame: PointFrame::Scan,
+        });
+    }
+    let again = run(&rec, &out, &p, false, &mrtmap_pipeline::Silent).unwrap();
+    // Tracking, fusion and segmentation reused; only the map ran again.
+    let skipped: Vec<bool> = again.stages.iter().map(|s| s.skipped).collect();
+    assert_eq!(skipped, [true, true, true, false]);
+    let marks = &again.maps[0].summary.marks;
+    assert_eq!(marks.len(), truth.points.len());
+    for (m, pt) in marks.iter().zip(&truth.points) {
+        let got = m.mrt_c;
+        assert!(
+            (got - pt.mrt_c).abs() < 0.2,
+            "{}: {got:.3} °C, truth {:.3} °C",
+            pt.name,
+            pt.mrt_c
+        );
+    }
+}

@@ -5,3 +5,4 @@ mod common;
 mod fusion;
 mod parts;
 mod segment;
+mod track;
