@@ -35,6 +35,9 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use mrtmap_geometry::icp::{IcpParams, IcpTarget, icp_point_to_plane};
+
+use crate::frame::{DepthPoints, DepthSampling, RayTable, depth_points};
 use crate::pose_graph::{Edge, optimise};
 
 /// Tracking settings.
@@ -117,6 +120,9 @@ pub struct TrackReport {
     pub lost: usize,
     /// Frames found again against an older keyframe after being lost or off the reference.
     pub relocalised: usize,
+    /// Frames placed by their depth alone (too few corners matched): point-to-plane ICP on the
+    /// keyframe's depth from the constant-velocity prediction.
+    pub depth_only: usize,
     /// Keyframes.
     pub keyframes: usize,
     /// Loop closures tried (candidate keyframe pairs) and accepted.
@@ -203,9 +209,24 @@ struct Features {
     zmap: Option<std::sync::Arc<Vec<f32>>>,
     /// Depth frame time minus colour frame time (s).
     dt: f64,
+    /// The depth frame's points and normals in the colour camera's frame (every 4th pixel), for
+    /// depth-only tracking where the corners do not suffice.
+    cloud: Option<std::sync::Arc<DepthPoints>>,
 }
 
 impl Features {
+    /// The depth cloud moved to the colour frame's time, thinned to about `n` points.
+    fn cloud_at(&self, motion: &Isometry3<f64>, n: usize) -> Option<DepthPoints> {
+        let c = self.cloud.as_deref()?;
+        let step = (c.points.len() / n.max(1)).max(1);
+        let mut out = DepthPoints::default();
+        for (p, nn) in c.points.iter().zip(&c.normals).step_by(step) {
+            out.points.push(motion * p);
+            out.normals.push(motion * nn);
+        }
+        Some(out)
+    }
+
     /// The 3D points at the colour frame's time: `motion` is colour(t)_from_colour(t + dt), the
     /// camera's motion over the depth frame's offset. The depth image saw each surface point at
     /// another pixel than the colour image: a corner's depth is looked up where its point was
@@ -614,6 +635,8 @@ struct Keyframe {
     xyz: Vec<Option<Point3<f64>>>,
     with_depth: usize,
     pose: Isometry3<f64>,
+    /// Its depth at its colour frame's time, for depth-only tracking.
+    target: Option<IcpTarget>,
 }
 
 /// The camera's velocity in its own frame: translation (m/s) and rotation (rad/s, scaled axis).
@@ -695,6 +718,12 @@ pub fn track(
             .min_by(|&a, &b| (depth_t[a] - t).abs().total_cmp(&(depth_t[b] - t).abs()))
             .filter(|&k| (depth_t[k] - t).abs() <= params.sync_tolerance_s)
     };
+    let rays = RayTable::new(&cams.depth);
+    let sampling = DepthSampling {
+        stride: 4,
+        max_m: params.max_depth_m,
+        ..DepthSampling::default()
+    };
     let read = |i: usize| -> Result<Features, TrackError> {
         let e = &rec.rgb[i];
         let path = rec.path_of(e);
@@ -708,9 +737,16 @@ pub fn track(
                 why: why.to_string(),
             })?
             .to_luma8();
+        let mut cloud = None;
         let depth = match nearest_depth(e.t) {
             Some(k) => {
                 let img = read_image16(&rec.path_of(&rec.depth[k]))?;
+                let mut pts = depth_points(&img, &rays, cams.depth_scale, &sampling);
+                for (p, n) in pts.points.iter_mut().zip(pts.normals.iter_mut()) {
+                    *p = cams.colour_from_depth * *p;
+                    *n = cams.colour_from_depth * *n;
+                }
+                cloud = Some(std::sync::Arc::new(pts));
                 Some((
                     std::sync::Arc::new(depth_in_colour(&img, &cams)),
                     depth_t[k] - e.t,
@@ -718,7 +754,9 @@ pub fn track(
             }
             None => None,
         };
-        Ok(features(&grey, depth, &cams, &pairs, params))
+        let mut f = features(&grey, depth, &cams, &pairs, params);
+        f.cloud = cloud;
+        Ok(f)
     };
 
     let fx = cams.colour.fx;
@@ -758,11 +796,19 @@ pub fn track(
                 }
                 poses[i] = Some(Isometry3::identity());
                 anchor[i] = Some((0, Isometry3::identity()));
+                let target = f
+                    .cloud_at(&motion, 20_000)
+                    .map(|c| IcpTarget::new(c.points, c.normals));
                 kfs.push(Keyframe {
-                    feats: Features { zmap: None, ..f },
+                    feats: Features {
+                        zmap: None,
+                        cloud: None,
+                        ..f
+                    },
                     xyz: xyz_now,
                     with_depth,
                     pose: Isometry3::identity(),
+                    target,
                 });
                 last = Some((i, Isometry3::identity()));
                 report.tracked += 1;
@@ -827,6 +873,17 @@ pub fn track(
                     }
                 }
             }
+            if found.is_none() {
+                // No corners to follow (a close-up of a plain surface, motion blur): the depth
+                // alone, registered on the reference keyframe's from the prediction.
+                found = predicted
+                    .as_ref()
+                    .and_then(|pr| depth_only(kf, &f, &motion, pr));
+                if found.is_some() {
+                    reference = kfs.len() - 1;
+                    report.depth_only += 1;
+                }
+            }
             let Some(fd) = found else {
                 report.lost += 1;
                 continue;
@@ -846,8 +903,10 @@ pub fn track(
             report.tracked += 1;
             inliers_sum += fd.inliers;
             reproj_sum += fd.reprojection_px;
-            let new_kf = (fd.inliers as f64)
-                < params.keyframe_inlier_ratio * kref.with_depth as f64
+            // A frame placed by depth alone (no inliers) starts a keyframe only by moving away.
+            let by_depth = fd.inliers == 0;
+            let new_kf = (!by_depth
+                && (fd.inliers as f64) < params.keyframe_inlier_ratio * kref.with_depth as f64)
                 || kf_from_frame.translation.vector.norm() > params.keyframe_move_m
                 || rotation_deg(&kf_from_frame) > params.keyframe_turn_deg
                 || reference != kfs.len() - 1;
@@ -858,10 +917,14 @@ pub fn track(
             let motion = velocity.over(f.dt);
             let xyz = f.moved(&motion, &cams.colour, params.max_depth_m);
             let with_depth = xyz.iter().flatten().count();
-            if with_depth < params.min_inliers {
+            let target = f
+                .cloud_at(&motion, 20_000)
+                .map(|c| IcpTarget::new(c.points, c.normals));
+            if with_depth < params.min_inliers && target.as_ref().is_none_or(|t| t.len() < 500) {
                 continue;
             }
-            let info = Matrix6::identity() * (fd.inliers as f64).max(1.0);
+            // Weight: the inliers; a depth-only link counts as a well-matched visual one.
+            let info = Matrix6::identity() * if by_depth { 100.0 } else { fd.inliers as f64 };
             edges.push(Edge {
                 from: reference as i64,
                 to: kfs.len() as i64,
@@ -871,10 +934,15 @@ pub fn track(
             let id = kfs.len();
             anchor[i] = Some((id, Isometry3::identity()));
             kfs.push(Keyframe {
-                feats: Features { zmap: None, ..f },
+                feats: Features {
+                    zmap: None,
+                    cloud: None,
+                    ..f
+                },
                 xyz,
                 with_depth,
                 pose: world,
+                target,
             });
             if params.loop_closure {
                 close_loops(&mut kfs, &mut edges, &cams, params, &mut report);
@@ -935,6 +1003,39 @@ pub fn track(
         });
     }
     Ok((traj, report))
+}
+
+/// current_from_keyframe by point-to-plane ICP of the frame's depth on the keyframe's, from the
+/// prediction; `None` when the fit is poor or leaves a direction unconstrained.
+fn depth_only(
+    kf: &Keyframe,
+    f: &Features,
+    motion: &Isometry3<f64>,
+    predicted: &Isometry3<f64>,
+) -> Option<Found> {
+    let target = kf.target.as_ref()?;
+    let src = f.cloud_at(motion, 2_000)?;
+    if src.points.len() < 300 {
+        return None;
+    }
+    let icp = IcpParams {
+        max_correspondence_m: 0.08,
+        max_iterations: 30,
+        converged_translation_m: 1e-4,
+        converged_rotation_rad: 1e-4,
+        ..IcpParams::default()
+    };
+    // ICP gives keyframe_from_frame; the prediction is frame_from_keyframe.
+    let reg = icp_point_to_plane(&src.points, target, &predicted.inverse(), &icp);
+    // Far from the prediction is a wrong minimum (a wall slid along a wall), not a fast camera.
+    let moved = predicted * reg.target_from_source;
+    let near = moved.translation.vector.norm() < 0.05 && rotation_deg(&moved) < 3.0;
+    (near && reg.fitness >= 0.7 && reg.inlier_plane_rmse_m <= 0.015 && reg.degenerate_dofs == 0)
+        .then(|| Found {
+            pose: reg.target_from_source.inverse(),
+            inliers: 0,
+            reprojection_px: 0.0,
+        })
 }
 
 /// Tries to join the newest keyframe to older ones nearby; adds accepted loops as edges.

@@ -21,7 +21,7 @@ pub fn run(a: &TrackArgs) -> anyhow::Result<()> {
     let (traj, r) = track_into(&rec, &params, &a.out, &bar)?;
     bar.finish();
     outln!(
-        "tracked {} of {} colour frames in {:.1} s: {} keyframes, {} loop closures accepted of {} tried, {} frames lost, {} found again",
+        "tracked {} of {} colour frames in {:.1} s: {} keyframes, {} loop closures accepted of {} tried, {} frames lost, {} found again, {} placed by depth alone",
         r.tracked,
         r.frames,
         r.seconds,
@@ -29,7 +29,8 @@ pub fn run(a: &TrackArgs) -> anyhow::Result<()> {
         r.loops_accepted,
         r.loops_tried,
         r.lost,
-        r.relocalised
+        r.relocalised,
+        r.depth_only
     );
     outln!(
         "  {:.0} corners per frame, {:.0} inliers per tracked frame, reprojection {:.2} px; {} frames without depth near in time",
