@@ -154,6 +154,9 @@ pub struct TrajectoryError {
     pub ate_rmse_m: f64,
     /// Largest position error (m).
     pub ate_max_m: f64,
+    /// RMSE of the orientations after the same alignment (degrees; ill-determined on a short,
+    /// nearly straight trajectory, whose alignment the positions do not fix).
+    pub ate_rotation_rmse_deg: f64,
     /// Relative pose error between consecutive poses (TUM's RPE at one frame): translation RMSE (m)…
     pub rpe_translation_rmse_m: f64,
     /// …and rotation RMSE (degrees).
@@ -1136,11 +1139,16 @@ pub fn trajectory_error(est: &Trajectory, truth: &Trajectory) -> Option<Trajecto
         .map(|(_, q)| Point3::from(q.translation.vector))
         .collect();
     let align = kabsch(&a, &b)?;
-    let (mut se, mut max) = (0.0, 0.0f64);
+    let (mut se, mut max, mut sr) = (0.0, 0.0f64, 0.0);
     for (p, q) in &pairs {
-        let e = ((align * p).translation.vector - q.translation.vector).norm();
+        let a = align * p;
+        let e = (a.translation.vector - q.translation.vector).norm();
         se += e * e;
         max = max.max(e);
+        sr += (a.rotation.inverse() * q.rotation)
+            .angle()
+            .to_degrees()
+            .powi(2);
     }
     let n = pairs.len() as f64;
     let stamps: Vec<f64> = est
@@ -1179,6 +1187,7 @@ pub fn trajectory_error(est: &Trajectory, truth: &Trajectory) -> Option<Trajecto
         poses: pairs.len(),
         ate_rmse_m: (se / n).sqrt(),
         ate_max_m: max,
+        ate_rotation_rmse_deg: (sr / n).sqrt(),
         rpe_translation_rmse_m: rt,
         rpe_rotation_rmse_deg: rr,
         drift_span_s: span,
@@ -1259,6 +1268,7 @@ mod tests {
             e.ate_rmse_m < 1e-9 && e.rpe_translation_rmse_m < 1e-9,
             "{e:?}"
         );
+        assert!(e.ate_rotation_rmse_deg < 1e-6, "{e:?}");
         assert!(e.drift_rotation_rmse_deg < 1e-6, "{e:?}");
         assert!((e.drift_span_s - 1.0).abs() < 1e-9);
         // A path that drifts 1 cm per pose along x: seen by the ATE and by the relative errors.

@@ -41,10 +41,11 @@ pub fn run(a: &TrackArgs) -> anyhow::Result<()> {
     );
     if let Some(e) = r.accuracy {
         outln!(
-            "  against groundtruth.txt ({} poses): ATE RMSE {:.1} mm (max {:.1} mm); frame to frame {:.2} mm, {:.3}°; over {:.2} s: {:.1} mm, {:.2}° (RMSE)",
+            "  against groundtruth.txt ({} poses): ATE RMSE {:.1} mm (max {:.1} mm), {:.2}° after alignment; frame to frame {:.2} mm, {:.3}°; over {:.2} s: {:.1} mm, {:.2}° (RMSE)",
             e.poses,
             e.ate_rmse_m * 1000.0,
             e.ate_max_m * 1000.0,
+            e.ate_rotation_rmse_deg,
             e.rpe_translation_rmse_m * 1000.0,
             e.rpe_rotation_rmse_deg,
             e.drift_span_s,
