@@ -18,7 +18,6 @@
 //! is sequential).
 
 use std::collections::BTreeMap;
-use std::path::Path;
 use std::time::Instant;
 
 use imageproc::binary_descriptors::brief::{TestPair, brief};
@@ -783,10 +782,7 @@ pub fn track(
         for (i, f) in (start..end).zip(feats) {
             progress(i + 1, n);
             corners_sum += f.px.len();
-            if f.xyz.iter().all(Option::is_none) && kfs.is_empty() {
-                report.unsynced += 1;
-                continue;
-            }
+            report.unsynced += f.zmap.is_none() as usize;
             let t_now = rec.rgb[i].t;
             // The depth's points at the colour frame's time: colour(t) from colour(t + dt).
             let motion = velocity.over(f.dt);
@@ -794,7 +790,8 @@ pub fn track(
             let Some(kf) = kfs.last() else {
                 let with_depth = xyz_now.iter().flatten().count();
                 if with_depth < params.min_inliers {
-                    report.unsynced += 1;
+                    // Nothing to start from yet (no depth, or too few corners with depth).
+                    report.lost += 1;
                     continue;
                 }
                 poses[i] = Some(Isometry3::identity());
@@ -820,60 +817,32 @@ pub fn track(
             let predicted_world = last.map(|(k, p)| p * velocity.over(t_now - rec.rgb[k].t));
             let predicted = predicted_world.map(|w| w.inverse() * kf.pose);
             let seed = i as u64;
-            let mut found = None;
-            if let Some(pr) = predicted.as_ref() {
-                let m = match_features(&kf.feats, &kf.xyz, &f, Some(pr), &cams.colour, params);
-                found = estimate(
-                    &kf.xyz,
-                    Seen {
-                        norm: &f.norm,
-                        xyz: &xyz_now,
-                    },
-                    &m,
-                    Some(pr),
-                    fx,
-                    params,
-                    seed,
-                );
-            }
-            if found.is_none() {
-                let m = match_features(&kf.feats, &kf.xyz, &f, None, &cams.colour, params);
-                found = estimate(
-                    &kf.xyz,
-                    Seen {
-                        norm: &f.norm,
-                        xyz: &xyz_now,
-                    },
-                    &m,
-                    None,
-                    fx,
-                    params,
-                    seed,
-                );
-            }
+            let seen = Seen {
+                norm: &f.norm,
+                xyz: &xyz_now,
+            };
+            // The pose against keyframe `k`: guided by `guess` when given, else over the image.
+            let against = |k: &Keyframe, guess: Option<&Isometry3<f64>>| {
+                let m = match_features(&k.feats, &k.xyz, &f, guess, &cams.colour, params);
+                estimate(&k.xyz, seen, &m, guess, fx, params, seed)
+            };
+            let mut found = predicted
+                .as_ref()
+                .and_then(|pr| against(kf, Some(pr)))
+                .or_else(|| against(kf, None));
             let mut reference = kfs.len() - 1;
             if found.is_none() {
                 // Lost against the reference: try the other keyframes, newest first.
-                for (k, other) in kfs.iter().enumerate().rev().skip(1) {
-                    let m =
-                        match_features(&other.feats, &other.xyz, &f, None, &cams.colour, params);
-                    if let Some(fd) = estimate(
-                        &other.xyz,
-                        Seen {
-                            norm: &f.norm,
-                            xyz: &xyz_now,
-                        },
-                        &m,
-                        None,
-                        fx,
-                        params,
-                        seed,
-                    ) {
-                        found = Some(fd);
-                        reference = k;
-                        report.relocalised += 1;
-                        break;
-                    }
+                if let Some((k, fd)) = kfs
+                    .iter()
+                    .enumerate()
+                    .rev()
+                    .skip(1)
+                    .find_map(|(k, other)| against(other, None).map(|fd| (k, fd)))
+                {
+                    found = Some(fd);
+                    reference = k;
+                    report.relocalised += 1;
                 }
             }
             if found.is_none() {
@@ -1098,49 +1067,47 @@ fn close_loops(
     }
 }
 
+/// Each estimated pose with the true pose interpolated at its time: (time, estimated, true).
+fn paired(est: &Trajectory, truth: &Trajectory) -> Vec<(f64, Isometry3<f64>, Isometry3<f64>)> {
+    let limits = mrtmap_io::InterpolationLimits::default();
+    est.stamps
+        .iter()
+        .zip(&est.poses)
+        .filter_map(|(&t, p)| Some((t, *p, truth.interpolate(t, &limits)?)))
+        .collect()
+}
+
+/// The rigid transform (Horn/Kabsch on the positions) that carries the pairs' estimated poses
+/// onto the true ones; `None` below three pairs.
+fn align_pairs(pairs: &[(f64, Isometry3<f64>, Isometry3<f64>)]) -> Option<Isometry3<f64>> {
+    if pairs.len() < 3 {
+        return None;
+    }
+    let (a, b): (Vec<Point3<f64>>, Vec<Point3<f64>>) = pairs
+        .iter()
+        .map(|(_, p, q)| {
+            (
+                Point3::from(p.translation.vector),
+                Point3::from(q.translation.vector),
+            )
+        })
+        .unzip();
+    kabsch(&a, &b)
+}
+
 /// truth_world_from_est_world: the rigid transform (Horn/Kabsch on the positions, poses paired by
 /// time) that carries an estimated trajectory onto the true one; `None` below three pairs.
 pub fn align(est: &Trajectory, truth: &Trajectory) -> Option<Isometry3<f64>> {
-    let limits = mrtmap_io::InterpolationLimits::default();
-    let (a, b): (Vec<Point3<f64>>, Vec<Point3<f64>>) = est
-        .stamps
-        .iter()
-        .zip(&est.poses)
-        .filter_map(|(&t, p)| {
-            let q = truth.interpolate(t, &limits)?;
-            Some((
-                Point3::from(p.translation.vector),
-                Point3::from(q.translation.vector),
-            ))
-        })
-        .unzip();
-    (a.len() >= 3).then(|| kabsch(&a, &b)).flatten()
+    align_pairs(&paired(est, truth))
 }
 
 /// TUM's absolute trajectory error: each estimated pose against the true pose interpolated at its
 /// time, after the rigid alignment (Horn) that minimises the position errors.
 pub fn trajectory_error(est: &Trajectory, truth: &Trajectory) -> Option<TrajectoryError> {
-    let limits = mrtmap_io::InterpolationLimits::default();
-    let pairs: Vec<(Isometry3<f64>, Isometry3<f64>)> = est
-        .stamps
-        .iter()
-        .zip(&est.poses)
-        .filter_map(|(&t, p)| Some((*p, truth.interpolate(t, &limits)?)))
-        .collect();
-    if pairs.len() < 3 {
-        return None;
-    }
-    let a: Vec<Point3<f64>> = pairs
-        .iter()
-        .map(|(p, _)| Point3::from(p.translation.vector))
-        .collect();
-    let b: Vec<Point3<f64>> = pairs
-        .iter()
-        .map(|(_, q)| Point3::from(q.translation.vector))
-        .collect();
-    let align = kabsch(&a, &b)?;
+    let pairs = paired(est, truth);
+    let align = align_pairs(&pairs)?;
     let (mut se, mut max, mut sr) = (0.0, 0.0f64, 0.0);
-    for (p, q) in &pairs {
+    for (_, p, q) in &pairs {
         let a = align * p;
         let e = (a.translation.vector - q.translation.vector).norm();
         se += e * e;
@@ -1151,27 +1118,20 @@ pub fn trajectory_error(est: &Trajectory, truth: &Trajectory) -> Option<Trajecto
             .powi(2);
     }
     let n = pairs.len() as f64;
-    let stamps: Vec<f64> = est
-        .stamps
-        .iter()
-        .zip(&est.poses)
-        .filter(|(t, _)| truth.interpolate(**t, &limits).is_some())
-        .map(|(t, _)| *t)
-        .collect();
     // Relative pose errors between pose k and the first pose at least `span` seconds later.
     let rpe = |span: f64| -> (f64, f64) {
         let (mut st, mut sr, mut m) = (0.0, 0.0, 0usize);
         let mut j = 0;
         for k in 0..pairs.len() {
             j = j.max(k + 1);
-            while j < pairs.len() && stamps[j] - stamps[k] < span - 1e-9 {
+            while j < pairs.len() && pairs[j].0 - pairs[k].0 < span - 1e-9 {
                 j += 1;
             }
             if j >= pairs.len() {
                 break;
             }
-            let de = pairs[k].0.inverse() * pairs[j].0;
-            let dg = pairs[k].1.inverse() * pairs[j].1;
+            let de = pairs[k].1.inverse() * pairs[j].1;
+            let dg = pairs[k].2.inverse() * pairs[j].2;
             let e = dg.inverse() * de;
             st += e.translation.vector.norm_squared();
             sr += e.rotation.angle().to_degrees().powi(2);
@@ -1181,7 +1141,7 @@ pub fn trajectory_error(est: &Trajectory, truth: &Trajectory) -> Option<Trajecto
         ((st / m).sqrt(), (sr / m).sqrt())
     };
     let (rt, rr) = rpe(0.0);
-    let span = (stamps[stamps.len() - 1] - stamps[0]).min(1.0);
+    let span = (pairs[pairs.len() - 1].0 - pairs[0].0).min(1.0);
     let (dt, dr) = rpe(span);
     Some(TrajectoryError {
         poses: pairs.len(),
@@ -1194,11 +1154,6 @@ pub fn trajectory_error(est: &Trajectory, truth: &Trajectory) -> Option<Trajecto
         drift_translation_rmse_m: dt,
         drift_rotation_rmse_deg: dr,
     })
-}
-
-/// Writes a trajectory as TUM text.
-pub fn write_trajectory(traj: &Trajectory, path: &Path, header: &str) -> std::io::Result<()> {
-    std::fs::write(path, traj.to_tum(header))
 }
 
 #[cfg(test)]
