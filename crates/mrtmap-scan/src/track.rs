@@ -45,6 +45,9 @@ use crate::pose_graph::{Edge, optimise};
 pub struct TrackParams {
     /// FAST-9 threshold (grey levels).
     pub fast_threshold: u8,
+    /// A cell without any corner at `fast_threshold` takes its corners at this lower one
+    /// (ORB-SLAM's rule: low-contrast surfaces still get corners where nothing stronger is).
+    pub min_fast_threshold: u8,
     /// Corners are spread over cells of this size (px)…
     pub cell_px: u32,
     /// …keeping at most this many (the strongest) per cell.
@@ -85,6 +88,7 @@ impl Default for TrackParams {
     fn default() -> Self {
         Self {
             fast_threshold: 12,
+            min_fast_threshold: 7,
             cell_px: 32,
             per_cell: 6,
             max_hamming: 70,
@@ -349,7 +353,7 @@ fn features(
 ) -> Features {
     let (w, h) = grey.dimensions();
     const BORDER: u32 = 17;
-    let mut corners = corners_fast9(grey, p.fast_threshold);
+    let mut corners = corners_fast9(grey, p.min_fast_threshold.min(p.fast_threshold));
     corners.retain(|c| c.x >= BORDER && c.y >= BORDER && c.x + BORDER < w && c.y + BORDER < h);
     // Non-maximum suppression (3 × 3) and the strongest few per cell.
     let mut score = vec![0f32; (w * h) as usize];
@@ -375,8 +379,13 @@ fn features(
             .push((c.score, c.y, c.x));
     }
     let mut kept: Vec<Point<u32>> = Vec::new();
+    let strong = p.fast_threshold as f32;
     for list in cells.values_mut() {
         list.sort_by(|a, b| b.0.total_cmp(&a.0).then((a.1, a.2).cmp(&(b.1, b.2))));
+        // A cell with corners at the full threshold keeps only those.
+        if list.first().is_some_and(|c| c.0 >= strong) {
+            list.retain(|c| c.0 >= strong);
+        }
         kept.extend(
             list.iter()
                 .take(p.per_cell)
@@ -1250,5 +1259,67 @@ mod tests {
             a.iter()
                 .all(|p| p.p0.x < 31 && p.p0.y < 31 && p.p1.x < 31 && p.p1.y < 31)
         );
+    }
+
+    #[test]
+    fn low_contrast_cells_take_corners_at_the_lower_threshold_and_strong_cells_only_strong_ones() {
+        // 4-px blocks of random grey: ±60 levels on the left half, ±5 on the right (a dim,
+        // low-contrast surface: no corner reaches the full threshold of 12 there).
+        let (w, h) = (256u32, 128u32);
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let blocks: Vec<f64> = (0..(w / 4) * (h / 4))
+            .map(|_| rng.random::<f64>() - 0.5)
+            .collect();
+        let grey = image::GrayImage::from_fn(w, h, |x, y| {
+            let r = blocks[((y / 4) * (w / 4) + x / 4) as usize];
+            // A flat band between them: no corner there sees both halves.
+            let amp = match x {
+                0..128 => 120.0,
+                128..136 => 0.0,
+                _ => 10.0,
+            };
+            image::Luma([(128.0 + amp * r).round() as u8])
+        });
+        let cam = PinholeCamera {
+            width: w,
+            height: h,
+            fx: 200.0,
+            fy: 200.0,
+            cx: 127.5,
+            cy: 63.5,
+            distortion: Default::default(),
+        };
+        let cams = Cameras {
+            colour: cam,
+            depth: cam,
+            depth_scale: 1000.0,
+            colour_from_depth: Isometry3::identity(),
+        };
+        let pairs = test_pairs();
+        let side = |f: &Features| {
+            let left: Vec<_> = f.px.iter().filter(|p| p.x < 128.0).copied().collect();
+            (left, f.px.len())
+        };
+        let strict = TrackParams {
+            min_fast_threshold: 12,
+            ..TrackParams::default()
+        };
+        let (left_strict, all_strict) = side(&features(&grey, None, &cams, &pairs, &strict));
+        let (left, all) = side(&features(
+            &grey,
+            None,
+            &cams,
+            &pairs,
+            &TrackParams::default(),
+        ));
+        // The strong half keeps exactly the corners it had; the dim half gains some.
+        assert!(left_strict.len() > 50, "{}", left_strict.len());
+        assert_eq!(left, left_strict);
+        assert_eq!(
+            all_strict,
+            left_strict.len(),
+            "no corner at 12 on the dim half"
+        );
+        assert!(all - left.len() > 20, "dim half: {}", all - left.len());
     }
 }

@@ -195,7 +195,8 @@ fn cell_components(grid: &HashMap<Cell, Vec<usize>>) -> Vec<(Vec<Cell>, Vec<usiz
 /// A box standing on the floor (`h0` = 0) grown, on the sides where a few of its points lie more
 /// than 10 cm beyond it (`beyond`: the part of a sofa the walk saw only from its end), 5 cm at a
 /// time and by at most 1 m, over floor that was never seen and lies inside the room (that part hides
-/// the floor under it); growth stops at floor seen (a fifth of a strip) or at the outline.
+/// the floor under it); growth stops at floor seen (a fifth of a strip's cells inside the room) or
+/// where most of the strip lies beyond the outline.
 fn grow_over_hidden_floor(
     room: &Room<'_>,
     [mut a0, mut a1, mut b0, mut b1]: [f64; 4],
@@ -207,20 +208,23 @@ fn grow_over_hidden_floor(
     }
     let c = FLOOR_CELL_M;
     // Whether the strip of floor cells from `s0` to `s1` at `t` (across the strip) is hidden
-    // floor inside the room; `along_b` when the strip runs along b.
+    // floor inside the room; `along_b` when the strip runs along b. Cells beyond the outline do
+    // not count (a box grown to a wall on one side reaches the outline at the ends of its strips
+    // on the others); a strip mostly beyond it is the outline reached.
     let hidden = |along_b: bool, s0: f64, s1: f64, t: f64| {
         let kt = (t / c).floor() as i32;
-        let (mut seen, mut total) = (0usize, 0usize);
+        let (mut seen, mut inside, mut total) = (0usize, 0usize, 0usize);
         for k in (s0 / c).floor() as i32..=(s1 / c).floor() as i32 {
             let cell = if along_b { (kt, k) } else { (k, kt) };
             let centre = Point2::new((cell.0 as f64 + 0.5) * c, (cell.1 as f64 + 0.5) * c);
-            if point_in_polygon(&centre, room.floor_2d, 0.0) != Containment::Inside {
-                return false;
-            }
             total += 1;
+            if point_in_polygon(&centre, room.floor_2d, 0.0) != Containment::Inside {
+                continue;
+            }
+            inside += 1;
             seen += usize::from(room.floor_seen.contains(&cell));
         }
-        total > 0 && seen * 5 < total
+        inside * 2 > total && seen * 5 < inside
     };
     let grow = beyond.map(|d| d > 0.1);
     for _ in 0..20 {
@@ -500,5 +504,100 @@ mod tests {
         // Its end in the far wall's band (the band alone would end it at y = 3.70).
         let y1 = f.corners.iter().map(|p| p.y).fold(f64::MIN, f64::max);
         assert!((y1 - 3.89).abs() < 0.03, "end at y = {y1:.3}");
+    }
+
+    /// A sofa in a corner (truth: x 4.0…5.9, y 1.6…2.48, 0.8 m high, in a 6 × 2.53 m room) of
+    /// which the walk saw the near 1.1 m and a glimpse of the top beyond: the box grows over the
+    /// hidden floor to the wall behind it and, at the same time, on along its length to the end
+    /// wall (growing to the back wall used to stop the growth along it).
+    #[test]
+    fn a_sofa_in_a_corner_seen_from_its_end_grows_to_both_walls() {
+        let up = Unit::new_normalize(Vector3::z());
+        let (mut pos, mut nrm) = (Vec::new(), Vec::new());
+        let mut add = |p: Point3<f64>, n: Vector3<f64>| {
+            pos.push(p);
+            nrm.push(n);
+        };
+        for k in 0..3000 {
+            let f = k as f64;
+            let (r1, r2) = ((f * 0.618_034).fract(), (f * 0.414_214).fract());
+            // Top, front face and the near end (their points in the back wall's band are left
+            // to the wall).
+            add(
+                Point3::new(4.0 + 1.1 * r1, 1.6 + 0.88 * r2, 0.8),
+                Vector3::z(),
+            );
+            add(
+                Point3::new(4.0 + 1.1 * r1, 1.6, 0.05 + 0.75 * r2),
+                -Vector3::y(),
+            );
+            add(
+                Point3::new(4.0, 1.6 + 0.88 * r1, 0.05 + 0.75 * r2),
+                -Vector3::x(),
+            );
+        }
+        // A glimpse of the top further on.
+        for k in 0..6 {
+            add(Point3::new(5.12 + 0.03 * k as f64, 1.9, 0.8), Vector3::z());
+        }
+        let n = pos.len();
+        let (temp, obs, sid) = (vec![294.5; n], vec![6u32; n], vec![-1i32; n]);
+        let floor_2d = [
+            Point2::new(0.0, 0.0),
+            Point2::new(6.0, 0.0),
+            Point2::new(6.0, 2.53),
+            Point2::new(0.0, 2.53),
+        ];
+        let wall = |p: [f64; 3], n: Vector3<f64>| {
+            (
+                Plane::from_point_normal(&Point3::from(p), Unit::new_normalize(n)),
+                0.15,
+            )
+        };
+        let walls = [
+            wall([0.0, 0.0, 0.0], Vector3::x()),
+            wall([6.0, 0.0, 0.0], -Vector3::x()),
+            wall([0.0, 0.0, 0.0], Vector3::y()),
+            wall([0.0, 2.53, 0.0], -Vector3::y()),
+        ];
+        // The floor was seen everywhere but under and beyond the sofa's seen part.
+        let c = FLOOR_CELL_M;
+        let floor_seen: std::collections::HashSet<(i32, i32)> = (0..120)
+            .flat_map(|i| (0..50).map(move |j| (i, j)))
+            .filter(|&(i, j)| {
+                let (x, y) = ((i as f64 + 0.5) * c, (j as f64 + 0.5) * c);
+                !(x > 3.97 && y > 1.57)
+            })
+            .collect();
+        let room = Room {
+            up,
+            along: Vector3::x(),
+            floor_height: 0.0,
+            room_height: 2.7,
+            floor_2d: &floor_2d,
+            wall_planes: &walls,
+            floor_seen: &floor_seen,
+        };
+        let found = find_furniture(
+            &pos,
+            &nrm,
+            &temp,
+            &obs,
+            &sid,
+            &room,
+            &SegmentParams::default(),
+        );
+        assert_eq!(found.len(), 1, "{found:?}");
+        let f = &found[0];
+        let max = |k: usize| f.corners.iter().map(|p| p[k]).fold(f64::MIN, f64::max);
+        let min = |k: usize| f.corners.iter().map(|p| p[k]).fold(f64::MAX, f64::min);
+        assert!((min(0) - 4.0).abs() < 0.03, "near end at x = {:.3}", min(0));
+        assert!((min(1) - 1.6).abs() < 0.03, "front at y = {:.3}", min(1));
+        assert!(max(1) > 2.4, "back at y = {:.3}, not at the wall", max(1));
+        assert!(
+            max(0) > 5.8,
+            "far end at x = {:.3}, not at the wall",
+            max(0)
+        );
     }
 }
