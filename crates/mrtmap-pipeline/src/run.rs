@@ -348,7 +348,7 @@ fn track_stage(
         return Ok(None);
     }
     let dir = out.join("track");
-    let fingerprint = ["rig.toml", "depth.txt", "rgb.txt"]
+    let fingerprint = ["rig.toml", "depth.txt", "rgb.txt", "imu.txt"]
         .iter()
         .fold(Fingerprint::new(), |f, n| f.file(&rec.dir.join(n)))
         .setting("track", &p.track);

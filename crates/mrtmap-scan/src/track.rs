@@ -76,6 +76,8 @@ pub struct TrackParams {
     pub sync_tolerance_s: f64,
     /// Look for loop closures.
     pub loop_closure: bool,
+    /// Predict each frame's rotation from the gyro (imu.txt) where the recording has one.
+    pub use_imu: bool,
     /// A loop joins keyframes at least this many keyframes apart…
     pub loop_min_separation: usize,
     /// …whose estimated positions lie within this distance (m)…
@@ -103,6 +105,7 @@ impl Default for TrackParams {
             max_depth_m: 3.5,
             sync_tolerance_s: 0.02,
             loop_closure: true,
+            use_imu: true,
             loop_min_separation: 12,
             loop_radius_m: 1.5,
             loop_min_inliers: 40,
@@ -132,6 +135,9 @@ pub struct TrackReport {
     pub loops_tried: usize,
     /// Accepted loop closures.
     pub loops_accepted: usize,
+    /// Gyro samples the prediction drew on (0: no imu.txt, or not used).
+    #[serde(default)]
+    pub gyro_samples: usize,
     /// Mean corners per frame.
     pub mean_corners: f64,
     /// Mean inliers per tracked frame.
@@ -675,6 +681,64 @@ impl Twist {
     }
 }
 
+/// The rig's gyro in the colour camera's frame: turns between two times, for the prediction.
+struct Gyro {
+    t: Vec<f64>,
+    w: Vec<Vector3<f64>>,
+}
+
+impl Gyro {
+    /// From `imu.txt`'s samples (depth camera frame); `None` without samples.
+    fn new(imu: &[mrtmap_io::ImuSample], colour_from_depth: &Isometry3<f64>) -> Option<Self> {
+        (imu.len() >= 2).then(|| Self {
+            t: imu.iter().map(|m| m.t).collect(),
+            w: imu
+                .iter()
+                .map(|m| colour_from_depth.rotation * m.gyro)
+                .collect(),
+        })
+    }
+
+    /// The rotation from `t0` to `t1` as earlier_from_later (the camera at `t0` from the camera
+    /// at `t1`; `t1` < `t0` gives the inverse), integrating the rates held from each sample to
+    /// the next; `None` when the samples do not cover the interval (a gap over 50 ms).
+    fn turn(&self, t0: f64, t1: f64) -> Option<UnitQuaternion<f64>> {
+        if t1 < t0 {
+            return self.turn(t1, t0).map(|q| q.inverse());
+        }
+        let n = self.t.len();
+        if self.t[0] > t0 + 0.05 || self.t[n - 1] < t1 - 0.05 {
+            return None;
+        }
+        let mut k = self.t.partition_point(|&x| x <= t0).saturating_sub(1);
+        let mut q = UnitQuaternion::identity();
+        let mut at = t0;
+        while at < t1 {
+            let next = if k + 1 < n { self.t[k + 1].min(t1) } else { t1 };
+            if next - self.t[k].max(at) > 0.05 && k + 1 < n {
+                return None;
+            }
+            q *= UnitQuaternion::from_scaled_axis(self.w[k] * (next - at));
+            at = next;
+            k += 1;
+            if k >= n {
+                break;
+            }
+        }
+        Some(q)
+    }
+}
+
+/// The predicted motion from `t0` to `t1` (earlier_from_later): the velocity's translation and
+/// rotation, the rotation from the gyro where there is one.
+fn predict(velocity: &Twist, gyro: Option<&Gyro>, t0: f64, t1: f64) -> Isometry3<f64> {
+    let m = velocity.over(t1 - t0);
+    match gyro.and_then(|g| g.turn(t0, t1)) {
+        Some(q) => Isometry3::from_parts(m.translation, q),
+        None => m,
+    }
+}
+
 /// The pose with its quaternion's norm restored (products of many poses drift from 1).
 fn renormalised(t: &Isometry3<f64>) -> Isometry3<f64> {
     Isometry3::from_parts(
@@ -778,6 +842,11 @@ pub fn track(
     let mut edges: Vec<Edge> = Vec::new();
     // Motion per second (earlier_from_later over 1 s, body frame) and the last tracked frame.
     let mut velocity = Twist::default();
+    let gyro = params
+        .use_imu
+        .then(|| Gyro::new(&rec.imu, &cams.colour_from_depth))
+        .flatten();
+    report.gyro_samples = gyro.as_ref().map_or(0, |g| g.t.len());
     let mut last: Option<(usize, Isometry3<f64>)> = None;
     let (mut corners_sum, mut inliers_sum, mut reproj_sum) = (0usize, 0usize, 0.0);
     let chunk = 16;
@@ -794,7 +863,7 @@ pub fn track(
             report.unsynced += f.zmap.is_none() as usize;
             let t_now = rec.rgb[i].t;
             // The depth's points at the colour frame's time: colour(t) from colour(t + dt).
-            let motion = velocity.over(f.dt);
+            let motion = predict(&velocity, gyro.as_ref(), t_now, t_now + f.dt);
             let xyz_now = f.moved(&motion, &cams.colour, params.max_depth_m);
             let Some(kf) = kfs.last() else {
                 let with_depth = xyz_now.iter().flatten().count();
@@ -823,7 +892,8 @@ pub fn track(
                 report.tracked += 1;
                 continue;
             };
-            let predicted_world = last.map(|(k, p)| p * velocity.over(t_now - rec.rgb[k].t));
+            let predicted_world =
+                last.map(|(k, p)| p * predict(&velocity, gyro.as_ref(), rec.rgb[k].t, t_now));
             let predicted = predicted_world.map(|w| w.inverse() * kf.pose);
             let seed = i as u64;
             let seen = Seen {
@@ -895,7 +965,7 @@ pub fn track(
                 continue;
             }
             // The motion model now holds this frame's velocity: move its depth again.
-            let motion = velocity.over(f.dt);
+            let motion = predict(&velocity, gyro.as_ref(), t_now, t_now + f.dt);
             let xyz = f.moved(&motion, &cams.colour, params.max_depth_m);
             let with_depth = xyz.iter().flatten().count();
             let target = f
@@ -1263,8 +1333,8 @@ mod tests {
 
     #[test]
     fn low_contrast_cells_take_corners_at_the_lower_threshold_and_strong_cells_only_strong_ones() {
-        // 4-px blocks of random grey: ±60 levels on the left half, ±5 on the right (a dim,
-        // low-contrast surface: no corner reaches the full threshold of 12 there).
+        // 4-px blocks of random grey: ±60 levels on the left half, ±8 on the right (a dim,
+        // low-contrast surface: hardly a corner reaches the full threshold of 12 there).
         let (w, h) = (256u32, 128u32);
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         let blocks: Vec<f64> = (0..(w / 4) * (h / 4))
@@ -1276,7 +1346,7 @@ mod tests {
             let amp = match x {
                 0..128 => 120.0,
                 128..136 => 0.0,
-                _ => 10.0,
+                _ => 16.0,
             };
             image::Luma([(128.0 + amp * r).round() as u8])
         });
@@ -1315,11 +1385,46 @@ mod tests {
         // The strong half keeps exactly the corners it had; the dim half gains some.
         assert!(left_strict.len() > 50, "{}", left_strict.len());
         assert_eq!(left, left_strict);
-        assert_eq!(
-            all_strict,
-            left_strict.len(),
-            "no corner at 12 on the dim half"
+        let (dim_strict, dim) = (all_strict - left_strict.len(), all - left.len());
+        assert!(dim_strict <= 3, "dim half at 12: {dim_strict}");
+        assert!(dim > 40, "dim half: {dim}");
+    }
+
+    #[test]
+    fn the_gyro_turn_integrates_the_rates_and_refuses_a_gap() {
+        // 0.5 rad/s about y, then about x after t = 1 s; 200 Hz, a gap from 1.5 to 1.6 s.
+        let imu: Vec<mrtmap_io::ImuSample> = (0..400)
+            .map(|k| k as f64 * 0.005)
+            .filter(|t| !(1.5..1.6).contains(t))
+            .map(|t| mrtmap_io::ImuSample {
+                t,
+                gyro: if t < 1.0 {
+                    Vector3::new(0.0, 0.5, 0.0)
+                } else {
+                    Vector3::new(0.5, 0.0, 0.0)
+                },
+                accel: Vector3::new(0.0, -9.81, 0.0),
+            })
+            .collect();
+        let g = Gyro::new(&imu, &Isometry3::identity()).unwrap();
+        let q = g.turn(0.2, 0.6).unwrap();
+        let want = UnitQuaternion::from_scaled_axis(Vector3::new(0.0, 0.2, 0.0));
+        assert!(q.angle_to(&want) < 1e-9, "{q:?}");
+        // Backwards: the inverse; across the change of axis: y then x.
+        assert!(g.turn(0.6, 0.2).unwrap().angle_to(&want.inverse()) < 1e-9);
+        let both = UnitQuaternion::from_scaled_axis(Vector3::new(0.0, 0.05, 0.0))
+            * UnitQuaternion::from_scaled_axis(Vector3::new(0.05, 0.0, 0.0));
+        assert!(g.turn(0.9, 1.1).unwrap().angle_to(&both) < 1e-9);
+        assert!(g.turn(1.4, 1.7).is_none(), "a 100 ms gap");
+        assert!(g.turn(2.5, 2.6).is_none(), "beyond the samples");
+        // In the colour camera's frame: a camera turned 90° about z sees the y rate about x.
+        let turned = Isometry3::from_parts(
+            Translation3::identity(),
+            UnitQuaternion::from_scaled_axis(Vector3::new(0.0, 0.0, std::f64::consts::FRAC_PI_2)),
         );
-        assert!(all - left.len() > 20, "dim half: {}", all - left.len());
+        let g = Gyro::new(&imu, &turned).unwrap();
+        let q = g.turn(0.2, 0.6).unwrap();
+        let want = UnitQuaternion::from_scaled_axis(Vector3::new(-0.2, 0.0, 0.0));
+        assert!(q.angle_to(&want) < 1e-9, "{q:?}");
     }
 }

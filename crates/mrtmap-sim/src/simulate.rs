@@ -8,8 +8,8 @@ use mrtmap_geometry::camera::{BrownConrady, PinholeCamera};
 use mrtmap_geometry::nalgebra::{Isometry3, Point3, Translation3, Unit, UnitQuaternion, Vector3};
 use mrtmap_io::masks::{labels_path, mask_labels_json};
 use mrtmap_io::{
-    EncodeError, FileError, PartialDir, RgbCamera, Rig, ThermalEncoding, Trajectory,
-    encode_png_rgb8, encode_png16, stream_list_text,
+    EncodeError, FileError, ImuSample, PartialDir, RgbCamera, Rig, ThermalEncoding, Trajectory,
+    encode_png_rgb8, encode_png16, imu_text, stream_list_text,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -308,6 +308,69 @@ fn write_poses(
     Ok(n_poses)
 }
 
+/// A D435i's inertial unit (Bosch BMI055) as `imu.txt` at the pose rate, in the depth camera's
+/// frame: angular velocity and specific force from the walk's motion (central differences of
+/// its poses, 2.5 ms apart for the rate, 20 ms for the acceleration), with realistic noise: white noise (gyro 0.014 °/s/√Hz and accelerometer
+/// 150 µg/√Hz over a 100 Hz bandwidth, the datasheet's densities) and a constant bias per axis
+/// (gyro σ 0.3 °/s, accelerometer σ 0.05 m/s²); exact without noise. Its own random stream, so the
+/// frames of a seed are the same with or without it.
+fn write_imu(
+    out: &Out,
+    walk: &Walk,
+    world_from_room: &Isometry3<f64>,
+    cfg: &SimConfig,
+    header: &str,
+) -> Result<(), SimError> {
+    const G: f64 = 9.80665;
+    let mut rng = ChaCha8Rng::seed_from_u64(cfg.seed ^ 0x1_3u64.rotate_left(40));
+    let realistic = cfg.noise == NoiseLevel::Realistic;
+    let std = Normal::new(0.0, 1.0).unwrap_or_else(|_| unreachable!("unit normal"));
+    let (gyro_white, gyro_bias) = (0.014f64.to_radians() * 10.0, 0.3f64.to_radians());
+    let (acc_white, acc_bias) = (150e-6 * G * 10.0, 0.05);
+    let draw3 = |sd: f64, rng: &mut ChaCha8Rng| {
+        if realistic {
+            Vector3::new(std.sample(rng), std.sample(rng), std.sample(rng)) * sd
+        } else {
+            Vector3::zeros()
+        }
+    };
+    let bg = draw3(gyro_bias, &mut rng);
+    let ba = draw3(acc_bias, &mut rng);
+    let up_world = world_from_room * Vector3::z();
+    let h = 0.5 / cfg.pose_hz;
+    let n = (cfg.seconds * cfg.pose_hz).floor() as usize + 1;
+    let pose = |t: f64| world_from_room * walk.room_from_depth(t);
+    // The acceleration over ±20 ms (an accelerometer's bandwidth; the walk's path has millimetre
+    // steps that a 2.5 ms difference turns into spikes); both windows kept inside the walk.
+    let wide = 0.02;
+    let samples: Vec<ImuSample> = (0..n)
+        .map(|k| {
+            let t = k as f64 / cfg.pose_hz;
+            let tw = t.clamp(h, cfg.seconds - h);
+            let (a, b, c) = (pose(tw - h), pose(tw), pose(tw + h));
+            // Body rates: the rotation from t - h to t + h (in the frame at t - h), turned into
+            // the frame at t.
+            let turn = (a.rotation.inverse() * c.rotation).scaled_axis() / (2.0 * h);
+            let w = (b.rotation.inverse() * a.rotation) * turn;
+            let ta = t.clamp(wide, cfg.seconds - wide);
+            let acc = (pose(ta + wide).translation.vector - 2.0 * pose(ta).translation.vector
+                + pose(ta - wide).translation.vector)
+                / (wide * wide);
+            // An accelerometer at rest reads +g upwards.
+            let f = b.rotation.inverse() * (acc + up_world * G);
+            ImuSample {
+                t: TIME_ORIGIN_S + t,
+                gyro: w + bg + draw3(gyro_white, &mut rng),
+                accel: f + ba + draw3(acc_white, &mut rng),
+            }
+        })
+        .collect();
+    out.write(
+        "imu.txt",
+        imu_text(&samples, &format!("{header}\ninertial unit (BMI055 model)")).as_bytes(),
+    )
+}
+
 /// The rig the simulated cameras form.
 fn rig(cfg: &SimConfig) -> Rig {
     Rig {
@@ -535,6 +598,7 @@ pub fn simulate(
         room.file.name, cfg.seed, cfg.noise
     );
     let poses = write_poses(&files, &walk, &world_from_room, cfg, &header, &mut rng)?;
+    write_imu(&files, &walk, &world_from_room, cfg, &header)?;
     let depth_t = stamps(cfg.seconds, cfg.depth_hz, 0.0003, &mut rng);
     let thermal_t = stamps(cfg.seconds, cfg.thermal_hz, 0.002, &mut rng);
     let rgb_t = stamps(cfg.seconds, cfg.rgb_hz, 0.0003, &mut rng);

@@ -633,6 +633,9 @@ pub struct TrackArgs {
     /// Do not look for loop closures.
     #[arg(long)]
     pub no_loops: bool,
+    /// Leave the recording's gyro (imu.txt) out of the prediction.
+    #[arg(long)]
+    pub no_imu: bool,
     /// FAST corner threshold (grey levels); lower finds more corners on weak texture.
     #[arg(long, default_value_t = 12)]
     pub fast_threshold: u8,

@@ -1,6 +1,7 @@
 //! The recording layout: one folder per scan, read by [`Recording`] and written frame by frame by
 //! [`LayoutWriter`] (see the crate docs for the files and what is accepted beyond them).
 
+mod imu;
 pub mod masks;
 mod recording;
 mod rig;
@@ -8,6 +9,7 @@ mod streams;
 mod trajectory;
 mod writer;
 
+pub use imu::{ImuSample, imu_text, parse_imu, read_imu};
 pub use recording::Recording;
 pub use rig::{PoseFile, RgbCamera, Rig, ThermalEncoding};
 pub use streams::{StreamEntry, parse_stream_list, stream_list_text};

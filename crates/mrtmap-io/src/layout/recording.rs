@@ -28,6 +28,8 @@ pub struct Recording {
     pub trajectory: Trajectory,
     /// True poses, when the recording has them (simulated scans).
     pub groundtruth: Option<Trajectory>,
+    /// Inertial samples (`imu.txt`, optional), in the depth camera's frame.
+    pub imu: Vec<super::ImuSample>,
     /// Things worth knowing that do not stop a scan from being used.
     pub warnings: Vec<String>,
 }
@@ -111,6 +113,12 @@ impl Recording {
         } else {
             None
         };
+        let imu_path = dir.join("imu.txt");
+        let imu = if imu_path.exists() {
+            super::read_imu(&imu_path)?
+        } else {
+            Vec::new()
+        };
         if depth.is_empty() {
             warnings.push("depth.txt lists no frames".to_string());
         }
@@ -140,6 +148,7 @@ impl Recording {
             masks,
             trajectory,
             groundtruth,
+            imu,
             warnings,
         })
     }

@@ -14,6 +14,7 @@ pub fn run(a: &TrackArgs) -> anyhow::Result<()> {
     }
     let params = TrackParams {
         loop_closure: !a.no_loops,
+        use_imu: !a.no_imu,
         fast_threshold: a.fast_threshold,
         ..TrackParams::default()
     };
@@ -33,11 +34,19 @@ pub fn run(a: &TrackArgs) -> anyhow::Result<()> {
         r.depth_only
     );
     outln!(
-        "  {:.0} corners per frame, {:.0} inliers per tracked frame, reprojection {:.2} px; {} frames without depth near in time",
+        "  {:.0} corners per frame, {:.0} inliers per tracked frame, reprojection {:.2} px; {} frames without depth near in time; {}",
         r.mean_corners,
         r.mean_inliers,
         r.mean_reprojection_px,
-        r.unsynced
+        r.unsynced,
+        if r.gyro_samples > 0 {
+            format!(
+                "rotation predicted from {} gyro samples (imu.txt)",
+                r.gyro_samples
+            )
+        } else {
+            "no gyro: constant-velocity prediction".to_string()
+        }
     );
     if let Some(e) = r.accuracy {
         outln!(
