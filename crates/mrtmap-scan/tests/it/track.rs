@@ -40,6 +40,9 @@ fn a_walk_without_poses_is_tracked_to_within_centimetres_and_the_same_every_time
         report.frames
     );
     assert!(report.keyframes >= 2, "{report:?}");
+    // The simulator writes imu.txt: the gyro carried the prediction.
+    assert_eq!(report.gyro_samples, rec.imu.len(), "{report:?}");
+    assert!(report.gyro_samples > 1000, "{report:?}");
     let e = report
         .accuracy
         .expect("the simulation writes groundtruth.txt");

@@ -273,3 +273,44 @@ fn drift_separates_trajectory_from_groundtruth() {
     let last = gt.len() - 1;
     assert!(err(last) > 1e-3 && err(last) < 0.1, "{}", err(last));
 }
+
+/// imu.txt: the gyro integrated between two true poses gives their relative rotation, and the
+/// accelerometer, turned into the world, reads gravity (the walk's own acceleration averages out).
+#[test]
+fn the_simulated_gyro_integrates_to_the_true_rotation_and_the_accelerometer_reads_gravity() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("scan");
+    let room = preset("office").unwrap().unwrap();
+    let mut cfg = mrtmap_sim::SimConfig {
+        seconds: 3.0,
+        noise: NoiseLevel::None,
+        truth_rays: 1000,
+        ..Default::default()
+    };
+    cfg.depth_camera = cfg.depth_camera.scaled(0.125);
+    mrtmap_sim::simulate(&room, &cfg, &out, &|_, _| {}).unwrap();
+    let rec = Recording::open(&out).unwrap();
+    let gt = rec.groundtruth.unwrap();
+    assert_eq!(rec.imu.len(), gt.len());
+    let (a, b) = (100, 500); // 0.5 s and 2.5 s
+    let mut q = mrtmap_geometry::nalgebra::UnitQuaternion::identity();
+    for m in &rec.imu[a..b] {
+        q *= mrtmap_geometry::nalgebra::UnitQuaternion::from_scaled_axis(m.gyro * 0.005);
+    }
+    let truth = gt.poses[a].rotation.inverse() * gt.poses[b].rotation;
+    assert!(
+        truth.angle() > 0.1,
+        "the walk turns: {:.3} rad",
+        truth.angle()
+    );
+    let off = q.angle_to(&truth).to_degrees();
+    assert!(off < 0.5, "gyro off by {off:.3}° over 2 s");
+    let mean: Vector3<f64> = rec
+        .imu
+        .iter()
+        .zip(&gt.poses)
+        .map(|(m, p)| p.rotation * m.accel)
+        .sum::<Vector3<f64>>()
+        / rec.imu.len() as f64;
+    assert!((mean.norm() - 9.807).abs() < 0.3, "{mean:?}");
+}
