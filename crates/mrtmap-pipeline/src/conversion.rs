@@ -64,6 +64,8 @@ pub struct Conversion {
     pub rgb: usize,
     /// Poses written.
     pub poses: usize,
+    /// Inertial samples written (imu.txt).
+    pub imu: usize,
     /// Where the thermal frames came from, when not from the source itself.
     pub thermal_from: Option<String>,
     /// Which poses were taken, when the source offers several kinds.

@@ -341,6 +341,7 @@ pub fn convert(source: &Path, out: &Path, o: &SourceOptions) -> Result<Conversio
         thermal: nt,
         rgb,
         poses,
+        imu: 0,
         thermal_from: Some(thermal_name),
         poses_from: Some(graph.said),
         skipped: skipped.len(),

@@ -198,6 +198,7 @@ pub fn convert(source: &Path, out: &Path, o: &SourceOptions) -> Result<Conversio
                 thermal: rep.thermal,
                 rgb: rep.rgb,
                 poses: rep.poses,
+                imu: rep.imu,
                 skipped: rep.skipped,
                 skipped_unit: "messages",
                 skipped_reasons: rep.skipped_reasons,

@@ -168,7 +168,7 @@ pub fn print_run(o: &mrtmap_pipeline::run::RunOutcome, out: &std::path::Path, se
 pub fn print_conversion(c: &mrtmap_pipeline::source::Conversion) {
     let from = |s: &Option<String>| s.as_ref().map(|s| format!(" ({s})")).unwrap_or_default();
     outln!(
-        "wrote {}: {} depth, {} thermal{}, {} colour frames, {} poses{}{}",
+        "wrote {}: {} depth, {} thermal{}, {} colour frames, {} poses{}{}{}",
         c.out.display(),
         c.depth,
         c.thermal,
@@ -176,6 +176,11 @@ pub fn print_conversion(c: &mrtmap_pipeline::source::Conversion) {
         c.rgb,
         c.poses,
         from(&c.poses_from),
+        if c.imu > 0 {
+            format!(", {} inertial samples", c.imu)
+        } else {
+            String::new()
+        },
         if c.skipped > 0 {
             format!("; skipped {} {}", c.skipped, c.skipped_unit)
         } else {

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::Isometry3;
 
+use super::imu::{ImuSample, imu_text};
 use super::rig::Rig;
 use super::streams::stream_list_text;
 use super::trajectory::Trajectory;
@@ -20,6 +21,7 @@ pub struct LayoutWriter {
     thermal: Vec<(f64, String)>,
     rgb: Vec<(f64, String)>,
     poses: Vec<(f64, Isometry3<f64>)>,
+    imu: Vec<ImuSample>,
     header: String,
 }
 
@@ -40,6 +42,7 @@ impl LayoutWriter {
             thermal: Vec::new(),
             rgb: Vec::new(),
             poses: Vec::new(),
+            imu: Vec::new(),
             header: header.to_string(),
         })
     }
@@ -80,6 +83,16 @@ impl LayoutWriter {
         self.poses.push((t, p));
     }
 
+    /// Adds an inertial sample (the depth camera's frame).
+    pub fn imu(&mut self, sample: ImuSample) {
+        self.imu.push(sample);
+    }
+
+    /// Inertial samples so far.
+    pub fn imu_count(&self) -> usize {
+        self.imu.len()
+    }
+
     /// Frames written so far: (depth, thermal, rgb, poses).
     pub fn counts(&self) -> (usize, usize, usize, usize) {
         (
@@ -90,7 +103,8 @@ impl LayoutWriter {
         )
     }
 
-    /// Writes the lists, trajectory, rig and `source.json`, then moves the folder into place.
+    /// Writes the lists, trajectory (when there are poses), imu.txt (when there are samples), rig
+    /// and `source.json`, then moves the folder into place.
     pub fn finish(mut self, rig: &Rig, source_json: &str) -> Result<PathBuf, FileError> {
         let d = self.dir.path().to_path_buf();
         let sort = |v: &mut Vec<(f64, String)>| v.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -120,15 +134,23 @@ impl LayoutWriter {
             stamps: self.poses.iter().map(|p| p.0).collect(),
             poses: self.poses.iter().map(|p| p.1).collect(),
         };
-        write(
-            &d,
-            "trajectory.txt",
-            traj.to_tum(&format!(
-                "{}\nworld_from_depth: timestamp tx ty tz qx qy qz qw",
-                self.header
-            ))
-            .as_bytes(),
-        )?;
+        // No poses (a source without odometry): no trajectory.txt; the recording is tracked.
+        if !traj.is_empty() {
+            write(
+                &d,
+                "trajectory.txt",
+                traj.to_tum(&format!(
+                    "{}\nworld_from_depth: timestamp tx ty tz qx qy qz qw",
+                    self.header
+                ))
+                .as_bytes(),
+            )?;
+        }
+        if !self.imu.is_empty() {
+            self.imu.sort_by(|a, b| a.t.total_cmp(&b.t));
+            self.imu.dedup_by(|b, a| b.t <= a.t);
+            write(&d, "imu.txt", imu_text(&self.imu, &self.header).as_bytes())?;
+        }
         write(&d, "rig.toml", rig.to_toml().as_bytes())?;
         write(&d, "source.json", source_json.as_bytes())?;
         self.dir.finish()

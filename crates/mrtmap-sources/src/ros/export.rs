@@ -161,6 +161,9 @@ pub struct ExportReport {
     pub rgb: usize,
     /// Poses written.
     pub poses: usize,
+    /// Inertial samples written to imu.txt (one per gyro message).
+    #[serde(default)]
+    pub imu: usize,
     /// Messages skipped (did not decode or had the wrong size), with the first reasons.
     pub skipped: usize,
     /// The first few reasons.
@@ -201,16 +204,60 @@ fn sized_image(
     Ok((t, img))
 }
 
+/// Gyro and accelerometer samples (depth camera frame) as they come, paired at the end.
+#[derive(Default)]
+struct ImuCollect {
+    gyro: Vec<(f64, nalgebra::Vector3<f64>)>,
+    accel: Vec<(f64, nalgebra::Vector3<f64>)>,
+}
+
+impl ImuCollect {
+    /// Each gyro sample with the accelerometer sample nearest in time (within 50 ms; else zero).
+    fn into_samples(mut self) -> Vec<mrtmap_io::ImuSample> {
+        self.accel.sort_by(|a, b| a.0.total_cmp(&b.0));
+        self.gyro
+            .iter()
+            .map(|&(t, g)| {
+                let k = self.accel.partition_point(|a| a.0 < t);
+                let near = [k.checked_sub(1), Some(k)]
+                    .into_iter()
+                    .flatten()
+                    .filter_map(|i| self.accel.get(i))
+                    .min_by(|a, b| (a.0 - t).abs().total_cmp(&(b.0 - t).abs()))
+                    .filter(|a| (a.0 - t).abs() <= 0.05);
+                mrtmap_io::ImuSample {
+                    t,
+                    gyro: g,
+                    accel: near.map_or_else(nalgebra::Vector3::zeros, |a| a.1),
+                }
+            })
+            .collect()
+    }
+}
+
 /// Writes one message of the plan's streams into `w` (other topics are ignored).
 fn write_message(
     m: &Message<'_>,
     p: &Plan,
     rig: &mrtmap_io::Rig,
     w: &mut LayoutWriter,
+    imu: &mut ImuCollect,
 ) -> Result<(), Step> {
     let topic = Some(m.topic.to_string());
     let kind = MsgKind::of(m.datatype);
-    if topic == p.depth {
+    if kind == MsgKind::Imu && (topic == p.gyro || topic == p.accel) {
+        let x = ros_msg::imu(m.data, m.wire, m.offset).map_err(|e| e.to_string())?;
+        let t = stamp_or(x.header.stamp, m.time);
+        let [g, a] = &p.depth_from_imu;
+        if topic == p.gyro {
+            imu.gyro.push((t, g.rotation * x.angular_velocity));
+            if p.accel.is_none() {
+                imu.accel.push((t, a.rotation * x.linear_acceleration));
+            }
+        } else {
+            imu.accel.push((t, a.rotation * x.linear_acceleration));
+        }
+    } else if topic == p.depth {
         let (t, img) = sized_image(m, kind, rig.depth_scale, false, &rig.depth)?;
         w.depth(t, &img).map_err(Step::Write)?;
     } else if topic == p.thermal {
@@ -259,8 +306,9 @@ pub fn export<'a>(
     let mut w = LayoutWriter::create(out, &format!("converted by mrtmap from {}", path.display()))?;
     let mut rep = ExportReport::default();
     let mut err: Option<FileError> = None;
+    let mut imu = ImuCollect::default();
     let res = for_each(s.container, file, &mut |m| {
-        match write_message(&m, p, &rig, &mut w) {
+        match write_message(&m, p, &rig, &mut w, &mut imu) {
             Ok(()) => {}
             Err(Step::Write(e)) => {
                 err = Some(e);
@@ -280,6 +328,10 @@ pub fn export<'a>(
         return Err(e);
     }
     res.map_err(|e| e.in_file(path))?;
+    for sample in imu.into_samples() {
+        w.imu(sample);
+    }
+    rep.imu = w.imu_count();
     (rep.depth, rep.thermal, rep.rgb, rep.poses) = w.counts();
     let source = serde_json::json!({
         "format": "mrtmap-source/1",

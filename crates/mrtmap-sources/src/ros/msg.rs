@@ -1,6 +1,6 @@
 //! The ROS messages a scan needs, decoded from ROS 1 serialisation (bags) or CDR (ROS 2, MCAP):
 //! `sensor_msgs/Image`, `CompressedImage`, `CameraInfo`, `nav_msgs/Odometry`,
-//! `geometry_msgs/PoseStamped`, `TransformStamped`, `tf2_msgs/TFMessage`. One decoder serves both
+//! `geometry_msgs/PoseStamped`, `TransformStamped`, `tf2_msgs/TFMessage`, `sensor_msgs/Imu`. One decoder serves both
 //! encodings (the field order is the same; ROS 1 headers carry a `seq`, CDR aligns and
 //! NUL-terminates strings), every length is checked against what is left, and errors carry the
 //! byte offset.
@@ -246,6 +246,37 @@ pub fn odometry(data: &[u8], wire: Wire, base: u64) -> Result<StampedTransform, 
     })
 }
 
+/// `sensor_msgs/Imu`: angular velocity (rad/s) and linear acceleration (m/s²) in the header's
+/// frame. A RealSense publishing gyro and accelerometer on separate topics fills only one of them
+/// in each message (the other zero).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImuMsg {
+    /// Stamp and frame.
+    pub header: Header,
+    /// rad/s.
+    pub angular_velocity: nalgebra::Vector3<f64>,
+    /// m/s².
+    pub linear_acceleration: nalgebra::Vector3<f64>,
+}
+
+/// Decodes `sensor_msgs/Imu` (the orientation and covariances are skipped).
+pub fn imu(data: &[u8], wire: Wire, base: u64) -> Result<ImuMsg, Corrupt> {
+    let mut c = cursor(data, wire, base)?;
+    let header = header(&mut c)?;
+    c.f64s(4 + 9, "orientation")?;
+    let w = c.f64s(3, "angular_velocity")?;
+    c.f64s(9, "angular_velocity_covariance")?;
+    let a = c.f64s(3, "linear_acceleration")?;
+    if w.iter().chain(a.iter()).any(|x| !x.is_finite()) {
+        return Err(c.err("angular velocity or acceleration is not finite"));
+    }
+    Ok(ImuMsg {
+        header,
+        angular_velocity: nalgebra::Vector3::new(w[0], w[1], w[2]),
+        linear_acceleration: nalgebra::Vector3::new(a[0], a[1], a[2]),
+    })
+}
+
 /// Decodes `geometry_msgs/PoseStamped` → world_from_body (child unnamed).
 pub fn pose_stamped(data: &[u8], wire: Wire, base: u64) -> Result<StampedTransform, Corrupt> {
     let mut c = cursor(data, wire, base)?;
@@ -310,6 +341,8 @@ pub enum MsgKind {
     PoseStamped,
     /// geometry_msgs/TransformStamped.
     TransformStamped,
+    /// sensor_msgs/Imu.
+    Imu,
     /// tf2_msgs/TFMessage.
     Tf,
     /// Anything else.
@@ -328,6 +361,7 @@ impl MsgKind {
             ("nav_msgs", "Odometry") => Self::Odometry,
             ("geometry_msgs", "PoseStamped") => Self::PoseStamped,
             ("geometry_msgs", "TransformStamped") => Self::TransformStamped,
+            ("sensor_msgs", "Imu") => Self::Imu,
             ("tf2_msgs" | "tf", "TFMessage" | "tfMessage") => Self::Tf,
             _ => Self::Other,
         }
@@ -517,6 +551,31 @@ pub mod encode {
         w.finish()
     }
 
+    /// sensor_msgs/Imu (identity orientation, zero covariances).
+    pub fn imu(wire: Wire, stamp: f64, frame: &str, gyro: [f64; 3], accel: [f64; 3]) -> Vec<u8> {
+        let mut w = Writer::new(wire);
+        w.header(stamp, frame);
+        for v in [0.0, 0.0, 0.0, 1.0] {
+            w.f64(v);
+        }
+        for _ in 0..9 {
+            w.f64(0.0);
+        }
+        for v in gyro {
+            w.f64(v);
+        }
+        for _ in 0..9 {
+            w.f64(0.0);
+        }
+        for v in accel {
+            w.f64(v);
+        }
+        for _ in 0..9 {
+            w.f64(0.0);
+        }
+        w.finish()
+    }
+
     /// tf2_msgs/TFMessage.
     pub fn tf_message(wire: Wire, transforms: &[(f64, &str, &str, Isometry3<f64>)]) -> Vec<u8> {
         let mut w = Writer::new(wire);
@@ -561,6 +620,16 @@ mod tests {
             .unwrap();
             assert_eq!(tf.len(), 2);
             assert_eq!(tf[1].child, "c");
+            let m = imu(
+                &encode::imu(wire, 4.5, "imu", [0.1, -0.2, 0.3], [0.0, -9.8, 0.5]),
+                wire,
+                0,
+            )
+            .unwrap();
+            assert_eq!(m.header.frame_id, "imu");
+            assert!((m.header.stamp - 4.5).abs() < 1e-9);
+            assert_eq!(m.angular_velocity, Vector3::new(0.1, -0.2, 0.3));
+            assert_eq!(m.linear_acceleration, Vector3::new(0.0, -9.8, 0.5));
             let cm = encode::compressed_image(wire, 1.0, "f", "jpeg", b"xyz");
             let c = compressed_image(&cm, wire, 0).unwrap();
             assert_eq!((c.format.as_str(), c.data), ("jpeg", &b"xyz"[..]));

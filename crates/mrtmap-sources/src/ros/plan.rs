@@ -54,6 +54,14 @@ pub struct Plan {
     pub rgb: Option<String>,
     /// Poses.
     pub poses: Option<PoseSource>,
+    /// The gyro's sensor_msgs/Imu topic (a united IMU topic carries the accelerometer too).
+    pub gyro: Option<String>,
+    /// The accelerometer's, when on a topic of its own.
+    pub accel: Option<String>,
+    /// depth camera ← the gyro's and the accelerometer's frames (through /tf_static; identity
+    /// when not found).
+    #[serde(skip)]
+    pub depth_from_imu: [Isometry3<f64>; 2],
     /// depth frame ← pose child frame, when found in the static transforms.
     #[serde(skip)]
     pub child_from_depth: Isometry3<f64>,
@@ -76,6 +84,66 @@ const RGB_DEFAULTS: [&str; 2] = [
     "/camera/color/image_raw/compressed",
 ];
 const POSE_DEFAULTS: [&str; 2] = ["/camera/odom/sample", "/rtabmap/odom"];
+/// A D435i/D455 under realsense-ros: one topic with `unite_imu_method`, else two.
+const IMU_UNITED: &str = "/camera/imu";
+const GYRO_DEFAULT: &str = "/camera/gyro/sample";
+const ACCEL_DEFAULT: &str = "/camera/accel/sample";
+
+/// The IMU topics: a united one, or the gyro's and the accelerometer's, or any Imu topic; with
+/// their frames' rotations into the depth camera.
+fn imu_topics(
+    s: &Survey,
+    depth_frame: &str,
+    notes: &mut Vec<String>,
+) -> (Option<String>, Option<String>, [Isometry3<f64>; 2]) {
+    let is_imu = |t: &str| {
+        s.topics
+            .get(t)
+            .is_some_and(|x| MsgKind::of(&x.datatype) == MsgKind::Imu)
+    };
+    let (gyro, accel) = if is_imu(IMU_UNITED) {
+        (Some(IMU_UNITED.to_string()), None)
+    } else if is_imu(GYRO_DEFAULT) {
+        (
+            Some(GYRO_DEFAULT.to_string()),
+            is_imu(ACCEL_DEFAULT).then(|| ACCEL_DEFAULT.to_string()),
+        )
+    } else {
+        let any = s
+            .topics
+            .values()
+            .find(|t| MsgKind::of(&t.datatype) == MsgKind::Imu)
+            .map(|t| t.topic.clone());
+        (any, None)
+    };
+    let mut rot = |t: &Option<String>| {
+        let frame = frame_of(s, t)?;
+        match static_lookup(&s.static_tf, depth_frame, &frame) {
+            Some(x) => Some(x),
+            None => {
+                notes.push(format!(
+                    "no static transform from the IMU frame {frame} to the depth camera {depth_frame}: its axes are taken as the depth camera's"
+                ));
+                None
+            }
+        }
+    };
+    let g = rot(&gyro).unwrap_or_else(Isometry3::identity);
+    let a = if accel.is_some() {
+        rot(&accel).unwrap_or_else(Isometry3::identity)
+    } else {
+        g
+    };
+    if let Some(t) = &gyro {
+        notes.push(match &accel {
+            Some(a) => {
+                format!("inertial samples from {t} (gyro) and {a} (accelerometer) into imu.txt")
+            }
+            None => format!("inertial samples from {t} into imu.txt"),
+        });
+    }
+    (gyro, accel, [g, a])
+}
 
 fn info_topic_for(image_topic: &str) -> String {
     let t = image_topic
@@ -233,11 +301,12 @@ fn image_topics(
 }
 
 /// Where poses come from: an Odometry or PoseStamped topic, else a dynamic transform whose child
-/// reaches the depth camera through static ones.
+/// reaches the depth camera through static ones; none with colour images (tracked later).
 fn pose_source(
     s: &Survey,
     o: &RosOptions,
     depth_frame: &str,
+    has_colour: bool,
     missing: &mut Vec<String>,
     notes: &mut Vec<String>,
 ) -> Option<PoseSource> {
@@ -267,9 +336,16 @@ fn pose_source(
             notes.push(format!("poses from /tf: {p} → {c}"));
             Some(PoseSource::Tf(p.clone(), c.clone()))
         }
+        None if has_colour => {
+            notes.push(
+                "no poses (no Odometry or PoseStamped topic, no /tf transform that reaches the depth camera): the recording gets no trajectory.txt, and `mrtmap run` tracks the camera from colour and depth"
+                    .into(),
+            );
+            None
+        }
         None => {
             missing.push(
-                "poses: no Odometry or PoseStamped topic, and no /tf transform that reaches the depth camera (name one with --pose-topic)"
+                "poses: no Odometry or PoseStamped topic, and no /tf transform that reaches the depth camera (name one with --pose-topic), nor colour images to track the camera with"
                     .into(),
             );
             None
@@ -392,9 +468,10 @@ pub fn plan(s: &Survey, o: &RosOptions) -> Plan {
     let mut notes = Vec::new();
     let (depth, thermal, rgb) = image_topics(s, o, &mut missing);
     let depth_frame = frame_of(s, &depth).unwrap_or_default();
-    let poses = pose_source(s, o, &depth_frame, &mut missing, &mut notes);
+    let poses = pose_source(s, o, &depth_frame, rgb.is_some(), &mut missing, &mut notes);
     let child_from_depth = child_to_depth(s, &poses, &depth_frame, &mut notes);
     let rig = assemble_rig(s, o, (&depth, &thermal, &rgb), &mut missing);
+    let (gyro, accel, depth_from_imu) = imu_topics(s, &depth_frame, &mut notes);
     if s.unfinished {
         notes.push("the file was cut or never closed: what was read is all there is".into());
     }
@@ -412,6 +489,9 @@ pub fn plan(s: &Survey, o: &RosOptions) -> Plan {
         thermal,
         rgb,
         poses,
+        gyro,
+        accel,
+        depth_from_imu,
         child_from_depth,
         rig,
         missing,

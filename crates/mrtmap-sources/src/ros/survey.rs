@@ -106,6 +106,11 @@ impl Survey {
                 st.child_frame = p.child;
                 p.stamp
             }
+            MsgKind::Imu => {
+                let i = ros_msg::imu(data, wire, at)?;
+                st.frame_id = i.header.frame_id;
+                i.header.stamp
+            }
             MsgKind::Tf | MsgKind::TransformStamped => {
                 let tfs = if kind == MsgKind::Tf {
                     ros_msg::tf_message(data, wire, at)?

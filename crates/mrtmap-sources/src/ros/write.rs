@@ -31,6 +31,22 @@ pub mod names {
     pub const POSE_FRAME: &str = "camera_pose_frame";
     /// Odometry parent frame.
     pub const ODOM_FRAME: &str = "camera_odom_frame";
+    /// Gyro and accelerometer in one topic (realsense-ros `unite_imu_method`).
+    pub const IMU: &str = "/camera/imu";
+    /// The IMU's frame.
+    pub const IMU_FRAME: &str = "camera_imu_optical_frame";
+}
+
+/// depth_from_imu of the bags [`write_ros`] writes: the IMU 5 mm beside the depth camera, turned
+/// 90° about its optical axis (so a reader must apply /tf_static to get the axes right).
+pub fn depth_from_imu() -> Isometry3<f64> {
+    Isometry3::from_parts(
+        nalgebra::Translation3::new(-0.005, 0.0, 0.0),
+        nalgebra::UnitQuaternion::from_axis_angle(
+            &nalgebra::Vector3::z_axis(),
+            std::f64::consts::FRAC_PI_2,
+        ),
+    )
 }
 
 /// How [`write_ros`] writes.
@@ -165,6 +181,7 @@ fn write_statics(
             names::DEPTH_FRAME,
             o.pose_from_depth.inverse(),
         ),
+        (t0, names::DEPTH_FRAME, names::IMU_FRAME, depth_from_imu()),
     ];
     if let Some(c) = &rig.rgb
         && c.depth_from_rgb != Isometry3::identity()
@@ -198,6 +215,7 @@ enum Item<'a> {
     Thermal(&'a StreamEntry),
     Rgb(&'a StreamEntry),
     Pose(usize),
+    Imu(usize),
 }
 
 /// Every frame and pose of a recording, in time order.
@@ -215,6 +233,7 @@ fn timeline(rec: &Recording) -> Vec<(f64, Item<'_>)> {
             .enumerate()
             .map(|(i, &t)| (t, Item::Pose(i))),
     );
+    items.extend(rec.imu.iter().enumerate().map(|(i, m)| (m.t, Item::Imu(i))));
     items.sort_by(|a, b| a.0.total_cmp(&b.0));
     items
 }
@@ -264,12 +283,22 @@ fn write_item(
             );
             sink.put(dir, names::ODOM, "nav_msgs/Odometry", t, &m)
         }
+        Item::Imu(i) => {
+            let imu_from_depth = depth_from_imu().rotation.inverse();
+            let (g, a) = (
+                imu_from_depth * rec.imu[i].gyro,
+                imu_from_depth * rec.imu[i].accel,
+            );
+            let m = encode::imu(wire, t, names::IMU_FRAME, g.into(), a.into());
+            sink.put(dir, names::IMU, "sensor_msgs/Imu", t, &m)
+        }
     }
 }
 
 /// Writes a recording as a bag or MCAP file with RealSense-style topics ([`names`]): aligned
 /// depth (16UC1), colour (rgb8), thermal (mono16), their CameraInfo, T265-style odometry of a
-/// pose frame, and /tf_static tying the frames together.
+/// pose frame (when the recording has poses), the IMU (when it has imu.txt), and /tf_static
+/// tying the frames together.
 pub fn write_ros(rec: &Recording, o: &RosWriteOptions) -> Result<Vec<u8>, FileError> {
     let mut sink = Sink::new(o, &rec.dir)?;
     let t0 = rec

@@ -737,3 +737,88 @@ fn db3_files_are_told_from_rtabmap_databases_and_bad_messages_skipped() {
         rep.skipped_reasons
     );
 }
+
+/// A D435i-style source without odometry but with its IMU: it converts (no trajectory.txt: the
+/// recording is tracked), and imu.txt comes back in the depth camera's axes through /tf_static.
+#[test]
+fn a_source_without_poses_converts_with_its_imu_in_the_depth_cameras_axes() {
+    let dir = tempfile::tempdir().unwrap();
+    let scan = dir.path().join("scan");
+    recording(&scan);
+    std::fs::remove_file(scan.join("trajectory.txt")).unwrap();
+    let samples: Vec<mrtmap_io::ImuSample> = (0..200)
+        .map(|k| {
+            let t = 1_700_000_000.0 + 0.005 * k as f64;
+            mrtmap_io::ImuSample {
+                t,
+                gyro: Vector3::new(0.3, -0.1 * (k as f64 * 0.05).sin(), 0.05),
+                accel: Vector3::new(0.2, -9.7, 0.4 + 0.001 * k as f64),
+            }
+        })
+        .collect();
+    std::fs::write(scan.join("imu.txt"), mrtmap_io::imu_text(&samples, "test")).unwrap();
+    let orig = Recording::open(&scan).unwrap();
+    assert!(orig.trajectory.is_empty() && orig.imu.len() == 200);
+    for container in [Container::Bag, Container::Mcap, Container::Db3] {
+        let bytes = ros::write_ros(
+            &orig,
+            &RosWriteOptions::t265_like(container, Compression::None),
+        )
+        .unwrap();
+        let s = ros::survey(container, &bytes).unwrap();
+        let p = ros::plan(&s, &RosOptions::default());
+        assert!(p.missing.is_empty(), "{:?}", p.missing);
+        assert!(p.poses.is_none());
+        assert!(
+            p.notes.iter().any(|n| n.contains("tracks the camera")),
+            "{:?}",
+            p.notes
+        );
+        assert_eq!(p.gyro.as_deref(), Some(names::IMU));
+        let out = dir.path().join(format!("{container:?}"));
+        let rep = ros::export(Path::new("x"), &bytes, &s, &p, &out).unwrap();
+        assert_eq!((rep.poses, rep.imu), (0, 200));
+        assert!(!out.join("trajectory.txt").exists());
+        let conv = Recording::open(&out).unwrap();
+        assert!(
+            conv.warnings
+                .iter()
+                .any(|w| w.contains("no trajectory.txt"))
+        );
+        assert_eq!(conv.imu.len(), 200);
+        for (a, b) in orig.imu.iter().zip(&conv.imu) {
+            assert!((a.t - b.t).abs() < 1e-6);
+            assert!(
+                (a.gyro - b.gyro).norm() < 1e-6,
+                "{:?} vs {:?}",
+                a.gyro,
+                b.gyro
+            );
+            assert!(
+                (a.accel - b.accel).norm() < 1e-4,
+                "{:?} vs {:?}",
+                a.accel,
+                b.accel
+            );
+        }
+    }
+    // Without colour either (the colour topic named is not there), the poses are missing.
+    let bytes = ros::write_ros(
+        &orig,
+        &RosWriteOptions::t265_like(Container::Bag, Compression::None),
+    )
+    .unwrap();
+    let s = ros::survey(Container::Bag, &bytes).unwrap();
+    let o = RosOptions {
+        rgb_topic: Some("/no/colour".into()),
+        ..RosOptions::default()
+    };
+    let p = ros::plan(&s, &o);
+    assert!(
+        p.missing
+            .iter()
+            .any(|m| m.starts_with("poses:") && m.contains("nor colour images")),
+        "{:?}",
+        p.missing
+    );
+}
