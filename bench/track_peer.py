@@ -20,6 +20,7 @@ import tomllib
 
 import numpy as np
 import open3d as o3d
+from scipy.spatial.transform import Rotation
 
 
 def read_list(path):
@@ -36,20 +37,11 @@ def read_poses(path):
     return np.array(rows)
 
 
-def quat_to_matrix(q):
-    x, y, z, w = q
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
-
-
 def to_matrices(rows):
     out = []
     for r in rows:
         m = np.eye(4)
-        m[:3, :3] = quat_to_matrix(r[4:8])
+        m[:3, :3] = Rotation.from_quat(r[4:8]).as_matrix()
         m[:3, 3] = r[1:4]
         out.append(m)
     return out

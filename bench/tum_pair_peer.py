@@ -12,6 +12,7 @@ import sys
 
 import cv2
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 mrtmap, data, work = sys.argv[1:4]
 src = os.path.join(data, "tum-rgbd")
@@ -37,11 +38,8 @@ rows = [[float(x) for x in l.split()] for l in open(os.path.join(out, "trajector
 
 
 def matrix(r):
-    x, y, z, w = r[4:8]
     m = np.eye(4)
-    m[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    m[:3, :3] = Rotation.from_quat(r[4:8]).as_matrix()
     m[:3, 3] = r[1:4]
     return m
 

@@ -410,6 +410,39 @@ mod tests {
     use super::*;
     use mrtmap_geometry::Plane;
 
+    /// The one piece of furniture found among `pos` (at 21 °C, seen in 6 frames, on no surface) in
+    /// a 2.7 m high room with z up and boxes along x.
+    fn the_one(
+        pos: &[Point3<f64>],
+        nrm: &[Vector3<f64>],
+        floor_2d: &[Point2<f64>],
+        walls: &[(Plane, f64)],
+        floor_seen: &std::collections::HashSet<(i32, i32)>,
+    ) -> FoundFurniture {
+        let room = Room {
+            up: Unit::new_normalize(Vector3::z()),
+            along: Vector3::x(),
+            floor_height: 0.0,
+            room_height: 2.7,
+            floor_2d,
+            wall_planes: walls,
+            floor_seen,
+        };
+        let n = pos.len();
+        let (temp, obs, sid) = (vec![294.15; n], vec![6u32; n], vec![-1i32; n]);
+        let mut found = find_furniture(
+            pos,
+            nrm,
+            &temp,
+            &obs,
+            &sid,
+            &room,
+            &SegmentParams::default(),
+        );
+        assert_eq!(found.len(), 1, "{found:?}");
+        found.remove(0)
+    }
+
     /// A bookcase standing against the wall x = 0 (truth: x 0.02…0.42, y 2.69…3.89, 1.9 m tall,
     /// its end 11 cm from the wall y = 4, whose fused band is 30 cm thick) seen only from the
     /// front, whose face is fused ±12 cm thick (depth noise from 3–4 m away), and from above. Its
@@ -417,7 +450,6 @@ mod tests {
     /// over the floor nobody saw, and its front runs on into the far wall's band to its end.
     #[test]
     fn a_bookcase_seen_from_the_front_stands_against_the_wall_at_its_face() {
-        let up = Unit::new_normalize(Vector3::z());
         let (mut pos, mut nrm) = (Vec::new(), Vec::new());
         // Front face: a deterministic spread of ±12 cm around x = 0.42.
         for k in 0..4000 {
@@ -436,10 +468,6 @@ mod tests {
             pos.push(Point3::new(x, y, 1.9));
             nrm.push(Vector3::z());
         }
-        let n = pos.len();
-        let temp = vec![293.5; n];
-        let obs = vec![6u32; n];
-        let sid = vec![-1i32; n];
         let floor_2d = [
             Point2::new(0.0, 0.0),
             Point2::new(4.0, 0.0),
@@ -468,26 +496,7 @@ mod tests {
                 !(x < 0.35 && (2.67..3.91).contains(&y))
             })
             .collect();
-        let room = Room {
-            up,
-            along: Vector3::x(),
-            floor_height: 0.0,
-            room_height: 2.7,
-            floor_2d: &floor_2d,
-            wall_planes: &walls,
-            floor_seen: &floor_seen,
-        };
-        let found = find_furniture(
-            &pos,
-            &nrm,
-            &temp,
-            &obs,
-            &sid,
-            &room,
-            &SegmentParams::default(),
-        );
-        assert_eq!(found.len(), 1, "{found:?}");
-        let f = &found[0];
+        let f = &the_one(&pos, &nrm, &floor_2d, &walls, &floor_seen);
         let xs: Vec<f64> = f.corners.iter().map(|p| p.x).collect();
         let (x0, x1) = (
             xs.iter().copied().fold(f64::MAX, f64::min),
@@ -512,7 +521,6 @@ mod tests {
     /// wall (growing to the back wall used to stop the growth along it).
     #[test]
     fn a_sofa_in_a_corner_seen_from_its_end_grows_to_both_walls() {
-        let up = Unit::new_normalize(Vector3::z());
         let (mut pos, mut nrm) = (Vec::new(), Vec::new());
         let mut add = |p: Point3<f64>, n: Vector3<f64>| {
             pos.push(p);
@@ -540,8 +548,6 @@ mod tests {
         for k in 0..6 {
             add(Point3::new(5.12 + 0.03 * k as f64, 1.9, 0.8), Vector3::z());
         }
-        let n = pos.len();
-        let (temp, obs, sid) = (vec![294.5; n], vec![6u32; n], vec![-1i32; n]);
         let floor_2d = [
             Point2::new(0.0, 0.0),
             Point2::new(6.0, 0.0),
@@ -569,26 +575,7 @@ mod tests {
                 !(x > 3.97 && y > 1.57)
             })
             .collect();
-        let room = Room {
-            up,
-            along: Vector3::x(),
-            floor_height: 0.0,
-            room_height: 2.7,
-            floor_2d: &floor_2d,
-            wall_planes: &walls,
-            floor_seen: &floor_seen,
-        };
-        let found = find_furniture(
-            &pos,
-            &nrm,
-            &temp,
-            &obs,
-            &sid,
-            &room,
-            &SegmentParams::default(),
-        );
-        assert_eq!(found.len(), 1, "{found:?}");
-        let f = &found[0];
+        let f = &the_one(&pos, &nrm, &floor_2d, &walls, &floor_seen);
         let max = |k: usize| f.corners.iter().map(|p| p[k]).fold(f64::MIN, f64::max);
         let min = |k: usize| f.corners.iter().map(|p| p[k]).fold(f64::MAX, f64::min);
         assert!((min(0) - 4.0).abs() < 0.03, "near end at x = {:.3}", min(0));

@@ -250,21 +250,25 @@ fn recording_reads_back_consistently() {
     }
 }
 
-#[test]
-fn drift_separates_trajectory_from_groundtruth() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("scan");
+/// A 3 s noise-free office walk at 80×60 depth with `drift`.
+fn noise_free_office(drift: mrtmap_sim::Drift, out: &std::path::Path) -> Recording {
     let room = preset("office").unwrap().unwrap();
     let mut cfg = mrtmap_sim::SimConfig {
         seconds: 3.0,
         noise: NoiseLevel::None,
         truth_rays: 1000,
-        drift: mrtmap_sim::Drift::ODOMETRY,
+        drift,
         ..Default::default()
     };
     cfg.depth_camera = cfg.depth_camera.scaled(0.125);
-    mrtmap_sim::simulate(&room, &cfg, &out, &|_, _| {}).unwrap();
-    let rec = Recording::open(&out).unwrap();
+    mrtmap_sim::simulate(&room, &cfg, out, &|_, _| {}).unwrap();
+    Recording::open(out).unwrap()
+}
+
+#[test]
+fn drift_separates_trajectory_from_groundtruth() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = noise_free_office(mrtmap_sim::Drift::ODOMETRY, &dir.path().join("scan"));
     let gt = rec.groundtruth.unwrap();
     let err = |k: usize| {
         (rec.trajectory.poses[k].translation.vector - gt.poses[k].translation.vector).norm()
@@ -279,17 +283,7 @@ fn drift_separates_trajectory_from_groundtruth() {
 #[test]
 fn the_simulated_gyro_integrates_to_the_true_rotation_and_the_accelerometer_reads_gravity() {
     let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("scan");
-    let room = preset("office").unwrap().unwrap();
-    let mut cfg = mrtmap_sim::SimConfig {
-        seconds: 3.0,
-        noise: NoiseLevel::None,
-        truth_rays: 1000,
-        ..Default::default()
-    };
-    cfg.depth_camera = cfg.depth_camera.scaled(0.125);
-    mrtmap_sim::simulate(&room, &cfg, &out, &|_, _| {}).unwrap();
-    let rec = Recording::open(&out).unwrap();
+    let rec = noise_free_office(mrtmap_sim::Drift::NONE, &dir.path().join("scan"));
     let gt = rec.groundtruth.unwrap();
     assert_eq!(rec.imu.len(), gt.len());
     let (a, b) = (100, 500); // 0.5 s and 2.5 s
