@@ -88,9 +88,6 @@ pub struct OutlineParams {
     pub merge_m: f64,
     /// Raster cell for the floor and ceiling seen (m).
     pub cell_m: f64,
-    /// Lines within this angle (degrees) of square to the best-seen wall are made square to it
-    /// (0: never).
-    pub square_deg: f64,
 }
 
 impl Default for OutlineParams {
@@ -103,7 +100,6 @@ impl Default for OutlineParams {
             merge_deg: 6.0,
             merge_m: 0.15,
             cell_m: 0.05,
-            square_deg: 2.0,
         }
     }
 }
@@ -401,41 +397,7 @@ pub fn wall_lines(
             && (l.density >= STRONG_DENSITY * densest
                 || (l.density >= 0.1 * densest && l.thickness <= 0.1))
     });
-    let mut lines = merge_lines(lines, pts, p);
-    square_up(&mut lines, pts, p.square_deg);
-    lines
-}
-
-/// Walls built square to each other, seen a little off: lines within `tol_deg` of parallel or
-/// perpendicular to the best-seen line (the most points) are turned to exactly that, about the
-/// point of each line nearest its points' centroid. A wall seen briefly or at a grazing angle
-/// was fitted 1.1° off on an L-shaped walk, 2 cm at the room's corner 1.2 m from its middle.
-fn square_up(lines: &mut [WallLine], pts: &[Point2<f64>], tol_deg: f64) {
-    let Some(best) = lines.iter().max_by_key(|l| l.points.len()) else {
-        return;
-    };
-    let reference = best.n.y.atan2(best.n.x);
-    for l in lines.iter_mut() {
-        if l.points.is_empty() {
-            continue;
-        }
-        let a = l.n.y.atan2(l.n.x) - reference;
-        // The angle off the nearest multiple of 90°.
-        let q = std::f64::consts::FRAC_PI_2;
-        let off = a - (a / q).round() * q;
-        if off.abs() >= tol_deg.to_radians() || off == 0.0 {
-            continue;
-        }
-        let centroid = l
-            .points
-            .iter()
-            .fold(Vector2::zeros(), |acc, &i| acc + pts[i].coords)
-            / l.points.len() as f64;
-        let on_line = centroid - l.n * (l.n.dot(&centroid) - l.rho);
-        let (c, s) = ((-off).cos(), (-off).sin());
-        l.n = Vector2::new(c * l.n.x - s * l.n.y, s * l.n.x + c * l.n.y).normalize();
-        l.rho = l.n.dot(&on_line);
-    }
+    merge_lines(lines, pts, p)
 }
 
 /// Lines that are one wall found twice (within `merge_deg` and `merge_m`, facing the same way):
@@ -1078,44 +1040,5 @@ mod tests {
             outline(Vec::new(), &[], &p).unwrap_err(),
             OutlineError::NothingSeen
         );
-    }
-
-    #[test]
-    fn walls_nearly_square_to_the_best_seen_one_are_made_square_and_others_left() {
-        // The best-seen wall along x (normal +y, 100 points); one 1.1° off perpendicular, through
-        // (6, 1.25); one 10° off (a bay), left as it is.
-        let mut pts: Vec<Point2<f64>> = (0..100)
-            .map(|k| Point2::new(0.06 * k as f64, 0.0))
-            .collect();
-        let tilt = 1.1f64.to_radians();
-        let n1 = Vector2::new(-(tilt.cos()), tilt.sin());
-        pts.extend((0..41).map(|k| {
-            let s = -1.0 + 0.05 * k as f64;
-            Point2::new(6.0, 1.25) + Vector2::new(-n1.y, n1.x) * s
-        }));
-        let n2 = Vector2::new(10f64.to_radians().sin(), -(10f64.to_radians().cos()));
-        let line = |n: Vector2<f64>, rho: f64, points: std::ops::Range<usize>| WallLine {
-            n,
-            rho,
-            points: points.collect(),
-            inferred: false,
-            density: 1.0,
-            thickness: 0.01,
-        };
-        let mut lines = vec![
-            line(Vector2::new(0.0, 1.0), 0.0, 0..100),
-            line(n1, n1.dot(&Vector2::new(6.0, 1.25)), 100..141),
-            line(n2, -5.0, 100..101),
-        ];
-        square_up(&mut lines, &pts, 2.0);
-        assert_eq!(lines[0].n, Vector2::new(0.0, 1.0));
-        assert!(
-            (lines[1].n - Vector2::new(-1.0, 0.0)).norm() < 1e-12,
-            "{}",
-            lines[1].n
-        );
-        // Turned about its middle: still through (6, 1.25).
-        assert!((lines[1].distance(&Point2::new(6.0, 1.25))).abs() < 1e-9);
-        assert_eq!((lines[2].n, lines[2].rho), (n2, -5.0));
     }
 }
