@@ -322,7 +322,7 @@ pub struct RunOutcome {
 }
 
 /// The track stage: `out/track`, when the recording has no poses or `[track] mode = "always"`;
-/// the recording's trajectory becomes the tracked one.
+/// the recording's trajectory becomes the tracked one (re-tracked: aligned to the recording's own).
 fn track_stage(
     rec: &mut Recording,
     out: &Path,
@@ -357,7 +357,14 @@ fn track_stage(
     let outcome = run_or_reuse(&stage, fingerprint, force, || {
         track_into(rec, &params, &dir, progress).map(|_| ())
     })?;
-    rec.trajectory = Trajectory::read(&dir.join("trajectory.txt"))?;
+    let tracked = Trajectory::read(&dir.join("trajectory.txt"))?;
+    // Re-tracked (mode = "always"): in the recording's own world frame, the frame of its
+    // references.csv and of the project's scan-frame points.
+    rec.trajectory = if has_poses {
+        mrtmap_scan::track::expressed_in(&tracked, &rec.trajectory).unwrap_or(tracked)
+    } else {
+        tracked
+    };
     Ok(Some((outcome, read_json(&dir.join("track.json"))?)))
 }
 

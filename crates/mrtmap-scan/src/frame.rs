@@ -62,7 +62,8 @@ impl RayTable {
         }
     }
 
-    fn ray(&self, u: u32, v: u32) -> &Vector3<f64> {
+    /// The unit-depth ray (z = 1) of pixel (u, v).
+    pub(crate) fn ray(&self, u: u32, v: u32) -> &Vector3<f64> {
         &self.rays[(v * self.width + u) as usize]
     }
 }

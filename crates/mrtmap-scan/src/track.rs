@@ -28,7 +28,7 @@ use mrtmap_geometry::nalgebra::{
     Isometry3, Matrix3, Matrix6, Point2, Point3, Rotation3, Translation3, UnitQuaternion, Vector3,
     Vector6,
 };
-use mrtmap_io::{Recording, Trajectory, read_image16};
+use mrtmap_io::{Recording, Trajectory};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -319,7 +319,7 @@ struct Cameras {
 
 /// Depth of the colour image's pixels: the depth frame's points moved into the colour camera and
 /// z-buffered (nearest wins).
-fn depth_in_colour(depth: &mrtmap_io::Image16, cams: &Cameras) -> Vec<f32> {
+fn depth_in_colour(depth: &mrtmap_io::Image16, cams: &Cameras, rays: &RayTable) -> Vec<f32> {
     let (cw, ch) = (cams.colour.width as usize, cams.colour.height as usize);
     let mut z = vec![f32::INFINITY; cw * ch];
     let same = cams.colour == cams.depth
@@ -336,7 +336,7 @@ fn depth_in_colour(depth: &mrtmap_io::Image16, cams: &Cameras) -> Vec<f32> {
                 z[v as usize * cw + u as usize] = d as f32;
                 continue;
             }
-            let p = Point3::from(cams.depth.unproject(&Point2::new(u as f64, v as f64)) * d);
+            let p = Point3::from(rays.ray(u, v) * d);
             let q = cams.colour_from_depth * p;
             if let Some(px) = cams.colour.project(&q) {
                 let (x, y) = (px.x.round(), px.y.round());
@@ -561,8 +561,6 @@ struct Found {
     reprojection_px: f64,
 }
 
-/// current_from_reference from matched corners: RANSAC on 3D–3D triples, scored by reprojection,
-/// then Gauss–Newton on the inliers' reprojection errors.
 /// A frame's corners as pose estimation sees them: normalised coordinates and 3D points.
 #[derive(Clone, Copy)]
 struct Seen<'a> {
@@ -573,6 +571,8 @@ struct Seen<'a> {
 /// A match: the reference's 3D point, the current corner and its own 3D point.
 type Observation = (Point3<f64>, Point2<f64>, Option<Point3<f64>>);
 
+/// current_from_reference from matched corners: RANSAC on 3D–3D triples, scored by reprojection,
+/// then Gauss–Newton on the inliers' reprojection errors.
 fn estimate(
     r_xyz: &[Option<Point3<f64>>],
     c: Seen<'_>,
@@ -815,7 +815,7 @@ pub fn track(
         let mut cloud = None;
         let depth = match nearest_depth(e.t) {
             Some(k) => {
-                let img = read_image16(&rec.path_of(&rec.depth[k]))?;
+                let img = rec.read_depth(&rec.depth[k])?;
                 let mut pts = depth_points(&img, &rays, cams.depth_scale, &sampling);
                 for (p, n) in pts.points.iter_mut().zip(pts.normals.iter_mut()) {
                     *p = cams.colour_from_depth * *p;
@@ -823,7 +823,7 @@ pub fn track(
                 }
                 cloud = Some(std::sync::Arc::new(pts));
                 Some((
-                    std::sync::Arc::new(depth_in_colour(&img, &cams)),
+                    std::sync::Arc::new(depth_in_colour(&img, &cams, &rays)),
                     depth_t[k] - e.t,
                 ))
             }
@@ -1180,6 +1180,16 @@ pub fn align(est: &Trajectory, truth: &Trajectory) -> Option<Isometry3<f64>> {
     align_pairs(&paired(est, truth))
 }
 
+/// `est` carried into `reference`'s world frame by [`align`] (a re-tracked recording keeps the
+/// frame its references and points are given in); `None` below three poses paired in time.
+pub fn expressed_in(est: &Trajectory, reference: &Trajectory) -> Option<Trajectory> {
+    let w = align(est, reference)?;
+    Some(Trajectory {
+        stamps: est.stamps.clone(),
+        poses: est.poses.iter().map(|p| renormalised(&(w * p))).collect(),
+    })
+}
+
 /// TUM's absolute trajectory error: each estimated pose against the true pose interpolated at its
 /// time, after the rigid alignment (Horn) that minimises the position errors.
 pub fn trajectory_error(est: &Trajectory, truth: &Trajectory) -> Option<TrajectoryError> {
@@ -1298,6 +1308,12 @@ mod tests {
         };
         let e = trajectory_error(&moved, &truth).unwrap();
         assert_eq!(e.poses, 40);
+        // Carried back into the truth's frame: the truth.
+        let back = expressed_in(&moved, &truth).unwrap();
+        assert!(back.poses.iter().zip(&truth.poses).all(|(a, b)| {
+            (a.translation.vector - b.translation.vector).norm() < 1e-9
+                && a.rotation.angle_to(&b.rotation) < 1e-9
+        }));
         assert!(
             e.ate_rmse_m < 1e-9 && e.rpe_translation_rmse_m < 1e-9,
             "{e:?}"
