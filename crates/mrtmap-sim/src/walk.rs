@@ -122,6 +122,65 @@ fn area_centroid(p: &[Point2<f64>]) -> Point2<f64> {
     Point2::new(cx / (3.0 * a), cy / (3.0 * a))
 }
 
+/// Distance from `q` to the closed polygon's edges, and whether `q` lies inside it (even-odd).
+fn edge_distance(p: &[Point2<f64>], q: Point2<f64>) -> (f64, bool) {
+    let (mut d, mut inside) = (f64::INFINITY, false);
+    for i in 0..p.len() {
+        let (a, b) = (p[i], p[(i + 1) % p.len()]);
+        let ab = b - a;
+        let s = ((q - a).dot(&ab) / ab.norm_squared().max(1e-18)).clamp(0.0, 1.0);
+        d = d.min((a + ab * s - q).norm());
+        if (a.y > q.y) != (b.y > q.y) && q.x < a.x + (q.y - a.y) / (b.y - a.y) * ab.x {
+            inside = !inside;
+        }
+    }
+    (d, inside)
+}
+
+/// The point the camera looks at: the floor plan's centroid, unless the walk passes close to it
+/// (a re-entrant room: the L-shaped preset's centroid lies on its walk, where looking at it would
+/// whip the camera round at over 1000°/s); then the point inside the innermost loop farthest from
+/// it, the one nearest the centroid among equals.
+fn look_target(plan: &[Point2<f64>], innermost: &[Point2<f64>]) -> Point2<f64> {
+    let c = area_centroid(plan);
+    let (lo, hi) = innermost.iter().fold(
+        (
+            Point2::new(f64::INFINITY, f64::INFINITY),
+            Point2::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+        ),
+        |(a, b), q| {
+            (
+                Point2::new(a.x.min(q.x), a.y.min(q.y)),
+                Point2::new(b.x.max(q.x), b.y.max(q.y)),
+            )
+        },
+    );
+    let step = 0.02;
+    let (nx, ny) = (
+        ((hi.x - lo.x) / step).ceil() as usize,
+        ((hi.y - lo.y) / step).ceil() as usize,
+    );
+    let mut best: Option<(f64, f64, Point2<f64>)> = None;
+    for i in 0..=nx {
+        for j in 0..=ny {
+            let q = Point2::new(lo.x + i as f64 * step, lo.y + j as f64 * step);
+            let (d, inside) = edge_distance(innermost, q);
+            if !inside {
+                continue;
+            }
+            let key = ((d / step).round() * step, -(q - c).norm());
+            if best.is_none_or(|(bd, bc, _)| key.0 > bd || (key.0 == bd && key.1 > bc)) {
+                best = Some((key.0, key.1, q));
+            }
+        }
+    }
+    let Some((r_max, _, far)) = best else {
+        return c;
+    };
+    let (dc, inside) = edge_distance(innermost, c);
+    if inside && dc >= 0.8 * r_max { c } else { far }
+}
+
 impl Walk {
     /// A walk through `room` with `params`, shake drawn from `seed`.
     pub fn new(room: &Room, params: WalkParams, seed: u64) -> Self {
@@ -145,9 +204,11 @@ impl Walk {
             .map(|_| [0, 1, 2].map(|_| (rng.random_range(0.4..3.0), rng.random_range(0.0..TAU))))
             .collect();
         let loop_ = inset_polygon(&room.plan, inset);
+        // The loop's inset breathes by ±25 %: the target keeps away from its innermost form.
+        let innermost = inset_polygon(&room.plan, 1.25 * inset);
         Self {
             perimeter: perimeter(&loop_),
-            target: area_centroid(&room.plan),
+            target: look_target(&room.plan, &innermost),
             plan: room.plan.clone(),
             inset,
             params,

@@ -136,6 +136,38 @@ fn gradient_truth_is_consistent() {
     assert_eq!(truth.grid.nodes.len(), 400);
 }
 
+/// A handheld camera turns smoothly: the default walk of every preset stays under 150°/s (sampled
+/// every 10 ms over 343 s). The L-shaped room's walk once looked at the plan's centroid, which lies
+/// on its loop, and whipped round at over 1500°/s there.
+#[test]
+fn the_walk_turns_at_a_handheld_rate() {
+    use mrtmap_sim::{SimConfig, Walk};
+    for (name, _) in PRESETS {
+        let room = preset(name).unwrap().unwrap();
+        let walk = Walk::new(&room, SimConfig::default().walk, 1);
+        let dt = 0.01;
+        let (mut worst, mut at) = (0.0f64, 0.0);
+        let mut prev = walk.room_from_depth(0.0);
+        for k in 1..34_300 {
+            let t = k as f64 * dt;
+            let pose = walk.room_from_depth(t);
+            let rate = (prev.rotation.inverse() * pose.rotation)
+                .angle()
+                .to_degrees()
+                / dt;
+            if rate > worst {
+                (worst, at) = (rate, t);
+            }
+            prev = pose;
+        }
+        eprintln!("{name}: fastest turn {worst:.1}°/s at {at:.2} s");
+        assert!(
+            worst < 150.0,
+            "{name}: the walk turns at {worst:.0}°/s at {at:.2} s"
+        );
+    }
+}
+
 /// The default 343 s walk sees every wall, the floor, the ceiling and every feature of each preset
 /// (sampled once per second with a sparse pixel grid of the depth camera).
 #[test]
