@@ -64,6 +64,23 @@ pub struct Walk {
     /// (frequency Hz, phase) per shake channel: 3 rotation + 3 translation, 3 sinusoids each.
     shake: Vec<[(f64, f64); 3]>,
     phase_pitch: f64,
+    /// The heading (radians, unwrapped) every [`HEADING_STEP_S`], turned towards the target at
+    /// most [`MAX_HEADING_RATE`]; `None` where it points at the target.
+    heading: Vec<Option<f64>>,
+}
+
+/// The heading table's step (s) and length (s): beyond it the heading points at the target.
+const HEADING_STEP_S: f64 = 0.01;
+const HEADING_SPAN_S: f64 = 7200.0;
+/// The fastest the walker turns to keep facing the target (rad/s, 60°/s). Where the walk passes
+/// close to its target (the L-shaped preset's centroid lies on its loop) the direction to it flips
+/// round in milliseconds; a person turns round in a few seconds instead.
+const MAX_HEADING_RATE: f64 = 60.0 * std::f64::consts::PI / 180.0;
+
+/// `a` − `b` wrapped to (−π, π].
+fn wrapped(a: f64, b: f64) -> f64 {
+    let d = (a - b).rem_euclid(TAU);
+    if d > std::f64::consts::PI { d - TAU } else { d }
 }
 
 /// The floor plan offset inward by `d` (counter-clockwise plan): each edge moved along its inward
@@ -122,65 +139,6 @@ fn area_centroid(p: &[Point2<f64>]) -> Point2<f64> {
     Point2::new(cx / (3.0 * a), cy / (3.0 * a))
 }
 
-/// Distance from `q` to the closed polygon's edges, and whether `q` lies inside it (even-odd).
-fn edge_distance(p: &[Point2<f64>], q: Point2<f64>) -> (f64, bool) {
-    let (mut d, mut inside) = (f64::INFINITY, false);
-    for i in 0..p.len() {
-        let (a, b) = (p[i], p[(i + 1) % p.len()]);
-        let ab = b - a;
-        let s = ((q - a).dot(&ab) / ab.norm_squared().max(1e-18)).clamp(0.0, 1.0);
-        d = d.min((a + ab * s - q).norm());
-        if (a.y > q.y) != (b.y > q.y) && q.x < a.x + (q.y - a.y) / (b.y - a.y) * ab.x {
-            inside = !inside;
-        }
-    }
-    (d, inside)
-}
-
-/// The point the camera looks at: the floor plan's centroid, unless the walk passes close to it
-/// (a re-entrant room: the L-shaped preset's centroid lies on its walk, where looking at it would
-/// whip the camera round at over 1000°/s); then the point inside the innermost loop farthest from
-/// it, the one nearest the centroid among equals.
-fn look_target(plan: &[Point2<f64>], innermost: &[Point2<f64>]) -> Point2<f64> {
-    let c = area_centroid(plan);
-    let (lo, hi) = innermost.iter().fold(
-        (
-            Point2::new(f64::INFINITY, f64::INFINITY),
-            Point2::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
-        ),
-        |(a, b), q| {
-            (
-                Point2::new(a.x.min(q.x), a.y.min(q.y)),
-                Point2::new(b.x.max(q.x), b.y.max(q.y)),
-            )
-        },
-    );
-    let step = 0.02;
-    let (nx, ny) = (
-        ((hi.x - lo.x) / step).ceil() as usize,
-        ((hi.y - lo.y) / step).ceil() as usize,
-    );
-    let mut best: Option<(f64, f64, Point2<f64>)> = None;
-    for i in 0..=nx {
-        for j in 0..=ny {
-            let q = Point2::new(lo.x + i as f64 * step, lo.y + j as f64 * step);
-            let (d, inside) = edge_distance(innermost, q);
-            if !inside {
-                continue;
-            }
-            let key = ((d / step).round() * step, -(q - c).norm());
-            if best.is_none_or(|(bd, bc, _)| key.0 > bd || (key.0 == bd && key.1 > bc)) {
-                best = Some((key.0, key.1, q));
-            }
-        }
-    }
-    let Some((r_max, _, far)) = best else {
-        return c;
-    };
-    let (dc, inside) = edge_distance(innermost, c);
-    if inside && dc >= 0.8 * r_max { c } else { far }
-}
-
 impl Walk {
     /// A walk through `room` with `params`, shake drawn from `seed`.
     pub fn new(room: &Room, params: WalkParams, seed: u64) -> Self {
@@ -204,16 +162,78 @@ impl Walk {
             .map(|_| [0, 1, 2].map(|_| (rng.random_range(0.4..3.0), rng.random_range(0.0..TAU))))
             .collect();
         let loop_ = inset_polygon(&room.plan, inset);
-        // The loop's inset breathes by ±25 %: the target keeps away from its innermost form.
-        let innermost = inset_polygon(&room.plan, 1.25 * inset);
-        Self {
+        let mut walk = Self {
             perimeter: perimeter(&loop_),
-            target: look_target(&room.plan, &innermost),
+            target: area_centroid(&room.plan),
             plan: room.plan.clone(),
             inset,
             params,
             shake,
             phase_pitch: rng.random_range(0.0..TAU),
+            heading: Vec::new(),
+        };
+        walk.heading = walk.limited_heading();
+        walk
+    }
+
+    /// Where the walker stands at `t` (the loop's inset breathes by ±25 % over three loops).
+    fn position(&self, t: f64) -> Point2<f64> {
+        let loop_time = self.perimeter / self.params.speed_m_s;
+        let d = self.inset * (1.0 + 0.25 * (TAU * t / (3.0 * loop_time)).sin());
+        at_fraction(&inset_polygon(&self.plan, d), t / loop_time)
+    }
+
+    /// The direction from the walker to the target at `t`.
+    fn target_heading(&self, t: f64) -> f64 {
+        let to = self.target - self.position(t);
+        to.y.atan2(to.x)
+    }
+
+    /// The heading turned towards the target at no more than [`MAX_HEADING_RATE`], every
+    /// [`HEADING_STEP_S`]: `None` while it is on the target, so a walk that never needs the limit
+    /// (every convex room) keeps the exact direction.
+    fn limited_heading(&self) -> Vec<Option<f64>> {
+        let n = (HEADING_SPAN_S / HEADING_STEP_S) as usize;
+        let max_step = MAX_HEADING_RATE * HEADING_STEP_S;
+        let mut yaw = self.target_heading(0.0);
+        let mut out = Vec::with_capacity(n + 1);
+        let mut limited = false;
+        for k in 0..=n {
+            let goal = self.target_heading(k as f64 * HEADING_STEP_S);
+            let d = wrapped(goal, yaw);
+            if d.abs() <= max_step {
+                yaw += d;
+                out.push(None);
+            } else {
+                yaw += max_step.copysign(d);
+                out.push(Some(yaw));
+                limited = true;
+            }
+        }
+        if !limited {
+            out.clear();
+        }
+        out
+    }
+
+    /// The walker's heading at `t`: towards the target, or the turn-rate-limited one around it.
+    fn heading_at(&self, t: f64) -> f64 {
+        let x = t / HEADING_STEP_S;
+        let k = x.floor();
+        let i = k as usize;
+        match (k >= 0.0).then(|| (self.heading.get(i), self.heading.get(i + 1))) {
+            Some((Some(Some(a)), Some(Some(b)))) => a + (b - a) * (x - k),
+            Some((Some(Some(a)), Some(None))) | Some((Some(None), Some(Some(a)))) => {
+                // At the limiter's edge: on the target within one step; take the nearer turn.
+                let g = self.target_heading(t);
+                g + wrapped(*a, g)
+                    * if self.heading[i].is_some() {
+                        1.0 - (x - k)
+                    } else {
+                        x - k
+                    }
+            }
+            _ => self.target_heading(t),
         }
     }
 
@@ -228,13 +248,9 @@ impl Walk {
     /// The depth camera's pose in the room at time `t` (s from the start of the walk).
     pub fn room_from_depth(&self, t: f64) -> Isometry3<f64> {
         let p = &self.params;
-        // The inset breathes by ±25 % over three loops.
-        let loop_time = self.perimeter / p.speed_m_s;
-        let d = self.inset * (1.0 + 0.25 * (TAU * t / (3.0 * loop_time)).sin());
-        let pos = at_fraction(&inset_polygon(&self.plan, d), t / loop_time);
-        let to = self.target - pos;
+        let pos = self.position(t);
         let yaw =
-            to.y.atan2(to.x) + p.yaw_sweep_deg.to_radians() * (TAU * t / p.yaw_period_s).sin();
+            self.heading_at(t) + p.yaw_sweep_deg.to_radians() * (TAU * t / p.yaw_period_s).sin();
         let pitch =
             p.pitch_sweep_deg.to_radians() * (TAU * t / p.pitch_period_s + self.phase_pitch).sin();
         let roll = 3f64.to_radians() * (TAU * t / 5.3).sin();
