@@ -72,10 +72,10 @@ pub struct Walk {
 /// The heading table's step (s) and length (s): beyond it the heading points at the target.
 const HEADING_STEP_S: f64 = 0.01;
 const HEADING_SPAN_S: f64 = 7200.0;
-/// The fastest the walker turns to keep facing the target (rad/s, 60°/s). Where the walk passes
+/// The fastest the walker turns to keep facing the target (rad/s, 120°/s). Where the walk passes
 /// close to its target (the L-shaped preset's centroid lies on its loop) the direction to it flips
 /// round in milliseconds; a person turns round in a few seconds instead.
-const MAX_HEADING_RATE: f64 = 60.0 * std::f64::consts::PI / 180.0;
+const MAX_HEADING_RATE: f64 = 120.0 * std::f64::consts::PI / 180.0;
 
 /// `a` − `b` wrapped to (−π, π].
 fn wrapped(a: f64, b: f64) -> f64 {

@@ -136,7 +136,7 @@ fn gradient_truth_is_consistent() {
     assert_eq!(truth.grid.nodes.len(), 400);
 }
 
-/// A handheld camera turns smoothly: the default walk of every preset stays under 150°/s (sampled
+/// A handheld camera turns smoothly: the default walk of every preset stays under 200°/s (a person turning round) (sampled
 /// every 10 ms over 343 s). The L-shaped room's walk once looked at the plan's centroid, which lies
 /// on its loop, and whipped round at over 1500°/s there.
 #[test]
@@ -162,7 +162,7 @@ fn the_walk_turns_at_a_handheld_rate() {
         }
         eprintln!("{name}: fastest turn {worst:.1}°/s at {at:.2} s");
         assert!(
-            worst < 150.0,
+            worst < 200.0,
             "{name}: the walk turns at {worst:.0}°/s at {at:.2} s"
         );
     }
