@@ -514,11 +514,14 @@ fn residual(t: &Isometry3<f64>, x: &Point3<f64>, obs: &Point2<f64>) -> Option<(f
     (y.z > 1e-3).then(|| (y.x / y.z - obs.x, y.y / y.z - obs.y))
 }
 
+/// A reference point and where it was seen (normalised image coordinates).
+type Projected = (Point3<f64>, Point2<f64>);
+
 /// The Gauss–Newton normal equations of the reprojection error at `t` (Huber at `huber` in
 /// normalised units), over a perturbation (ω, v) on the left of `t` (in the current camera's frame).
 fn normal_equations(
     t: &Isometry3<f64>,
-    pts: &[(Point3<f64>, Point2<f64>)],
+    pts: &[Projected],
     huber: f64,
 ) -> (Matrix6<f64>, Vector6<f64>) {
     let mut hmat = Matrix6::<f64>::zeros();
@@ -546,7 +549,7 @@ fn normal_equations(
 }
 
 /// Gauss–Newton on the reprojection error (Huber at `huber` in normalised units).
-fn refine(mut t: Isometry3<f64>, pts: &[(Point3<f64>, Point2<f64>)], huber: f64) -> Isometry3<f64> {
+fn refine(mut t: Isometry3<f64>, pts: &[Projected], huber: f64) -> Isometry3<f64> {
     for _ in 0..10 {
         let (hmat, g) = normal_equations(&t, pts, huber);
         let Some(step) = hmat.cholesky().map(|c| c.solve(&(-g))) else {
@@ -569,22 +572,11 @@ fn refine(mut t: Isometry3<f64>, pts: &[(Point3<f64>, Point2<f64>)], huber: f64)
 /// nominal reprojection error of [`GRAPH_SIGMA_PX`]. The edge's residual at the truth is minus
 /// the current frame's perturbation, so the Hessian carries over; a view that pins a direction
 /// weakly (a distant flat wall: turning and sliding look alike) pins the graph weakly there too.
-fn information(
-    t: &Isometry3<f64>,
-    pts: &[(Point3<f64>, Point2<f64>)],
-    huber: f64,
-    fx: f64,
-) -> Matrix6<f64> {
+fn information(t: &Isometry3<f64>, pts: &[Projected], huber: f64, fx: f64) -> Matrix6<f64> {
     let (h, _) = normal_equations(t, pts, huber);
-    let mut info = Matrix6::zeros();
     // (ω, v) → (v, ω).
     let map = [3, 4, 5, 0, 1, 2];
-    for i in 0..6 {
-        for j in 0..6 {
-            info[(i, j)] = h[(map[i], map[j])];
-        }
-    }
-    info * (fx / GRAPH_SIGMA_PX).powi(2)
+    Matrix6::from_fn(|i, j| h[(map[i], map[j])]) * (fx / GRAPH_SIGMA_PX).powi(2)
 }
 
 /// The reprojection error (px) an edge's information is scaled to. Only the ratios between edges
@@ -661,7 +653,7 @@ fn estimate(
     let (_, mut t) = best?;
     for round in 0..2 {
         let huber = if round == 0 { 2.0 * tol } else { tol };
-        let inl: Vec<(Point3<f64>, Point2<f64>)> = obs
+        let inl: Vec<Projected> = obs
             .iter()
             .filter(|(x, o, _)| {
                 residual(&t, x, o).is_some_and(|(a, b)| a * a + b * b < 4.0 * tol * tol)
@@ -673,20 +665,18 @@ fn estimate(
         }
         t = refine(t, &inl, huber);
     }
-    let inl: Vec<(Point3<f64>, Point2<f64>)> = obs
+    let (inl, errs): (Vec<Projected>, Vec<f64>) = obs
         .iter()
-        .filter(|(x, o, _)| residual(&t, x, o).is_some_and(|(a, b)| a * a + b * b < tol * tol))
-        .map(|(x, o, _)| (*x, *o))
-        .collect();
-    let errs: Vec<f64> = inl
-        .iter()
-        .filter_map(|(x, o)| residual(&t, x, o))
-        .map(|(a, b)| (a * a + b * b).sqrt())
-        .collect();
-    (errs.len() >= p.min_inliers).then(|| Found {
+        .filter_map(|(x, o, _)| {
+            let (a, b) = residual(&t, x, o)?;
+            let e = (a * a + b * b).sqrt();
+            (e < tol).then_some(((*x, *o), e))
+        })
+        .unzip();
+    (inl.len() >= p.min_inliers).then(|| Found {
         pose: t,
         information: information(&t, &inl, tol, fx),
-        inliers: errs.len(),
+        inliers: inl.len(),
         reprojection_px: fx * errs.iter().sum::<f64>() / errs.len() as f64,
     })
 }
@@ -1316,7 +1306,7 @@ mod tests {
     #[test]
     fn a_distant_flat_view_pins_turning_against_sliding_weakly() {
         // Corners on a 40°-wide patch of a wall, seen exactly; with a second wall nearer.
-        let grid = |z: f64| -> Vec<(Point3<f64>, Point2<f64>)> {
+        let grid = |z: f64| -> Vec<Projected> {
             let mut v = Vec::new();
             for i in -6..=6 {
                 for j in -4..=4 {

@@ -223,15 +223,14 @@ impl Walk {
         let i = k as usize;
         match (k >= 0.0).then(|| (self.heading.get(i), self.heading.get(i + 1))) {
             Some((Some(Some(a)), Some(Some(b)))) => a + (b - a) * (x - k),
-            Some((Some(Some(a)), Some(None))) | Some((Some(None), Some(Some(a)))) => {
-                // At the limiter's edge: on the target within one step; take the nearer turn.
+            // At the limiter's edges, on the target within one step: ease the lag in or out.
+            Some((Some(Some(a)), Some(None))) => {
                 let g = self.target_heading(t);
-                g + wrapped(*a, g)
-                    * if self.heading[i].is_some() {
-                        1.0 - (x - k)
-                    } else {
-                        x - k
-                    }
+                g + wrapped(*a, g) * (1.0 - (x - k))
+            }
+            Some((Some(None), Some(Some(b)))) => {
+                let g = self.target_heading(t);
+                g + wrapped(*b, g) * (x - k)
             }
             _ => self.target_heading(t),
         }

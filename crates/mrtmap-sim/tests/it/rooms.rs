@@ -136,9 +136,9 @@ fn gradient_truth_is_consistent() {
     assert_eq!(truth.grid.nodes.len(), 400);
 }
 
-/// A handheld camera turns smoothly: the default walk of every preset stays under 200°/s (a person turning round) (sampled
-/// every 10 ms over 343 s). The L-shaped room's walk once looked at the plan's centroid, which lies
-/// on its loop, and whipped round at over 1500°/s there.
+/// A handheld camera turns smoothly: the default walk of every preset stays under 200°/s, a person
+/// turning round (sampled every 10 ms over 343 s). The L-shaped room's walk once looked at the
+/// plan's centroid, which lies on its loop, and whipped round at over 1500°/s there.
 #[test]
 fn the_walk_turns_at_a_handheld_rate() {
     use mrtmap_sim::{SimConfig, Walk};
