@@ -44,8 +44,16 @@ pub struct IcpSettings {
     /// The target keeps one voxel in `target_every`³.
     pub target_every: i32,
     /// Gain of the carried drift correction: each accepted refinement moves it this fraction of the
-    /// way (per-frame depth errors average out, slow drift is followed).
+    /// way (per-frame depth errors average out, slow drift is followed): about 4 s to follow a
+    /// drift at a Lepton's 8.7 Hz. The map is built from corrected frames, so nothing holds the
+    /// correction to the pose source: with exact poses a gain of 0.1 let it wander 1–3 cm over a
+    /// minute and moved walls with it (L-shaped walk 12: the window wall 2.2 cm out).
     pub correction_gain: f64,
+    /// The gain while the refinements' steps show a drift the carried correction does not follow
+    /// (their mean over the last [`DRIFT_WINDOW`] accepted frames more than twice its standard
+    /// error): plain odometry drifts faster than 4 s of lag allows.
+    #[serde(default = "default_drift_gain")]
+    pub drift_gain: f64,
     /// Reject refinements with a lower fitness.
     pub min_fitness: f64,
     /// Reject refinements with a larger point-to-plane RMSE (m).
@@ -74,12 +82,51 @@ impl Default for IcpSettings {
             min_map_voxels: 3000,
             rebuild_every: 30,
             target_every: 2,
-            correction_gain: 0.1,
+            correction_gain: 0.03,
+            drift_gain: 0.1,
             min_fitness: 0.7,
             max_rmse_m: 0.02,
             max_step_m: 0.03,
             max_step_deg: 1.0,
         }
+    }
+}
+
+fn default_drift_gain() -> f64 {
+    IcpSettings::default().drift_gain
+}
+
+/// Accepted refinements over which a drift is detected (3 s at 8.7 Hz).
+pub const DRIFT_WINDOW: usize = 26;
+
+/// The last accepted refinements' steps (translation, and the rotation as the displacement it
+/// makes 3 m away), to tell a drift (steps with a consistent direction) from each frame's own
+/// depth error (steps that average out).
+#[derive(Default)]
+struct Steps {
+    recent: std::collections::VecDeque<[f64; 6]>,
+}
+
+impl Steps {
+    /// Adds a step; whether the window's mean step is more than twice its standard error.
+    fn drifting(&mut self, step: &Isometry3<f64>) -> bool {
+        let (t, w) = (step.translation.vector, step.rotation.scaled_axis() * 3.0);
+        self.recent.push_back([t.x, t.y, t.z, w.x, w.y, w.z]);
+        if self.recent.len() > DRIFT_WINDOW {
+            self.recent.pop_front();
+        }
+        let n = self.recent.len();
+        if n < DRIFT_WINDOW {
+            return false;
+        }
+        let nf = n as f64;
+        let (mut mean2, mut var) = (0.0, 0.0);
+        for k in 0..6 {
+            let m = self.recent.iter().map(|s| s[k]).sum::<f64>() / nf;
+            mean2 += m * m;
+            var += self.recent.iter().map(|s| (s[k] - m).powi(2)).sum::<f64>() / (nf - 1.0);
+        }
+        mean2 > 4.0 * var / nf
     }
 }
 
@@ -138,6 +185,9 @@ pub struct IcpReport {
     pub mean_iterations: f64,
     /// Frames where some directions were unconstrained (left unchanged).
     pub degenerate_frames: usize,
+    /// Accepted refinements that followed a detected drift with the higher gain.
+    #[serde(default)]
+    pub drift_frames: usize,
     /// The final correction applied to the trajectory: translation (m) and rotation (degrees).
     pub final_correction_m: f64,
     /// Rotation of the final correction (degrees).
@@ -273,6 +323,8 @@ struct Fuser<'a> {
     since_rebuild: usize,
     /// The ICP correction carried from frame to frame.
     correction: Isometry3<f64>,
+    /// The recent refinements' steps.
+    steps: Steps,
     fit_sum: f64,
     rmse_sum: f64,
     iterations_sum: usize,
@@ -396,9 +448,13 @@ impl Fuser<'_> {
                     self.rmse_sum += r.rmse_m;
                     self.report.icp.degenerate_frames += (r.degenerate_dofs > 0) as usize;
                     frame_correction = r.delta * start;
-                    self.correction = self
-                        .correction
-                        .lerp_slerp(&frame_correction, self.params.icp.correction_gain);
+                    let gain = if self.steps.drifting(&r.delta) {
+                        self.report.icp.drift_frames += 1;
+                        self.params.icp.drift_gain
+                    } else {
+                        self.params.icp.correction_gain
+                    };
+                    self.correction = self.correction.lerp_slerp(&frame_correction, gain);
                 }
             }
             let world_from_depth = frame_correction * wd;
@@ -600,6 +656,7 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
         target: None,
         since_rebuild: 0,
         correction: Isometry3::identity(),
+        steps: Steps::default(),
         fit_sum: 0.0,
         rmse_sum: 0.0,
         iterations_sum: 0,
