@@ -19,11 +19,10 @@ fn noise_free_fusion_recovers_surface_temperatures() {
     assert!(s.distance_median_m < 0.005, "{s:?}");
     let r = &fused.report;
     assert_eq!(r.used_frames, r.thermal_frames, "{:?}", r.skipped);
-    assert!(
-        r.observations.occluded > 0 && r.observations.edge > 0,
-        "{:?}",
-        r.observations
-    );
+    // Mixed pixels at temperature edges are dropped. (What the thermal camera cannot see is
+    // tested in `observe`'s unit test: this 4 s walk has no depth step beyond the visibility
+    // tolerance, which grows with z² since the depth noise does.)
+    assert!(r.observations.edge > 0, "{:?}", r.observations);
 }
 
 /// Realistic noise: the same figures stay well inside the targets.
