@@ -6,7 +6,8 @@ pipeline, and compare the map with the truth.
                   [--noise realistic,none] [--drift none] [--seconds 60]
                   [--camera-errors auto|none|realistic] [--keep]
 
-Prints one row per scan and a summary per room and noise; writes WORKDIR/robustness.json. A scan
+Prints one row per scan and a summary per room and noise; writes WORKDIR/robustness.json. Each
+row also says how many nodes' errors lie within twice the standard error the run states. A scan
 whose segmentation fails counts as a failure with its message. Grid errors are at the truth's
 20x20 nodes (mrtmap mrt --frame scan on the run's scene); a node the run refuses (outside its
 room or inside its furniture) is counted, not compared. The worst error is given over all nodes
@@ -36,7 +37,8 @@ def seeds(spec):
 
 
 def mrt_at(mrtmap, scene, places):
-    """MRT at each place (None where refused), in chunks; a refused chunk goes point by point."""
+    """(MRT, its stated standard error) at each place (None where refused), in chunks; a refused
+    chunk goes point by point."""
     def call(chunk):
         args = [mrtmap, "mrt", "--scene", scene, "--frame", "scan", "--json"]
         for p in chunk:
@@ -44,7 +46,7 @@ def mrt_at(mrtmap, scene, places):
         r = subprocess.run(args, capture_output=True, text=True)
         if r.returncode != 0:
             return None
-        return [o["mrt_c"] for o in json.loads(r.stdout)["points"]]
+        return [(o["mrt_c"], o["std_error_k"]) for o in json.loads(r.stdout)["points"]]
 
     out = []
     for k in range(0, len(places), 40):
@@ -103,15 +105,17 @@ def one(mrtmap, work, room, seed, noise, drift, secs, keep, camera, reuse_fusion
         nodes = [n for n in truth["grid"]["nodes"] if n["mrt_c"] is not None]
         got = mrt_at(mrtmap, os.path.join(run, "segment", "scene.json"),
                      [n["xyz_world"] for n in nodes] + [p["xyz_world"] for p in truth["points"]])
-        g = [(v - n["mrt_c"]) for v, n in zip(got, nodes) if v is not None]
-        clear = [(v - n["mrt_c"]) for v, n, near in zip(got, nodes, near_furniture(rec, nodes))
+        g = [(v[0] - n["mrt_c"]) for v, n in zip(got, nodes) if v is not None]
+        covered = [abs(v[0] - n["mrt_c"]) <= 2.0 * v[1] for v, n in zip(got, nodes) if v is not None]
+        clear = [(v[0] - n["mrt_c"]) for v, n, near in zip(got, nodes, near_furniture(rec, nodes))
                  if v is not None and not near]
-        pts = {p["name"]: (None if v is None else round(v - p["mrt_c"], 3))
+        pts = {p["name"]: (None if v is None else round(v[0] - p["mrt_c"], 3))
                for p, v in zip(truth["points"], got[len(nodes):])}
         row.update({
             "nodes": len(g), "refused": len(nodes) - len(g),
             "max_abs_k": max(abs(x) for x in g) if g else None,
             "rmse_k": math.sqrt(sum(x * x for x in g) / len(g)) if g else None,
+            "within_2se": sum(covered) / len(covered) if covered else None,
             "clear_nodes": len(clear),
             "clear_max_abs_k": max(abs(x) for x in clear) if clear else None,
             "clear_rmse_k": math.sqrt(sum(x * x for x in clear) / len(clear)) if clear else None,
@@ -154,7 +158,8 @@ def main():
                         desc = (f"grid max |Δ| {row['max_abs_k']:.3f} K, RMSE {row['rmse_k']:.3f} K "
                                 f"(10 cm clear of furniture: {row['clear_max_abs_k']:.3f}, "
                                 f"{row['clear_rmse_k']:.3f} K), "
-                                f"{row['refused']} nodes refused; " +
+                                f"{row['refused']} nodes refused, "
+                                f"{100 * row['within_2se']:.0f} % within 2σ; " +
                                 " ".join(f"{k} {v:+.3f}" if v is not None else f"{k} —"
                                          for k, v in row["points_k"].items()))
                     print(f"{room:<16} seed {seed:>3} {noise:<9} {drift:<8} run {row['run_s']:5.1f} s  {desc}",
@@ -171,9 +176,10 @@ def main():
         clear_rmse = max((r["clear_rmse_k"] for r in ok), default=float("nan"))
         rmse = max((r["rmse_k"] for r in ok), default=float("nan"))
         times = sorted(r["run_s"] for r in rs)
+        cover = min((r["within_2se"] for r in ok), default=float("nan"))
         print(f"  {room:<16} {noise:<9} {drift:<8} {len(rs):>3} scans, {len(rs) - len(ok)} failed, "
               f"max |Δ| {worst:.3f} K, RMSE {rmse:.3f} K (clear of furniture: {clear:.3f}, "
-              f"{clear_rmse:.3f} K), "
+              f"{clear_rmse:.3f} K), at least {100 * cover:.0f} % of nodes within 2σ, "
               f"run {times[len(times) // 2]:.1f} s")
     json.dump(rows, open(os.path.join(a.work, "robustness.json"), "w"), indent=1)
 

@@ -69,6 +69,7 @@ rays = 20000              # Monte Carlo rays per point
 seed = 1
 directions = "fibonacci"  # fibonacci | random
 replicates = 8            # independent ray sets the standard error comes from
+placement_std_m = 0.01    # how well a point is placed relative to the walls (m, 1σ); adds the MRT's gradient × it to every ±; 0: leave out
 "#;
 
 /// `[map]`.
@@ -503,6 +504,9 @@ pub struct MrtSection {
     /// Answer at points the scene does not enclose (ΣF short of 1: a missing wall, floor or
     /// ceiling) instead of refusing them; the result says how much of the view is missing.
     pub allow_open: bool,
+    /// Standard deviation (m) of a point's place relative to the room's surfaces: the MRT's
+    /// gradient times it joins every standard error (0 leaves it out).
+    pub placement_std_m: f64,
 }
 
 impl Default for MrtSection {
@@ -515,6 +519,7 @@ impl Default for MrtSection {
             directions: DirectionChoice::Fibonacci,
             replicates: mc.replicates,
             allow_open: false,
+            placement_std_m: 0.01,
         }
     }
 }
@@ -552,7 +557,18 @@ impl MrtSection {
     /// The engine for `scene` with these settings (its method, and whether open scenes are
     /// answered).
     pub fn engine<'a>(&self, scene: &'a RadiantScene) -> Result<MrtEngine<'a>> {
-        Ok(MrtEngine::new(scene, self.method(scene)?)?.allow_open(self.allow_open))
+        if !(self.placement_std_m.is_finite() && (0.0..=1.0).contains(&self.placement_std_m)) {
+            return Err(Error::setting(
+                format!(
+                    "--placement-std-m {} ([mrt] placement_std_m)",
+                    self.placement_std_m
+                ),
+                "must be between 0 and 1 m",
+            ));
+        }
+        Ok(MrtEngine::new(scene, self.method(scene)?)?
+            .allow_open(self.allow_open)
+            .with_placement_std(self.placement_std_m))
     }
 }
 
@@ -678,5 +694,28 @@ mod tests {
             e.contains("--replicates 0") && e.contains("at least 2"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn a_placement_uncertainty_reaches_the_engine_and_a_senseless_one_is_refused() {
+        let scene = mrtmap_radiation::example_office();
+        let s = MrtSection::default();
+        assert_eq!(s.engine(&scene).unwrap().placement_std(), 0.01);
+        let p = Project::parse("[mrt]\nplacement_std_m = 0.0\n").unwrap();
+        assert_eq!(p.mrt.engine(&scene).unwrap().placement_std(), 0.0);
+        for bad in [-0.01, f64::NAN, 2.0] {
+            let e = MrtSection {
+                placement_std_m: bad,
+                ..s
+            }
+            .engine(&scene)
+            .err()
+            .unwrap()
+            .to_string();
+            assert!(
+                e.contains("placement_std_m") && e.contains("between 0 and 1 m"),
+                "{e}"
+            );
+        }
     }
 }

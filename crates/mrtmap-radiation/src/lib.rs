@@ -101,6 +101,10 @@ pub struct PointRecord {
     pub sampling_std_error_k: f64,
     /// From the surfaces' temperature uncertainties (K).
     pub temperature_std_error_k: f64,
+    /// From where the point lies relative to the surfaces (K; 0 when no placement uncertainty
+    /// was set).
+    #[serde(default)]
+    pub placement_std_error_k: f64,
     /// Σ F.
     pub view_factor_sum: f64,
     /// Rays traced (0 for exact).
@@ -119,6 +123,7 @@ impl PointRecord {
             std_error_k: r.std_error_k,
             sampling_std_error_k: r.sampling_std_error_k,
             temperature_std_error_k: r.temperature_std_error_k,
+            placement_std_error_k: r.placement_std_error_k,
             view_factor_sum: r.view_factor_sum,
             rays: r.rays,
             view_factors: patches

@@ -732,6 +732,10 @@ pub struct MethodArgs {
     /// of the view empty: ΣF short of 1) instead of refusing them; ΣF is printed with each point.
     #[arg(long)]
     pub allow_open: bool,
+    /// How well a point is placed relative to the room's surfaces (m, one standard deviation): the
+    /// MRT's gradient times it joins every ± (near a cold window it dominates); 0 leaves it out.
+    #[arg(long, default_value_t = 0.01)]
+    pub placement_std_m: f64,
 }
 
 impl MethodArgs {
@@ -744,6 +748,7 @@ impl MethodArgs {
             directions: self.directions,
             replicates: self.replicates,
             allow_open: self.allow_open,
+            placement_std_m: self.placement_std_m,
         }
     }
 }

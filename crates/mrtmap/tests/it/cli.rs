@@ -119,10 +119,18 @@ fn mrt_exact_and_montecarlo_agree_on_the_example() {
     for k in 0..2 {
         let (a, b) = (&ex["points"][k], &mc["points"][k]);
         assert!((a["view_factor_sum"].as_f64().unwrap() - 1.0).abs() < 1e-9);
-        let se = b["std_error_k"].as_f64().unwrap();
+        // Exact and Monte Carlo differ by sampling alone; the total ± also holds the point's
+        // placement (1 cm by default: the MRT's gradient there times it).
+        let se = b["sampling_std_error_k"].as_f64().unwrap();
         assert!(se > 0.0 && se < 0.05, "{se}");
         let d = (a["mrt_c"].as_f64().unwrap() - b["mrt_c"].as_f64().unwrap()).abs();
         assert!(d < 4.0 * se + 1e-3, "exact vs MC: {d} K, se {se}");
+        let placed = a["placement_std_error_k"].as_f64().unwrap();
+        let total = a["std_error_k"].as_f64().unwrap();
+        assert!(
+            placed > 0.001 && (total - placed).abs() < 1e-12,
+            "{placed} {total}"
+        );
         // The table names every surface and feature.
         let table = a["view_factors"].as_array().unwrap();
         assert_eq!(table.len(), 13);

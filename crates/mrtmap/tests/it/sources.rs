@@ -400,5 +400,14 @@ fn run_on_an_mcap_file_maps_the_same_as_on_the_folder() {
             .filter_map(|l| l.split(',').nth(4)?.parse().ok())
             .collect()
     };
-    assert!(se(&ga).iter().all(|s| *s < 0.1) && se(&gb).iter().all(|s| *s > 4.9));
+    // The folder's ± is sampling, temperatures and a centimetre of placement (a tenth of a kelvin
+    // or more beside the window); the converted scan's adds the camera's ±5 K.
+    let (max_a, min_b) = (
+        se(&ga).into_iter().fold(0.0, f64::max),
+        se(&gb).into_iter().fold(f64::INFINITY, f64::min),
+    );
+    assert!(
+        max_a < 1.0 && min_b > 4.9,
+        "folder ± up to {max_a} K, MCAP ± from {min_b} K"
+    );
 }
