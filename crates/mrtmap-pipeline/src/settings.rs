@@ -69,7 +69,7 @@ rays = 20000              # Monte Carlo rays per point
 seed = 1
 directions = "fibonacci"  # fibonacci | random
 replicates = 8            # independent ray sets the standard error comes from
-placement_std_m = 0.01    # how well a point is placed relative to the walls (m, 1σ); adds the MRT's gradient × it to every ±; 0: leave out
+placement_std_m = 0.01    # how well a point is placed relative to the walls (m, 1σ); adds the MRT's gradient × it to the MRT's ± (not a person's or a plane's); 0: leave out
 "#;
 
 /// `[map]`.

@@ -733,7 +733,8 @@ pub struct MethodArgs {
     #[arg(long)]
     pub allow_open: bool,
     /// How well a point is placed relative to the room's surfaces (m, one standard deviation): the
-    /// MRT's gradient times it joins every ± (near a cold window it dominates); 0 leaves it out.
+    /// MRT's gradient times it joins the MRT's ± (near a cold window it dominates; not yet a
+    /// person's or a plane's); 0 leaves it out.
     #[arg(long, default_value_t = 0.01)]
     pub placement_std_m: f64,
 }
