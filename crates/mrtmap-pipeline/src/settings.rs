@@ -505,7 +505,7 @@ pub struct MrtSection {
     /// ceiling) instead of refusing them; the result says how much of the view is missing.
     pub allow_open: bool,
     /// Standard deviation (m) of a point's place relative to the room's surfaces: the MRT's
-    /// gradient times it joins every standard error (0 leaves it out).
+    /// gradient times it joins the MRT's standard error (0 leaves it out).
     pub placement_std_m: f64,
 }
 
@@ -554,9 +554,9 @@ impl MrtSection {
         })
     }
 
-    /// The engine for `scene` with these settings (its method, and whether open scenes are
-    /// answered).
-    pub fn engine<'a>(&self, scene: &'a RadiantScene) -> Result<MrtEngine<'a>> {
+    /// Settings that need no scene: the placement uncertainty (checked before a run's fusion,
+    /// not after it).
+    pub fn check(&self) -> Result<()> {
         if !(self.placement_std_m.is_finite() && (0.0..=1.0).contains(&self.placement_std_m)) {
             return Err(Error::setting(
                 format!(
@@ -566,6 +566,13 @@ impl MrtSection {
                 "must be between 0 and 1 m",
             ));
         }
+        Ok(())
+    }
+
+    /// The engine for `scene` with these settings (its method, and whether open scenes are
+    /// answered).
+    pub fn engine<'a>(&self, scene: &'a RadiantScene) -> Result<MrtEngine<'a>> {
+        self.check()?;
         Ok(MrtEngine::new(scene, self.method(scene)?)?
             .allow_open(self.allow_open)
             .with_placement_std(self.placement_std_m))
@@ -643,6 +650,7 @@ impl Project {
             ));
         }
         self.comfort.check(&self.air, &self.map.quantities)?;
+        self.mrt.check()?;
         Ok(())
     }
 
@@ -703,6 +711,10 @@ mod tests {
         assert_eq!(s.engine(&scene).unwrap().placement_std(), 0.01);
         let p = Project::parse("[mrt]\nplacement_std_m = 0.0\n").unwrap();
         assert_eq!(p.mrt.engine(&scene).unwrap().placement_std(), 0.0);
+        // A project's bad value is refused by its check, before any fusion.
+        let bad = Project::parse("[mrt]\nplacement_std_m = -0.5\n").unwrap();
+        let e = bad.check().unwrap_err().to_string();
+        assert!(e.contains("[mrt] placement_std_m"), "{e}");
         for bad in [-0.01, f64::NAN, 2.0] {
             let e = MrtSection {
                 placement_std_m: bad,
