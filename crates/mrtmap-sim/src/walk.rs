@@ -2,6 +2,13 @@
 //! varies, looking across the room with slow yaw and pitch sweeps (so walls, floor and ceiling are
 //! all seen), a walking bob and a little hand shake. Poses are `room_from_depth` in OpenCV's
 //! camera convention (x right, y down, z forward).
+//!
+//! Where it looks: at the floor plan's centroid, when that shows every wall (checked on the plan
+//! over one loop, see [`Walk::faces_the_centroid`]: true of every preset). In a room where it does
+//! not (a U-shaped room's wing looks at the centroid with its end wall behind it), the walker does
+//! what a person scanning does and turns to the walls it has seen least: the heading is planned
+//! every [`PLAN_STEP_S`] towards the direction whose visible walls have been in view least often,
+//! turning at most [`PLAN_TURN_RATE`].
 
 use std::f64::consts::TAU;
 
@@ -67,6 +74,84 @@ pub struct Walk {
     /// The heading (radians, unwrapped) every [`HEADING_STEP_S`], turned towards the target at
     /// most [`MAX_HEADING_RATE`]; `None` where it points at the target.
     heading: Vec<Option<f64>>,
+    /// The coverage-planned heading (radians, unwrapped) every [`PLAN_STEP_S`], where the
+    /// centroid does not show every wall; empty otherwise.
+    planned: Vec<f64>,
+}
+
+/// The coverage planner's step (s), the half field of view it counts a wall point seen within
+/// (inside the D435's 43.5°), the range (m) and the largest incidence (from the wall's normal)
+/// at which a point counts as seen, and the planner's turn rate (rad/s).
+pub const PLAN_STEP_S: f64 = 0.25;
+const PLAN_HALF_FOV: f64 = 40.0 * std::f64::consts::PI / 180.0;
+const PLAN_RANGE_M: f64 = 5.0;
+const PLAN_MAX_INCIDENCE: f64 = 70.0 * std::f64::consts::PI / 180.0;
+/// The planner's fastest turn (60°/s): the sweeps add under 80°/s.
+pub const PLAN_TURN_RATE: f64 = 60.0 * std::f64::consts::PI / 180.0;
+/// Spacing of the wall points the coverage is counted on (m).
+const PLAN_SAMPLE_M: f64 = 0.25;
+/// The share of each wall's points the centroid must show over one loop for the walk to face it.
+const CENTROID_COVERAGE: f64 = 0.9;
+
+/// A point on a wall (1 cm inside the room), its wall and the wall's inward normal.
+struct WallPoint {
+    at: Point2<f64>,
+    wall: usize,
+    inward: mrtmap_geometry::nalgebra::Vector2<f64>,
+}
+
+/// Points every [`PLAN_SAMPLE_M`] along each wall of a counter-clockwise plan.
+fn wall_points(plan: &[Point2<f64>]) -> Vec<WallPoint> {
+    let n = plan.len();
+    let mut out = Vec::new();
+    for i in 0..n {
+        let (a, b) = (plan[i], plan[(i + 1) % n]);
+        let len = (b - a).norm();
+        if len < 1e-9 {
+            continue;
+        }
+        let e = (b - a) / len;
+        let inward = mrtmap_geometry::nalgebra::Vector2::new(-e.y, e.x);
+        let m = (len / PLAN_SAMPLE_M).ceil().max(1.0) as usize;
+        for k in 0..m {
+            let s = (k as f64 + 0.5) / m as f64 * len;
+            out.push(WallPoint {
+                at: a + e * s + inward * 0.01,
+                wall: i,
+                inward,
+            });
+        }
+    }
+    out
+}
+
+/// Whether segments p–q and a–b cross.
+fn crosses(p: Point2<f64>, q: Point2<f64>, a: Point2<f64>, b: Point2<f64>) -> bool {
+    let side = |o: Point2<f64>, u: Point2<f64>, v: Point2<f64>| (u - o).perp(&(v - o));
+    let (d1, d2) = (side(a, b, p), side(a, b, q));
+    let (d3, d4) = (side(p, q, a), side(p, q, b));
+    d1 * d2 < 0.0 && d3 * d4 < 0.0
+}
+
+/// The bearing (radians) from `p` of each wall point it sees: within range, at an incidence
+/// under [`PLAN_MAX_INCIDENCE`], with no wall in between.
+fn visible(plan: &[Point2<f64>], points: &[WallPoint], p: Point2<f64>) -> Vec<(usize, f64)> {
+    let n = plan.len();
+    let cos_max = PLAN_MAX_INCIDENCE.cos();
+    points
+        .iter()
+        .enumerate()
+        .filter_map(|(j, w)| {
+            let d = w.at - p;
+            let dist = d.norm();
+            if dist > PLAN_RANGE_M || dist < 1e-6 || -d.dot(&w.inward) / dist < cos_max {
+                return None;
+            }
+            let blocked =
+                (0..n).any(|i| i != w.wall && crosses(p, w.at, plan[i], plan[(i + 1) % n]));
+            (!blocked).then(|| (j, d.y.atan2(d.x)))
+        })
+        .collect()
 }
 
 /// The heading table's step (s) and length (s): beyond it the heading points at the target.
@@ -171,9 +256,86 @@ impl Walk {
             shake,
             phase_pitch: rng.random_range(0.0..TAU),
             heading: Vec::new(),
+            planned: Vec::new(),
         };
-        walk.heading = walk.limited_heading();
+        if walk.faces_the_centroid() {
+            walk.heading = walk.limited_heading();
+        } else {
+            walk.planned = walk.coverage_heading();
+        }
         walk
+    }
+
+    /// One loop's duration (s).
+    fn loop_time(&self) -> f64 {
+        self.perimeter / self.params.speed_m_s
+    }
+
+    /// Whether looking at the plan's centroid shows every wall: over one loop, sampled every
+    /// [`PLAN_STEP_S`], at least [`CENTROID_COVERAGE`] of each wall's points come within
+    /// [`PLAN_HALF_FOV`] of the heading (sweeps left out), in range and in sight.
+    pub fn faces_the_centroid(&self) -> bool {
+        let points = wall_points(&self.plan);
+        let mut seen = vec![false; points.len()];
+        let steps = (self.loop_time() / PLAN_STEP_S).ceil() as usize;
+        for k in 0..steps {
+            let t = k as f64 * PLAN_STEP_S;
+            let yaw = self.target_heading(t);
+            for (j, bearing) in visible(&self.plan, &points, self.position(t)) {
+                if wrapped(bearing, yaw).abs() <= PLAN_HALF_FOV {
+                    seen[j] = true;
+                }
+            }
+        }
+        (0..self.plan.len()).all(|wall| {
+            let (mut all, mut ok) = (0usize, 0usize);
+            for (w, s) in points.iter().zip(&seen) {
+                if w.wall == wall {
+                    all += 1;
+                    ok += usize::from(*s);
+                }
+            }
+            all == 0 || ok as f64 >= CENTROID_COVERAGE * all as f64
+        })
+    }
+
+    /// The heading every [`PLAN_STEP_S`] over [`HEADING_SPAN_S`], planned for coverage: at each
+    /// step the goal is the direction (of 72) whose visible wall points have been in view least,
+    /// each point weighing 1/(1 + the steps it was in view) and the goal's score discounted by a
+    /// tenth per radian of turn; the walker turns towards it at most [`PLAN_TURN_RATE`].
+    fn coverage_heading(&self) -> Vec<f64> {
+        let points = wall_points(&self.plan);
+        let mut count = vec![0u32; points.len()];
+        let steps = (HEADING_SPAN_S / PLAN_STEP_S) as usize;
+        let max_turn = PLAN_TURN_RATE * PLAN_STEP_S;
+        let mut yaw = self.target_heading(0.0);
+        let mut out = Vec::with_capacity(steps + 1);
+        for k in 0..=steps {
+            let t = k as f64 * PLAN_STEP_S;
+            let vis = visible(&self.plan, &points, self.position(t));
+            let score = |dir: f64| -> f64 {
+                vis.iter()
+                    .filter(|(_, b)| wrapped(*b, dir).abs() <= PLAN_HALF_FOV)
+                    .map(|(j, _)| 1.0 / (1.0 + count[*j] as f64))
+                    .sum()
+            };
+            let (mut best, mut best_score) = (yaw, f64::NEG_INFINITY);
+            for c in 0..72 {
+                let dir = yaw + wrapped(c as f64 * TAU / 72.0, yaw);
+                let s = score(dir) * (1.0 - 0.1 * wrapped(dir, yaw).abs());
+                if s > best_score {
+                    (best, best_score) = (dir, s);
+                }
+            }
+            yaw += (best - yaw).clamp(-max_turn, max_turn);
+            for (j, b) in &vis {
+                if wrapped(*b, yaw).abs() <= PLAN_HALF_FOV {
+                    count[*j] += 1;
+                }
+            }
+            out.push(yaw);
+        }
+        out
     }
 
     /// Where the walker stands at `t` (the loop's inset breathes by ±25 % over three loops).
@@ -216,8 +378,17 @@ impl Walk {
         out
     }
 
-    /// The walker's heading at `t`: towards the target, or the turn-rate-limited one around it.
+    /// The walker's heading at `t`: the coverage plan's where there is one, else towards the
+    /// target, or the turn-rate-limited one around it.
     fn heading_at(&self, t: f64) -> f64 {
+        if let Some(last) = self.planned.last() {
+            let x = (t / PLAN_STEP_S).max(0.0);
+            let k = x.floor() as usize;
+            return match (self.planned.get(k), self.planned.get(k + 1)) {
+                (Some(a), Some(b)) => a + (b - a) * (x - k as f64),
+                _ => *last,
+            };
+        }
         let x = t / HEADING_STEP_S;
         let k = x.floor();
         let i = k as usize;
