@@ -100,19 +100,20 @@ impl IcpTarget {
         self.points.is_empty()
     }
 
-    /// The nearest target point to `p` and its distance, and the distance of the second nearest
-    /// (infinite when there is none).
-    fn nearest_two(&self, p: &Point3<f64>) -> Option<(usize, f64, f64)> {
+    /// The nearest target point to `p` within `radius` and its distance, and the distance of the
+    /// second nearest, or `radius` when there is none within it (a lower bound of its distance:
+    /// what the query cache needs). A bounded search prunes most of the tree.
+    fn nearest_two(&self, p: &Point3<f64>, radius: f64) -> Option<(usize, f64, f64)> {
+        let r = radius as f32;
         let found = self
             .tree
             .query(&[p.x as f32, p.y as f32, p.z as f32])
             .nearest_n::<SquaredEuclidean<f32>>(TWO)
+            .within(r * r)
             .execute();
         let first = found.first()?;
         let k = first.item as usize;
-        let second = found
-            .get(1)
-            .map_or(f64::INFINITY, |r| (r.distance as f64).sqrt());
+        let second = found.get(1).map_or(radius, |r| (r.distance as f64).sqrt());
         Some((k, (p - self.points[k]).norm(), second))
     }
 }
@@ -130,18 +131,24 @@ struct Query {
 }
 
 impl Query {
-    /// The nearest target point to `p` and its distance, from the cache when it still holds.
+    /// The nearest target point to `p` within `radius` and its distance, from the cache when it
+    /// still holds. A point with none within `radius` is asked again next time (the bounded search
+    /// finds nothing fast).
     fn nearest(
         cached: &mut Option<Query>,
         target: &IcpTarget,
         p: &Point3<f64>,
+        radius: f64,
     ) -> Option<(usize, f64)> {
         if let Some(q) = cached
             && (p - q.at).norm() < q.half_gap
         {
             return Some((q.nearest, (p - target.points[q.nearest]).norm()));
         }
-        let (k, d1, d2) = target.nearest_two(p)?;
+        let Some((k, d1, d2)) = target.nearest_two(p, radius) else {
+            *cached = None;
+            return None;
+        };
         // The tree's distances are f32: a margin of 10 µm keeps the test exact.
         *cached = Some(Query {
             at: *p,
@@ -198,6 +205,9 @@ pub fn icp_point_to_plane(
         return result;
     }
     let mut queries: Vec<Option<Query>> = vec![None; source.len()];
+    // Correspondences farther than the limit are not used: the search looks no farther (a
+    // millimetre beyond it, so the f32 tree never drops one the f64 test keeps).
+    let radius = params.max_correspondence_m + 1e-3;
     for it in 0..params.max_iterations {
         // Normal equations over all correspondences (in parallel for large sources; the sum is
         // taken in a fixed chunk order, so results do not depend on the thread count).
@@ -205,7 +215,7 @@ pub fn icp_point_to_plane(
             let mut a = Accum::default();
             for (s, cached) in chunk.iter().zip(cache) {
                 let p = t * s;
-                let Some((k, d)) = Query::nearest(cached, target, &p) else {
+                let Some((k, d)) = Query::nearest(cached, target, &p, radius) else {
                     continue;
                 };
                 if d > params.max_correspondence_m {
