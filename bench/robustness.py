@@ -76,10 +76,16 @@ def near_furniture(rec, nodes, clearance=0.1):
     return out
 
 
+def room_label(room):
+    """A preset's name, or a room file's name without its folder and .toml."""
+    return os.path.splitext(os.path.basename(room))[0] if room.endswith(".toml") else room
+
+
 def one(mrtmap, work, room, seed, noise, drift, secs, keep, camera, reuse_fusion=False):
-    name = f"{room}-s{seed}-{noise}-{drift}-cam{camera}"
+    name = f"{room_label(room)}-s{seed}-{noise}-{drift}-cam{camera}"
     rec, run = os.path.join(work, name), os.path.join(work, name + ".run")
-    row = {"room": room, "seed": seed, "noise": noise, "drift": drift, "camera_errors": camera}
+    row = {"room": room_label(room), "seed": seed, "noise": noise, "drift": drift,
+           "camera_errors": camera}
     t0 = time.time()
     if not os.path.exists(os.path.join(rec, "truth.json")):
         shutil.rmtree(rec + ".partial", ignore_errors=True)
@@ -131,7 +137,8 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("mrtmap")
     ap.add_argument("work")
-    ap.add_argument("--rooms", default="office,l-shaped,radiant-ceiling")
+    ap.add_argument("--rooms", default="office,l-shaped,radiant-ceiling",
+                    help="preset names or room files (.toml, docs/simulator.md's format)")
     ap.add_argument("--seeds", default="1-10")
     ap.add_argument("--noise", default="realistic,none")
     ap.add_argument("--drift", default="none")
