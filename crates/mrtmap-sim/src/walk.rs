@@ -149,7 +149,7 @@ fn visible(plan: &[Point2<f64>], points: &[WallPoint], p: Point2<f64>) -> Vec<(u
         .filter_map(|(j, w)| {
             let d = w.at - p;
             let dist = d.norm();
-            if dist > PLAN_RANGE_M || dist < 1e-6 || -d.dot(&w.inward) / dist < cos_max {
+            if !(1e-6..=PLAN_RANGE_M).contains(&dist) || -d.dot(&w.inward) / dist < cos_max {
                 return None;
             }
             let blocked =
