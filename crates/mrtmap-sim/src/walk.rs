@@ -386,8 +386,8 @@ impl Walk {
         out
     }
 
-    /// The walker's heading at `t`: the coverage plan's where there is one, else towards the
-    /// target, or the turn-rate-limited one around it.
+    /// The walker's heading at `t`: the coverage plan's where there is one (its last heading
+    /// beyond [`HEADING_SPAN_S`]), else towards the target, or the turn-rate-limited one around it.
     fn heading_at(&self, t: f64) -> f64 {
         if let Some(last) = self.planned.last() {
             let x = (t / PLAN_STEP_S).max(0.0);
