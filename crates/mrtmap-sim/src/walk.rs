@@ -15,6 +15,7 @@ use std::f64::consts::TAU;
 use mrtmap_geometry::nalgebra::{
     Isometry3, Matrix3, Point2, Rotation3, Translation3, UnitQuaternion, Vector3,
 };
+use mrtmap_geometry::polygon::segments_cross;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -82,12 +83,12 @@ pub struct Walk {
 /// The coverage planner's step (s), the half field of view it counts a wall point seen within
 /// (inside the D435's 43.5°), the range (m) and the largest incidence (from the wall's normal)
 /// at which a point counts as seen, and the planner's turn rate (rad/s).
-pub const PLAN_STEP_S: f64 = 0.25;
+const PLAN_STEP_S: f64 = 0.25;
 const PLAN_HALF_FOV: f64 = 40.0 * std::f64::consts::PI / 180.0;
 const PLAN_RANGE_M: f64 = 5.0;
 const PLAN_MAX_INCIDENCE: f64 = 70.0 * std::f64::consts::PI / 180.0;
 /// The planner's fastest turn (60°/s): the sweeps add under 80°/s.
-pub const PLAN_TURN_RATE: f64 = 60.0 * std::f64::consts::PI / 180.0;
+const PLAN_TURN_RATE: f64 = 60.0 * std::f64::consts::PI / 180.0;
 /// Spacing of the wall points the coverage is counted on (m).
 const PLAN_SAMPLE_M: f64 = 0.25;
 /// The share of each wall's points the centroid must show over one loop for the walk to face it,
@@ -130,14 +131,6 @@ fn wall_points(plan: &[Point2<f64>]) -> Vec<WallPoint> {
     out
 }
 
-/// Whether segments p–q and a–b cross.
-fn crosses(p: Point2<f64>, q: Point2<f64>, a: Point2<f64>, b: Point2<f64>) -> bool {
-    let side = |o: Point2<f64>, u: Point2<f64>, v: Point2<f64>| (u - o).perp(&(v - o));
-    let (d1, d2) = (side(a, b, p), side(a, b, q));
-    let (d3, d4) = (side(p, q, a), side(p, q, b));
-    d1 * d2 < 0.0 && d3 * d4 < 0.0
-}
-
 /// The bearing (radians) from `p` of each wall point it sees: within range, at an incidence
 /// under [`PLAN_MAX_INCIDENCE`], with no wall in between.
 fn visible(plan: &[Point2<f64>], points: &[WallPoint], p: Point2<f64>) -> Vec<(usize, f64)> {
@@ -152,8 +145,9 @@ fn visible(plan: &[Point2<f64>], points: &[WallPoint], p: Point2<f64>) -> Vec<(u
             if !(1e-6..=PLAN_RANGE_M).contains(&dist) || -d.dot(&w.inward) / dist < cos_max {
                 return None;
             }
-            let blocked =
-                (0..n).any(|i| i != w.wall && crosses(p, w.at, plan[i], plan[(i + 1) % n]));
+            let blocked = (0..n).any(|i| {
+                i != w.wall && segments_cross(&p, &w.at, &plan[i], &plan[(i + 1) % n], 0.0)
+            });
             (!blocked).then(|| (j, d.y.atan2(d.x)))
         })
         .collect()

@@ -473,6 +473,45 @@ mod tests {
         found.remove(0)
     }
 
+    /// A `w` × `d` m room from the origin: its floor plan and its walls (x = 0, x = w, y = 0,
+    /// y = d) with their bands.
+    fn box_room(w: f64, d: f64, bands: [f64; 4]) -> ([Point2<f64>; 4], [(Plane, f64); 4]) {
+        let wall = |p: [f64; 3], n: Vector3<f64>, band: f64| {
+            (
+                Plane::from_point_normal(&Point3::from(p), Unit::new_normalize(n)),
+                band,
+            )
+        };
+        (
+            [
+                Point2::new(0.0, 0.0),
+                Point2::new(w, 0.0),
+                Point2::new(w, d),
+                Point2::new(0.0, d),
+            ],
+            [
+                wall([0.0, 0.0, 0.0], Vector3::x(), bands[0]),
+                wall([w, 0.0, 0.0], -Vector3::x(), bands[1]),
+                wall([0.0, 0.0, 0.0], Vector3::y(), bands[2]),
+                wall([0.0, d, 0.0], -Vector3::y(), bands[3]),
+            ],
+        )
+    }
+
+    /// The floor cells of a `w` × `d` m room seen, all but those whose centres are `hidden`.
+    fn floor_seen_but(
+        w: f64,
+        d: f64,
+        hidden: impl Fn(f64, f64) -> bool,
+    ) -> std::collections::HashSet<(i32, i32)> {
+        let c = FLOOR_CELL_M;
+        let (nx, ny) = ((w / c + 1e-9) as i32, (d / c + 1e-9) as i32);
+        (0..nx)
+            .flat_map(|i| (0..ny).map(move |j| (i, j)))
+            .filter(|&(i, j)| !hidden((i as f64 + 0.5) * c, (j as f64 + 0.5) * c))
+            .collect()
+    }
+
     /// A cabinet against the wall y = 3 (x 0.1…1.3, y 2.4…2.9, 1 m high; its points seen in 6
     /// frames) beside a slab of depth noise seen once each, scattered beyond the far wall x = 0's
     /// band from y = 0.3 to the cabinet, up to 1.7 m (a wall seen from afar). The noise does not
@@ -507,32 +546,8 @@ mod tests {
             nrm.push(n);
             obs.push(1);
         }
-        let floor_2d = [
-            Point2::new(0.0, 0.0),
-            Point2::new(8.0, 0.0),
-            Point2::new(8.0, 3.0),
-            Point2::new(0.0, 3.0),
-        ];
-        let wall = |p: [f64; 3], n: Vector3<f64>| {
-            (
-                Plane::from_point_normal(&Point3::from(p), Unit::new_normalize(n)),
-                0.15,
-            )
-        };
-        let walls = [
-            wall([0.0, 0.0, 0.0], Vector3::x()),
-            wall([8.0, 0.0, 0.0], -Vector3::x()),
-            wall([0.0, 0.0, 0.0], Vector3::y()),
-            wall([0.0, 3.0, 0.0], -Vector3::y()),
-        ];
-        let c = FLOOR_CELL_M;
-        let floor_seen: std::collections::HashSet<(i32, i32)> = (0..160)
-            .flat_map(|i| (0..60).map(move |j| (i, j)))
-            .filter(|&(i, j)| {
-                let (x, y) = ((i as f64 + 0.5) * c, (j as f64 + 0.5) * c);
-                !(x < 1.3 && y > 2.4)
-            })
-            .collect();
+        let (floor_2d, walls) = box_room(8.0, 3.0, [0.15; 4]);
+        let floor_seen = floor_seen_but(8.0, 3.0, |x, y| x < 1.3 && y > 2.4);
         let f = the_one_seen(&pos, &nrm, &obs, &floor_2d, &walls, &floor_seen);
         let y0 = f.corners.iter().map(|p| p.y).fold(f64::MAX, f64::min);
         assert!((y0 - 2.4).abs() < 0.06, "front at y = {y0:.3}");
@@ -568,34 +583,10 @@ mod tests {
             pos.push(Point3::new(x, y, 1.9));
             nrm.push(Vector3::z());
         }
-        let floor_2d = [
-            Point2::new(0.0, 0.0),
-            Point2::new(4.0, 0.0),
-            Point2::new(4.0, 4.0),
-            Point2::new(0.0, 4.0),
-        ];
-        let wall = |p: [f64; 3], n: Vector3<f64>, band: f64| {
-            (
-                Plane::from_point_normal(&Point3::from(p), Unit::new_normalize(n)),
-                band,
-            )
-        };
-        let walls = [
-            wall([0.0, 0.0, 0.0], Vector3::x(), 0.15),
-            wall([4.0, 0.0, 0.0], -Vector3::x(), 0.15),
-            wall([0.0, 0.0, 0.0], Vector3::y(), 0.15),
-            wall([0.0, 4.0, 0.0], -Vector3::y(), 0.30),
-        ];
+        let (floor_2d, walls) = box_room(4.0, 4.0, [0.15, 0.15, 0.15, 0.30]);
         // The floor was seen everywhere but under and behind the bookcase, and at the foot of its
         // front (its points are as noisy as the face's).
-        let c = FLOOR_CELL_M;
-        let floor_seen: std::collections::HashSet<(i32, i32)> = (0..80)
-            .flat_map(|i| (0..80).map(move |j| (i, j)))
-            .filter(|&(i, j)| {
-                let (x, y) = ((i as f64 + 0.5) * c, (j as f64 + 0.5) * c);
-                !(x < 0.35 && (2.67..3.91).contains(&y))
-            })
-            .collect();
+        let floor_seen = floor_seen_but(4.0, 4.0, |x, y| x < 0.35 && (2.67..3.91).contains(&y));
         let f = &the_one(&pos, &nrm, &floor_2d, &walls, &floor_seen);
         let xs: Vec<f64> = f.corners.iter().map(|p| p.x).collect();
         let (x0, x1) = (
@@ -648,33 +639,9 @@ mod tests {
         for k in 0..6 {
             add(Point3::new(5.12 + 0.03 * k as f64, 1.9, 0.8), Vector3::z());
         }
-        let floor_2d = [
-            Point2::new(0.0, 0.0),
-            Point2::new(6.0, 0.0),
-            Point2::new(6.0, 2.53),
-            Point2::new(0.0, 2.53),
-        ];
-        let wall = |p: [f64; 3], n: Vector3<f64>| {
-            (
-                Plane::from_point_normal(&Point3::from(p), Unit::new_normalize(n)),
-                0.15,
-            )
-        };
-        let walls = [
-            wall([0.0, 0.0, 0.0], Vector3::x()),
-            wall([6.0, 0.0, 0.0], -Vector3::x()),
-            wall([0.0, 0.0, 0.0], Vector3::y()),
-            wall([0.0, 2.53, 0.0], -Vector3::y()),
-        ];
+        let (floor_2d, walls) = box_room(6.0, 2.53, [0.15; 4]);
         // The floor was seen everywhere but under and beyond the sofa's seen part.
-        let c = FLOOR_CELL_M;
-        let floor_seen: std::collections::HashSet<(i32, i32)> = (0..120)
-            .flat_map(|i| (0..50).map(move |j| (i, j)))
-            .filter(|&(i, j)| {
-                let (x, y) = ((i as f64 + 0.5) * c, (j as f64 + 0.5) * c);
-                !(x > 3.97 && y > 1.57)
-            })
-            .collect();
+        let floor_seen = floor_seen_but(6.0, 2.53, |x, y| x > 3.97 && y > 1.57);
         let f = &the_one(&pos, &nrm, &floor_2d, &walls, &floor_seen);
         let max = |k: usize| f.corners.iter().map(|p| p[k]).fold(f64::MIN, f64::max);
         let min = |k: usize| f.corners.iter().map(|p| p[k]).fold(f64::MAX, f64::min);
