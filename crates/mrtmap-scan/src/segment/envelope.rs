@@ -297,6 +297,12 @@ fn observed_share(
     count.iter().filter(|&&c| c >= 2).count() as f64 / bins as f64
 }
 
+/// Two outlines whose walls' unobserved lengths differ by more than this (m) are told apart by
+/// it. Measured on 60 s walks: where both outlines are right it is at most 0.29 m (a few 10 cm
+/// bins at corners; 49 preset, T- and U-shaped scans); a bay window's front wall lost to a
+/// slanted line 10° off left 0.58 m of the outline unseen against none.
+const UNOBSERVED_MARGIN_M: f64 = 0.3;
+
 /// Classifies planes against an up estimate, picks floor and ceiling, refines up from the floor,
 /// finds the outline of walls on the floor plan (`outline`) and computes the corners. The walls
 /// become planes of their own, appended to `planes`; vertical planes found by RANSAC on a wall
@@ -322,7 +328,9 @@ pub fn envelope(
         .collect();
     let op = OutlineParams::default();
     // Walls reach the ceiling, furniture mostly does not: their points in the upper half of the
-    // room, and just below the ceiling; of the two outlines, the one with fewer walls inferred,
+    // room, and just below the ceiling. Of the two outlines, the one whose walls have less length
+    // without wall points along them (a wrong line leaves part of its wall unseen) when they
+    // differ by more than [`UNOBSERVED_MARGIN_M`]; otherwise the one with fewer walls inferred,
     // then fewer walls (lines of noise add walls, they do not remove any).
     let bands = [
         (0.5 * h_room, h_room - 0.05),
@@ -331,7 +339,7 @@ pub fn envelope(
             h_room - 0.05,
         ),
     ];
-    let mut result = Err(OutlineError::NothingSeen);
+    let mut result: Result<(outline::Outline, f64), OutlineError> = Err(OutlineError::NothingSeen);
     let mut used = (Vec::new(), Vec::new(), Vec::new());
     let score = |o: &outline::Outline| {
         (
@@ -339,12 +347,33 @@ pub fn envelope(
             o.walls.len(),
         )
     };
+    let all = vertical_points(points, normals, &frame, (0.05 * h_room, h_room - 0.05), p);
+    // The length of the outline's walls (m) along which no wall points were seen.
+    let unobserved = |o: &outline::Outline| {
+        let n = o.walls.len();
+        (0..n)
+            .map(|k| {
+                let (a, b) = (o.corners[k], o.corners[(k + 1) % n]);
+                (b - a).norm()
+                    * (1.0 - observed_share(&a, &b, &o.normals[k], &all.1, &all.2, op.band_m))
+            })
+            .sum::<f64>()
+    };
     for band in bands {
         let vp = vertical_points(points, normals, &frame, band, p);
         let lines = outline::wall_lines(&vp.1, &vp.2, &op);
-        let this = outline::outline(lines, &evidence, &op);
+        let this = outline::outline(lines, &evidence, &op).map(|o| {
+            let u = unobserved(&o);
+            (o, u)
+        });
         let better = match (&this, &result) {
-            (Ok(a), Ok(b)) => score(a) < score(b),
+            (Ok((a, ua)), Ok((b, ub))) => {
+                if (ua - ub).abs() > UNOBSERVED_MARGIN_M {
+                    ua < ub
+                } else {
+                    score(a) < score(b)
+                }
+            }
             (Ok(_), Err(_)) => true,
             _ => false,
         };
@@ -353,7 +382,7 @@ pub fn envelope(
             used = vp;
         }
     }
-    let out = result.map_err(|e| match e {
+    let out = result.map(|r| r.0).map_err(|e| match e {
         OutlineError::NothingSeen => SegmentError::NoWalls,
         OutlineError::Open(a, b) => SegmentError::OpenOutline {
             from: arr(&frame.to_3d(&a)),
@@ -361,7 +390,6 @@ pub fn envelope(
             length_m: (b - a).norm(),
         },
     })?;
-    let all = vertical_points(points, normals, &frame, (0.05 * h_room, h_room - 0.05), p);
     // The walls' planes, made exactly vertical, facing into the room.
     let n = out.walls.len();
     let to3 = |v: &Vector2<f64>| frame.u.as_ref() * v.x + frame.v.as_ref() * v.y;
