@@ -4,12 +4,14 @@
 //!    ceiling, most furniture does not), seen from above, vote with their normals' directions (a
 //!    Hough transform on the normals); each direction's points vote for an offset; each peak is a
 //!    line, refitted to the middle of its points (a far wall is fused as thick as the depth noise
-//!    there). Lines of noise are sparse or thick and are dropped. A wall seen briefly, at a grazing
-//!    angle or only above furniture still gives a line.
+//!    there). Lines of noise are sparse or thick and are dropped, and so are lines made of the
+//!    spread of stronger walls (their points nearly all among those walls' points). A wall seen
+//!    briefly, at a grazing angle or only above furniture still gives a line.
 //! 2. Where the room is: the floor and ceiling points seen, on a 5 cm raster.
 //! 3. The plane is cut into cells by every line (and, along each wall direction, by the floor and
-//!    ceiling's extreme extent, for a wall never seen); a cell is the room's when most of it was
-//!    seen as floor or ceiling. The kept cells' boundary is the loop of walls, counter-clockwise;
+//!    ceiling's extreme extent, for a wall never seen); a cell is the room's when most of its
+//!    inside (15 cm from its edges, past the floor points scattered beyond a wall) was seen as
+//!    floor or ceiling. The kept cells' boundary is the loop of walls, counter-clockwise;
 //!    its corners are the lines' intersections. Spurious lines inside the room (a tall cupboard's
 //!    side, a wall's shadow) cut cells that are kept on both sides and drop out; lines outside it
 //!    bound cells that are empty. The loop closes whenever the floor or ceiling was seen. Walls
