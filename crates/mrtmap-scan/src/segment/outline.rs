@@ -415,7 +415,7 @@ const SPREAD_M: f64 = 0.05;
 /// A line with at least this share of its points among stronger lines' is their spread.
 const SPREAD_SHARE: f64 = 0.9;
 
-/// Lines that are the spread of stronger ones (`lines` strongest first): a thick fused wall
+/// Lines that are the spread of stronger (denser) ones: a thick fused wall
 /// leaves points beyond its line's band, and its blended normals at corners, which can make a
 /// line of their own a few degrees off it, even across a corner (bay window, walk 1: 1,366 points,
 /// 9 cm thick, 12° off the wall, from one wall's spread to the next). Nearly all such a line's
@@ -430,8 +430,12 @@ fn drop_spread(lines: Vec<WallLine>, pts: &[Point2<f64>]) -> Vec<WallLine> {
         )
     };
     let mut grid: std::collections::HashMap<(i64, i64), Vec<usize>> = Default::default();
-    let mut out: Vec<WallLine> = Vec::with_capacity(lines.len());
-    for line in lines {
+    // Densest first: a line of spread can hold more points than a short wall it crosses.
+    let mut order: Vec<usize> = (0..lines.len()).collect();
+    order.sort_by(|&a, &b| lines[b].density.total_cmp(&lines[a].density));
+    let mut keep = vec![false; lines.len()];
+    for (rank, &k) in order.iter().enumerate() {
+        let line = &lines[k];
         let among = line
             .points
             .iter()
@@ -447,15 +451,19 @@ fn drop_spread(lines: Vec<WallLine>, pts: &[Point2<f64>]) -> Vec<WallLine> {
                 })
             })
             .count();
-        if !out.is_empty() && among as f64 >= SPREAD_SHARE * line.points.len() as f64 {
+        if rank > 0 && among as f64 >= SPREAD_SHARE * line.points.len() as f64 {
             continue;
         }
         for &i in &line.points {
             grid.entry(key(&pts[i])).or_default().push(i);
         }
-        out.push(line);
+        keep[k] = true;
     }
-    out
+    lines
+        .into_iter()
+        .zip(keep)
+        .filter_map(|(l, k)| k.then_some(l))
+        .collect()
 }
 
 /// Lines that are one wall found twice (within `merge_deg` and `merge_m`, facing the same way):
@@ -1167,23 +1175,31 @@ mod tests {
         corners_match(&o, &L, 0.03);
     }
 
-    /// A line through `pts` as `wall_lines` gives it (normal `n`, through `q`).
-    fn line_of(n: Vector2<f64>, q: Point2<f64>, points: std::ops::Range<usize>) -> WallLine {
+    /// A line through `pts` as `wall_lines` gives it (normal `n`, through `q`, `density` points
+    /// per 10 cm).
+    fn line_of(
+        n: Vector2<f64>,
+        q: Point2<f64>,
+        points: std::ops::Range<usize>,
+        density: f64,
+    ) -> WallLine {
         WallLine {
             n,
             rho: n.dot(&q.coords),
             points: points.collect(),
             inferred: false,
-            density: 50.0,
+            density,
             thickness: 0.02,
         }
     }
 
     #[test]
     fn a_wall_s_spread_is_not_a_line_of_its_own() {
-        // A wall along y = 0 (x from 0 to 3 m, 1 cm thick), its spread 3 cm beyond it over the
-        // same length, a wall meeting it at a right angle at x = 3 and a 0.8 m wall at 50° from
-        // its start, 6 cm thick (a bay window's side).
+        // A wall along y = 0 (x from 0 to 3 m, 1 cm thick), a wall meeting it at a right angle
+        // at x = 3, and a 0.8 m wall at 50° from its start, 6 cm thick (a bay window's side).
+        // Two lines of spread: 3 cm beyond the wall over its length, and 4 cm beyond both the
+        // wall and the slanted wall, with more points than the slanted wall but sparser (bay
+        // window walk 3: checked by number of points, that line hid the slanted wall).
         let mut pts = Vec::new();
         for i in 0..300 {
             for off in [-0.005, 0.0, 0.005] {
@@ -1207,16 +1223,25 @@ mod tests {
             }
         }
         let slant = side.end..pts.len();
+        for i in 0..80 {
+            pts.push(Point2::origin() + d * (i as f64 * 0.01) - n_slant * 0.07);
+        }
+        for i in 0..300 {
+            pts.push(Point2::new(i as f64 * 0.01, -0.04));
+        }
+        let crossing = slant.end..pts.len();
+        assert!(crossing.len() > slant.len());
         let y = Vector2::new(0.0, 1.0);
         let lines = vec![
-            line_of(y, Point2::origin(), wall),
-            line_of(Vector2::new(-1.0, 0.0), Point2::new(3.0, 0.0), side),
-            line_of(n_slant, Point2::origin(), slant),
-            line_of(y, Point2::new(0.0, -0.03), spread),
+            line_of(y, Point2::origin(), wall, 100.0),
+            line_of(Vector2::new(-1.0, 0.0), Point2::new(3.0, 0.0), side, 100.0),
+            line_of(y, Point2::new(0.0, -0.04), crossing, 30.0),
+            line_of(n_slant, Point2::origin(), slant, 80.0),
+            line_of(y, Point2::new(0.0, -0.03), spread, 30.0),
         ];
         let kept = drop_spread(lines, &pts);
-        assert_eq!(kept.len(), 3, "{kept:?}");
-        assert!(kept.iter().all(|l| l.rho.abs() < 1e-9 || l.n.x < 0.0));
+        let densities: Vec<f64> = kept.iter().map(|l| l.density).collect();
+        assert_eq!(densities, [100.0, 100.0, 80.0]);
     }
 
     #[test]
