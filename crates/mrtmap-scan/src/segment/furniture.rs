@@ -15,7 +15,8 @@
 //! over floor never seen on sides where a few of its points continue (a sofa seen from its end) or
 //! that end within reach of a wall (its points near the wall were left to the wall: a bookcase
 //! against it). Groups reaching within 15 cm of the ceiling are wall
-//! remainders too, and so are groups most of whose points were seen in one frame only (depth
+//! remainders too unless they stand 30 cm or more from every wall (a column, taken to the
+//! ceiling), and so are groups most of whose points were seen in one frame only (depth
 //! noise off a wall; real furniture is seen frame after frame).
 
 use std::collections::{HashMap, VecDeque};
@@ -72,6 +73,10 @@ fn axes(room: &Room<'_>) -> (Vector3<f64>, Vector3<f64>) {
     let u = (room.along - up.as_ref() * room.along.dot(up)).normalize();
     (u, up.cross(&u))
 }
+
+/// A group reaching the ceiling is a column, not a wall's remainder, when its box stands at least
+/// this far (m) from every wall (a wall's noisy remainder lies within its band and 5 cm).
+const FREE_STANDING_M: f64 = 0.3;
 
 /// A 3D cell of 5 cm.
 type Cell = [i32; 3];
@@ -351,13 +356,33 @@ fn furniture_box(
             beyond[k] = beyond[k].max(1.0);
         }
     }
-    let (mut h0, h1) = (percentile(&mut h, 0.01), percentile(&mut h, 0.99));
+    let (mut h0, mut h1) = (percentile(&mut h, 0.01), percentile(&mut h, 0.99));
     if h0 < 0.15 {
         h0 = 0.0;
     }
-    // Reaching the ceiling, it is the noisy remainder of a wall; lower than 20 cm, the remainder
-    // of the floor (or a rug, which is floor): not furniture.
-    if h1 > room.room_height - 0.15 || h1 < 0.2 {
+    // Reaching the ceiling, it is the noisy remainder of a wall, unless it stands at least
+    // [`FREE_STANDING_M`] from every wall: a column, which then reaches the ceiling (the points
+    // sought stop 10 cm below it). Lower than 20 cm, the remainder of the floor (or a rug, which
+    // is floor): not furniture.
+    if h1 > room.room_height - 0.15 {
+        let clear = |x: f64, y: f64| {
+            point_in_polygon(&Point2::new(x, y), room.floor_2d, 0.0) == Containment::Inside
+        };
+        let f = FREE_STANDING_M;
+        let free = [
+            (a0 - f, b0 - f),
+            (a1 + f, b0 - f),
+            (a0 - f, b1 + f),
+            (a1 + f, b1 + f),
+        ]
+        .into_iter()
+        .all(|(x, y)| clear(x, y));
+        if !free {
+            return None;
+        }
+        h1 = room.room_height;
+    }
+    if h1 < 0.2 {
         return None;
     }
     let (a0, a1, b0, b1) = grow_over_hidden_floor(room, [a0, a1, b0, b1], beyond, h0);
@@ -555,6 +580,68 @@ mod tests {
             (f.size_m[2] - 1.0).abs() < 0.06,
             "height {:.3}",
             f.size_m[2]
+        );
+    }
+
+    /// A 0.4 m square column from floor to ceiling (x 3.6…4.0, y 2.2…2.6) in the middle of a
+    /// 6 × 5 m room, 2.7 m high, and a 40 cm slab of a wall's depth noise reaching the ceiling
+    /// just beyond the wall x = 0's band: the column is furniture up to the ceiling (its points
+    /// stop 10 cm below it), the slab is not (without the 30 cm test both are).
+    #[test]
+    fn a_column_reaching_the_ceiling_is_furniture_and_a_wall_s_remainder_is_not() {
+        let (mut pos, mut nrm) = (Vec::new(), Vec::new());
+        for k in 0..2000 {
+            let f = k as f64;
+            let (r1, r2) = ((f * 0.618_034).fract(), (f * 0.414_214).fract());
+            let (s, z) = (0.4 * r1, 0.05 + 2.55 * r2);
+            for (p, n) in [
+                (Point3::new(3.6 + s, 2.2, z), -Vector3::y()),
+                (Point3::new(3.6 + s, 2.6, z), Vector3::y()),
+                (Point3::new(3.6, 2.2 + s, z), -Vector3::x()),
+                (Point3::new(4.0, 2.2 + s, z), Vector3::x()),
+            ] {
+                pos.push(p);
+                nrm.push(n);
+            }
+        }
+        for k in 0..40000 {
+            let f = k as f64;
+            let (r1, r2, r3) = (
+                (f * 0.618_034).fract(),
+                (f * 0.414_214).fract(),
+                (f * 0.732_051).fract(),
+            );
+            pos.push(Point3::new(
+                0.22 + 0.4 * r1,
+                1.0 + 2.0 * r2,
+                0.05 + 2.55 * r3,
+            ));
+            nrm.push(Vector3::new(1.0, r2 - 0.5, r3 - 0.5).normalize());
+        }
+        let (floor_2d, walls) = box_room(6.0, 5.0, [0.15; 4]);
+        let floor_seen = floor_seen_but(6.0, 5.0, |x, y| {
+            (3.6..4.0).contains(&x) && (2.2..2.6).contains(&y)
+        });
+        let f = the_one(&pos, &nrm, &floor_2d, &walls, &floor_seen);
+        let max = |k: usize| f.corners.iter().map(|p| p[k]).fold(f64::MIN, f64::max);
+        let min = |k: usize| f.corners.iter().map(|p| p[k]).fold(f64::MAX, f64::min);
+        assert!(
+            (min(0) - 3.6).abs() < 0.03 && (max(0) - 4.0).abs() < 0.03,
+            "x {:.3}…{:.3}",
+            min(0),
+            max(0)
+        );
+        assert!(
+            (min(1) - 2.2).abs() < 0.03 && (max(1) - 2.6).abs() < 0.03,
+            "y {:.3}…{:.3}",
+            min(1),
+            max(1)
+        );
+        assert!(
+            min(2).abs() < 1e-9 && (max(2) - 2.7).abs() < 1e-9,
+            "z {:.3}…{:.3}",
+            min(2),
+            max(2)
         );
     }
 
