@@ -793,14 +793,27 @@ pub fn analyse_surface(
         out.temperature_std_k = std;
     }
     if p.raster_m > 0.0 {
-        out.raster = background_raster(&g, &in_feature, &bg, frame, p.raster_m);
+        // The raster leaves out what the features' outlines cover: a feature's texels outside
+        // its outline (a window whose upper corner was never seen, outlined as the rectangle
+        // seen in full) radiate from the raster at their own temperature.
+        let in_outline: Vec<bool> = (0..nx * ny)
+            .map(|c| {
+                g.inside[c] && {
+                    let centre = g.centre_of(c);
+                    out.features
+                        .iter()
+                        .any(|f| point_in_polygon_fast(&centre, &f.polygon_2d))
+                }
+            })
+            .collect();
+        out.raster = background_raster(&g, &in_outline, &bg, frame, p.raster_m);
     }
     out
 }
 
 /// The background's temperature raster at about `raster_m` (a whole number of analysis texels):
-/// each raster texel the radiant average of its observed background texels, leaving out features
-/// and a 10 cm margin around them and along the surface's edges (where the thermal camera's blur
+/// each raster texel the radiant average of its observed background texels, leaving out the
+/// features' outlines (`in_feature`) and a 10 cm margin around them and along the surface's edges (where the thermal camera's blur
 /// spreads a feature's or the next surface's temperature); a raster texel with less than a quarter of its texels so observed is filled
 /// from its neighbours (repeatedly, then the background model where nothing is near) and listed
 /// as filled.
@@ -948,6 +961,95 @@ mod tests {
             refine_side(&rising[..5], 0.90, (0.0, 1.0), true, 0.03),
             0.90
         );
+    }
+
+    /// A 10 × 4 m wall at 19.8 °C with a 9 °C window 8 × 2.4 m (x 1…9, z 0.8…3.2) whose upper
+    /// end the walk never saw (as on a 10 × 7 m hall's walk 2): the feature's outline is the
+    /// rectangle seen in full (x 1…7.5), and wherever else the window was seen the scene radiates
+    /// cold from the raster (it radiated the wall's 19.8 °C when the raster left out the whole
+    /// cold region).
+    #[test]
+    fn a_window_seen_in_part_radiates_cold_wherever_it_was_seen() {
+        use mrtmap_geometry::nalgebra::{Unit, Vector3};
+        let unseen = |x: f64, z: f64| {
+            (x > 7.5 && z > 1.8)
+                || (x > 8.0 && z > 1.4)
+                || ((6.0..7.5).contains(&x) && (1.4..1.9).contains(&z))
+        };
+        let window = |x: f64, z: f64| (1.0..9.0).contains(&x) && (0.8..3.2).contains(&z);
+        let (mut pos, mut temp) = (Vec::new(), Vec::new());
+        for i in 0..334 {
+            for j in 0..134 {
+                let (x, z) = ((i as f64 + 0.5) * 0.03, (j as f64 + 0.5) * 0.03);
+                if unseen(x, z) {
+                    continue;
+                }
+                pos.push(Point3::new(x, 0.0, z));
+                temp.push(ZERO_CELSIUS_K + if window(x, z) { 9.0 } else { 19.8 });
+            }
+        }
+        let frame = PlaneFrame::new(
+            Point3::origin(),
+            Unit::new_normalize(Vector3::y()),
+            &Vector3::x(),
+        );
+        let host: Vec<Point2<f64>> = [[0.0, 0.0], [10.0, 0.0], [10.0, 4.0], [0.0, 4.0]]
+            .iter()
+            .map(|q| frame.to_2d(&Point3::new(q[0], 0.0, q[1])))
+            .collect();
+        let idx: Vec<usize> = (0..pos.len()).collect();
+        let a = analyse_surface(
+            &frame,
+            &host,
+            &idx,
+            &pos,
+            &temp,
+            true,
+            &SegmentParams::default(),
+        );
+        let raster = a.raster.as_ref().expect("a raster");
+        // Every point seen on the window, 20 cm or more inside its edges and its unseen part.
+        for (q, t) in pos.iter().zip(&temp) {
+            let inner = window(q.x - 0.2, q.z - 0.2) && window(q.x + 0.2, q.z + 0.2);
+            let clear = [
+                (-0.2, -0.2),
+                (0.2, -0.2),
+                (-0.2, 0.2),
+                (0.2, 0.2),
+                (0.0, 0.2),
+                (0.2, 0.0),
+            ]
+            .iter()
+            .all(|(dx, dz)| !unseen(q.x + dx, q.z + dz));
+            if *t > ZERO_CELSIUS_K + 10.0 || !inner || !clear {
+                continue;
+            }
+            let q2 = frame.to_2d(q);
+            let radiates = match a
+                .features
+                .iter()
+                .find(|f| point_in_polygon_fast(&q2, &f.polygon_2d))
+            {
+                Some(f) => f.temperature_k,
+                None => {
+                    let o = Point3::from(raster.origin);
+                    let d = q - o;
+                    let (u, v) = (Vector3::from(raster.u), Vector3::from(raster.v));
+                    let (c, r) = (
+                        (d.dot(&u) / raster.texel_m) as usize,
+                        (d.dot(&v) / raster.texel_m) as usize,
+                    );
+                    ZERO_CELSIUS_K + raster.temperature_c[r * raster.cols + c].expect("filled")
+                }
+            };
+            assert!(
+                radiates < ZERO_CELSIUS_K + 12.0,
+                "at ({:.2}, {:.2}) {:.1} °C",
+                q.x,
+                q.z,
+                radiates - ZERO_CELSIUS_K
+            );
+        }
     }
 
     /// A stratified wall (18 °C at mid-height, 0.8 K/m) with a 14 °C window over a quarter of it.
