@@ -43,7 +43,16 @@ pub fn scan_seeded(
         ..SimConfig::default()
     };
     cfg.depth_camera = cfg.depth_camera.scaled(depth_scale);
-    let room = preset(room).unwrap().unwrap();
+    // A preset, or a room of bench/rooms by its file name.
+    let room = match preset(room) {
+        Some(r) => r.unwrap(),
+        None => {
+            let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../bench/rooms")
+                .join(room);
+            Room::from_toml(&std::fs::read_to_string(&path).unwrap()).unwrap()
+        }
+    };
     simulate(&room, &cfg, out, &|_, _| {}).unwrap();
     room
 }

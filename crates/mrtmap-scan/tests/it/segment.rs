@@ -27,12 +27,36 @@ fn run_seeded(
     mrtmap_scan::segment::SegmentReport,
     Isometry3<f64>,
 ) {
+    run_at(room, noise, seconds, seed, 0.5)
+}
+
+/// [`run_seeded`] with the depth camera's resolution scaled by `depth_scale` (every pixel at
+/// half the resolution, every second pixel at full resolution, as `mrtmap fuse` by default).
+fn run_at(
+    room: &str,
+    noise: NoiseLevel,
+    seconds: f64,
+    seed: u64,
+    depth_scale: f64,
+) -> (
+    SceneScore,
+    mrtmap_scan::segment::SegmentReport,
+    Isometry3<f64>,
+) {
     let dir = tempfile::tempdir().unwrap();
     let rec_dir = dir.path().join("scan");
-    scan_seeded(room, noise, Drift::NONE, seconds, 0.5, seed, &rec_dir);
+    scan_seeded(
+        room,
+        noise,
+        Drift::NONE,
+        seconds,
+        depth_scale,
+        seed,
+        &rec_dir,
+    );
     let rec = Recording::open(&rec_dir).unwrap();
     let mut p = params(true);
-    p.depth.stride = 1;
+    p.depth.stride = if depth_scale < 1.0 { 1 } else { 2 };
     let fused = mrtmap_scan::fuse(&rec, &p, &|_, _| {});
     let poses = Trajectory {
         stamps: fused.poses.iter().map(|x| x.0).collect(),
@@ -195,4 +219,23 @@ fn a_realistic_walk_of_another_seed_closes_the_l_shaped_outline() {
     );
     mrt_within("l-shaped, seed 5", &s, 0.2);
     println!("l-shaped seed 5: {:?}", s.points);
+}
+
+/// A room with no preset: the bay window of bench/rooms (slanted 0.78 m walls at 50°, a 1 m
+/// front wall 0.6 m out holding a 9.5 °C window), a 30 s realistic walk at the depth camera's
+/// full resolution: the bay closes with its three walls (its slanted walls' spread and the floor
+/// seen beyond its front wall cut it off before), corners within 5 cm, MRT at A–D within 0.2 K.
+/// (At half resolution, whose depth noise is twice as thick, the outline does not hold yet.)
+#[test]
+fn a_bay_window_closes_with_its_three_walls() {
+    let (s, report, _) = run_at("bay.toml", NoiseLevel::Realistic, 30.0, 1, 1.0);
+    assert_eq!(walls(&report), 8, "{report:?}");
+    assert!(report.inferred_walls.is_empty(), "{report:?}");
+    assert!(
+        s.corner_max_error_m < 0.05,
+        "corners off by {:.1} mm",
+        s.corner_max_error_m * 1e3
+    );
+    mrt_within("bay window", &s, 0.2);
+    println!("bay window: {:?}", s.points);
 }
