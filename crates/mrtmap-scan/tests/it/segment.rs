@@ -210,15 +210,25 @@ fn the_room_frame_does_not_depend_on_where_the_walk_started() {
 #[test]
 fn a_realistic_walk_of_another_seed_closes_the_l_shaped_outline() {
     let (s, report, _) = run_seeded("l-shaped", NoiseLevel::Realistic, 30.0, 5);
-    assert_eq!(walls(&report), 6);
-    assert!(report.inferred_walls.is_empty(), "{report:?}");
+    closes_within("l-shaped, seed 5", &s, &report, 6);
+    println!("l-shaped seed 5: {:?}", s.points);
+}
+
+/// The outline has `n` walls, all seen, corners within 5 cm, MRT at A–D within 0.2 K.
+fn closes_within(
+    what: &str,
+    s: &SceneScore,
+    report: &mrtmap_scan::segment::SegmentReport,
+    n: usize,
+) {
+    assert_eq!(walls(report), n, "{what}: {report:?}");
+    assert!(report.inferred_walls.is_empty(), "{what}: {report:?}");
     assert!(
         s.corner_max_error_m < 0.05,
-        "corners off by {:.1} mm",
+        "{what}: corners off by {:.1} mm",
         s.corner_max_error_m * 1e3
     );
-    mrt_within("l-shaped, seed 5", &s, 0.2);
-    println!("l-shaped seed 5: {:?}", s.points);
+    mrt_within(what, s, 0.2);
 }
 
 /// A room with no preset: the bay window of bench/rooms (slanted 0.78 m walls at 50°, a 1 m
@@ -229,13 +239,6 @@ fn a_realistic_walk_of_another_seed_closes_the_l_shaped_outline() {
 #[test]
 fn a_bay_window_closes_with_its_three_walls() {
     let (s, report, _) = run_at("bay.toml", NoiseLevel::Realistic, 30.0, 1, 1.0);
-    assert_eq!(walls(&report), 8, "{report:?}");
-    assert!(report.inferred_walls.is_empty(), "{report:?}");
-    assert!(
-        s.corner_max_error_m < 0.05,
-        "corners off by {:.1} mm",
-        s.corner_max_error_m * 1e3
-    );
-    mrt_within("bay window", &s, 0.2);
+    closes_within("bay window", &s, &report, 8);
     println!("bay window: {:?}", s.points);
 }
