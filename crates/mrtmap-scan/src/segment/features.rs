@@ -663,12 +663,13 @@ fn feature(
 }
 
 /// The host's temperature and its uncertainty: its background texels only (the features' are
-/// subtracted, Algorithm 1), one texel clear of every feature (border texels mix both).
+/// subtracted, Algorithm 1), one texel clear of every feature's region (border texels mix both)
+/// and outside every feature's outline (`in_outline`).
 fn host_temperature(
     g: &Grid,
     cells: &[usize],
     in_feature: &[bool],
-    features: &[FoundFeature],
+    in_outline: &[bool],
     observed_fraction: f64,
 ) -> Option<(f64, f64)> {
     let (nx, ny) = (g.nx, g.ny);
@@ -680,12 +681,7 @@ fn host_temperature(
     };
     let mut host_avg = RadiantAverage::new();
     for &c in cells {
-        let centre = g.centre_of(c);
-        if !near_feature(c)
-            && !features
-                .iter()
-                .any(|f| point_in_polygon_fast(&centre, &f.polygon_2d))
-        {
+        if !near_feature(c) && !in_outline[c] {
             host_avg.add(Temperature::from_kelvin(g.kelvin(c)), 1.0);
         }
     }
@@ -786,8 +782,19 @@ pub fn analyse_surface(
                 .push(feature(&g, &comp, poly, &resid, &bg, &near_edge));
         }
     }
+    // The texels inside a feature's outline.
+    let in_outline: Vec<bool> = (0..nx * ny)
+        .map(|c| {
+            g.inside[c] && {
+                let centre = g.centre_of(c);
+                out.features
+                    .iter()
+                    .any(|f| point_in_polygon_fast(&centre, &f.polygon_2d))
+            }
+        })
+        .collect();
     if let Some((t, std)) =
-        host_temperature(&g, &cells, &in_feature, &out.features, observed_fraction)
+        host_temperature(&g, &cells, &in_feature, &in_outline, observed_fraction)
     {
         out.temperature_k = Some(t);
         out.temperature_std_k = std;
@@ -796,16 +803,6 @@ pub fn analyse_surface(
         // The raster leaves out what the features' outlines cover: a feature's texels outside
         // its outline (a window whose upper corner was never seen, outlined as the rectangle
         // seen in full) radiate from the raster at their own temperature.
-        let in_outline: Vec<bool> = (0..nx * ny)
-            .map(|c| {
-                g.inside[c] && {
-                    let centre = g.centre_of(c);
-                    out.features
-                        .iter()
-                        .any(|f| point_in_polygon_fast(&centre, &f.polygon_2d))
-                }
-            })
-            .collect();
         out.raster = background_raster(&g, &in_outline, &bg, frame, p.raster_m);
     }
     out

@@ -498,6 +498,12 @@ mod tests {
         found.remove(0)
     }
 
+    /// Point `k` of a deterministic, evenly spread sequence in the unit cube.
+    fn spread(k: usize) -> [f64; 3] {
+        let f = k as f64;
+        [0.618_034, 0.414_214, 0.732_051].map(|a| (f * a).fract())
+    }
+
     /// A `w` × `d` m room from the origin: its floor plan and its walls (x = 0, x = w, y = 0,
     /// y = d) with their bands.
     fn box_room(w: f64, d: f64, bands: [f64; 4]) -> ([Point2<f64>; 4], [(Plane, f64); 4]) {
@@ -546,8 +552,7 @@ mod tests {
     fn depth_noise_seen_once_does_not_join_a_cabinet() {
         let (mut pos, mut nrm, mut obs) = (Vec::new(), Vec::new(), Vec::new());
         for k in 0..3000 {
-            let f = k as f64;
-            let (r1, r2) = ((f * 0.618_034).fract(), (f * 0.414_214).fract());
+            let [r1, r2, _] = spread(k);
             // Front face (y = 2.4) and top.
             pos.push(Point3::new(0.1 + 1.2 * r1, 2.4, 0.05 + 0.95 * r2));
             nrm.push(-Vector3::y());
@@ -556,12 +561,7 @@ mod tests {
             obs.extend([6, 6]);
         }
         for k in 0..12000 {
-            let f = k as f64;
-            let (r1, r2, r3) = (
-                (f * 0.618_034).fract(),
-                (f * 0.414_214).fract(),
-                (f * 0.732_051).fract(),
-            );
+            let [r1, r2, r3] = spread(k);
             let n = Vector3::new(r2 - 0.5, r3 - 0.5, r1 - 0.5).normalize();
             pos.push(Point3::new(
                 0.2 + 0.2 * r1,
@@ -591,8 +591,7 @@ mod tests {
     fn a_column_reaching_the_ceiling_is_furniture_and_a_wall_s_remainder_is_not() {
         let (mut pos, mut nrm) = (Vec::new(), Vec::new());
         for k in 0..2000 {
-            let f = k as f64;
-            let (r1, r2) = ((f * 0.618_034).fract(), (f * 0.414_214).fract());
+            let [r1, r2, _] = spread(k);
             let (s, z) = (0.4 * r1, 0.05 + 2.55 * r2);
             for (p, n) in [
                 (Point3::new(3.6 + s, 2.2, z), -Vector3::y()),
@@ -605,12 +604,7 @@ mod tests {
             }
         }
         for k in 0..40000 {
-            let f = k as f64;
-            let (r1, r2, r3) = (
-                (f * 0.618_034).fract(),
-                (f * 0.414_214).fract(),
-                (f * 0.732_051).fract(),
-            );
+            let [r1, r2, r3] = spread(k);
             pos.push(Point3::new(
                 0.22 + 0.4 * r1,
                 1.0 + 2.0 * r2,
@@ -655,18 +649,15 @@ mod tests {
         let (mut pos, mut nrm) = (Vec::new(), Vec::new());
         // Front face: a deterministic spread of ±12 cm around x = 0.42.
         for k in 0..4000 {
-            let f = k as f64;
-            let spread = ((f * 0.618_034).fract() - 0.5) * 0.24;
-            let y = 2.69 + 1.2 * (f * 0.414_214).fract();
-            let z = 0.05 + 1.8 * (f * 0.732_051).fract();
-            pos.push(Point3::new(0.42 + spread, y, z));
+            let [r1, r2, r3] = spread(k);
+            let (y, z) = (2.69 + 1.2 * r2, 0.05 + 1.8 * r3);
+            pos.push(Point3::new(0.42 + (r1 - 0.5) * 0.24, y, z));
             nrm.push(Vector3::x());
         }
         // Top, seen from above.
         for k in 0..600 {
-            let f = k as f64;
-            let x = 0.20 + 0.22 * (f * 0.618_034).fract();
-            let y = 2.69 + 1.2 * (f * 0.414_214).fract();
+            let [r1, r2, _] = spread(k);
+            let (x, y) = (0.20 + 0.22 * r1, 2.69 + 1.2 * r2);
             pos.push(Point3::new(x, y, 1.9));
             nrm.push(Vector3::z());
         }
@@ -705,8 +696,7 @@ mod tests {
             nrm.push(n);
         };
         for k in 0..3000 {
-            let f = k as f64;
-            let (r1, r2) = ((f * 0.618_034).fract(), (f * 0.414_214).fract());
+            let [r1, r2, _] = spread(k);
             // Top, front face and the near end (their points in the back wall's band are left
             // to the wall).
             add(
