@@ -383,7 +383,7 @@ pub fn envelope(
             used = vp;
         }
     }
-    let out = result.map(|r| r.0).map_err(|e| match e {
+    let mut out = result.map(|r| r.0).map_err(|e| match e {
         OutlineError::NothingSeen => SegmentError::NoWalls,
         OutlineError::Open(a, b) => SegmentError::OpenOutline {
             from: arr(&frame.to_3d(&a)),
@@ -391,6 +391,7 @@ pub fn envelope(
             length_m: (b - a).norm(),
         },
     })?;
+    outline::refine_walls(&mut out, &all.1, &all.2, &op);
     // The walls' planes, made exactly vertical, facing into the room.
     let n = out.walls.len();
     let to3 = |v: &Vector2<f64>| frame.u.as_ref() * v.x + frame.v.as_ref() * v.y;
