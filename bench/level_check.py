@@ -31,6 +31,8 @@ def main(mrtmap, run, rec):
         "grid_rmse_k": math.sqrt(sum(x * x for x in g) / len(g)),
         "grid_mean_k": m,
         "grid_relative_max_abs_k": max(abs(x) for x in rel),
+        # The largest error in a difference between two nodes (the map relative to itself).
+        "grid_difference_max_k": max(g) - min(g),
         "points_k": {p["name"]: round(x, 3) for p, x in zip(truth["points"], d[len(nodes):])},
         "stated_se_median_k": sorted(se)[len(se) // 2],
         "covered_at_2se": sum(abs(x) <= 2 * s for x, s in zip(d, se)) / len(d),
