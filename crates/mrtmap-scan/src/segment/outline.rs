@@ -864,13 +864,13 @@ pub fn outline(
     })
 }
 
-/// A wall's line is placed anew from its wall's points at every height between its corners,
-/// whatever their normals: the lines are found from the points in the upper part of the room whose
-/// normals agree with the wall's (furniture and noise make lines of their own lower down), but on a
-/// thick fused wall the points with agreeing normals lie on its inner side. L-shaped walk 6: the
+/// A wall's line is placed anew from its wall's points at every height between its corners with
+/// normals within this angle of the wall's: the lines are found from the points in the upper part
+/// of the room whose normals lie within 20° of the wall's (furniture and noise make lines of their
+/// own lower down), but on a thick fused wall those lie on its inner side. L-shaped walk 6: the
 /// window wall's upper points with normals within 20° lie 13–15 mm inside at its west end and
-/// 1 mm outside at its east end, all its points 8 mm and 2 mm; its line was 20 mm inside at the
-/// window.
+/// 1 mm outside at its east end; its line was 7–16 mm inside along the window; refitted,
+/// 6–8 mm.
 const REFIT_NORMAL_DEG: f64 = 80.0;
 /// Points this close to a wall's corners (m) are left out of its refit (the next wall's points).
 const REFIT_END_M: f64 = 0.15;
