@@ -39,6 +39,15 @@ def detect(path, size, thermal):
     return (c + 0.5) / scale - 0.5, (grey.shape[1] // scale, grey.shape[0] // scale)
 
 
+def quaternion_matrix(x, y, z, w):
+    """The rotation matrix of a unit quaternion (x, y, z, w)."""
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+    ])
+
+
 def rotation_angle(R):
     return float(np.degrees(np.arccos(np.clip((np.trace(R) - 1) / 2, -1, 1))))
 
@@ -111,11 +120,7 @@ def main(pairs, calib_json, grid, square):
     t = np.array(ours["rgb_from_thermal"]["translation"])
     x, y, z, w = ours["rgb_from_thermal"]["rotation_xyzw"]
     used = [p for p in ours["pairs"] if p.get("result", {}).get("status") == "used"]
-    R_ours = np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
+    R_ours = quaternion_matrix(x, y, z, w)
     # The stereo RMS as OpenCV's: over every corner distance of both cameras in the used pairs.
     sq, n = 0.0, 0
     for p in used:

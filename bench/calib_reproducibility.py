@@ -26,7 +26,7 @@ import cv2
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from calib_real_peer import detect, opencv_rig, rotation_angle  # noqa: E402
+from calib_real_peer import detect, opencv_rig, quaternion_matrix, rotation_angle  # noqa: E402
 
 
 def write_set(src, dst, names, change):
@@ -53,14 +53,6 @@ def blur(img, thermal):
 
 def noise(img, _thermal, rng=np.random.default_rng(1)):
     return np.clip(img.astype(float) + rng.normal(0, 6, img.shape), 0, 255).astype(np.uint8)
-
-
-def quaternion_matrix(x, y, z, w):
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
 
 
 def run_mrtmap(mrtmap, pairs, grid, square, report):
