@@ -6,22 +6,72 @@
 Absolute errors, errors with their mean removed (the map relative to itself), the largest error in
 a difference between two nodes (all nodes, neighbouring nodes, nodes 30 cm or more from the grid's
 box), the errors' slope against the true MRT (a camera gain error) and the largest difference
-error without it, and how often the stated standard error covers the error (|Δ| ≤ 2σ)."""
+error without it, and how often the stated standard error covers the error (|Δ| ≤ 2σ).
+
+Twice: at the truth's places in the scan's frame (where the pose source puts them), and under
+"room" at the same places measured from the room's walls, as a person with a tape measure from a
+corner gives them (the scene's own room frame, `--frame room`): the truth's room coordinates
+taken from the corner that the scene's origin corner is, turned by the multiple of 90° that
+carries the truth's axes onto the scene's. The two differ by where the fused map sits against the
+pose source's frame (its displacement, not its shape)."""
 import json
 import math
 import subprocess
 import sys
 
+import numpy as np
 
-def main(mrtmap, run, rec):
-    truth = json.load(open(f"{rec}/truth.json"))
-    scene = f"{run}/segment/scene.json"
-    nodes = [n for n in truth["grid"]["nodes"] if n["mrt_c"] is not None]
-    places = nodes + truth["points"]
-    args = [mrtmap, "mrt", "--scene", scene, "--frame", "scan", "--json"]
+
+def mrt_at(mrtmap, scene, frame, xyz):
+    args = [mrtmap, "mrt", "--scene", scene, "--frame", frame, "--json"]
+    args += ["--at=" + ",".join(f"{v:.5f}" for v in p) for p in xyz]
+    return json.loads(subprocess.run(args, capture_output=True, text=True, check=True).stdout)["points"]
+
+
+def quaternion_matrix(x, y, z, w):
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+    ])
+
+
+def taped(truth, scene_path, places):
+    """The places' room coordinates in the scene's room frame, measured from its origin corner."""
+    nodes = truth["grid"]["nodes"]
+    a = np.array([n["xyz_room"] for n in nodes])
+    b = np.array([n["xyz_world"] for n in nodes])
+    # world_from_truth_room (exact: the truth's nodes in both frames), by the Kabsch fit.
+    ma, mb = a.mean(0), b.mean(0)
+    u, _, vt = np.linalg.svd((b - mb).T @ (a - ma))
+    r_t = u @ np.diag([1, 1, np.linalg.det(u @ vt)]) @ vt
+    t_t = mb - r_t @ ma
+    w = json.load(open(scene_path))["world_from_room"]
+    r_s = quaternion_matrix(*w["rotation_xyzw"])
+    t_s = np.array(w["translation"])
+    # scene_room_from_truth_room: a turn about the vertical (snapped to 90°) and a shift.
+    r = r_s.T @ r_t
+    yaw = math.degrees(math.atan2(r[1, 0], r[0, 0]))
+    snapped = 90 * round(yaw / 90)
+    if abs(yaw - snapped) < 3:
+        yaw = snapped
+    c, s = math.cos(math.radians(yaw)), math.sin(math.radians(yaw))
+    turn = np.array([[c, -s], [s, c]])
+    margin = truth["grid"]["margin_m"]
+    lo, hi = a[:, :2].min(0) - margin, a[:, :2].max(0) + margin
+    corners = [np.array([x, y]) for x in (lo[0], hi[0]) for y in (lo[1], hi[1])]
+    # The truth's corner that the scene's origin corner is: the nearest to where the fused map
+    # puts the scene's origin.
+    origin = (r_t.T @ (r_s @ np.zeros(3) + t_s - t_t))[:2]
+    corner = min(corners, key=lambda k: np.linalg.norm(k - origin))
+    out = []
     for p in places:
-        args += ["--at=" + ",".join(f"{v:.5f}" for v in p["xyz_world"])]
-    out = json.loads(subprocess.run(args, capture_output=True, text=True, check=True).stdout)["points"]
+        q = turn @ (np.array(p["xyz_room"][:2]) - corner)
+        out.append([q[0], q[1], p["xyz_room"][2]])
+    return out
+
+
+def metrics(truth, nodes, places, out):
     d = [o["mrt_c"] - p["mrt_c"] for o, p in zip(out, places)]
     se = [o["std_error_k"] for o in out]
     g = d[: len(nodes)]
@@ -42,7 +92,7 @@ def main(mrtmap, run, rec):
     tm = sum(t) / len(t)
     slope = sum((a - tm) * (b - m) for a, b in zip(t, g)) / sum((a - tm) ** 2 for a in t)
     flat = [b - m - slope * (a - tm) for a, b in zip(t, g)]
-    print(json.dumps({
+    return {
         "grid_nodes": len(g),
         "grid_max_abs_k": max(abs(x) for x in g),
         "grid_rmse_k": math.sqrt(sum(x * x for x in g) / len(g)),
@@ -58,7 +108,19 @@ def main(mrtmap, run, rec):
         "points_k": {p["name"]: round(x, 3) for p, x in zip(truth["points"], d[len(nodes):])},
         "stated_se_median_k": sorted(se)[len(se) // 2],
         "covered_at_2se": sum(abs(x) <= 2 * s for x, s in zip(d, se)) / len(d),
-    }))
+    }
+
+
+def main(mrtmap, run, rec):
+    truth = json.load(open(f"{rec}/truth.json"))
+    scene = f"{run}/segment/scene.json"
+    nodes = [n for n in truth["grid"]["nodes"] if n["mrt_c"] is not None]
+    places = nodes + truth["points"]
+    result = metrics(truth, nodes, places,
+                     mrt_at(mrtmap, scene, "scan", [p["xyz_world"] for p in places]))
+    result["room"] = metrics(truth, nodes, places,
+                             mrt_at(mrtmap, scene, "room", taped(truth, scene, places)))
+    print(json.dumps(result))
 
 
 if __name__ == "__main__":
