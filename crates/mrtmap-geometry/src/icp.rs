@@ -10,7 +10,9 @@
 use std::num::NonZero;
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
-use nalgebra::{Isometry3, Matrix6, Point3, Translation3, UnitQuaternion, Vector3, Vector6};
+use nalgebra::{
+    Isometry3, Matrix3, Matrix6, Point3, Rotation3, Translation3, UnitQuaternion, Vector3, Vector6,
+};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -288,4 +290,25 @@ pub fn icp_point_to_plane(
     }
     result.target_from_source = t;
     result
+}
+
+/// The rigid transform b = T · a of three or more pairs (Kabsch).
+pub fn kabsch(a: &[Point3<f64>], b: &[Point3<f64>]) -> Option<Isometry3<f64>> {
+    let n = a.len() as f64;
+    let ca = a.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / n;
+    let cb = b.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / n;
+    let mut h = Matrix3::zeros();
+    for (p, q) in a.iter().zip(b) {
+        h += (p.coords - ca) * (q.coords - cb).transpose();
+    }
+    let svd = h.svd(true, true);
+    let (u, vt) = (svd.u?, svd.v_t?);
+    let mut d = Matrix3::identity();
+    if (vt.transpose() * u.transpose()).determinant() < 0.0 {
+        d[(2, 2)] = -1.0;
+    }
+    let r = vt.transpose() * d * u.transpose();
+    let rot = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(r));
+    let t = cb - rot * ca;
+    Some(Isometry3::from_parts(Translation3::from(t), rot))
 }

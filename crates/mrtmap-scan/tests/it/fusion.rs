@@ -63,7 +63,15 @@ fn icp_cuts_drift_at_least_in_half() {
         0.25,
         &rec,
     );
-    let on = score(&room, &rec, &fuse_dir(&rec, &params(true)));
+    let fused_on = fuse_dir(&rec, &params(true));
+    println!("drift: {:?}", fused_on.report.icp);
+    // A drifting pose source: the map keeps its own frame, not the source's average.
+    assert!(
+        fused_on.report.icp.anchored.is_none(),
+        "{:?}",
+        fused_on.report.icp
+    );
+    let on = score(&room, &rec, &fused_on);
     let off = score(&room, &rec, &fuse_dir(&rec, &params(false)));
     println!(
         "drift: ICP on median {:.1} mm p95 {:.1} mm; off median {:.1} mm p95 {:.1} mm",
