@@ -20,6 +20,9 @@ import sys
 import cv2
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from rotations import quaternion_matrix, rotation_angle  # noqa: E402,F401
+
 
 def detect(path, size, thermal):
     img = cv2.imread(path, cv2.IMREAD_COLOR)
@@ -37,19 +40,6 @@ def detect(path, size, thermal):
                          (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_MAX_ITER, 50, 1e-4))
     # Pixel centres: x in the upscaled image is (x + 0.5) / scale - 0.5 in the original.
     return (c + 0.5) / scale - 0.5, (grey.shape[1] // scale, grey.shape[0] // scale)
-
-
-def quaternion_matrix(x, y, z, w):
-    """The rotation matrix of a unit quaternion (x, y, z, w)."""
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
-
-
-def rotation_angle(R):
-    return float(np.degrees(np.arccos(np.clip((np.trace(R) - 1) / 2, -1, 1))))
 
 
 def opencv_rig(names, found, dims, obj, reject):
@@ -100,9 +90,10 @@ def summary(rig):
     }
 
 
-def main(pairs, calib_json, grid, square):
+def detect_all(pairs, grid, square):
+    """The board's points and OpenCV's corners in every pair's images: names, found (per camera,
+    by name), image sizes, object points."""
     cols, rows = (int(x) for x in grid.split("x"))
-    size = (cols, rows)
     obj = np.zeros((cols * rows, 3), np.float32)
     obj[:, :2] = np.mgrid[0:cols, 0:rows].T.reshape(-1, 2) * square
     names = sorted(os.path.basename(p) for p in glob.glob(os.path.join(pairs, "rgb", "*.png")))
@@ -110,10 +101,15 @@ def main(pairs, calib_json, grid, square):
     dims = {}
     for cam in ("rgb", "thermal"):
         for n in names:
-            c, d = detect(os.path.join(pairs, cam, n), size, cam == "thermal")
+            c, d = detect(os.path.join(pairs, cam, n), (cols, rows), cam == "thermal")
             dims[cam] = d
             if c is not None:
                 found[cam][n] = c
+    return names, found, dims, obj
+
+
+def main(pairs, calib_json, grid, square):
+    names, found, dims, obj = detect_all(pairs, grid, square)
     plain = opencv_rig(names, found, dims, obj, None)
     careful = opencv_rig(names, found, dims, obj, 2.0)
     ours = json.load(open(calib_json))

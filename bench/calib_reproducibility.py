@@ -26,7 +26,8 @@ import cv2
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from calib_real_peer import detect, opencv_rig, quaternion_matrix, rotation_angle  # noqa: E402
+from calib_real_peer import detect_all, opencv_rig  # noqa: E402
+from rotations import quaternion_matrix, rotation_angle  # noqa: E402
 
 
 def write_set(src, dst, names, change):
@@ -43,7 +44,7 @@ def write_set(src, dst, names, change):
 
 
 def jpeg(img, _thermal):
-    ok, buf = cv2.imencode(".jpg", img, [cv2.IMWRITE_JPEG_QUALITY, 60])
+    _, buf = cv2.imencode(".jpg", img, [cv2.IMWRITE_JPEG_QUALITY, 60])
     return cv2.imdecode(buf, cv2.IMREAD_COLOR)
 
 
@@ -67,17 +68,7 @@ def run_mrtmap(mrtmap, pairs, grid, square, report):
 
 
 def run_opencv(pairs, grid, square):
-    cols, rows = (int(x) for x in grid.split("x"))
-    obj = np.zeros((cols * rows, 3), np.float32)
-    obj[:, :2] = np.mgrid[0:cols, 0:rows].T.reshape(-1, 2) * square
-    names = sorted(os.path.basename(p) for p in glob.glob(os.path.join(pairs, "rgb", "*.png")))
-    found, dims = {"rgb": {}, "thermal": {}}, {}
-    for cam in ("rgb", "thermal"):
-        for n in names:
-            c, d = detect(os.path.join(pairs, cam, n), (cols, rows), cam == "thermal")
-            dims[cam] = d
-            if c is not None:
-                found[cam][n] = c
+    names, found, dims, obj = detect_all(pairs, grid, square)
     rig = opencv_rig(names, found, dims, obj, None)
     # OpenCV's R takes colour to thermal; rgb_from_thermal is its transpose.
     return {"rgb_f": rig["mono"]["rgb"][1][0, 0], "thermal_f": rig["mono"]["thermal"][1][0, 0],
@@ -120,9 +111,8 @@ def main(mrtmap, pairs, grid, square, work):
     summary = {tool: dict(zip(("centre_spread_mm", "rotation_spread_deg"), spread(out[tool])))
                for tool in out}
     for tool in out:
-        for pair in (("even", "odd"),):
-            sub = {k: out[tool][k] for k in pair}
-            summary[tool]["halves"] = dict(zip(("centre_mm", "rotation_deg"), spread(sub)))
+        halves = {k: out[tool][k] for k in ("even", "odd")}
+        summary[tool]["halves"] = dict(zip(("centre_mm", "rotation_deg"), spread(halves)))
     summary["between_tools"] = {
         name: {"centre_mm": round(float(np.linalg.norm(out["mrtmap"][name]["centre"]
                                                        - out["opencv"][name]["centre"])) * 1000, 1),

@@ -16,24 +16,20 @@ carries the truth's axes onto the scene's. The two differ by where the fused map
 pose source's frame (its displacement, not its shape)."""
 import json
 import math
+import os
 import subprocess
 import sys
 
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from rotations import quaternion_matrix  # noqa: E402
 
 
 def mrt_at(mrtmap, scene, frame, xyz):
     args = [mrtmap, "mrt", "--scene", scene, "--frame", frame, "--json"]
     args += ["--at=" + ",".join(f"{v:.5f}" for v in p) for p in xyz]
     return json.loads(subprocess.run(args, capture_output=True, text=True, check=True).stdout)["points"]
-
-
-def quaternion_matrix(x, y, z, w):
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
 
 
 def taped(truth, scene_path, places):
@@ -62,7 +58,7 @@ def taped(truth, scene_path, places):
     corners = [np.array([x, y]) for x in (lo[0], hi[0]) for y in (lo[1], hi[1])]
     # The truth's corner that the scene's origin corner is: the nearest to where the fused map
     # puts the scene's origin.
-    origin = (r_t.T @ (r_s @ np.zeros(3) + t_s - t_t))[:2]
+    origin = (r_t.T @ (t_s - t_t))[:2]
     corner = min(corners, key=lambda k: np.linalg.norm(k - origin))
     out = []
     for p in places:

@@ -312,3 +312,29 @@ pub fn kabsch(a: &[Point3<f64>], b: &[Point3<f64>]) -> Option<Isometry3<f64>> {
     let t = cb - rot * ca;
     Some(Isometry3::from_parts(Translation3::from(t), rot))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kabsch_recovers_a_rigid_transform() {
+        let t = Isometry3::from_parts(
+            Translation3::new(0.3, -0.2, 1.1),
+            UnitQuaternion::from_scaled_axis(Vector3::new(0.1, -0.4, 0.25)),
+        );
+        let a: Vec<Point3<f64>> = (0..7)
+            .map(|k| {
+                Point3::new(
+                    k as f64 * 0.3,
+                    (k * k) as f64 * 0.1 - 1.0,
+                    2.0 - k as f64 * 0.2,
+                )
+            })
+            .collect();
+        let b: Vec<Point3<f64>> = a.iter().map(|p| t * p).collect();
+        let got = kabsch(&a, &b).unwrap();
+        assert!((got.translation.vector - t.translation.vector).norm() < 1e-9);
+        assert!((got.rotation.inverse() * t.rotation).angle() < 1e-9);
+    }
+}

@@ -656,10 +656,11 @@ fn anchor_to_poses(
     if !icp.enabled || icp.accepted < 20 || icp.drift_frames * 8 > icp.accepted {
         return None;
     }
+    if pairs.len() < 3 {
+        return None;
+    }
     let (refined, given): (Vec<Point3<f64>>, Vec<Point3<f64>>) = pairs.iter().copied().unzip();
-    (refined.len() >= 3)
-        .then(|| kabsch(&refined, &given))
-        .flatten()
+    kabsch(&refined, &given)
 }
 
 /// Moves a cloud's points and turns its normals by `a`.
