@@ -12,7 +12,8 @@ Twice: at the truth's places in the scan's frame (where the pose source puts the
 "room" at the same places measured from the room's walls, as a person with a tape measure from a
 corner gives them (the scene's own room frame, `--frame room`): the truth's room coordinates
 taken from the corner that the scene's origin corner is, turned by the multiple of 90° that
-carries the truth's axes onto the scene's. The two differ by where the fused map sits against the
+carries the truth's axes onto the scene's (the corners are those of the grid's box widened by its
+margin: right for box rooms only). The two differ by where the fused map sits against the
 pose source's frame (its displacement, not its shape)."""
 import json
 import math
