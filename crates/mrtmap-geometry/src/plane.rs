@@ -46,6 +46,28 @@ impl Plane {
             return None;
         }
         let (c, scatter) = crate::cloud::centroid_and_scatter(points);
+        Self::from_scatter(c, scatter)
+    }
+
+    /// Weighted least-squares plane (PCA of the weighted scatter): a fused cloud's point stands
+    /// for as many measurements as its voxel holds, and its sparsely seen points (the depth
+    /// noise's tails) should count for less. `None` for fewer than 3 points of positive weight,
+    /// collinear points or a weight that is not finite.
+    pub fn fit_weighted(points: &[Point3<f64>], weights: &[f64]) -> Option<Self> {
+        let used = || points.iter().zip(weights).filter(|(_, w)| **w > 0.0);
+        if used().count() < 3 || weights.iter().any(|w| !w.is_finite()) {
+            return None;
+        }
+        let total: f64 = used().map(|(_, w)| w).sum();
+        let c = used().fold(Vector3::zeros(), |a, (p, w)| a + p.coords * *w) / total;
+        let scatter = used().fold(Matrix3::zeros(), |s, (p, w)| {
+            let d = p.coords - c;
+            s + d * d.transpose() * *w
+        });
+        Self::from_scatter(Point3::from(c), scatter)
+    }
+
+    fn from_scatter(c: Point3<f64>, scatter: Matrix3<f64>) -> Option<Self> {
         let eig = nalgebra::SymmetricEigen::new(scatter);
         let mut idx = [0usize, 1, 2];
         idx.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
@@ -183,4 +205,58 @@ pub fn ransac_plane<R: Rng>(
         .filter(|&i| is_inlier(&pl, i, params.distance_m))
         .collect();
     Some((pl, inliers))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A floor at z = 0 seen as a fused cloud: three layers about the surface (weight 30) and a
+    /// sparse tail 2–6 cm below it (weight 1), on a 2 × 2 m patch.
+    fn floor_with_tail() -> (Vec<Point3<f64>>, Vec<f64>) {
+        let (mut pts, mut w) = (Vec::new(), Vec::new());
+        for i in 0..40 {
+            for j in 0..40 {
+                for layer in -6..=1 {
+                    pts.push(Point3::new(
+                        0.05 * i as f64,
+                        0.05 * j as f64,
+                        0.01 * layer as f64,
+                    ));
+                    w.push(if layer >= -1 { 30.0 } else { 1.0 });
+                }
+            }
+        }
+        (pts, w)
+    }
+
+    #[test]
+    fn a_weighted_fit_follows_the_measurements_not_the_points() {
+        let (pts, w) = floor_with_tail();
+        let counted = Plane::fit(&pts).expect("a plane");
+        let weighted = Plane::fit_weighted(&pts, &w).expect("a plane");
+        let up = |p: &Plane| if p.normal.z < 0.0 { p.flipped() } else { *p };
+        let (counted, weighted) = (up(&counted), up(&weighted));
+        // Per column the layers sum to −0.2 m: 8 points, or 3 × 30 + 5 × 1 of weight.
+        assert!((counted.d + 0.2 / 8.0).abs() < 1e-9, "plain: {}", counted.d);
+        assert!(
+            (weighted.d + 0.2 / 95.0).abs() < 1e-9,
+            "weighted: {}",
+            weighted.d
+        );
+        assert!(weighted.normal.z > 1.0 - 1e-12);
+        // Equal weights are the plain fit.
+        let same = up(&Plane::fit_weighted(&pts, &vec![2.5; pts.len()]).expect("a plane"));
+        assert!((same.d - counted.d).abs() < 1e-12);
+        assert!((same.normal.into_inner() - counted.normal.into_inner()).norm() < 1e-9);
+    }
+
+    #[test]
+    fn a_weighted_fit_needs_three_weighted_points_and_finite_weights() {
+        let (pts, mut w) = floor_with_tail();
+        assert!(Plane::fit_weighted(&pts[..3], &[1.0, 1.0, 0.0]).is_none());
+        assert!(Plane::fit_weighted(&pts[..2], &[1.0, 1.0]).is_none());
+        w[7] = f64::NAN;
+        assert!(Plane::fit_weighted(&pts, &w).is_none());
+    }
 }

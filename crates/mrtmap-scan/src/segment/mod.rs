@@ -766,7 +766,13 @@ pub fn segment(
     let pts = Points::of(cloud);
     let up0 = up_from_poses(camera_poses).ok_or(SegmentError::NoPoses)?;
     let planes = envelope::find_planes(&pts.pos, &pts.nrm, p);
-    let env = envelope::envelope(&pts.pos, &pts.nrm, planes, up0, p)?;
+    let weights: Vec<f64> = pts.obs.iter().map(|&o| o.max(1) as f64).collect();
+    let cloud_in = envelope::Cloud {
+        points: &pts.pos,
+        normals: &pts.nrm,
+        weights: &weights,
+    };
+    let env = envelope::envelope(cloud_in, planes, up0, p)?;
     let up = env.up;
     let height_m = env.planes[env.floor]
         .plane

@@ -139,14 +139,19 @@ fn angle_diff_deg(a: f64, b: f64) -> f64 {
 /// A line through `pts` robust to a minority off it: total least squares, then again on the points
 /// within 2.5 robust standard deviations of the first fit (at least 1 cm).
 fn fit_line(pts: &[Point2<f64>], n0: &Vector2<f64>) -> Option<(Vector2<f64>, f64)> {
-    let (n, rho) = fit_line_tls(pts, n0)?;
-    Some(trimmed_fit(pts, (n, rho), (0.01, f64::INFINITY)).map_or((n, rho), |(n, rho, _)| (n, rho)))
+    let (n, rho) = fit_line_tls(pts, None, n0)?;
+    Some(
+        trimmed_fit(pts, None, (n, rho), (0.01, f64::INFINITY))
+            .map_or((n, rho), |(n, rho, _)| (n, rho)),
+    )
 }
 
 /// The line `(n, rho)` refitted to the points of `pts` within 2.5 robust standard deviations of
-/// their median distance from it (the cut clamped to `clamp`), and the cut.
+/// their median distance from it (the cut clamped to `clamp`), each weighted by `weights` when
+/// given, and the cut.
 fn trimmed_fit(
     pts: &[Point2<f64>],
+    weights: Option<&[f64]>,
     (n, rho): (Vector2<f64>, f64),
     clamp: (f64, f64),
 ) -> Option<(Vector2<f64>, f64, f64)> {
@@ -160,27 +165,41 @@ fn trimmed_fit(
     let mut dev: Vec<f64> = r.iter().map(|x| (x - med).abs()).collect();
     dev.sort_by(f64::total_cmp);
     let cut = (2.5 * 1.4826 * dev[dev.len() / 2]).clamp(clamp.0, clamp.1);
-    let near: Vec<Point2<f64>> = pts
-        .iter()
-        .filter(|q| (dist(q) - med).abs() <= cut)
-        .copied()
+    let keep: Vec<usize> = (0..pts.len())
+        .filter(|&i| (dist(&pts[i]) - med).abs() <= cut)
         .collect();
-    let (n, rho) = fit_line_tls(&near, &n)?;
+    let near: Vec<Point2<f64>> = keep.iter().map(|&i| pts[i]).collect();
+    let w: Option<Vec<f64>> = weights.map(|w| keep.iter().map(|&i| w[i]).collect());
+    let (n, rho) = fit_line_tls(&near, w.as_deref(), &n)?;
     Some((n, rho, cut))
 }
 
-/// Total least squares line through `pts`, its normal oriented like `n0`.
-fn fit_line_tls(pts: &[Point2<f64>], n0: &Vector2<f64>) -> Option<(Vector2<f64>, f64)> {
+/// Total least squares line through `pts` (each weighted by `weights` when given), its normal
+/// oriented like `n0`.
+fn fit_line_tls(
+    pts: &[Point2<f64>],
+    weights: Option<&[f64]>,
+    n0: &Vector2<f64>,
+) -> Option<(Vector2<f64>, f64)> {
     if pts.len() < 2 {
         return None;
     }
-    let c = pts.iter().fold(Vector2::zeros(), |a, q| a + q.coords) / pts.len() as f64;
+    let w = |i: usize| weights.map_or(1.0, |w| w[i]);
+    let total: f64 = (0..pts.len()).map(w).sum();
+    if !(total > 0.0 && total.is_finite()) {
+        return None;
+    }
+    let c = pts
+        .iter()
+        .enumerate()
+        .fold(Vector2::zeros(), |a, (i, q)| a + q.coords * w(i))
+        / total;
     let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
-    for q in pts {
+    for (i, q) in pts.iter().enumerate() {
         let d = q.coords - c;
-        sxx += d.x * d.x;
-        sxy += d.x * d.y;
-        syy += d.y * d.y;
+        sxx += w(i) * d.x * d.x;
+        sxy += w(i) * d.x * d.y;
+        syy += w(i) * d.y * d.y;
     }
     // The direction of least spread: the eigenvector of the smaller eigenvalue.
     let theta = 0.5 * (2.0 * sxy).atan2(sxx - syy); // direction of largest spread
@@ -359,7 +378,7 @@ pub fn wall_lines(
                     break;
                 }
                 let q: Vec<Point2<f64>> = near.iter().map(|&i| pts[i]).collect();
-                let Some((n, rho, cut)) = trimmed_fit(&q, (line.n, line.rho), (0.02, WIDE_M))
+                let Some((n, rho, cut)) = trimmed_fit(&q, None, (line.n, line.rho), (0.02, WIDE_M))
                 else {
                     break;
                 };
@@ -890,6 +909,7 @@ pub fn refine_walls(
     o: &mut Outline,
     pts: &[Point2<f64>],
     normals: &[Vector2<f64>],
+    weights: &[f64],
     p: &OutlineParams,
 ) {
     let n = o.walls.len();
@@ -916,16 +936,18 @@ pub fn refine_walls(
         let old = (o.lines[l].n, o.lines[l].rho);
         let mut fit = old;
         for _ in 0..3 {
-            let q: Vec<Point2<f64>> = pts
-                .iter()
-                .zip(normals)
-                .filter(|(q, nq)| (fit.0.dot(&q.coords) - fit.1).abs() <= WIDE_M && on_span(q, nq))
-                .map(|(q, _)| *q)
+            let idx: Vec<usize> = (0..pts.len())
+                .filter(|&i| {
+                    (fit.0.dot(&pts[i].coords) - fit.1).abs() <= WIDE_M
+                        && on_span(&pts[i], &normals[i])
+                })
                 .collect();
-            if q.len() < p.min_points {
+            if idx.len() < p.min_points {
                 break;
             }
-            let Some((nn, rho, _)) = trimmed_fit(&q, fit, (0.02, WIDE_M)) else {
+            let q: Vec<Point2<f64>> = idx.iter().map(|&i| pts[i]).collect();
+            let w: Vec<f64> = idx.iter().map(|&i| weights[i]).collect();
+            let Some((nn, rho, _)) = trimmed_fit(&q, Some(&w), fit, (0.02, WIDE_M)) else {
                 break;
             };
             fit = (nn, rho);
@@ -1411,7 +1433,7 @@ mod tests {
                 before.iter().all(|y| (y - inner).abs() < 0.003),
                 "the line from agreeing normals lies in the inner half: {before:?}"
             );
-            refine_walls(&mut o, &pts, &nrm, &p);
+            refine_walls(&mut o, &pts, &nrm, &vec![1.0; pts.len()], &p);
             assert!(
                 south(&o).iter().all(|y| (y - expect).abs() < 0.003),
                 "refitted ({half} cm): {:?}",
@@ -1424,6 +1446,48 @@ mod tests {
                 assert!(o.normals[k].dot(&d).abs() < 1e-9 && o.normals[k].perp(&d) < 0.0);
             }
         }
+    }
+
+    #[test]
+    fn a_wall_is_placed_by_its_measurements_not_by_its_sparsely_seen_points() {
+        // The south wall at y = 0 fused as a fused cloud holds a noisy far wall: three layers seen
+        // 40 times each about the surface, and the depth noise's long far tail, five layers
+        // behind it (2–6 cm outside the room) seen once each. Counted as points the tail pulls
+        // the wall out; weighted by what each point stands for it stays within 2 mm.
+        let south = |o: &Outline| {
+            o.corners
+                .iter()
+                .filter(|c| c.y.abs() < 0.1)
+                .map(|c| c.y)
+                .collect::<Vec<_>>()
+        };
+        let (mut pts, mut nrm, ev) = room(&L, Some(0));
+        let mut w = vec![1.0; pts.len()];
+        for s in 0..200 {
+            for layer in -6..=1 {
+                pts.push(Point2::new(0.03 * s as f64, 0.01 * layer as f64));
+                nrm.push(Vector2::y());
+                w.push(if layer >= -1 { 40.0 } else { 1.0 });
+            }
+        }
+        let p = OutlineParams::default();
+        let placed = |w: &[f64]| {
+            let mut o = outline(wall_lines(&pts, &nrm, &p), &ev, &p).expect("an outline");
+            refine_walls(&mut o, &pts, &nrm, w, &p);
+            let y = south(&o);
+            assert_eq!(y.len(), 2, "corners {:?}", o.corners);
+            y
+        };
+        let counted = placed(&vec![1.0; pts.len()]);
+        assert!(
+            counted.iter().all(|y| *y < -0.01),
+            "counted as points, the tail pulls the wall out: {counted:?}"
+        );
+        let weighted = placed(&w);
+        assert!(
+            weighted.iter().all(|y| y.abs() < 0.002),
+            "weighted by observations: {weighted:?}"
+        );
     }
 
     #[test]
