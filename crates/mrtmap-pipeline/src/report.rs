@@ -266,6 +266,25 @@ fn asymmetry_words(k: mrtmap_physics::AsymmetryKind) -> &'static str {
     }
 }
 
+/// Without two readings at different temperatures the camera's gain is not known, and it
+/// stretches every difference between places: how much, for the first map's range of MRT.
+fn gain_row(l: &crate::level::Level, o: &RunOutcome) -> Option<(String, String)> {
+    if l.basis.contains("gain") {
+        return None;
+    }
+    let m = o.maps.first()?;
+    let f = m.summary.map.field.as_ref()?;
+    let span = f.max.mrt_c - f.min.mrt_c;
+    Some((
+        "differences between places".into(),
+        format!(
+            "rest on the camera's gain too, which only two readings at different temperatures reveal: each 1 % of gain error stretches the map's {span:.2} K of MRT range (at {:.2} m) by {:.3} K (a Lepton-class camera's gain may be a few percent off)",
+            m.summary.map.height_m,
+            span / 100.0
+        ),
+    ))
+}
+
 /// "What the temperatures rest on": the level and the self-calibration; the references table.
 #[allow(clippy::type_complexity)]
 fn level_rows(o: &RunOutcome) -> (KeyValues, Vec<[String; 5]>) {
@@ -287,6 +306,9 @@ fn level_rows(o: &RunOutcome) -> (KeyValues, Vec<[String; 5]>) {
             )
         };
         rows.push(("absolute level".into(), text));
+        if let Some(row) = gain_row(l, o) {
+            rows.push(row);
+        }
         refs = l
             .references
             .iter()

@@ -72,6 +72,8 @@ pub struct Background {
 /// A surface's texels: which lie inside its outline, their radiant averages and their points.
 struct Grid {
     lo: Point2<f64>,
+    /// The host's far corner (the last row and column of texels end here, partly filled).
+    hi: Point2<f64>,
     t: f64,
     nx: usize,
     ny: usize,
@@ -83,13 +85,13 @@ struct Grid {
 }
 
 impl Grid {
-    /// Rasterises the points `idx` of a surface (`host` its outline in `frame`) at texel `t`.
+    /// Rasterises the points `idx` of a surface (`host` its outline in `frame`) at texel `t`, each
+    /// point's temperature weighted by `weights` (its observations) in its texel's average.
     fn rasterise(
         frame: &PlaneFrame,
         host: &[Point2<f64>],
         idx: &[usize],
-        pos: &[Point3<f64>],
-        temp_k: &[f64],
+        (pos, temp_k, weights): (&[Point3<f64>], &[f64], &[f64]),
         t: f64,
     ) -> Self {
         let (mut lo, mut hi) = (
@@ -104,6 +106,7 @@ impl Grid {
         let ny = ((hi.y - lo.y) / t).ceil().max(1.0) as usize;
         let mut g = Grid {
             lo,
+            hi,
             t,
             nx,
             ny,
@@ -122,7 +125,7 @@ impl Grid {
             let (i, j) = (((q.x - lo.x) / t).floor(), ((q.y - lo.y) / t).floor());
             if i >= 0.0 && j >= 0.0 && (i as usize) < nx && (j as usize) < ny {
                 let c = j as usize * nx + i as usize;
-                g.temp[c].add(Temperature::from_kelvin(temp_k[k]), 1.0);
+                g.temp[c].add(Temperature::from_kelvin(temp_k[k]), weights[k]);
                 g.points[c].push(k);
                 g.samples[c].push((q, temp_k[k]));
             }
@@ -164,13 +167,20 @@ impl Grid {
         ]
     }
 
-    /// Which texels lie within `m` of the grid's edge or of a texel outside the surface.
+    /// Which texels reach within `m` of the host's outer edge (measured: the last row and column
+    /// end at the host's edge, partly filled, so the texel before a narrow last one is near it
+    /// too), or lie within `m` (in whole texels) of a texel outside the surface.
     fn near_edge(&self, m: f64) -> Vec<bool> {
         let r = (m / self.t).ceil() as usize;
+        let t = self.t;
+        let near = |k: usize, lo: f64, hi: f64| {
+            let (a, b) = (lo + k as f64 * t, (lo + (k + 1) as f64 * t).min(hi));
+            a - lo < m || hi - b < m
+        };
         let mut out = vec![false; self.nx * self.ny];
         for c in 0..self.nx * self.ny {
             let (i, j) = (c % self.nx, c / self.nx);
-            if i < r || j < r || i + r >= self.nx || j + r >= self.ny {
+            if near(i, self.lo.x, self.hi.x) || near(j, self.lo.y, self.hi.y) {
                 out[c] = true;
             }
             if self.inside[c] {
@@ -693,17 +703,17 @@ fn host_temperature(
 }
 
 /// Analyses one surface: `frame` and `host` (its polygon in the frame), the cloud's points on it
-/// (`idx` into `pos`/`temp_k`), whether the background may vary linearly along v (walls).
+/// (`idx` into the cloud's positions, temperatures and weights), whether the background may vary
+/// linearly along v (walls).
 pub fn analyse_surface(
     frame: &PlaneFrame,
     host: &[Point2<f64>],
     idx: &[usize],
-    pos: &[Point3<f64>],
-    temp_k: &[f64],
+    cloud: (&[Point3<f64>], &[f64], &[f64]),
     linear: bool,
     p: &SegmentParams,
 ) -> SurfaceAnalysis {
-    let g = Grid::rasterise(frame, host, idx, pos, temp_k, p.texel_m);
+    let g = Grid::rasterise(frame, host, idx, cloud, p.texel_m);
     let (nx, ny) = (g.nx, g.ny);
     let cells: Vec<usize> = (0..nx * ny)
         .filter(|&c| g.inside[c] && g.observed(c))
@@ -965,6 +975,90 @@ mod tests {
     /// rectangle seen in full (x 1…7.5), and wherever else the window was seen the scene radiates
     /// cold from the raster (it radiated the wall's 19.8 °C when the raster left out the whole
     /// cold region).
+    /// A 4 × 2.5 m wall at 17.6 °C in the plane y = 0, each point seen 40 times, and `extra`
+    /// points (x, z, °C, observations) on it.
+    fn wall_with(extra: &[(f64, f64, f64, f64)]) -> SurfaceAnalysis {
+        use mrtmap_geometry::nalgebra::{Unit, Vector3};
+        let (mut pos, mut temp, mut w) = (Vec::new(), Vec::new(), Vec::new());
+        for i in 0..134 {
+            for j in 0..84 {
+                pos.push(Point3::new(
+                    (i as f64 + 0.5) * 0.03,
+                    0.0,
+                    (j as f64 + 0.5) * 0.03,
+                ));
+                temp.push(ZERO_CELSIUS_K + 17.6);
+                w.push(40.0);
+            }
+        }
+        for &(x, z, c, o) in extra {
+            pos.push(Point3::new(x, 0.0, z));
+            temp.push(ZERO_CELSIUS_K + c);
+            w.push(o);
+        }
+        let frame = PlaneFrame::new(
+            Point3::origin(),
+            Unit::new_normalize(Vector3::y()),
+            &Vector3::x(),
+        );
+        let host: Vec<Point2<f64>> = [[0.0, 0.0], [4.0, 0.0], [4.0, 2.5], [0.0, 2.5]]
+            .iter()
+            .map(|q| frame.to_2d(&Point3::new(q[0], 0.0, q[1])))
+            .collect();
+        let idx: Vec<usize> = (0..pos.len()).collect();
+        analyse_surface(
+            &frame,
+            &host,
+            &idx,
+            (&pos, &temp, &w),
+            true,
+            &SegmentParams::default(),
+        )
+    }
+
+    /// As many points seen once each at 21 °C as the wall's own over a 0.6 m patch (a far
+    /// surface's noise, a corner's blur): counted as points they make a +1.7 K feature; weighted
+    /// by their observations the patch reads +0.08 K and is no feature.
+    #[test]
+    fn a_texel_averages_its_measurements_not_its_points() {
+        let patch: Vec<(f64, f64, f64, f64)> = (0..20)
+            .flat_map(|i| (0..20).map(move |j| (i, j)))
+            .map(|(i, j)| (1.5 + (i as f64 + 0.5) * 0.03, 1.0 + (j as f64 + 0.5) * 0.03))
+            .map(|(x, z)| (x, z, 21.0, 1.0))
+            .collect();
+        assert!(wall_with(&patch).features.is_empty(), "weighted");
+        let counted: Vec<_> = patch.iter().map(|&(x, z, c, _)| (x, z, c, 40.0)).collect();
+        let a = wall_with(&counted);
+        assert_eq!(a.features.len(), 1, "counted: {:?}", a.dropped);
+        assert!(
+            (a.features[0].contrast_k - 1.7).abs() < 0.1,
+            "{}",
+            a.features[0].contrast_k
+        );
+    }
+
+    /// The host's last texel column is 3 mm wide (the wall 4.053 m long, 15 cm texels): the
+    /// column before it, reaching within 3 mm of the edge, is near the edge too.
+    #[test]
+    fn a_texel_before_a_narrow_last_one_is_near_the_edge() {
+        use mrtmap_geometry::nalgebra::{Unit, Vector3};
+        let frame = PlaneFrame::new(
+            Point3::origin(),
+            Unit::new_normalize(Vector3::y()),
+            &Vector3::x(),
+        );
+        let host: Vec<Point2<f64>> = [[0.0, 0.0], [4.053, 0.0], [4.053, 2.5], [0.0, 2.5]]
+            .iter()
+            .map(|q| frame.to_2d(&Point3::new(q[0], 0.0, q[1])))
+            .collect();
+        let g = Grid::rasterise(&frame, &host, &[], (&[], &[], &[]), 0.15);
+        assert_eq!(g.nx, 28);
+        let near = g.near_edge(EDGE_STRIP_M);
+        let row = g.ny / 2;
+        let near_in_row: Vec<usize> = (0..g.nx).filter(|&i| near[row * g.nx + i]).collect();
+        assert_eq!(near_in_row, vec![0, 26, 27]);
+    }
+
     #[test]
     fn a_window_seen_in_part_radiates_cold_wherever_it_was_seen() {
         use mrtmap_geometry::nalgebra::{Unit, Vector3};
@@ -995,12 +1089,12 @@ mod tests {
             .map(|q| frame.to_2d(&Point3::new(q[0], 0.0, q[1])))
             .collect();
         let idx: Vec<usize> = (0..pos.len()).collect();
+        let ones = vec![1.0; pos.len()];
         let a = analyse_surface(
             &frame,
             &host,
             &idx,
-            &pos,
-            &temp,
+            (&pos, &temp, &ones),
             true,
             &SegmentParams::default(),
         );

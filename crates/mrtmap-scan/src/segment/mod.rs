@@ -795,8 +795,7 @@ pub fn segment(
                 &g.frame,
                 &polys2[s],
                 &members[s],
-                &pts.pos,
-                &pts.temp,
+                (&pts.pos, &pts.temp, &weights),
                 g.kind == SurfaceKind::Wall,
                 p,
             )

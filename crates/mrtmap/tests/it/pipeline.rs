@@ -555,4 +555,12 @@ fn camera_errors_are_self_calibrated_and_anchored_by_references() {
     }
     let html = std::fs::read_to_string(run.join("report.html")).unwrap();
     assert!(html.contains("<h2>What the temperatures rest on</h2>"));
+    // The gain: fixed by the two readings; without them the report says what it could stretch.
+    assert!(!html.contains("differences between places"));
+    let html = std::fs::read_to_string(run2.join("report.html")).unwrap();
+    assert!(
+        html.contains("differences between places")
+            && html.contains("each 1 % of gain error stretches the map"),
+        "the report says the gain is unknown"
+    );
 }
