@@ -975,10 +975,24 @@ mod tests {
     /// rectangle seen in full (x 1…7.5), and wherever else the window was seen the scene radiates
     /// cold from the raster (it radiated the wall's 19.8 °C when the raster left out the whole
     /// cold region).
+    /// A `w` × `h` m wall in the plane y = 0 from the origin: its frame and outline.
+    fn wall_in_y0(w: f64, h: f64) -> (PlaneFrame, Vec<Point2<f64>>) {
+        use mrtmap_geometry::nalgebra::{Unit, Vector3};
+        let frame = PlaneFrame::new(
+            Point3::origin(),
+            Unit::new_normalize(Vector3::y()),
+            &Vector3::x(),
+        );
+        let host = [[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]]
+            .iter()
+            .map(|q| frame.to_2d(&Point3::new(q[0], 0.0, q[1])))
+            .collect();
+        (frame, host)
+    }
+
     /// A 4 × 2.5 m wall at 17.6 °C in the plane y = 0, each point seen 40 times, and `extra`
     /// points (x, z, °C, observations) on it.
     fn wall_with(extra: &[(f64, f64, f64, f64)]) -> SurfaceAnalysis {
-        use mrtmap_geometry::nalgebra::{Unit, Vector3};
         let (mut pos, mut temp, mut w) = (Vec::new(), Vec::new(), Vec::new());
         for i in 0..134 {
             for j in 0..84 {
@@ -996,15 +1010,7 @@ mod tests {
             temp.push(ZERO_CELSIUS_K + c);
             w.push(o);
         }
-        let frame = PlaneFrame::new(
-            Point3::origin(),
-            Unit::new_normalize(Vector3::y()),
-            &Vector3::x(),
-        );
-        let host: Vec<Point2<f64>> = [[0.0, 0.0], [4.0, 0.0], [4.0, 2.5], [0.0, 2.5]]
-            .iter()
-            .map(|q| frame.to_2d(&Point3::new(q[0], 0.0, q[1])))
-            .collect();
+        let (frame, host) = wall_in_y0(4.0, 2.5);
         let idx: Vec<usize> = (0..pos.len()).collect();
         analyse_surface(
             &frame,
@@ -1041,16 +1047,7 @@ mod tests {
     /// column before it, reaching within 3 mm of the edge, is near the edge too.
     #[test]
     fn a_texel_before_a_narrow_last_one_is_near_the_edge() {
-        use mrtmap_geometry::nalgebra::{Unit, Vector3};
-        let frame = PlaneFrame::new(
-            Point3::origin(),
-            Unit::new_normalize(Vector3::y()),
-            &Vector3::x(),
-        );
-        let host: Vec<Point2<f64>> = [[0.0, 0.0], [4.053, 0.0], [4.053, 2.5], [0.0, 2.5]]
-            .iter()
-            .map(|q| frame.to_2d(&Point3::new(q[0], 0.0, q[1])))
-            .collect();
+        let (frame, host) = wall_in_y0(4.053, 2.5);
         let g = Grid::rasterise(&frame, &host, &[], (&[], &[], &[]), 0.15);
         assert_eq!(g.nx, 28);
         let near = g.near_edge(EDGE_STRIP_M);
@@ -1061,7 +1058,7 @@ mod tests {
 
     #[test]
     fn a_window_seen_in_part_radiates_cold_wherever_it_was_seen() {
-        use mrtmap_geometry::nalgebra::{Unit, Vector3};
+        use mrtmap_geometry::nalgebra::Vector3;
         let unseen = |x: f64, z: f64| {
             (x > 7.5 && z > 1.8)
                 || (x > 8.0 && z > 1.4)
@@ -1079,15 +1076,7 @@ mod tests {
                 temp.push(ZERO_CELSIUS_K + if window(x, z) { 9.0 } else { 19.8 });
             }
         }
-        let frame = PlaneFrame::new(
-            Point3::origin(),
-            Unit::new_normalize(Vector3::y()),
-            &Vector3::x(),
-        );
-        let host: Vec<Point2<f64>> = [[0.0, 0.0], [10.0, 0.0], [10.0, 4.0], [0.0, 4.0]]
-            .iter()
-            .map(|q| frame.to_2d(&Point3::new(q[0], 0.0, q[1])))
-            .collect();
+        let (frame, host) = wall_in_y0(10.0, 4.0);
         let idx: Vec<usize> = (0..pos.len()).collect();
         let ones = vec![1.0; pos.len()];
         let a = analyse_surface(

@@ -1401,6 +1401,15 @@ mod tests {
         corners_match(&o, &bay, 0.02);
     }
 
+    /// The y of the outline's corners on the south wall (y near 0).
+    fn south_corners(o: &Outline) -> Vec<f64> {
+        o.corners
+            .iter()
+            .filter(|c| c.y.abs() < 0.1)
+            .map(|c| c.y)
+            .collect()
+    }
+
     #[test]
     fn a_thick_wall_is_placed_at_the_middle_of_all_its_points() {
         // The south wall fused thick: the points on its inner side have normals facing the room,
@@ -1408,13 +1417,6 @@ mod tests {
         // from normals within 20°, so the line lies on the inner side; the refit takes the
         // wall's middle, unless that moves the wall more than [`REFIT_MAX_MOVE_M`].
         let tilted = Vector2::new(40f64.to_radians().sin(), 40f64.to_radians().cos());
-        let south = |o: &Outline| {
-            o.corners
-                .iter()
-                .filter(|c| c.y.abs() < 0.1)
-                .map(|c| c.y)
-                .collect::<Vec<_>>()
-        };
         // (half the thickness in cm, where the refit leaves the wall's corners (m)).
         for (half, expect) in [(4, 0.0), (6, 0.03)] {
             let (mut pts, mut nrm, ev) = room(&L, Some(0));
@@ -1426,7 +1428,7 @@ mod tests {
             }
             let p = OutlineParams::default();
             let mut o = outline(wall_lines(&pts, &nrm, &p), &ev, &p).expect("an outline");
-            let before = south(&o);
+            let before = south_corners(&o);
             assert_eq!(before.len(), 2, "corners {:?}", o.corners);
             let inner = 0.005 * half as f64;
             assert!(
@@ -1435,9 +1437,9 @@ mod tests {
             );
             refine_walls(&mut o, &pts, &nrm, &vec![1.0; pts.len()], &p);
             assert!(
-                south(&o).iter().all(|y| (y - expect).abs() < 0.003),
+                south_corners(&o).iter().all(|y| (y - expect).abs() < 0.003),
                 "refitted ({half} cm): {:?}",
-                south(&o)
+                south_corners(&o)
             );
             corners_match(&o, &L, 0.031);
             assert!(mrtmap_geometry::polygon::signed_area(&o.corners) > 0.0);
@@ -1454,13 +1456,6 @@ mod tests {
         // 40 times each about the surface, and the depth noise's long far tail, five layers
         // behind it (2–6 cm outside the room) seen once each. Counted as points the tail pulls
         // the wall out; weighted by what each point stands for it stays within 2 mm.
-        let south = |o: &Outline| {
-            o.corners
-                .iter()
-                .filter(|c| c.y.abs() < 0.1)
-                .map(|c| c.y)
-                .collect::<Vec<_>>()
-        };
         let (mut pts, mut nrm, ev) = room(&L, Some(0));
         let mut w = vec![1.0; pts.len()];
         for s in 0..200 {
@@ -1474,7 +1469,7 @@ mod tests {
         let placed = |w: &[f64]| {
             let mut o = outline(wall_lines(&pts, &nrm, &p), &ev, &p).expect("an outline");
             refine_walls(&mut o, &pts, &nrm, w, &p);
-            let y = south(&o);
+            let y = south_corners(&o);
             assert_eq!(y.len(), 2, "corners {:?}", o.corners);
             y
         };
