@@ -25,6 +25,7 @@ pub fn updated_rig(r: &StereoResult, existing: Option<&Rig>) -> Rig {
         thermal: r.thermal,
         thermal_encoding: existing.map_or(ThermalEncoding::Centikelvin, |e| e.thermal_encoding),
         thermal_accuracy_k: existing.and_then(|e| e.thermal_accuracy_k),
+        thermal_time_offset_s: existing.and_then(|e| e.thermal_time_offset_s),
         depth_from_thermal: depth_from_rgb * r.rgb_from_thermal,
         rgb: Some(RgbCamera {
             camera: r.rgb,

@@ -312,6 +312,7 @@ pub fn convert(source: &Path, out: &Path, o: &SourceOptions) -> Result<Conversio
         thermal: given.thermal,
         thermal_encoding: given.thermal_encoding,
         thermal_accuracy_k: given.thermal_accuracy_k,
+        thermal_time_offset_s: given.thermal_time_offset_s,
         depth_from_thermal: given.depth_from_thermal,
         rgb: Some(RgbCamera {
             camera: cal.camera,

@@ -8,6 +8,7 @@ use mrtmap_geometry::sampling::DirectionSet;
 use mrtmap_physics::Posture;
 use mrtmap_radiation::{Facing, Method, MonteCarlo, MrtEngine, RadiantScene};
 use mrtmap_scan::FuseParams;
+use mrtmap_scan::clock::ClockOffset;
 use mrtmap_scan::segment::SegmentParams;
 use serde::{Deserialize, Serialize};
 
@@ -48,7 +49,9 @@ clo = 0.7                 # clothing insulation
 [fuse]
 voxel_m = 0.03
 icp = true                # refine poses by ICP against the map (as the seed paper)
-sync_tolerance_ms = 20.0  # thermal frame ↔ nearest depth frame
+sync_tolerance_ms = 20.0  # thermal frame ↔ nearest depth frame (at least 0.55 of the depth frames' interval)
+time_offset = "auto"      # added to the thermal stamps: auto (rig.toml's [thermal] time_offset_s, else
+                          # estimated from the scan) | estimate | off | milliseconds, e.g. "-70"
 depth_stride = 0          # every N-th depth pixel; 0: about one per thermal pixel
 self_calibrate = true     # remove each frame's offset (FFC, drift) and the vignetting, from overlaps
 
@@ -371,6 +374,36 @@ pub struct FuseSection {
     /// Estimate and remove each frame's offset (flat-field corrections, drift) and the lens's
     /// vignetting from the frames' overlaps.
     pub self_calibrate: bool,
+    /// What to add to the thermal stamps: "auto" (rig.toml's `[thermal] time_offset_s`, else
+    /// estimated from the scan), "estimate", "off", or milliseconds ("-70").
+    pub time_offset: String,
+}
+
+/// The thermal clock's setting from its text: auto, estimate, off, or milliseconds.
+pub fn parse_time_offset(text: &str) -> Result<ClockOffset> {
+    let refuse = || {
+        Error::setting(
+            format!("time offset '{text}' (--time-offset, [fuse] time_offset)"),
+            "is not auto, estimate, off or a number of milliseconds between -1000 and 1000",
+        )
+    };
+    match text.trim() {
+        "auto" => Ok(ClockOffset::Auto),
+        "estimate" => Ok(ClockOffset::Estimate),
+        "off" => Ok(ClockOffset::Off),
+        other => {
+            let ms: f64 = other
+                .trim_end_matches("ms")
+                .trim()
+                .parse()
+                .map_err(|_| refuse())?;
+            if ms.is_finite() && ms.abs() <= 1000.0 {
+                Ok(ClockOffset::Fixed(ms / 1000.0))
+            } else {
+                Err(refuse())
+            }
+        }
+    }
 }
 
 impl Default for FuseSection {
@@ -381,6 +414,7 @@ impl Default for FuseSection {
             sync_tolerance_ms: 20.0,
             depth_stride: 0,
             self_calibrate: true,
+            time_offset: "auto".into(),
         }
     }
 }
@@ -411,6 +445,7 @@ impl FuseSection {
         p.icp.enabled = self.icp;
         p.depth.stride = self.depth_stride;
         p.radiometric.enabled = self.self_calibrate;
+        p.clock = parse_time_offset(&self.time_offset)?;
         Ok(p)
     }
 }

@@ -20,6 +20,7 @@ use mrtmap_io::{InterpolationLimits, Recording, ThermalCloud};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use crate::clock::{ClockOffset, ClockReport, ClockSearch, OffsetSource, estimate_offset};
 use crate::frame::{DepthPoints, DepthSampling, RayTable, ThermalImage, depth_points};
 use crate::observe::{ObservationCounts, ObservationParams, observe};
 use crate::radiometric::{
@@ -149,6 +150,16 @@ pub struct FuseParams {
     /// Radiometric self-calibration (per-frame offsets, vignetting).
     #[serde(default)]
     pub radiometric: SelfCalibration,
+    /// The thermal stamps' offset from the depth clock: given, from rig.toml, or estimated.
+    #[serde(default = "default_clock")]
+    pub clock: ClockOffset,
+    /// How the offset is searched for when estimated.
+    #[serde(default)]
+    pub clock_search: ClockSearch,
+}
+
+fn default_clock() -> ClockOffset {
+    ClockOffset::Auto
 }
 
 impl Default for FuseParams {
@@ -161,6 +172,8 @@ impl Default for FuseParams {
             icp: IcpSettings::default(),
             chunk: 8,
             radiometric: SelfCalibration::default(),
+            clock: ClockOffset::Auto,
+            clock_search: ClockSearch::default(),
         }
     }
 }
@@ -230,6 +243,15 @@ pub struct FusionReport {
     /// Every this many depth pixels were used, in each direction.
     #[serde(default)]
     pub depth_stride: u32,
+    /// The largest time between a thermal frame and the depth frame it took (s): the setting, or
+    /// just over half the depth frames' median interval where that is longer, so that every
+    /// thermal frame finds a depth frame whatever the depth rate (each is placed by the pose at its
+    /// own time).
+    #[serde(default)]
+    pub sync_tolerance_used_s: f64,
+    /// The thermal clock's offset applied to the thermal stamps, and how it was found.
+    #[serde(default)]
+    pub clock: ClockReport,
     /// Frames skipped, by reason.
     pub skipped: BTreeMap<String, usize>,
     /// The first few problems, with file names.
@@ -689,6 +711,40 @@ struct Observed {
     cpu_s: f64,
 }
 
+/// The sync tolerance used: the setting, or 0.55 of the depth frames' median interval where that
+/// is longer (15 Hz depth: 37 ms), so that every thermal frame has a depth frame.
+fn sync_tolerance(rec: &Recording, setting_s: f64) -> f64 {
+    let mut gaps: Vec<f64> = rec.depth.windows(2).map(|w| w[1].t - w[0].t).collect();
+    if gaps.is_empty() {
+        return setting_s;
+    }
+    let mid = gaps.len() / 2;
+    let (_, median, _) = gaps.select_nth_unstable_by(mid, f64::total_cmp);
+    setting_s.max(0.55 * *median)
+}
+
+/// The thermal clock's offset: given, rig.toml's, or estimated from the scan.
+fn thermal_clock(
+    rec: &Recording,
+    params: &FuseParams,
+    tolerance_s: f64,
+    limits: &InterpolationLimits,
+) -> ClockReport {
+    let fixed = |offset_s, source| ClockReport {
+        offset_s,
+        source,
+        ..Default::default()
+    };
+    match (params.clock, rec.rig.thermal_time_offset_s) {
+        (ClockOffset::Off, _) => fixed(0.0, OffsetSource::None),
+        (ClockOffset::Fixed(o), _) => fixed(o, OffsetSource::Given),
+        (ClockOffset::Auto, Some(o)) => fixed(o, OffsetSource::RigToml),
+        (ClockOffset::Auto, None) | (ClockOffset::Estimate, _) => {
+            estimate_offset(rec, &params.clock_search, tolerance_s, limits)
+        }
+    }
+}
+
 /// Fuses a recording. `progress(done, total)` is called after each frame.
 pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) + Sync)) -> Fused {
     let mut params = *params;
@@ -698,12 +754,27 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
     let params = &params;
     let t_start = Instant::now();
     let limits = InterpolationLimits::default();
-    let pairs = pair_frames(rec, params.sync_tolerance_s, &limits);
+    let tolerance = sync_tolerance(rec, params.sync_tolerance_s);
+    let clock = thermal_clock(rec, params, tolerance, &limits);
+    let shifted;
+    let rec = if clock.offset_s != 0.0 {
+        let mut r = rec.clone();
+        for e in &mut r.thermal {
+            e.t += clock.offset_s;
+        }
+        shifted = r;
+        &shifted
+    } else {
+        rec
+    };
+    let pairs = pair_frames(rec, tolerance, &limits);
     let mut report = FusionReport {
         recording: rec.dir.display().to_string(),
         thermal_frames: rec.thermal.len(),
         depth_frames: rec.depth.len(),
         depth_stride: params.depth.stride,
+        sync_tolerance_used_s: tolerance,
+        clock,
         parameters: *params,
         ..Default::default()
     };

@@ -9,6 +9,7 @@
 //!
 //! See [`fuse`] for the pipeline and [`observe`](mod@observe) for the observation weights.
 
+pub mod clock;
 pub mod frame;
 mod fuse;
 pub mod observe;

@@ -103,7 +103,7 @@ fn main() {
             &r,
             &cfg.thermal_camera,
             &trays,
-            &p,
+            std::slice::from_ref(&p),
             ThermalEncoding::Centikelvin,
             &ThermalNoise::REALISTIC,
             None,

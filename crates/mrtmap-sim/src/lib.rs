@@ -28,7 +28,7 @@ pub use evaluate_scene::{FeatureScore, PointScore, SceneScore, SurfaceScore, sco
 pub use radiometric::{
     CameraErrors, FfcPeriod, RadiometricModel, ReferenceReading, reference_readings,
 };
-pub use render::{Element, Hit, RoomRenderer, temperature_at};
+pub use render::{Element, Hit, RoomRenderer, is_glass, temperature_at};
 pub use room::{
     FeatureSpec, FurnitureSpec, GRADIENT_STRIP_M, PRESETS, PlacedFeature, PointSpec, Room,
     RoomError, RoomFile, SurfaceRef, TemperaturesFile, WallFile, preset,

@@ -44,11 +44,15 @@ struct Plane {
     hi: Point2<f64>,
     rect: bool,
     features: Vec<PlaneFeature>,
+    /// Whether any of its features is glass.
+    has_glass: bool,
 }
 
-/// A feature on a plane: its index in the room, polygon and bounds in the plane's 2D frame.
+/// A feature on a plane: its index in the room, polygon and bounds in the plane's 2D frame, and
+/// whether it is glass (which an active-stereo depth camera does not see).
 struct PlaneFeature {
     index: usize,
+    glass: bool,
     poly: Vec<Point2<f64>>,
     lo: Point2<f64>,
     hi: Point2<f64>,
@@ -98,13 +102,15 @@ impl RoomRenderer {
                         let (lo, hi) = bounds(&f.polygon_2d);
                         PlaneFeature {
                             index: k,
+                            glass: is_glass(&f.label),
                             poly: f.polygon_2d.clone(),
                             lo,
                             hi,
                         }
                     })
-                    .collect();
+                    .collect::<Vec<PlaneFeature>>();
                 Plane {
+                    has_glass: features.iter().any(|f| f.glass),
                     offset: n.dot(&origin.coords),
                     origin,
                     u,
@@ -280,15 +286,24 @@ impl View<'_> {
         hit
     }
 
-    /// Distance (in units of `d_cam`) and the cosine of incidence of the nearest hit of a ray in
-    /// the camera frame (no feature lookup: what depth needs).
-    pub fn cast_depth(&self, d_cam: &Vector3<f64>) -> Option<(f64, f64)> {
+    /// Distance (in units of `d_cam`), the cosine of incidence of the nearest hit of a ray in the
+    /// camera frame, and whether it landed on glass (features are looked up only on surfaces that
+    /// carry glass: what depth needs).
+    pub fn cast_depth(&self, d_cam: &Vector3<f64>) -> Option<(f64, f64, bool)> {
         let (t, target, n) = self.nearest(d_cam)?;
-        let den = match target {
-            Target::Plane(k) => self.normals_cam[k].dot(d_cam),
-            Target::Box(_) => (self.rot.transpose() * n).dot(d_cam),
+        let (den, glass) = match target {
+            Target::Plane(k) => {
+                let p = &self.r.planes[k];
+                let glass = p.has_glass && {
+                    let q = self.o + self.rot * d_cam * t - p.origin;
+                    let q2 = Point2::new(p.u.dot(&q), p.v.dot(&q));
+                    p.features.iter().any(|f| f.glass && f.contains(&q2))
+                };
+                (self.normals_cam[k].dot(d_cam), glass)
+            }
+            Target::Box(_) => ((self.rot.transpose() * n).dot(d_cam), false),
         };
-        Some((t, den.abs() / d_cam.norm()))
+        Some((t, den.abs() / d_cam.norm(), glass))
     }
 
     /// The nearest hit of a ray in the camera frame, with the feature it lands on; `t` is in units
@@ -305,16 +320,7 @@ impl View<'_> {
                 } else {
                     let q = self.o + d * t - p.origin;
                     let q2 = Point2::new(p.u.dot(&q), p.v.dot(&q));
-                    p.features
-                        .iter()
-                        .find(|f| {
-                            q2.x >= f.lo.x
-                                && q2.x <= f.hi.x
-                                && q2.y >= f.lo.y
-                                && q2.y <= f.hi.y
-                                && point_in_polygon_fast(&q2, &f.poly)
-                        })
-                        .map(|f| f.index)
+                    p.features.iter().find(|f| f.contains(&q2)).map(|f| f.index)
                 };
                 Element::Surface {
                     surface: k,
@@ -324,6 +330,27 @@ impl View<'_> {
         };
         Some(Hit { t, element, normal })
     }
+}
+
+impl PlaneFeature {
+    /// Whether a point of the plane's 2D frame lies on the feature.
+    fn contains(&self, q: &Point2<f64>) -> bool {
+        q.x >= self.lo.x
+            && q.x <= self.hi.x
+            && q.y >= self.lo.y
+            && q.y <= self.hi.y
+            && point_in_polygon_fast(q, &self.poly)
+    }
+}
+
+/// Whether a feature's label names glass: windows, glazing, glass doors, mirrors. Near-infrared
+/// light passes through (or is mirrored by) them, so an active-stereo depth camera gets no depth
+/// there; a thermal camera sees the pane itself, which is opaque at 8–14 µm.
+pub fn is_glass(label: &str) -> bool {
+    let l = label.to_lowercase();
+    ["window", "glass", "glazing", "mirror", "skylight"]
+        .iter()
+        .any(|w| l.contains(w))
 }
 
 fn polygon_area(p: &[Point2<f64>]) -> f64 {

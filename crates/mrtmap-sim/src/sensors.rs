@@ -49,6 +49,31 @@ pub struct DepthNoise {
     pub min_m: f64,
     /// Valid range (m).
     pub max_m: f64,
+    /// Glass (windows, glazing, mirrors: [`crate::is_glass`]): `None` returns the pane's depth
+    /// like any surface (an idealised camera); `Some(p)`: the projector's pattern passes through,
+    /// so a glass pixel has no depth, except a share `p` that matches on what lies beyond the
+    /// pane ([`glass_far_m`](Self::glass_far_m) farther along the ray: outdoors, so often beyond
+    /// range).
+    #[serde(default)]
+    pub glass_see_through: Option<f64>,
+    /// How far beyond a pane the far side lies (m).
+    #[serde(default = "default_glass_far_m")]
+    pub glass_far_m: f64,
+}
+
+fn default_glass_far_m() -> f64 {
+    4.0
+}
+
+impl DepthNoise {
+    /// A D435i's realistic noise with glass as the camera sees it: no depth, 10 % of the pixels
+    /// matched on the far side 4 m beyond.
+    pub fn with_glass(self) -> Self {
+        Self {
+            glass_see_through: Some(0.10),
+            ..self
+        }
+    }
 }
 
 impl Default for DepthNoise {
@@ -65,6 +90,8 @@ impl Default for DepthNoise {
             dropout: 0.005,
             min_m: 0.2,
             max_m: 6.0,
+            glass_see_through: None,
+            glass_far_m: default_glass_far_m(),
         }
     }
 }
@@ -82,6 +109,12 @@ pub struct ThermalNoise {
     pub supersample: u32,
     /// Whether emissivity falls at grazing view (beyond 60°), mixing in reflected radiation.
     pub grazing_emissivity: bool,
+    /// The microbolometer's thermal time constant (s): a pixel reads the scene's radiance
+    /// averaged over the past with weight exp(−age/τ), which smears edges when the camera turns
+    /// fast (0: an instantaneous image). Sampled with the sub-pixel rays: ray j of a pixel looks
+    /// at the scene as it was at the j-th quantile of that exponential age.
+    #[serde(default)]
+    pub time_constant_s: f64,
 }
 
 impl ThermalNoise {
@@ -92,15 +125,32 @@ impl ThermalNoise {
         bias_k: 0.0,
         supersample: 1,
         grazing_emissivity: false,
+        time_constant_s: 0.0,
     };
-    /// Realistic defaults: NETD 50 mK, blur σ 0.5 px, 3×3 supersampling, grazing emissivity, no bias.
+    /// Realistic defaults: NETD 50 mK, blur σ 0.5 px, 3×3 supersampling, grazing emissivity, no
+    /// bias, a 12 ms time constant (a Lepton's is of order 10 ms).
     pub const REALISTIC: ThermalNoise = ThermalNoise {
         netd_k: 0.05,
         blur_sigma_px: 0.5,
         bias_k: 0.0,
         supersample: 3,
         grazing_emissivity: true,
+        time_constant_s: 0.012,
     };
+
+    /// The ages (s) at which a pixel's `n` sub-pixel rays look at the scene: the exponential
+    /// age's quantiles (j + ½)/n, each ray weighted equally; all 0 without a time constant.
+    pub fn sample_ages_s(&self, n: usize) -> Vec<f64> {
+        (0..n)
+            .map(|j| {
+                if self.time_constant_s > 0.0 {
+                    -self.time_constant_s * (1.0 - (j as f64 + 0.5) / n as f64).ln()
+                } else {
+                    0.0
+                }
+            })
+            .collect()
+    }
 }
 
 /// Ray directions (z = 1 in the camera frame) for every pixel (row-major), with `ss`×`ss`
@@ -135,10 +185,24 @@ pub fn render_depth<R: Rng>(
     let view = renderer.view(room_from_cam);
     let mut z = vec![0.0f64; w * h];
     let mut cosi = vec![1.0f64; w * h];
+    let glass = noise.and_then(|n| n.glass_see_through);
     for (k, d) in rays.iter().enumerate() {
-        if let Some((t, c)) = view.cast_depth(d) {
-            z[k] = t; // d has z = 1 in the camera frame, so t is the z-depth
-            cosi[k] = c;
+        if let Some((t, c, on_glass)) = view.cast_depth(d) {
+            // d has z = 1 in the camera frame, so t is the z-depth.
+            match glass {
+                Some(p) if on_glass => {
+                    // Through the pane: nothing, or now and then the far side.
+                    if rng.random::<f64>() < p {
+                        let range = t * d.norm();
+                        z[k] = t * (1.0 + noise.map_or(0.0, |n| n.glass_far_m) / range);
+                        cosi[k] = 1.0;
+                    }
+                }
+                _ => {
+                    z[k] = t;
+                    cosi[k] = c;
+                }
+            }
         }
     }
     let mut img = Image16::zeros(cam.width, cam.height);
@@ -225,13 +289,16 @@ fn grazing_emissivity(cos: f64) -> f64 {
 }
 
 /// Renders a radiometric thermal image from `rays` (see [`camera_rays`] with `noise.supersample`).
+/// `room_from_cam` holds the camera's pose at each of a pixel's sub-pixel rays' ages
+/// ([`ThermalNoise::sample_ages_s`]; one pose: every ray sees the same instant): sub-pixel ray j
+/// looks from pose `(5·j) mod n`, so that time and position within the pixel are not tied.
 #[allow(clippy::too_many_arguments)]
 pub fn render_thermal<R: Rng>(
     room: &Room,
     renderer: &RoomRenderer,
     cam: &PinholeCamera,
     rays: &[Vector3<f64>],
-    room_from_cam: &Isometry3<f64>,
+    room_from_cam: &[Isometry3<f64>],
     encoding: ThermalEncoding,
     noise: &ThermalNoise,
     camera: Option<(&CameraErrors, f64)>,
@@ -239,15 +306,21 @@ pub fn render_thermal<R: Rng>(
 ) -> Image16 {
     let (w, h) = (cam.width as usize, cam.height as usize);
     let ss = (noise.supersample.max(1) * noise.supersample.max(1)) as usize;
-    let o: Point3<f64> = room_from_cam.translation.vector.into();
-    let view = renderer.view(room_from_cam);
-    let rot = room_from_cam.rotation.to_rotation_matrix();
+    let views: Vec<_> = room_from_cam
+        .iter()
+        .map(|p| {
+            let o: Point3<f64> = p.translation.vector.into();
+            (o, renderer.view(p), p.rotation.to_rotation_matrix())
+        })
+        .collect();
+    let n_views = views.len().max(1);
     let t_refl4 = (room.file.air_temperature_c + ZERO_CELSIUS_K).powi(4);
     // Radiance (∝ T⁴) per pixel, averaged over its sub-pixel rays.
     let mut rad = vec![0.0f64; w * h];
     for (k, chunk) in rays.chunks(ss).enumerate() {
         let mut acc = 0.0;
-        for d in chunk {
+        for (j, d) in chunk.iter().enumerate() {
+            let (o, view, rot) = &views[(5 * j) % n_views];
             let dw = rot * d;
             let t4 = match view.cast(d) {
                 Some(hit) => {

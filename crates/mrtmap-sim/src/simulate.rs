@@ -111,6 +111,28 @@ pub struct SimConfig {
     /// Write trajectory.txt (the pose source's estimate); without it the recording has no poses
     /// and a tracker must find them (groundtruth.txt keeps the truth either way).
     pub poses_in_recording: bool,
+    /// How late the thermal frames are stamped (s): a USB thermal board's frames are stamped by
+    /// the host when they arrive, after readout and transfer, so thermal.txt's times are the
+    /// exposure's plus this. `None`: the noise level's default (a lag drawn from the seed,
+    /// uniform in 40–120 ms, with realistic noise; none without noise).
+    pub thermal_lag_s: Option<f64>,
+}
+
+/// Where a realistic thermal lag is drawn from (s).
+pub const REALISTIC_LAG_S: std::ops::Range<f64> = 0.040..0.120;
+
+impl SimConfig {
+    /// The thermal stamps' lag this configuration gives (s).
+    pub fn lag_s(&self) -> f64 {
+        match (self.thermal_lag_s, self.noise) {
+            (Some(l), _) => l,
+            (None, NoiseLevel::None) => 0.0,
+            (None, NoiseLevel::Realistic) => {
+                let mut r = ChaCha8Rng::seed_from_u64(self.seed ^ 0x1a6_u64.rotate_left(52));
+                r.random_range(REALISTIC_LAG_S)
+            }
+        }
+    }
 }
 
 impl Default for SimConfig {
@@ -144,6 +166,7 @@ impl Default for SimConfig {
             references: 0,
             reference_std_k: 0.1,
             poses_in_recording: true,
+            thermal_lag_s: None,
         }
     }
 }
@@ -232,6 +255,14 @@ fn check(cfg: &SimConfig) -> Result<(), SimError> {
                 range: "0…1000 Hz",
             });
         }
+    }
+    let lag = cfg.lag_s();
+    if !(0.0..=1.0).contains(&lag) {
+        return Err(SimError::OutOfRange {
+            what: "thermal lag (s)".into(),
+            value: lag,
+            range: "0…1 s",
+        });
     }
     Ok(())
 }
@@ -385,6 +416,8 @@ fn rig(cfg: &SimConfig) -> Rig {
         } else {
             5.0
         }),
+        // The simulated rig, like a real one, does not know its thermal stamps' lag.
+        thermal_time_offset_s: None,
         depth_from_thermal: cfg.depth_from_thermal,
         rgb: Some(RgbCamera {
             camera: cfg.depth_camera,
@@ -446,14 +479,23 @@ impl Frames<'_> {
             }
         };
         let rays = camera_rays(&cfg.thermal_camera, noise.supersample);
+        let ss = noise.supersample.max(1) as usize;
+        let ages = noise.sample_ages_s(ss * ss);
         times.par_iter().enumerate().try_for_each(|(k, &t)| {
-            let pose = self.walk.room_from_depth(t) * cfg.depth_from_thermal;
+            // The walk starts at 0: a frame exposed at its very start sees no earlier scene.
+            let poses: Vec<Isometry3<f64>> = if noise.time_constant_s > 0.0 {
+                ages.iter()
+                    .map(|a| self.walk.room_from_depth((t - a).max(0.0)) * cfg.depth_from_thermal)
+                    .collect()
+            } else {
+                vec![self.walk.room_from_depth(t) * cfg.depth_from_thermal]
+            };
             let img = render_thermal(
                 self.room,
                 &self.renderer,
                 &cfg.thermal_camera,
                 &rays,
-                &pose,
+                &poses,
                 ThermalEncoding::Centikelvin,
                 &noise,
                 self.camera.as_ref().map(|c| (c, t)),
@@ -496,31 +538,47 @@ impl Frames<'_> {
 }
 
 /// Writes the stream lists of the frames' times.
+/// (thermal frames are stamped `lag_s` after their exposure).
 fn write_lists(
     out: &Out,
     header: &str,
     depth_t: &[f64],
     thermal_t: &[f64],
     rgb_t: &[f64],
+    lag_s: f64,
 ) -> Result<(), SimError> {
-    let list = |ts: &[f64], dir: &str| -> Vec<(f64, String)> {
+    let list = |ts: &[f64], dir: &str, lag: f64| -> Vec<(f64, String)> {
         ts.iter()
             .enumerate()
-            .map(|(k, &t)| (TIME_ORIGIN_S + t, format!("{dir}/{k:06}.png")))
+            .map(|(k, &t)| (TIME_ORIGIN_S + t + lag, format!("{dir}/{k:06}.png")))
             .collect()
     };
-    for (file, what, ts, dir) in [
-        ("depth.txt", "depth frames", depth_t, "depth"),
-        ("thermal.txt", "thermal frames", thermal_t, "thermal"),
-        ("rgb.txt", "colour frames", rgb_t, "rgb"),
+    let thermal_what = format!(
+        "thermal frames (stamped {:.1} ms after exposure)",
+        lag_s * 1e3
+    );
+    for (file, what, ts, dir, lag) in [
+        ("depth.txt", "depth frames", depth_t, "depth", 0.0),
+        (
+            "thermal.txt",
+            thermal_what.as_str(),
+            thermal_t,
+            "thermal",
+            lag_s,
+        ),
+        ("rgb.txt", "colour frames", rgb_t, "rgb", 0.0),
         (
             "masks.txt",
             "instance masks (16-bit ids, labels in the .json beside each)",
             rgb_t,
             "masks",
+            0.0,
         ),
     ] {
-        let text = stream_list_text(&format!("{header}\n{what}: timestamp path"), &list(ts, dir));
+        let text = stream_list_text(
+            &format!("{header}\n{what}: timestamp path"),
+            &list(ts, dir, lag),
+        );
         out.write(file, text.as_bytes())?;
     }
     Ok(())
@@ -628,10 +686,15 @@ pub fn simulate(
     frames.depth(&depth_t)?;
     frames.thermal(&thermal_t)?;
     frames.colour_and_masks(&rgb_t)?;
-    write_lists(&files, &header, &depth_t, &thermal_t, &rgb_t)?;
+    let lag_s = cfg.lag_s();
+    write_lists(&files, &header, &depth_t, &thermal_t, &rgb_t, lag_s)?;
     let room_toml = toml::to_string(&room.file)?;
     files.write("room.toml", room_toml.as_bytes())?;
-    let truth = compute_truth(room, &world_from_room, cfg.truth_rays, cfg.seed)?;
+    let mut truth = compute_truth(room, &world_from_room, cfg.truth_rays, cfg.seed)?;
+    truth.thermal_lag_s = lag_s;
+    if cfg.noise == NoiseLevel::Realistic {
+        truth.thermal_time_constant_s = cfg.thermal_noise.time_constant_s;
+    }
     let truth_json = serde_json::to_string_pretty(&truth)?;
     files.write("truth.json", (truth_json + "\n").as_bytes())?;
     write_camera_truth(

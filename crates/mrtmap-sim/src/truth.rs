@@ -78,6 +78,16 @@ pub struct Truth {
     pub up_world: [f64; 3],
     /// "exact" or "montecarlo".
     pub method: String,
+    /// How late the recording's thermal frames are stamped (s): thermal.txt's time minus the
+    /// exposure's.
+    #[serde(default)]
+    pub thermal_lag_s: f64,
+    /// The simulated microbolometer's time constant τ (s): a pixel reads the scene's radiance
+    /// weighted by exp(−age/τ), whose centroid lies τ before the exposure's nominal time. The
+    /// offset that places the frames best is therefore −(`thermal_lag_s` + this), what a reader
+    /// that estimates the clock offset should find.
+    #[serde(default)]
+    pub thermal_time_constant_s: f64,
     /// Rays per point for Monte Carlo.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rays: Option<usize>,
@@ -150,6 +160,8 @@ pub fn compute_truth(
         world_from_room: PoseFile::from_isometry(world_from_room),
         up_world: [up.x, up.y, up.z],
         method: method.name().into(),
+        thermal_lag_s: 0.0,
+        thermal_time_constant_s: 0.0,
         rays: (!exact).then_some(rays),
         points,
         grid: TruthGrid {

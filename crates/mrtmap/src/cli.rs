@@ -589,7 +589,8 @@ pub struct FuseArgs {
     /// Refine poses by point-to-plane ICP against the map built so far.
     #[arg(long, value_enum, default_value_t = OnOff::On)]
     pub icp: OnOff,
-    /// Largest time between a thermal frame and the depth frame it takes (ms).
+    /// Largest time between a thermal frame and the depth frame it takes (ms); at least 0.55 of
+    /// the depth frames' interval is used, so every thermal frame finds one at any depth rate.
     #[arg(long = "sync-tolerance-ms", default_value_t = 20.0)]
     pub sync_tolerance_ms: f64,
     /// Use every N-th depth pixel in each direction; 0: about one depth point per thermal pixel
@@ -600,6 +601,11 @@ pub struct FuseArgs {
     /// corrections, drift) and the vignetting from the frames' overlaps.
     #[arg(long, value_enum, default_value_t = OnOff::On)]
     pub self_calibrate: OnOff,
+    /// What to add to the thermal stamps to put them on the depth camera's clock: auto (rig.toml's
+    /// `[thermal] time_offset_s`, else estimated from the scan), estimate, off, or milliseconds
+    /// (-70: frames stamped 70 ms after their exposure).
+    #[arg(long, default_value = "auto", allow_hyphen_values = true)]
+    pub time_offset: String,
 }
 
 /// Sensor noise of a simulation.
@@ -684,6 +690,18 @@ pub struct SimulateArgs {
     /// only), for `mrtmap track`; groundtruth.txt still has the true poses.
     #[arg(long)]
     pub no_poses: bool,
+    /// How late the thermal frames are stamped (ms): a USB thermal board's frames are stamped on
+    /// arrival. Default: drawn from the seed, 40–120 ms, with --noise realistic; 0 with none.
+    #[arg(long, value_name = "MS")]
+    pub thermal_lag_ms: Option<f64>,
+    /// The microbolometer's time constant (ms): fast turns smear the thermal image (realistic
+    /// noise only).
+    #[arg(long, value_name = "MS", default_value_t = 12.0)]
+    pub thermal_time_constant_ms: f64,
+    /// Windows as an active-stereo depth camera sees them: no depth on the glass (10 % of its
+    /// pixels see 4 m beyond). Without it the panes return depth like a wall.
+    #[arg(long)]
+    pub glass: bool,
     /// Monte Carlo rays per truth point (rooms with furniture or not convex).
     #[arg(long, default_value_t = 100_000)]
     pub truth_rays: usize,

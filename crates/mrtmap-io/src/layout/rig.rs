@@ -56,6 +56,8 @@ struct ThermalSection {
     depth_from_thermal: PoseFile,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     absolute_accuracy_k: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    time_offset_s: Option<f64>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -134,6 +136,11 @@ pub struct Rig {
     /// The thermal camera's stated absolute accuracy (K, `[thermal] absolute_accuracy_k`); `None`:
     /// not stated (a Lepton 3.5's ±5 K is then assumed).
     pub thermal_accuracy_k: Option<f64>,
+    /// What to add to thermal.txt's stamps to put them on the depth camera's clock (s,
+    /// `[thermal] time_offset_s`): a USB thermal camera stamped on arrival is late, so this is
+    /// negative (−0.07 for frames stamped 70 ms after exposure). `None`: not known (fusion
+    /// estimates it from the scan).
+    pub thermal_time_offset_s: Option<f64>,
     /// Optional colour camera.
     pub rgb: Option<RgbCamera>,
 }
@@ -226,6 +233,13 @@ impl Rig {
                 "[thermal] absolute_accuracy_k = {a} is outside 0…100 K"
             )));
         }
+        if let Some(o) = t.time_offset_s
+            && !(o.is_finite() && o.abs() <= 1.0)
+        {
+            return Err(bad(format!(
+                "[thermal] time_offset_s = {o} is outside −1…1 s (a thermal camera's stamps are late by tens to a hundred milliseconds, so the offset is about −0.03 to −0.15)"
+            )));
+        }
         let rgb = match &f.rgb {
             None => None,
             Some(r) => Some(RgbCamera {
@@ -247,6 +261,7 @@ impl Rig {
             thermal_encoding,
             depth_from_thermal,
             thermal_accuracy_k: t.absolute_accuracy_k,
+            thermal_time_offset_s: t.time_offset_s,
             rgb,
         })
     }
@@ -282,6 +297,7 @@ impl Rig {
                 encoding: self.thermal_encoding.as_str().to_string(),
                 depth_from_thermal: PoseFile::from_isometry(&self.depth_from_thermal),
                 absolute_accuracy_k: self.thermal_accuracy_k,
+                time_offset_s: self.thermal_time_offset_s,
             },
             rgb: self.rgb.map(|r| RgbSection {
                 width: r.camera.width,

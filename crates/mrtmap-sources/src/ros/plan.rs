@@ -457,6 +457,7 @@ fn assemble_rig(
         thermal: t,
         thermal_encoding: ThermalEncoding::Centikelvin,
         thermal_accuracy_k: None,
+        thermal_time_offset_s: None,
         depth_from_thermal: x,
         rgb: rgb_cam,
     })

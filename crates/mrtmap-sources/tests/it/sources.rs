@@ -25,6 +25,7 @@ fn rig() -> Rig {
         thermal,
         thermal_encoding: ThermalEncoding::Centikelvin,
         thermal_accuracy_k: None,
+        thermal_time_offset_s: None,
         depth_from_thermal: Isometry3::new(
             Vector3::new(0.04, -0.02, 0.005),
             Vector3::new(0.0, 0.02, 0.01),

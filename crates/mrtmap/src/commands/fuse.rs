@@ -15,6 +15,7 @@ pub fn run(a: &FuseArgs) -> anyhow::Result<()> {
         sync_tolerance_ms: a.sync_tolerance_ms,
         depth_stride: a.depth_stride,
         self_calibrate: a.self_calibrate == OnOff::On,
+        time_offset: a.time_offset.clone(),
     };
     let params = settings.params()?;
     let prepared = prepare(&a.recording, &a.out, &a.src.options())?;
@@ -43,6 +44,7 @@ pub fn run(a: &FuseArgs) -> anyhow::Result<()> {
         r.timing_s.total,
         r.frames_per_second
     );
+    outln!("  {}", r.clock.describe());
     for (why, n) in &r.skipped {
         outln!("  skipped {n} frames: {why}");
     }

@@ -28,8 +28,15 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<()> {
     cfg.thermal_noise = ThermalNoise {
         bias_k: a.thermal_bias,
         blur_sigma_px: a.thermal_blur,
+        time_constant_s: a.thermal_time_constant_ms / 1000.0,
         ..ThermalNoise::REALISTIC
     };
+    if a.glass {
+        cfg.depth_noise = cfg.depth_noise.with_glass();
+    }
+    if let Some(ms) = a.thermal_lag_ms {
+        cfg.thermal_lag_s = Some(ms / 1000.0);
+    }
     set_depth_size(&mut cfg, a.depth_size)?;
     cfg.depth_hz = a.depth_hz;
     cfg.thermal_hz = a.thermal_hz;
@@ -54,6 +61,10 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<()> {
         summary.poses,
         summary.bytes as f64 / 1e6,
         summary.out.display()
+    );
+    outln!(
+        "thermal frames stamped {:.1} ms after their exposure (truth.json: thermal_lag_s)",
+        cfg.lag_s() * 1000.0
     );
     outln!(
         "truth.json: MRT at the validation points and on the 20×20 grid at 1.1 m ({} view factors)",

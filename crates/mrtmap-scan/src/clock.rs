@@ -1,0 +1,388 @@
+//! The thermal camera's clock against the depth camera's, found from the scan itself.
+//!
+//! A USB thermal camera has no hardware clock shared with the depth camera: its frames are
+//! stamped by the host when they arrive, tens to over a hundred milliseconds after the exposure.
+//! Placed by the pose at its stamp, a frame taken while the camera turns lands beside where it
+//! was taken (60°/s for 70 ms is 4°, ten Lepton pixels), and edges smear across the map.
+//!
+//! The offset (what to add to a thermal stamp to get its exposure on the depth clock) is the one
+//! at which the frames agree best, as spatio-temporal calibration tools (Kalibr) find it: depth
+//! points are placed once, by the depth frames' own poses, which do not depend on the offset; for
+//! each candidate offset every sampled thermal frame is posed at its stamp plus the offset and
+//! projected onto those points, and the mismatch is the observation-weighted variance of the
+//! temperatures each 5 cm voxel receives. A coarse search over ±250 ms
+//! (25 ms steps) is refined in 5 ms steps and by a parabola through the three lowest. A scan that
+//! turns fast constrains the offset sharply; a slow, straight walk leaves the mismatch flat,
+//! which the report says (`contrast`, `weak`).
+
+use std::collections::HashMap;
+
+use mrtmap_geometry::cloud::voxel_key;
+use mrtmap_geometry::nalgebra::{Point3, Vector3};
+use mrtmap_io::{InterpolationLimits, Recording};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::frame::{DepthPoints, DepthSampling, RayTable, ThermalImage, depth_points};
+use crate::observe::{ObservationParams, observe};
+
+/// How fusion sets the thermal clock's offset.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ClockOffset {
+    /// rig.toml's `[thermal] time_offset_s` when it has one, else estimated from the scan.
+    Auto,
+    /// Estimated from the scan, whatever rig.toml says.
+    Estimate,
+    /// This offset (s), added to every thermal stamp.
+    Fixed(f64),
+    /// The stamps as recorded.
+    Off,
+}
+
+/// Where the offset used came from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OffsetSource {
+    /// Not applied.
+    #[default]
+    None,
+    /// rig.toml's `[thermal] time_offset_s`.
+    RigToml,
+    /// Given in the settings.
+    Given,
+    /// Found from the scan.
+    Estimated,
+}
+
+/// The search's settings.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ClockSearch {
+    /// Offsets searched: ±this (s).
+    pub range_s: f64,
+    /// Coarse step (s).
+    pub coarse_step_s: f64,
+    /// Fine step (s).
+    pub fine_step_s: f64,
+    /// Thermal frames sampled, spread evenly over the scan.
+    pub frames: usize,
+    /// Depth pixel stride of the points the frames are projected onto.
+    pub stride: u32,
+    /// Voxel whose temperatures must agree (m).
+    pub voxel_m: f64,
+    /// Below this relative rise of the mismatch 50 ms either side of its minimum, the offset is
+    /// called weakly constrained.
+    pub weak_contrast: f64,
+}
+
+impl Default for ClockSearch {
+    fn default() -> Self {
+        Self {
+            range_s: 0.25,
+            coarse_step_s: 0.025,
+            fine_step_s: 0.005,
+            frames: 90,
+            stride: 6,
+            voxel_m: 0.05,
+            weak_contrast: 0.05,
+        }
+    }
+}
+
+/// What the clock's offset was and how it was found (`fusion.json`'s `clock`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ClockReport {
+    /// Added to every thermal stamp (s); negative when the stamps are late.
+    pub offset_s: f64,
+    /// Where it came from.
+    pub source: OffsetSource,
+    /// Thermal frames the estimate compared (0 when not estimated).
+    pub frames: usize,
+    /// The mismatch (K², weighted variance within voxels) at each offset tried, by offset.
+    pub curve: Vec<[f64; 2]>,
+    /// The mismatch's relative rise 50 ms either side of the minimum: how sharply the scan
+    /// constrains the offset.
+    pub contrast: f64,
+    /// Whether the scan constrains the offset only weakly (too little turning, or a minimum at
+    /// the search's edge).
+    pub weak: bool,
+}
+
+/// One sampled frame, ready to be projected at any offset.
+struct Sample {
+    t: f64,
+    points: Vec<Point3<f64>>,
+    normals: Vec<Vector3<f64>>,
+    /// Each point's voxel, numbered over all the samples.
+    voxels: Vec<u32>,
+    thermal: ThermalImage,
+}
+
+/// Reads the sampled frames: evenly spread thermal frames whose poses exist over the whole search
+/// range, each with its nearest depth frame (within `tolerance_s`), placed by the depth pose.
+fn samples(
+    rec: &Recording,
+    search: &ClockSearch,
+    tolerance_s: f64,
+    limits: &InterpolationLimits,
+) -> Vec<Sample> {
+    let depth_t: Vec<f64> = rec.depth.iter().map(|e| e.t).collect();
+    let traj = &rec.trajectory;
+    let usable: Vec<(usize, usize)> = rec
+        .thermal
+        .iter()
+        .enumerate()
+        .filter_map(|(i, th)| {
+            let k = depth_t.partition_point(|&t| t < th.t);
+            let d = [k.checked_sub(1), (k < depth_t.len()).then_some(k)]
+                .into_iter()
+                .flatten()
+                .min_by(|&a, &b| {
+                    (depth_t[a] - th.t)
+                        .abs()
+                        .total_cmp(&(depth_t[b] - th.t).abs())
+                })?;
+            let ok = (depth_t[d] - th.t).abs() <= tolerance_s
+                && traj.interpolate(depth_t[d], limits).is_some()
+                && traj.interpolate(th.t - search.range_s, limits).is_some()
+                && traj.interpolate(th.t + search.range_s, limits).is_some();
+            ok.then_some((i, d))
+        })
+        .collect();
+    let n = search.frames.min(usable.len());
+    if n == 0 {
+        return Vec::new();
+    }
+    let picked: Vec<(usize, usize)> = (0..n)
+        .map(|j| usable[(j * usable.len() + usable.len() / (2 * n)) / n])
+        .collect();
+    let rays = RayTable::new(&rec.rig.depth);
+    let sampling = DepthSampling {
+        stride: search.stride.max(1),
+        ..DepthSampling::default()
+    };
+    picked
+        .par_iter()
+        .filter_map(|&(ti, di)| {
+            let depth = rec.read_depth(&rec.depth[di]).ok()?;
+            let raw = rec.read_thermal(&rec.thermal[ti]).ok()?;
+            let wd = traj.interpolate(rec.depth[di].t, limits)?;
+            let DepthPoints { points, normals } =
+                depth_points(&depth, &rays, rec.rig.depth_scale, &sampling);
+            if points.len() < 100 {
+                return None;
+            }
+            let points: Vec<Point3<f64>> = points.iter().map(|p| wd * p).collect();
+            let normals: Vec<Vector3<f64>> = normals.iter().map(|n| wd.rotation * n).collect();
+            Some(Sample {
+                t: rec.thermal[ti].t,
+                points,
+                normals,
+                voxels: Vec::new(),
+                thermal: ThermalImage::from_raw(&raw, rec.rig.thermal_encoding),
+            })
+        })
+        .collect::<Vec<Sample>>()
+}
+
+/// Numbers the samples' voxels; returns how many there are.
+fn number_voxels(samples: &mut [Sample], voxel_m: f64) -> usize {
+    let mut ids: HashMap<[i32; 3], u32> = HashMap::new();
+    for s in samples.iter_mut() {
+        s.voxels = s
+            .points
+            .iter()
+            .map(|p| {
+                let n = ids.len() as u32;
+                *ids.entry(voxel_key(p, voxel_m)).or_insert(n)
+            })
+            .collect();
+    }
+    ids.len()
+}
+
+/// The mismatch at `offset_s`: the weighted variance of the temperatures each voxel receives.
+fn mismatch(
+    rec: &Recording,
+    samples: &[Sample],
+    voxels: usize,
+    offset_s: f64,
+    limits: &InterpolationLimits,
+) -> f64 {
+    // Edges are the signal here: no sample is dropped or down-weighted for its contrast.
+    let params = ObservationParams {
+        edge_drop_k: f64::INFINITY,
+        edge_scale_k: f64::INFINITY,
+        ..ObservationParams::default()
+    };
+    let sums = samples
+        .par_iter()
+        .fold(
+            || vec![[0.0f64; 3]; voxels],
+            |mut acc, s| {
+                let Some(wt) = rec.trajectory.interpolate(s.t + offset_s, limits) else {
+                    return acc;
+                };
+                let wt = wt * rec.rig.depth_from_thermal;
+                let (obs, _) = observe(
+                    &s.points,
+                    &s.normals,
+                    &wt,
+                    &rec.rig.thermal,
+                    &s.thermal,
+                    &params,
+                );
+                for o in obs {
+                    let a = &mut acc[s.voxels[o.index] as usize];
+                    a[0] += o.w;
+                    a[1] += o.w * o.t_k;
+                    a[2] += o.w * o.t_k * o.t_k;
+                }
+                acc
+            },
+        )
+        .reduce_with(|mut a, b| {
+            for (x, y) in a.iter_mut().zip(&b) {
+                for i in 0..3 {
+                    x[i] += y[i];
+                }
+            }
+            a
+        })
+        .unwrap_or_default();
+    let (mut num, mut den) = (0.0, 0.0);
+    for a in &sums {
+        if a[0] > 0.0 {
+            num += (a[2] - a[1] * a[1] / a[0]).max(0.0);
+            den += a[0];
+        }
+    }
+    if den > 0.0 { num / den } else { f64::NAN }
+}
+
+/// Estimates the offset to add to the thermal stamps. `tolerance_s`: how far a sampled thermal
+/// frame's depth frame may lie from it.
+pub fn estimate_offset(
+    rec: &Recording,
+    search: &ClockSearch,
+    tolerance_s: f64,
+    limits: &InterpolationLimits,
+) -> ClockReport {
+    let mut samples = samples(rec, search, tolerance_s, limits);
+    let voxels = number_voxels(&mut samples, search.voxel_m);
+    let mut report = ClockReport {
+        source: OffsetSource::Estimated,
+        frames: samples.len(),
+        weak: true,
+        ..Default::default()
+    };
+    if samples.len() < 3 {
+        return report;
+    }
+    let mut curve: Vec<[f64; 2]> = Vec::new();
+    let eval = |d: f64, curve: &mut Vec<[f64; 2]>| -> f64 {
+        if let Some(c) = curve.iter().find(|c| (c[0] - d).abs() < 1e-9) {
+            return c[1];
+        }
+        let m = mismatch(rec, &samples, voxels, d, limits);
+        curve.push([d, m]);
+        m
+    };
+    let steps = (search.range_s / search.coarse_step_s).round() as i64;
+    let mut best = (0.0, f64::INFINITY);
+    for k in -steps..=steps {
+        let d = k as f64 * search.coarse_step_s;
+        let m = eval(d, &mut curve);
+        if m < best.1 {
+            best = (d, m);
+        }
+    }
+    if !best.1.is_finite() {
+        return report;
+    }
+    let fine = (search.coarse_step_s / search.fine_step_s).round() as i64;
+    let centre = best.0;
+    for k in -fine..=fine {
+        let d = centre + k as f64 * search.fine_step_s;
+        if d.abs() > search.range_s + 1e-9 {
+            continue;
+        }
+        let m = eval(d, &mut curve);
+        if m < best.1 {
+            best = (d, m);
+        }
+    }
+    let at_edge = best.0.abs() > search.range_s - search.coarse_step_s / 2.0;
+    // A parabola through the best fine point and its neighbours.
+    let h = search.fine_step_s;
+    let mut offset = best.0;
+    if best.0.abs() + h <= search.range_s + 1e-9 {
+        let (a, b, c) = (
+            eval(best.0 - h, &mut curve),
+            best.1,
+            eval(best.0 + h, &mut curve),
+        );
+        let den = a - 2.0 * b + c;
+        if den > 0.0 {
+            offset = best.0 + 0.5 * h * (a - c) / den;
+        }
+    }
+    curve.sort_by(|x, y| x[0].total_cmp(&y[0]));
+    let around: Vec<f64> = [-0.05, 0.05]
+        .iter()
+        .filter_map(|d| {
+            curve
+                .iter()
+                .min_by(|x, y| {
+                    (x[0] - best.0 - d)
+                        .abs()
+                        .total_cmp(&(y[0] - best.0 - d).abs())
+                })
+                .filter(|x| (x[0] - best.0 - d).abs() < search.coarse_step_s)
+                .map(|x| x[1])
+        })
+        .collect();
+    let rise = if around.is_empty() {
+        0.0
+    } else {
+        around.iter().sum::<f64>() / around.len() as f64 / best.1.max(1e-12) - 1.0
+    };
+    // A minimum at the search's edge is no estimate: the stamps are left as they are.
+    report.offset_s = if at_edge { 0.0 } else { offset };
+    report.curve = curve;
+    report.contrast = rise;
+    report.weak = at_edge || rise < search.weak_contrast;
+    report
+}
+
+impl ClockReport {
+    /// One sentence for people: the offset, where it came from and how well the scan fixed it.
+    pub fn describe(&self) -> String {
+        let ms = self.offset_s * 1000.0;
+        match self.source {
+            OffsetSource::None => "thermal stamps used as recorded (no clock offset)".into(),
+            OffsetSource::RigToml => {
+                format!("thermal clock offset {ms:+.1} ms, from rig.toml's [thermal] time_offset_s")
+            }
+            OffsetSource::Given => format!("thermal clock offset {ms:+.1} ms, as given"),
+            OffsetSource::Estimated if self.frames < 3 => {
+                "thermal clock offset not estimated: too few frames with depth and poses; stamps used as recorded".into()
+            }
+            OffsetSource::Estimated if self.weak && self.offset_s == 0.0 => format!(
+                "thermal clock offset not found within ±{:.0} ms (the frames agree best at the search's edge); stamps used as recorded: give it as [thermal] time_offset_s in rig.toml",
+                self.curve.last().map_or(250.0, |c| c[0] * 1000.0)
+            ),
+            OffsetSource::Estimated => format!(
+                "thermal clock offset {ms:+.1} ms, estimated from {} frames (the stamps are {:.0} ms {}); {}",
+                self.frames,
+                ms.abs(),
+                if ms < 0.0 { "late" } else { "early" },
+                if self.weak {
+                    format!("weakly constrained: the frames' mismatch rises only {:.1} % 50 ms either side (a scan that turns faster fixes it better)", self.contrast * 100.0)
+                } else {
+                    format!("the frames' mismatch rises {:.0} % 50 ms either side", self.contrast * 100.0)
+                }
+            ),
+        }
+    }
+}
