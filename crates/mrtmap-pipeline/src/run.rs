@@ -15,7 +15,10 @@ use std::path::Path;
 use mrtmap_geometry::nalgebra::{Isometry3, Point3};
 use mrtmap_io::{Recording, Trajectory, read_cloud_ply, write_atomic, write_cloud_ply};
 use mrtmap_radiation::{GridSpec, RadiantScene};
-use mrtmap_scan::segment::{MaskInput, SegmentParams, SegmentReport, refined_poses, segment};
+use mrtmap_scan::FusedFrame;
+use mrtmap_scan::segment::{
+    MaskInput, SegmentParams, SegmentReport, TextureInput, refined_poses, segment_textured,
+};
 use mrtmap_scan::track::{TrackParams, TrackReport, track};
 use mrtmap_scan::{FuseParams, FusionReport, fuse};
 
@@ -77,6 +80,7 @@ pub fn fuse_into(
         traj.to_tum("world_from_depth of each fused thermal frame's depth frame, after ICP")
             .as_bytes(),
     )?;
+    write_json(&out.join("frames.json"), &fused.frames)?;
     Ok(fused.report)
 }
 
@@ -153,7 +157,7 @@ fn mean_temperature_c(scene: &RadiantScene) -> f64 {
 /// temperatures are carried to the level the references of `level` fix.
 pub fn segment_into(
     fused: &Path,
-    masks: Option<&Recording>,
+    inputs: &SegmentInputs<'_>,
     params: &SegmentParams,
     level: &LevelInputs,
     out: &Path,
@@ -161,16 +165,38 @@ pub fn segment_into(
     let cloud_path = fused.join("cloud.ply");
     let cloud = read_cloud_ply(&cloud_path)?.cloud;
     let poses = Trajectory::read(&fused.join("poses.txt"))?;
+    let masks = inputs.recording.filter(|_| inputs.masks);
     let pose_fn = masks.map(|r| refined_poses(r, &poses));
     let mask_input = masks.zip(pose_fn.as_ref()).map(|(r, f)| MaskInput {
         recording: r,
         world_from_depth: f,
     });
-    let mut seg = segment(&cloud, &poses.poses, mask_input.as_ref(), params).map_err(|source| {
-        Error::Segment {
-            cloud: cloud_path.clone(),
-            source,
+    let frames_path = fused.join("frames.json");
+    let texture_frames: Option<(Vec<FusedFrame>, f64)> = match inputs.recording {
+        Some(_) if inputs.texture && frames_path.exists() => {
+            let report: FusionReport = read_json(&fused.join("fusion.json"))?;
+            Some((read_json(&frames_path)?, report.radiometric.vignetting_k))
         }
+        _ => None,
+    };
+    let texture_input = inputs
+        .recording
+        .zip(texture_frames.as_ref())
+        .map(|(r, (frames, a))| TextureInput {
+            recording: r,
+            frames,
+            vignetting_k: *a,
+        });
+    let mut seg = segment_textured(
+        &cloud,
+        &poses.poses,
+        mask_input.as_ref(),
+        texture_input.as_ref(),
+        params,
+    )
+    .map_err(|source| Error::Segment {
+        cloud: cloud_path.clone(),
+        source,
     })?;
     let world_from_room = seg
         .report
@@ -201,6 +227,17 @@ pub fn segment_into(
     )?;
     write_json(&out.join("segment.json"), &seg.report)?;
     Ok(seg.report)
+}
+
+/// What segmentation takes from the recording besides the cloud.
+#[derive(Clone, Copy, Default)]
+pub struct SegmentInputs<'a> {
+    /// The recording that was fused.
+    pub recording: Option<&'a Recording>,
+    /// Label features by its instance masks.
+    pub masks: bool,
+    /// Cast its thermal frames onto the room model (needs the fusion's frames.json).
+    pub texture: bool,
 }
 
 /// One map of a run.
@@ -384,7 +421,11 @@ fn fuse_stage(
         .fold(Fingerprint::new(), |f, n| f.file(&rec.dir.join(n)))
         .maybe_file(tracked.exists().then_some(tracked.as_path()))
         .setting("fuse", &p.fuse);
-    let stage = Stage::in_dir("fuse", &dir, &["cloud.ply", "fusion.json", "poses.txt"]);
+    let stage = Stage::in_dir(
+        "fuse",
+        &dir,
+        &["cloud.ply", "fusion.json", "poses.txt", "frames.json"],
+    );
     let outcome = run_or_reuse(&stage, fingerprint, force, || {
         fuse_into(rec, &params, &dir, progress).map(|_| ())
     })?;
@@ -405,6 +446,11 @@ fn segment_stage(
     let fingerprint = Fingerprint::new()
         .file(&fused.join("cloud.ply"))
         .file(&fused.join("poses.txt"))
+        .maybe_file(
+            Some(fused.join("frames.json"))
+                .filter(|f| p.segment.texture && f.exists())
+                .as_deref(),
+        )
         .maybe_file(use_masks.then(|| rec.dir.join("masks.txt")).as_deref())
         .setting("segment", &p.segment)
         .setting("room", &p.room)
@@ -423,9 +469,13 @@ fn segment_stage(
     let outcome = run_or_reuse(&stage, fingerprint, force, || {
         progress.begin("segmenting surfaces and features");
         progress.advance(0, 1);
-        let masks = use_masks.then_some(rec);
+        let inputs = SegmentInputs {
+            recording: Some(rec),
+            masks: use_masks,
+            texture: p.segment.texture,
+        };
         let level = LevelInputs::of(rec, p)?;
-        segment_into(&fused, masks, &p.segment.params(&p.room), &level, &dir).map(|_| ())
+        segment_into(&fused, &inputs, &p.segment.params(&p.room), &level, &dir).map(|_| ())
     })?;
     Ok((outcome, read_json(&dir.join("segment.json"))?))
 }

@@ -65,6 +65,8 @@ feature_threshold_k = 0.3 # a texel differing from its surface's background by m
 feature_min_area_m2 = 0.04
 raster_m = 0.15           # each surface's temperature raster (texel, m); 0: one temperature per surface
 masks = true              # label features by the recording's instance masks when it has masks.txt
+texture = true            # cast the thermal frames onto the room model: glass and other surfaces the
+                          # depth camera did not see take the thermal camera's temperatures
 
 [mrt]
 method = "auto"           # auto | exact | montecarlo
@@ -462,6 +464,10 @@ pub struct SegmentSection {
     pub raster_m: f64,
     /// Label features by the recording's instance masks when it has them.
     pub masks: bool,
+    /// Cast the fused thermal frames onto the room model found, so that what the depth camera
+    /// did not see (glass, dark or shiny surfaces, dropouts) takes the thermal camera's
+    /// temperatures.
+    pub texture: bool,
 }
 
 impl Default for SegmentSection {
@@ -471,6 +477,7 @@ impl Default for SegmentSection {
             feature_min_area_m2: 0.04,
             raster_m: 0.15,
             masks: true,
+            texture: true,
         }
     }
 }

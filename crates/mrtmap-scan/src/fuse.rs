@@ -273,14 +273,50 @@ pub struct FusionReport {
     pub parameters: FuseParams,
 }
 
+/// A fused thermal frame, for what comes after fusion (texturing the room model): which frames,
+/// where the cameras were, and the offset self-calibration removed.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FusedFrame {
+    /// Index into the recording's thermal list.
+    pub thermal: usize,
+    /// Index into its depth list.
+    pub depth: usize,
+    /// The thermal frame's time on the depth clock (its stamp plus the clock offset).
+    pub t: f64,
+    /// world_from_thermal at the exposure, after ICP (and the map's anchoring).
+    pub world_from_thermal: [f64; 7],
+    /// world_from_depth of its depth frame, after ICP.
+    pub world_from_depth: [f64; 7],
+    /// The offset self-calibration removed from this frame (K): pixel − offset − vignetting·ρ.
+    pub offset_k: f64,
+}
+
+/// An isometry as [tx, ty, tz, qx, qy, qz, qw].
+pub fn pose7(p: &Isometry3<f64>) -> [f64; 7] {
+    let (t, q) = (p.translation.vector, p.rotation.coords);
+    [t.x, t.y, t.z, q.x, q.y, q.z, q.w]
+}
+
+/// The isometry of [tx, ty, tz, qx, qy, qz, qw] (the quaternion normalised).
+pub fn from_pose7(a: &[f64; 7]) -> Isometry3<f64> {
+    use mrtmap_geometry::nalgebra::{Quaternion, Translation3, UnitQuaternion};
+    Isometry3::from_parts(
+        Translation3::new(a[0], a[1], a[2]),
+        UnitQuaternion::from_quaternion(Quaternion::new(a[6], a[3], a[4], a[5])),
+    )
+}
+
 /// The result of fusion.
 pub struct Fused {
     /// The cloud.
     pub cloud: ThermalCloud,
     /// The report.
     pub report: FusionReport,
-    /// The refined world_from_depth pose of each used thermal frame's depth frame, by thermal time.
+    /// The refined world_from_depth pose of each used thermal frame's depth frame, by the depth
+    /// frame's time.
     pub poses: Vec<(f64, Isometry3<f64>)>,
+    /// The frames fused, in order.
+    pub frames: Vec<FusedFrame>,
 }
 
 /// An accepted ICP refinement: the correction and its quality.
@@ -293,6 +329,8 @@ struct Refinement {
 
 /// A prepared frame.
 struct Prepared {
+    thermal_index: usize,
+    depth_index: usize,
     thermal_t: f64,
     depth_t: f64,
     points: DepthPoints,
@@ -321,6 +359,8 @@ fn prepare(
                 let depth = rec.read_depth(de).map_err(|e| e.to_string())?;
                 let thermal = rec.read_thermal(th).map_err(|e| e.to_string())?;
                 Ok(Prepared {
+                    thermal_index: ti,
+                    depth_index: di,
                     thermal_t: th.t,
                     depth_t: de.t,
                     points: depth_points(&depth, rays, rec.rig.depth_scale, &params.depth),
@@ -356,6 +396,7 @@ struct Fuser<'a> {
     rmse_sum: f64,
     iterations_sum: usize,
     poses: Vec<(f64, Isometry3<f64>)>,
+    frames: Vec<FusedFrame>,
     /// A few of each frame's depth points, placed by its refined and by its given pose.
     anchor: Vec<(Point3<f64>, Point3<f64>)>,
     timing: Timing,
@@ -494,7 +535,11 @@ impl Fuser<'_> {
                     self.anchor.push((world_from_depth * p, wd * p));
                 }
             }
-            self.poses.push((pr.thermal_t, world_from_depth));
+            // Keyed by the depth frame's own time (two thermal frames may share one depth frame
+            // when depth runs slower): the pose is the depth frame's.
+            if self.poses.last().is_none_or(|l| l.0 < pr.depth_t) {
+                self.poses.push((pr.depth_t, world_from_depth));
+            }
             work.push((pr, world_from_depth, world_from_thermal));
         }
         self.timing.icp += t1.elapsed().as_secs_f64();
@@ -583,6 +628,22 @@ impl Fuser<'_> {
         results
     }
 
+    /// Records the frames that reached the map, with their poses and offsets.
+    fn record_frames(&mut self, work: &[Posed], results: &[Observed]) {
+        for ((pr, wd, wt), o) in work.iter().zip(results) {
+            if o.counts.kept > 0 {
+                self.frames.push(FusedFrame {
+                    thermal: pr.thermal_index,
+                    depth: pr.depth_index,
+                    t: pr.thermal_t,
+                    world_from_thermal: pose7(wt),
+                    world_from_depth: pose7(wd),
+                    offset_k: o.offset,
+                });
+            }
+        }
+    }
+
     /// Merges the frames into the map in frame order, and rebuilds the ICP target when due.
     fn merge(&mut self, results: Vec<Observed>, total: u64, progress: &(dyn Fn(u64, u64) + Sync)) {
         let t3 = Instant::now();
@@ -629,6 +690,10 @@ impl Fuser<'_> {
             for (_, pose) in &mut self.poses {
                 *pose = a * *pose;
             }
+            for f in &mut self.frames {
+                f.world_from_thermal = pose7(&(a * from_pose7(&f.world_from_thermal)));
+                f.world_from_depth = pose7(&(a * from_pose7(&f.world_from_depth)));
+            }
             self.report.icp.anchored = Some((a.translation.vector.norm(), rotation_deg(&a)));
         }
         self.timing.output = t4.elapsed().as_secs_f64();
@@ -652,6 +717,7 @@ impl Fuser<'_> {
             cloud,
             report: self.report,
             poses: self.poses,
+            frames: self.frames,
         }
     }
 }
@@ -793,6 +859,7 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
         rmse_sum: 0.0,
         iterations_sum: 0,
         poses: Vec::new(),
+        frames: Vec::new(),
         anchor: Vec::new(),
         timing: Timing::default(),
         done: 0,
@@ -822,6 +889,7 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
                 let ready = fuser.posed(prepared);
                 let work = fuser.register(ready);
                 let results = fuser.observe(&work);
+                fuser.record_frames(&work, &results);
                 fuser.merge(results, total, progress);
             },
         );

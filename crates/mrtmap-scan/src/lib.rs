@@ -20,5 +20,8 @@ mod sync;
 pub mod track;
 pub mod voxels;
 
-pub use fuse::{FuseParams, Fused, FusionReport, IcpReport, IcpSettings, Timing, fuse};
+pub use fuse::{
+    FuseParams, Fused, FusedFrame, FusionReport, IcpReport, IcpSettings, Timing, from_pose7, fuse,
+    pose7,
+};
 pub use sync::{Pairing, SkipReason, pair_frames};

@@ -537,6 +537,11 @@ pub struct SegmentArgs {
     /// the features by a majority vote over frames. Without it, features get rule labels.
     #[arg(long, value_name = "DIR")]
     pub masks: Option<PathBuf>,
+    /// The recording that was fused: its thermal frames are cast onto the room model found, so
+    /// that what the depth camera did not see (glass, dark surfaces, dropouts) takes the thermal
+    /// camera's temperatures (needs the fusion's frames.json; --masks implies it).
+    #[arg(long, value_name = "DIR")]
+    pub recording: Option<PathBuf>,
     /// Output folder for scene.json, segments.ply and segment.json.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,

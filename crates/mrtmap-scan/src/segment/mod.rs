@@ -11,6 +11,7 @@ mod furniture;
 pub mod labels;
 mod outline;
 pub mod room;
+mod texture;
 
 use std::collections::BTreeMap;
 
@@ -27,6 +28,7 @@ use serde::{Deserialize, Serialize};
 
 pub use envelope::{Envelope, FoundPlane, PlaneClass, up_from_poses};
 pub use labels::{MaskSummary, Votes, WEAK_MAJORITY, rule_label};
+pub use texture::{TextureInput, TextureParams, TextureReport};
 
 /// Segmentation settings (all documented in docs/segmentation.md).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -157,8 +159,12 @@ pub struct SurfaceSummary {
     pub temperature_c: Option<f64>,
     /// Standard uncertainty (K).
     pub temperature_std_k: f64,
-    /// Observed fraction.
+    /// Observed fraction: seen by the cloud (with depth) or by thermal texturing.
     pub observed_fraction: f64,
+    /// The part of it seen by thermal texturing only (no depth there: glass, dark or shiny
+    /// surfaces, dropouts, beyond range).
+    #[serde(default)]
+    pub textured_fraction: f64,
     /// Area (m²).
     pub area_m2: f64,
     /// Cloud points on it.
@@ -245,6 +251,9 @@ pub struct SegmentReport {
     /// Walls never seen, placed at the edge of the floor and ceiling seen (ids).
     #[serde(default)]
     pub inferred_walls: Vec<String>,
+    /// Thermal texturing on the room model, when the frames were given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub texture: Option<TextureReport>,
 }
 
 /// The result of segmentation.
@@ -655,6 +664,7 @@ fn build_surfaces(
             temperature_c: a.temperature_k.map(|t| t - ZERO_CELSIUS_K),
             temperature_std_k: a.temperature_std_k,
             observed_fraction: a.observed_fraction,
+            textured_fraction: 0.0,
             area_m2: mrtmap_geometry::polygon::area_3d(&g.polygon),
             points: members[s].len(),
             background_c: a.background.a - ZERO_CELSIUS_K,
@@ -763,10 +773,92 @@ pub fn segment(
     masks: Option<&MaskInput<'_>>,
     p: &SegmentParams,
 ) -> Result<Segmentation, SegmentError> {
-    let pts = Points::of(cloud);
+    segment_textured(cloud, camera_poses, masks, None, p)
+}
+
+/// Texels the cloud's points of a surface cover, in the texel grid of its outline's lower corner.
+fn covered_texels(
+    g: &SurfaceGeom,
+    lo: &Point2<f64>,
+    members: &[usize],
+    pts: &Points,
+    texel_m: f64,
+) -> std::collections::HashSet<(i64, i64)> {
+    members
+        .iter()
+        .map(|&i| {
+            let q = g.frame.to_2d(&pts.pos[i]);
+            (
+                ((q.x - lo.x) / texel_m).floor() as i64,
+                ((q.y - lo.y) / texel_m).floor() as i64,
+            )
+        })
+        .collect()
+}
+
+/// Thermal texturing of the texels the cloud left empty: samples appended to the points (and
+/// their weights and the surfaces' members).
+#[allow(clippy::too_many_arguments)]
+fn fill_from_texture(
+    input: &TextureInput<'_>,
+    geoms: &[SurfaceGeom],
+    polys2: &[Vec<Point2<f64>>],
+    furniture: &[furniture::FoundFurniture],
+    pts: &mut Points,
+    weights: &mut Vec<f64>,
+    members: &mut [Vec<usize>],
+    p: &SegmentParams,
+) -> TextureReport {
+    let surfaces: Vec<texture::ModelSurface<'_>> = geoms
+        .iter()
+        .enumerate()
+        .map(|(s, g)| {
+            let lo = polys2[s]
+                .iter()
+                .fold(Point2::new(f64::INFINITY, f64::INFINITY), |a, q| {
+                    Point2::new(a.x.min(q.x), a.y.min(q.y))
+                });
+            texture::ModelSurface {
+                frame: &g.frame,
+                polygon: &polys2[s],
+                texel_origin: lo,
+                covered: covered_texels(g, &lo, &members[s], pts, p.texel_m),
+            }
+        })
+        .collect();
+    let boxes: Vec<[Point3<f64>; 8]> = furniture.iter().map(|f| f.corners).collect();
+    let (tx, report) = texture::texture(
+        input,
+        &surfaces,
+        &boxes,
+        p.texel_m,
+        &TextureParams::default(),
+    );
+    for k in 0..tx.surface.len() {
+        members[tx.surface[k]].push(pts.pos.len());
+        pts.pos.push(tx.pos[k]);
+        pts.nrm.push(tx.nrm[k]);
+        pts.temp.push(tx.temp_k[k]);
+        pts.obs.push(tx.pixels[k]);
+        weights.push(f64::from(tx.pixels[k]));
+    }
+    report
+}
+
+/// Segments the cloud into a radiant scene; with `texture`, the thermal frames are also cast onto
+/// the room model found, and what the cloud did not cover takes their temperatures.
+pub fn segment_textured(
+    cloud: &ThermalCloud,
+    camera_poses: &[Isometry3<f64>],
+    masks: Option<&MaskInput<'_>>,
+    texture: Option<&TextureInput<'_>>,
+    p: &SegmentParams,
+) -> Result<Segmentation, SegmentError> {
+    let mut pts = Points::of(cloud);
+    let cloud_points = pts.pos.len();
     let up0 = up_from_poses(camera_poses).ok_or(SegmentError::NoPoses)?;
     let planes = envelope::find_planes(&pts.pos, &pts.nrm, p);
-    let weights: Vec<f64> = pts.obs.iter().map(|&o| o.max(1) as f64).collect();
+    let mut weights: Vec<f64> = pts.obs.iter().map(|&o| o.max(1) as f64).collect();
     let cloud_in = envelope::Cloud {
         points: &pts.pos,
         normals: &pts.nrm,
@@ -785,8 +877,21 @@ pub fn segment(
         .map(|g| g.polygon.iter().map(|q| g.frame.to_2d(q)).collect())
         .collect();
     let bands = surface_bands(&geoms, &polys2, &pts, p);
-    let (surface_id, members) = assign_points(&geoms, &polys2, &bands, &pts, p);
+    let (surface_id, mut members) = assign_points(&geoms, &polys2, &bands, &pts, p);
     let unassigned = surface_id.iter().filter(|s| **s < 0).count();
+    let furniture = furniture_of(&env, &longest, &bands, &pts, &surface_id, height_m, p);
+    let texture_report = texture.map(|t| {
+        fill_from_texture(
+            t,
+            &geoms,
+            &polys2,
+            &furniture,
+            &mut pts,
+            &mut weights,
+            &mut members,
+            p,
+        )
+    });
     let analyses: Vec<features::SurfaceAnalysis> = geoms
         .iter()
         .enumerate()
@@ -806,7 +911,6 @@ pub fn segment(
         .enumerate()
         .flat_map(|(s, a)| a.features.iter().map(move |f| (s, f)))
         .collect();
-    let furniture = furniture_of(&env, &longest, &bands, &pts, &surface_id, height_m, p);
     let frame = choose_room_frame(&env, &analyses, p)?;
     let mut geoms = geoms;
     number_walls(&mut geoms, &frame);
@@ -822,13 +926,22 @@ pub fn segment(
         &mut ids,
         &mut warnings,
     );
-    let (surfaces, summaries) = build_surfaces(
+    let (surfaces, mut summaries) = build_surfaces(
         &geoms,
         &analyses,
         &members,
         found.per_surface,
         &mut warnings,
     );
+    if let Some(t) = &texture_report {
+        for (summary, filled) in summaries.iter_mut().zip(&t.texels_filled) {
+            let area = *filled as f64 * p.texel_m * p.texel_m;
+            summary.textured_fraction =
+                (area / summary.area_m2.max(1e-9)).min(summary.observed_fraction);
+        }
+    }
+    let mut feature_id = found.feature_id;
+    feature_id.truncate(cloud_points);
     let (occluders, furniture_summaries) = build_furniture(&furniture, furniture_votes, &mut ids);
     let in_world = SceneFile {
         format: SCENE_FORMAT.into(),
@@ -894,7 +1007,7 @@ pub fn segment(
         surfaces: summaries,
         features: found.summaries,
         furniture: furniture_summaries,
-        unassigned_fraction: unassigned as f64 / pts.pos.len().max(1) as f64,
+        unassigned_fraction: unassigned as f64 / cloud_points.max(1) as f64,
         dropped: analyses
             .iter()
             .flat_map(|a| a.dropped.iter().cloned())
@@ -902,11 +1015,12 @@ pub fn segment(
         masks: mask_summary,
         warnings,
         inferred_walls,
+        texture: texture_report,
     };
     Ok(Segmentation {
         scene,
         surface_id,
-        feature_id: found.feature_id,
+        feature_id,
         report,
     })
 }

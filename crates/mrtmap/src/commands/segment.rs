@@ -3,7 +3,7 @@
 use anyhow::bail;
 use mrtmap_io::Recording;
 use mrtmap_pipeline::level::{DEFAULT_CAMERA_ACCURACY_K, read_references};
-use mrtmap_pipeline::run::{LevelInputs, segment_into};
+use mrtmap_pipeline::run::{LevelInputs, SegmentInputs, segment_into};
 use mrtmap_pipeline::settings::{RoomSection, SegmentSection};
 use mrtmap_scan::segment::{SegmentReport, Votes};
 
@@ -32,11 +32,21 @@ pub fn run(a: &SegmentArgs) -> anyhow::Result<()> {
         }
         None => None,
     };
+    let recording = match (&a.recording, masks) {
+        (Some(dir), _) => Some(Recording::open(dir)?),
+        (None, m) => m,
+    };
     let section = SegmentSection {
         feature_threshold_k: a.feature_threshold_k,
         feature_min_area_m2: a.feature_min_area_m2,
         raster_m: a.raster_m,
-        masks: masks.is_some(),
+        masks: a.masks.is_some(),
+        texture: recording.is_some(),
+    };
+    let inputs = SegmentInputs {
+        recording: recording.as_ref(),
+        masks: section.masks,
+        texture: section.texture,
     };
     let room = RoomSection {
         origin_corner: a.origin_corner,
@@ -48,13 +58,7 @@ pub fn run(a: &SegmentArgs) -> anyhow::Result<()> {
         },
         camera_accuracy_k: DEFAULT_CAMERA_ACCURACY_K,
     };
-    let report = segment_into(
-        &a.fused,
-        masks.as_ref(),
-        &section.params(&room),
-        &level,
-        &a.out,
-    )?;
+    let report = segment_into(&a.fused, &inputs, &section.params(&room), &level, &a.out)?;
     print_report(&report);
     for w in &report.warnings {
         outln!("  warning: {w}");

@@ -1,0 +1,362 @@
+//! Thermal texturing on the room model: every thermal pixel of the fused frames cast onto the
+//! surfaces segmentation found, so that what the depth camera did not see still gets its
+//! temperature from the thermal camera.
+//!
+//! An active-stereo depth camera gets no depth from window glass (its projector's pattern passes
+//! through), from black or shiny surfaces, beyond its range and in its dropouts; the fused cloud
+//! has holes there, while the thermal camera saw those places (glass is opaque at 8–14 µm). Once
+//! the envelope and the furniture are known, each thermal pixel's ray is cast against that model
+//! (the nearest surface or piece of furniture); the frame's measured depth is the occlusion test:
+//! where the depth camera measured something nearer than the model along that line (a person, a
+//! chair, clutter), the pixel is not the surface's. Where it measured nothing, or something
+//! farther (glass seen through), the pixel is. Texels the cloud already covers keep the cloud's
+//! temperatures; each texel the cloud left empty and texturing saw becomes a sample on the surface
+//! with the pixels' weighted mean temperature (each corrected by the frame's self-calibration
+//! offset and the vignetting) and the number of pixels behind it, for the feature and background
+//! analysis as a cloud point would be.
+
+use std::collections::{HashMap, HashSet};
+
+use mrtmap_geometry::camera::PinholeCamera;
+use mrtmap_geometry::nalgebra::{Point2, Point3, Vector3};
+use mrtmap_geometry::{BOX_TRIANGLES, PlaneFrame};
+use mrtmap_io::Recording;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::frame::ThermalImage;
+use crate::fuse::{FusedFrame, from_pose7};
+
+/// What texturing needs: the recording (its thermal and depth images), the fused frames with
+/// their poses and offsets, and the vignetting self-calibration found.
+pub struct TextureInput<'a> {
+    /// The recording.
+    pub recording: &'a Recording,
+    /// The fused frames.
+    pub frames: &'a [FusedFrame],
+    /// Vignetting (K at the image corner, ρ = 1).
+    pub vignetting_k: f64,
+}
+
+/// Texturing settings.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TextureParams {
+    /// Frames used at most (spread evenly over the scan).
+    pub max_frames: usize,
+    /// Rays beyond this incidence are not used (degrees from the normal).
+    pub max_incidence_deg: f64,
+    /// A pixel whose 3×3 neighbourhood spans more than this (K) mixes two surfaces: not used.
+    pub edge_drop_k: f64,
+    /// A texel needs this many pixels.
+    pub min_pixels: u32,
+}
+
+impl Default for TextureParams {
+    fn default() -> Self {
+        Self {
+            max_frames: 600,
+            max_incidence_deg: 75.0,
+            edge_drop_k: 3.0,
+            min_pixels: 3,
+        }
+    }
+}
+
+/// One surface of the model as texturing sees it.
+pub(crate) struct ModelSurface<'a> {
+    /// Its plane frame (2D coordinates of its texels).
+    pub frame: &'a PlaneFrame,
+    /// Its outline in that frame.
+    pub polygon: &'a [Point2<f64>],
+    /// The texel grid's origin (the outline's lower corner) and size.
+    pub texel_origin: Point2<f64>,
+    /// Texels (i, j) the cloud already covers.
+    pub covered: HashSet<(i64, i64)>,
+}
+
+/// Texture samples for texels the cloud left empty.
+#[derive(Default)]
+pub(crate) struct Textured {
+    /// Surface of each sample.
+    pub surface: Vec<usize>,
+    /// Position (world): the texel's centre on its surface.
+    pub pos: Vec<Point3<f64>>,
+    /// Its surface's normal.
+    pub nrm: Vec<Vector3<f64>>,
+    /// Temperature (K).
+    pub temp_k: Vec<f64>,
+    /// Pixels behind it.
+    pub pixels: Vec<u32>,
+}
+
+/// What texturing did, for segment.json.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TextureReport {
+    /// Frames cast.
+    pub frames: usize,
+    /// Pixels that landed on a surface and were used.
+    pub pixels_used: u64,
+    /// Pixels that another object hid (measured depth nearer than the model).
+    pub pixels_occluded: u64,
+    /// Pixels that landed on furniture.
+    pub pixels_on_furniture: u64,
+    /// Texels the cloud had left empty that texturing filled, per surface index.
+    pub texels_filled: Vec<usize>,
+}
+
+/// Ray–triangle intersection (Möller–Trumbore): the distance along `d`.
+fn ray_triangle(o: &Point3<f64>, d: &Vector3<f64>, tri: [&Point3<f64>; 3]) -> Option<f64> {
+    let e1 = tri[1] - tri[0];
+    let e2 = tri[2] - tri[0];
+    let p = d.cross(&e2);
+    let det = e1.dot(&p);
+    if det.abs() < 1e-12 {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = o - tri[0];
+    let u = s.dot(&p) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let q = s.cross(&e1);
+    let v = d.dot(&q) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    let t = e2.dot(&q) * inv;
+    (t > 1e-6).then_some(t)
+}
+
+/// What a ray hits first: a surface (index, distance) or furniture.
+enum ModelHit {
+    Surface(usize, f64),
+    Furniture,
+}
+
+fn cast(
+    surfaces: &[ModelSurface<'_>],
+    boxes: &[[Point3<f64>; 8]],
+    o: &Point3<f64>,
+    d: &Vector3<f64>,
+) -> Option<ModelHit> {
+    let mut best: Option<(f64, Option<usize>)> = None;
+    for (s, m) in surfaces.iter().enumerate() {
+        let n = m.frame.normal;
+        let den = n.dot(d);
+        if den.abs() < 1e-9 {
+            continue;
+        }
+        let t = n.dot(&(m.frame.origin - o)) / den;
+        if t <= 1e-6 || best.is_some_and(|b| t >= b.0) {
+            continue;
+        }
+        let q = m.frame.to_2d(&(o + d * t));
+        if mrtmap_geometry::polygon::point_in_polygon_fast(&q, m.polygon) {
+            best = Some((t, Some(s)));
+        }
+    }
+    for corners in boxes {
+        for tri in BOX_TRIANGLES.iter() {
+            let v = [&corners[tri[0]], &corners[tri[1]], &corners[tri[2]]];
+            if let Some(t) = ray_triangle(o, d, v)
+                && best.is_none_or(|b| t < b.0)
+            {
+                best = Some((t, None));
+            }
+        }
+    }
+    best.map(|(t, s)| match s {
+        Some(s) => ModelHit::Surface(s, t),
+        None => ModelHit::Furniture,
+    })
+}
+
+/// The smallest valid depth (m) in the 3×3 pixels around (u, v), if any.
+fn measured_depth(depth: &mrtmap_io::Image16, scale: f64, u: f64, v: f64) -> Option<f64> {
+    let (w, h) = (depth.width as i64, depth.height as i64);
+    let (iu, iv) = (u.round() as i64, v.round() as i64);
+    let mut best: Option<f64> = None;
+    for dv in -1..=1 {
+        for du in -1..=1 {
+            let (x, y) = (iu + du, iv + dv);
+            if x < 0 || y < 0 || x >= w || y >= h {
+                continue;
+            }
+            let raw = depth.data[(y * w + x) as usize];
+            if raw > 0 {
+                let z = raw as f64 / scale;
+                best = Some(best.map_or(z, |b: f64| b.min(z)));
+            }
+        }
+    }
+    best
+}
+
+/// The 3×3 spread (max − min, K) around pixel (u, v).
+fn contrast(img: &ThermalImage, u: usize, v: usize) -> f64 {
+    let (w, h) = (img.width as usize, img.height as usize);
+    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+    for y in v.saturating_sub(1)..=(v + 1).min(h - 1) {
+        for x in u.saturating_sub(1)..=(u + 1).min(w - 1) {
+            let t = img.kelvin[y * w + x];
+            lo = lo.min(t);
+            hi = hi.max(t);
+        }
+    }
+    f64::from(hi - lo)
+}
+
+/// Per-texel sums: (Σw, Σw·T, pixels).
+type TexelSums = HashMap<(usize, i64, i64), (f64, f64, u32)>;
+
+/// Casts the frames' thermal pixels onto the model; returns a sample for every texel the cloud
+/// left empty and enough pixels saw.
+pub(crate) fn texture(
+    input: &TextureInput<'_>,
+    surfaces: &[ModelSurface<'_>],
+    boxes: &[[Point3<f64>; 8]],
+    texel_m: f64,
+    params: &TextureParams,
+) -> (Textured, TextureReport) {
+    let rec = input.recording;
+    let cam: &PinholeCamera = &rec.rig.thermal;
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    let rays: Vec<Vector3<f64>> = (0..h)
+        .flat_map(|v| (0..w).map(move |u| (u, v)))
+        .map(|(u, v)| cam.unproject(&Point2::new(u as f64, v as f64)).normalize())
+        .collect();
+    let rmax2 = (cam.cx.powi(2) + cam.cy.powi(2)).max(1e-9);
+    let n = input.frames.len();
+    let take = params.max_frames.min(n);
+    let picked: Vec<&FusedFrame> = (0..take)
+        .map(|j| &input.frames[j * n / take.max(1)])
+        .collect();
+    let cos_max = params.max_incidence_deg.to_radians().cos();
+    let per_frame: Vec<(TexelSums, [u64; 3])> = picked
+        .par_iter()
+        .filter_map(|f| {
+            let raw = rec.read_thermal(rec.thermal.get(f.thermal)?).ok()?;
+            let img = ThermalImage::from_raw(&raw, rec.rig.thermal_encoding);
+            if img.width as usize != w || img.height as usize != h {
+                return None;
+            }
+            let depth = rec.read_depth(rec.depth.get(f.depth)?).ok()?;
+            let wt = from_pose7(&f.world_from_thermal);
+            let depth_from_world = from_pose7(&f.world_from_depth).inverse();
+            let o = Point3::from(wt.translation.vector);
+            let mut sums = TexelSums::new();
+            let mut counts = [0u64; 3];
+            for v in 0..h {
+                for u in 0..w {
+                    let d = wt.rotation * rays[v * w + u];
+                    let (s, t) = match cast(surfaces, boxes, &o, &d) {
+                        Some(ModelHit::Surface(s, t)) => (s, t),
+                        Some(ModelHit::Furniture) => {
+                            counts[2] += 1;
+                            continue;
+                        }
+                        None => continue,
+                    };
+                    let m = &surfaces[s];
+                    let cos = m.frame.normal.dot(&d).abs();
+                    if cos < cos_max || contrast(&img, u, v) > params.edge_drop_k {
+                        continue;
+                    }
+                    let x = o + d * t;
+                    // The occlusion test: what the depth camera measured along its own line of
+                    // sight to this point.
+                    let xd = depth_from_world * x;
+                    if xd.z > 0.0
+                        && let Some(px) = rec.rig.depth.project(&xd)
+                        && let Some(z) = measured_depth(&depth, rec.rig.depth_scale, px.x, px.y)
+                        && z < xd.z - (0.05 + 0.03 * xd.z + 0.0125 * xd.z * xd.z)
+                    {
+                        counts[1] += 1;
+                        continue;
+                    }
+                    let q = m.frame.to_2d(&x);
+                    let key = (
+                        ((q.x - m.texel_origin.x) / texel_m).floor() as i64,
+                        ((q.y - m.texel_origin.y) / texel_m).floor() as i64,
+                    );
+                    if m.covered.contains(&key) {
+                        continue;
+                    }
+                    let rho = ((u as f64 - cam.cx).powi(2) + (v as f64 - cam.cy).powi(2)) / rmax2;
+                    let temp =
+                        f64::from(img.kelvin[v * w + u]) - f.offset_k - input.vignetting_k * rho;
+                    let dist_w = (2.0 / t.max(2.0)).powi(2);
+                    let wgt = cos * dist_w * (1.0 - 0.5 * rho.min(1.0));
+                    let e = sums.entry((s, key.0, key.1)).or_insert((0.0, 0.0, 0));
+                    e.0 += wgt;
+                    e.1 += wgt * temp;
+                    e.2 += 1;
+                    counts[0] += 1;
+                }
+            }
+            Some((sums, counts))
+        })
+        .collect();
+    let mut report = TextureReport {
+        frames: per_frame.len(),
+        texels_filled: vec![0; surfaces.len()],
+        ..Default::default()
+    };
+    let mut all = TexelSums::new();
+    for (sums, c) in per_frame {
+        report.pixels_used += c[0];
+        report.pixels_occluded += c[1];
+        report.pixels_on_furniture += c[2];
+        for (k, v) in sums {
+            let e = all.entry(k).or_insert((0.0, 0.0, 0));
+            e.0 += v.0;
+            e.1 += v.1;
+            e.2 += v.2;
+        }
+    }
+    let mut keys: Vec<_> = all.keys().copied().collect();
+    keys.sort_unstable();
+    let mut out = Textured::default();
+    for key in keys {
+        let (sw, swt, n) = all[&key];
+        if n < params.min_pixels || sw <= 0.0 {
+            continue;
+        }
+        let (s, i, j) = key;
+        let m = &surfaces[s];
+        let centre = Point2::new(
+            m.texel_origin.x + (i as f64 + 0.5) * texel_m,
+            m.texel_origin.y + (j as f64 + 0.5) * texel_m,
+        );
+        if !mrtmap_geometry::polygon::point_in_polygon_fast(&centre, m.polygon) {
+            continue;
+        }
+        report.texels_filled[s] += 1;
+        out.surface.push(s);
+        out.pos.push(m.frame.to_3d(&centre));
+        out.nrm.push(m.frame.normal.into_inner());
+        out.temp_k.push(swt / sw);
+        out.pixels.push(n);
+    }
+    (out, report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_ray_meets_a_triangle_inside_and_misses_it_outside() {
+        let (a, b, c) = (
+            Point3::new(0.0, 0.0, 1.0),
+            Point3::new(1.0, 0.0, 1.0),
+            Point3::new(0.0, 1.0, 1.0),
+        );
+        let o = Point3::new(0.2, 0.2, 0.0);
+        let t = ray_triangle(&o, &Vector3::z(), [&a, &b, &c]).expect("hit");
+        assert!((t - 1.0).abs() < 1e-12);
+        assert!(ray_triangle(&Point3::new(0.8, 0.8, 0.0), &Vector3::z(), [&a, &b, &c]).is_none());
+        assert!(ray_triangle(&o, &-Vector3::z(), [&a, &b, &c]).is_none());
+    }
+}
