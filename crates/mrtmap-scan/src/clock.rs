@@ -66,7 +66,8 @@ pub struct ClockSearch {
     pub fine_step_s: f64,
     /// Thermal frames sampled, spread evenly over the scan.
     pub frames: usize,
-    /// Depth pixel stride of the points the frames are projected onto.
+    /// Depth pixel stride of the points the frames are projected onto; 0: twice the fusion's
+    /// automatic stride (6 for a 640×480 D435 beside a Lepton, 2 at 320×240).
     pub stride: u32,
     /// Voxel whose temperatures must agree (m).
     pub voxel_m: f64,
@@ -82,7 +83,7 @@ impl Default for ClockSearch {
             coarse_step_s: 0.025,
             fine_step_s: 0.005,
             frames: 90,
-            stride: 6,
+            stride: 0,
             voxel_m: 0.05,
             weak_contrast: 0.05,
         }
@@ -157,8 +158,12 @@ fn samples(
         .map(|j| usable[(j * usable.len() + usable.len() / (2 * n)) / n])
         .collect();
     let rays = RayTable::new(&rec.rig.depth);
+    let stride = match search.stride {
+        0 => 2 * DepthSampling::auto_stride(&rec.rig.depth, &rec.rig.thermal),
+        s => s,
+    };
     let sampling = DepthSampling {
-        stride: search.stride.max(1),
+        stride,
         ..DepthSampling::default()
     };
     picked

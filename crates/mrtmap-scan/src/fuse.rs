@@ -23,6 +23,7 @@ use serde::{Deserialize, Serialize};
 use crate::clock::{ClockOffset, ClockReport, ClockSearch, OffsetSource, estimate_offset};
 use crate::frame::{DepthPoints, DepthSampling, RayTable, ThermalImage, depth_points};
 use crate::observe::{ObservationCounts, ObservationParams, observe};
+use crate::pose_check::{PoseCheck, drop_outlier_poses};
 use crate::radiometric::{
     Calibrator, FrameResiduals, RadiometricReport, SelfCalibration, frame_residuals,
 };
@@ -252,6 +253,10 @@ pub struct FusionReport {
     /// The thermal clock's offset applied to the thermal stamps, and how it was found.
     #[serde(default)]
     pub clock: ClockReport,
+    /// Poses of the pose source dropped because they jumped away from their neighbours' motion
+    /// and back.
+    #[serde(default)]
+    pub pose_check: PoseCheck,
     /// Frames skipped, by reason.
     pub skipped: BTreeMap<String, usize>,
     /// The first few problems, with file names.
@@ -821,6 +826,18 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
     let t_start = Instant::now();
     let limits = InterpolationLimits::default();
     let tolerance = sync_tolerance(rec, params.sync_tolerance_s);
+    // Poses that jump away from their neighbours' motion and back are dropped first, then the
+    // thermal clock is set.
+    let (checked, pose_check) = drop_outlier_poses(&rec.trajectory);
+    let cleaned;
+    let rec = if pose_check.dropped > 0 {
+        let mut r = rec.clone();
+        r.trajectory = checked;
+        cleaned = r;
+        &cleaned
+    } else {
+        rec
+    };
     let clock = thermal_clock(rec, params, tolerance, &limits);
     let shifted;
     let rec = if clock.offset_s != 0.0 {
@@ -841,6 +858,7 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
         depth_stride: params.depth.stride,
         sync_tolerance_used_s: tolerance,
         clock,
+        pose_check,
         parameters: *params,
         ..Default::default()
     };

@@ -13,6 +13,7 @@ pub mod clock;
 pub mod frame;
 mod fuse;
 pub mod observe;
+pub mod pose_check;
 pub mod pose_graph;
 pub mod radiometric;
 pub mod segment;

@@ -36,6 +36,7 @@ fn main() {
             &walk.room_from_depth(k as f64),
             1000.0,
             None,
+            None,
             &mut rng,
         ));
     });
@@ -48,6 +49,7 @@ fn main() {
             &walk.room_from_depth(k as f64),
             1000.0,
             Some(&cfg.depth_noise),
+            None,
             &mut rng,
         ));
     });

@@ -171,7 +171,8 @@ pub fn camera_rays(cam: &PinholeCamera, ss: u32) -> Vec<Vector3<f64>> {
     out
 }
 
-/// Renders a depth image (raw units at `scale` per metre), from `rays` (see [`camera_rays`] with 1).
+/// Renders a depth image (raw units at `scale` per metre), from `rays` (see [`camera_rays`] with 1),
+/// with `noise`'s depth noise and `glass`'s glass model (each independent of the other).
 pub fn render_depth<R: Rng>(
     renderer: &RoomRenderer,
     cam: &PinholeCamera,
@@ -179,22 +180,26 @@ pub fn render_depth<R: Rng>(
     room_from_cam: &Isometry3<f64>,
     scale: f64,
     noise: Option<&DepthNoise>,
+    glass: Option<&DepthNoise>,
     rng: &mut R,
 ) -> Image16 {
     let (w, h) = (cam.width as usize, cam.height as usize);
     let view = renderer.view(room_from_cam);
     let mut z = vec![0.0f64; w * h];
     let mut cosi = vec![1.0f64; w * h];
-    let glass = noise.and_then(|n| n.glass_see_through);
+    let (see_through, far_m) = match glass {
+        Some(g) => (g.glass_see_through, g.glass_far_m),
+        None => (None, 0.0),
+    };
     for (k, d) in rays.iter().enumerate() {
         if let Some((t, c, on_glass)) = view.cast_depth(d) {
             // d has z = 1 in the camera frame, so t is the z-depth.
-            match glass {
+            match see_through {
                 Some(p) if on_glass => {
                     // Through the pane: nothing, or now and then the far side.
                     if rng.random::<f64>() < p {
                         let range = t * d.norm();
-                        z[k] = t * (1.0 + noise.map_or(0.0, |n| n.glass_far_m) / range);
+                        z[k] = t * (1.0 + far_m / range);
                         cosi[k] = 1.0;
                     }
                 }

@@ -459,6 +459,7 @@ impl Frames<'_> {
                 &self.walk.room_from_depth(t),
                 cfg.depth_scale,
                 noise,
+                Some(&cfg.depth_noise),
                 &mut self.rng(1, k),
             );
             self.out

@@ -2,6 +2,7 @@
 #![allow(clippy::unwrap_used)]
 
 mod common;
+mod field;
 mod fusion;
 mod parts;
 mod segment;

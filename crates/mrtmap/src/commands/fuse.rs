@@ -45,6 +45,17 @@ pub fn run(a: &FuseArgs) -> anyhow::Result<()> {
         r.frames_per_second
     );
     outln!("  {}", r.clock.describe());
+    if r.pose_check.dropped > 0 {
+        outln!(
+            "  dropped {} of {} poses that jumped away from their neighbours' motion and back (the largest {:.2} m)",
+            r.pose_check.dropped,
+            r.pose_check.poses,
+            r.pose_check
+                .examples
+                .iter()
+                .fold(0.0f64, |m, d| m.max(d.off_m))
+        );
+    }
     for (why, n) in &r.skipped {
         outln!("  skipped {n} frames: {why}");
     }
