@@ -49,31 +49,24 @@ pub struct DepthNoise {
     pub min_m: f64,
     /// Valid range (m).
     pub max_m: f64,
-    /// Glass (windows, glazing, mirrors: [`crate::is_glass`]): `None` returns the pane's depth
-    /// like any surface (an idealised camera); `Some(p)`: the projector's pattern passes through,
-    /// so a glass pixel has no depth, except a share `p` that matches on what lies beyond the
-    /// pane ([`glass_far_m`](Self::glass_far_m) farther along the ray: outdoors, so often beyond
+    /// Glass (windows, glazing, mirrors: [`crate::is_glass`]), where the scan has it on (see
+    /// [`SimConfig::glass`](crate::SimConfig::glass)): the projector's pattern passes through, so
+    /// a glass pixel has no depth, except this share that matches on what lies beyond the pane
+    /// ([`glass_far_m`](Self::glass_far_m) farther along the ray: outdoors, so often beyond
     /// range).
-    #[serde(default)]
-    pub glass_see_through: Option<f64>,
+    #[serde(default = "default_glass_see_through")]
+    pub glass_see_through: f64,
     /// How far beyond a pane the far side lies (m).
     #[serde(default = "default_glass_far_m")]
     pub glass_far_m: f64,
 }
 
-fn default_glass_far_m() -> f64 {
-    4.0
+fn default_glass_see_through() -> f64 {
+    0.10
 }
 
-impl DepthNoise {
-    /// A D435i's realistic noise with glass as the camera sees it: no depth, 10 % of the pixels
-    /// matched on the far side 4 m beyond.
-    pub fn with_glass(self) -> Self {
-        Self {
-            glass_see_through: Some(0.10),
-            ..self
-        }
-    }
+fn default_glass_far_m() -> f64 {
+    4.0
 }
 
 impl Default for DepthNoise {
@@ -90,7 +83,7 @@ impl Default for DepthNoise {
             dropout: 0.005,
             min_m: 0.2,
             max_m: 6.0,
-            glass_see_through: None,
+            glass_see_through: default_glass_see_through(),
             glass_far_m: default_glass_far_m(),
         }
     }
@@ -172,7 +165,8 @@ pub fn camera_rays(cam: &PinholeCamera, ss: u32) -> Vec<Vector3<f64>> {
 }
 
 /// Renders a depth image (raw units at `scale` per metre), from `rays` (see [`camera_rays`] with 1),
-/// with `noise`'s depth noise and `glass`'s glass model (each independent of the other).
+/// with `noise`'s depth noise and, when given, `glass`'s glass model (each independent of the
+/// other; without it panes return depth like a wall).
 pub fn render_depth<R: Rng>(
     renderer: &RoomRenderer,
     cam: &PinholeCamera,
@@ -188,7 +182,7 @@ pub fn render_depth<R: Rng>(
     let mut z = vec![0.0f64; w * h];
     let mut cosi = vec![1.0f64; w * h];
     let (see_through, far_m) = match glass {
-        Some(g) => (g.glass_see_through, g.glass_far_m),
+        Some(g) => (Some(g.glass_see_through), g.glass_far_m),
         None => (None, 0.0),
     };
     for (k, d) in rays.iter().enumerate() {

@@ -116,12 +116,21 @@ pub struct SimConfig {
     /// exposure's plus this. `None`: the noise level's default (a lag drawn from the seed,
     /// uniform in 40–120 ms, with realistic noise; none without noise).
     pub thermal_lag_s: Option<f64>,
+    /// Whether glass gives no depth (see [`DepthNoise::glass_see_through`]); `None`: the noise
+    /// level's default (on with realistic noise, off without: panes then return depth like a
+    /// wall, an idealised camera).
+    pub glass: Option<bool>,
 }
 
 /// Where a realistic thermal lag is drawn from (s).
 pub const REALISTIC_LAG_S: std::ops::Range<f64> = 0.040..0.120;
 
 impl SimConfig {
+    /// Whether the depth camera sees through glass in this configuration.
+    pub fn glass_on(&self) -> bool {
+        self.glass.unwrap_or(self.noise == NoiseLevel::Realistic)
+    }
+
     /// The thermal stamps' lag this configuration gives (s).
     pub fn lag_s(&self) -> f64 {
         match (self.thermal_lag_s, self.noise) {
@@ -167,6 +176,7 @@ impl Default for SimConfig {
             reference_std_k: 0.1,
             poses_in_recording: true,
             thermal_lag_s: None,
+            glass: None,
         }
     }
 }
@@ -459,7 +469,7 @@ impl Frames<'_> {
                 &self.walk.room_from_depth(t),
                 cfg.depth_scale,
                 noise,
-                Some(&cfg.depth_noise),
+                cfg.glass_on().then_some(&cfg.depth_noise),
                 &mut self.rng(1, k),
             );
             self.out

@@ -613,6 +613,28 @@ pub struct FuseArgs {
     pub time_offset: String,
 }
 
+/// A simulated effect: on, off, or the noise level's default.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum AutoOnOff {
+    /// On with --noise realistic, off with none.
+    Auto,
+    /// On.
+    On,
+    /// Off.
+    Off,
+}
+
+impl AutoOnOff {
+    /// `None` for auto.
+    pub fn choice(self) -> Option<bool> {
+        match self {
+            Self::Auto => None,
+            Self::On => Some(true),
+            Self::Off => Some(false),
+        }
+    }
+}
+
 /// Sensor noise of a simulation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum NoiseArg {
@@ -704,9 +726,10 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "MS", default_value_t = 12.0)]
     pub thermal_time_constant_ms: f64,
     /// Windows as an active-stereo depth camera sees them: no depth on the glass (10 % of its
-    /// pixels see 4 m beyond). Without it the panes return depth like a wall.
-    #[arg(long)]
-    pub glass: bool,
+    /// pixels see 4 m beyond); off: panes return depth like a wall. Auto: on with --noise
+    /// realistic, off with none.
+    #[arg(long, value_enum, default_value_t = AutoOnOff::Auto)]
+    pub glass: AutoOnOff,
     /// Monte Carlo rays per truth point (rooms with furniture or not convex).
     #[arg(long, default_value_t = 100_000)]
     pub truth_rays: usize,

@@ -165,9 +165,7 @@ fn a_pose_that_jumps_and_comes_back_is_dropped() {
 fn a_window_without_depth_is_found_by_thermal_texturing() {
     let dir = tempfile::tempdir().unwrap();
     let rec_dir = dir.path().join("scan");
-    let room = office(12.0, &rec_dir, |c| {
-        c.depth_noise = c.depth_noise.with_glass();
-    });
+    let room = office(12.0, &rec_dir, |c| c.glass = Some(true));
     let window = room.features.iter().find(|f| f.label == "window").unwrap();
     let rec = Recording::open(&rec_dir).unwrap();
     let fused = fuse(&rec, &params(true), &|_, _| {});

@@ -31,9 +31,7 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<()> {
         time_constant_s: a.thermal_time_constant_ms / 1000.0,
         ..ThermalNoise::REALISTIC
     };
-    if a.glass {
-        cfg.depth_noise = cfg.depth_noise.with_glass();
-    }
+    cfg.glass = a.glass.choice();
     if let Some(ms) = a.thermal_lag_ms {
         cfg.thermal_lag_s = Some(ms / 1000.0);
     }
@@ -63,8 +61,13 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<()> {
         summary.out.display()
     );
     outln!(
-        "thermal frames stamped {:.1} ms after their exposure (truth.json: thermal_lag_s)",
-        cfg.lag_s() * 1000.0
+        "thermal frames stamped {:.1} ms after their exposure (truth.json: thermal_lag_s); glass {}",
+        cfg.lag_s() * 1000.0,
+        if cfg.glass_on() {
+            "gives no depth"
+        } else {
+            "returns depth like a wall"
+        }
     );
     outln!(
         "truth.json: MRT at the validation points and on the 20×20 grid at 1.1 m ({} view factors)",
