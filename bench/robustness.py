@@ -4,7 +4,8 @@ pipeline, and compare the map with the truth.
 
     robustness.py MRTMAP WORKDIR [--rooms office,l-shaped,radiant-ceiling] [--seeds 1-10]
                   [--noise realistic,none] [--drift none] [--seconds 60]
-                  [--camera-errors auto|none|realistic] [--keep]
+                  [--camera-errors auto|none|realistic] [--depth-hz 30] [--glass auto|on|off]
+                  [--score-scene BIN] [--keep]
 
 Prints one row per scan and a summary per room and noise; writes WORKDIR/robustness.json. Each
 row also says how many nodes' errors lie within twice the standard error the run states. A scan
@@ -12,7 +13,10 @@ whose segmentation fails counts as a failure with its message. Grid errors are a
 20x20 nodes (mrtmap mrt --frame scan on the run's scene); a node the run refuses (outside its
 room or inside its furniture) is counted, not compared. The worst error is given over all nodes
 and over the nodes at least 10 cm from the room's furniture (a node on a bookcase's face is not
-a place a globe can measure). With --keep the
+a place a globe can measure). With --score-scene (the mrtmap-sim example `score_scene`) each row
+also scores the features against the truth: every window found (temperature error, found area
+over true area), features of over 0.2 m² matching no true feature; and from fusion.json the
+thermal clock offset found against the truth's -(lag + time constant), and the frames used. With --keep the
 recordings stay in WORKDIR and a later study reuses them (only the pipeline runs again)."""
 import argparse
 import json
@@ -81,17 +85,51 @@ def room_label(room):
     return os.path.splitext(os.path.basename(room))[0] if room.endswith(".toml") else room
 
 
-def one(mrtmap, work, room, seed, noise, drift, secs, keep, camera, reuse_fusion=False):
+def features_and_clock(score_bin, rec, run):
+    """Windows, spurious features and the thermal clock of a run, against the truth."""
+    out = {}
+    fusion = json.load(open(os.path.join(run, "fuse", "fusion.json")))
+    truth = json.load(open(os.path.join(rec, "truth.json")))
+    clock = fusion.get("clock", {})
+    expected = -(truth.get("thermal_lag_s", 0.0) + truth.get("thermal_time_constant_s", 0.0))
+    out["clock_error_ms"] = round(1000 * (clock.get("offset_s", 0.0) - expected), 1)
+    out["clock_weak"] = clock.get("weak")
+    out["frames_used"] = fusion["used_frames"]
+    out["frames_listed"] = fusion["thermal_frames"]
+    out["skipped"] = fusion.get("skipped", {})
+    if score_bin:
+        r = subprocess.run([score_bin, rec, os.path.join(run, "segment", "scene.json"), "--json"],
+                           capture_output=True, text=True)
+        if r.returncode == 0:
+            s = json.loads(r.stdout)
+            out["windows"] = [
+                {"truth": f["truth_id"], "found": f["found"] is not None,
+                 "dt_k": f["temperature_error_k"],
+                 "area_ratio": (f["area_m2"] / f["truth_area_m2"]) if f["area_m2"] else None}
+                for f in s["features"] if "window" in f["truth_label"]]
+            out["spurious_over_0_2"] = [
+                (i, round(a, 2)) for i, a in zip(s["spurious_features"], s.get("spurious_areas_m2", []))
+                if a > 0.2]
+    return out
+
+
+def one(mrtmap, work, room, seed, noise, drift, secs, keep, camera, reuse_fusion=False,
+        depth_hz=None, glass="auto", score_bin=None):
     name = f"{room_label(room)}-s{seed}-{noise}-{drift}-cam{camera}"
+    if depth_hz:
+        name += f"-d{depth_hz}"
+    if glass != "auto":
+        name += f"-glass{glass}"
     rec, run = os.path.join(work, name), os.path.join(work, name + ".run")
     row = {"room": room_label(room), "seed": seed, "noise": noise, "drift": drift,
            "camera_errors": camera}
     t0 = time.time()
     if not os.path.exists(os.path.join(rec, "truth.json")):
         shutil.rmtree(rec + ".partial", ignore_errors=True)
+        extra = (["--depth-hz", str(depth_hz)] if depth_hz else []) + ["--glass", glass]
         subprocess.run([mrtmap, "simulate", "--room", room, "--seed", str(seed), "--noise", noise,
                         "--drift", drift, "--camera-errors", camera, "--seconds", str(secs),
-                        "--out", rec],
+                        "--out", rec] + extra,
                        check=True, capture_output=True)
     t1 = time.time()
     if reuse_fusion and os.path.exists(os.path.join(run, "fuse", "cloud.ply")):
@@ -127,6 +165,7 @@ def one(mrtmap, work, room, seed, noise, drift, secs, keep, camera, reuse_fusion
             "clear_rmse_k": math.sqrt(sum(x * x for x in clear) / len(clear)) if clear else None,
             "points_k": pts,
         })
+        row.update(features_and_clock(score_bin, rec, run))
     if not keep:
         shutil.rmtree(rec, ignore_errors=True)
         shutil.rmtree(run, ignore_errors=True)
@@ -146,6 +185,11 @@ def main():
     ap.add_argument("--camera-errors", default="auto",
                     help="the simulator's radiometric camera errors: auto (realistic with realistic "
                          "noise, corrected from two reference readings), none, realistic")
+    ap.add_argument("--depth-hz", type=float, default=None,
+                    help="the simulated depth camera's frame rate (default: the simulator's 30 Hz)")
+    ap.add_argument("--glass", default="auto", help="the simulator's glass: auto, on, off")
+    ap.add_argument("--score-scene", default=None,
+                    help="the mrtmap-sim example score_scene, to score features against the truth")
     ap.add_argument("--keep", action="store_true")
     ap.add_argument("--reuse-fusion", action="store_true",
                     help="with --keep: keep the fusion of an earlier study (segmentation work)")
@@ -157,7 +201,8 @@ def main():
             for room in a.rooms.split(","):
                 for seed in seeds(a.seeds):
                     row = one(a.mrtmap, a.work, room, seed, noise, drift, a.seconds, a.keep,
-                              a.camera_errors, a.reuse_fusion)
+                              a.camera_errors, a.reuse_fusion, a.depth_hz, a.glass,
+                              a.score_scene)
                     rows.append(row)
                     if "error" in row:
                         desc = "FAILED: " + row["error"]
@@ -168,7 +213,15 @@ def main():
                                 f"{row['refused']} nodes refused, "
                                 f"{100 * row['within_2se']:.0f} % within 2σ; " +
                                 " ".join(f"{k} {v:+.3f}" if v is not None else f"{k} —"
-                                         for k, v in row["points_k"].items()))
+                                         for k, v in row["points_k"].items()) +
+                                f"; clock {row['clock_error_ms']:+.1f} ms"
+                                f"{' (weak)' if row['clock_weak'] else ''}, frames "
+                                f"{row['frames_used']}/{row['frames_listed']}" +
+                                "".join(f"; {w['truth']} " + (
+                                    f"ΔT {w['dt_k']:+.2f} K, area x{w['area_ratio']:.2f}"
+                                    if w["found"] else "MISSED") for w in row.get("windows", [])) +
+                                (f"; spurious {row['spurious_over_0_2']}"
+                                 if row.get("spurious_over_0_2") else ""))
                     print(f"{room:<16} seed {seed:>3} {noise:<9} {drift:<8} run {row['run_s']:5.1f} s  {desc}",
                           flush=True)
     print("\nsummary (room, noise, drift: scans, failures, worst grid max |Δ| and RMSE (over nodes 10 cm "

@@ -34,7 +34,12 @@ fn surface_rows(s: &SegmentReport) -> Vec<[String; 6]> {
                 x.temperature_c
                     .map_or("not observed".into(), |t| format!("{t:.2}")),
                 format!("{:.3}", x.temperature_std_k),
-                format!("{:.0} %", x.observed_fraction * 100.0),
+                format!(
+                    "{:.0} % ({:.0} % texturing only; {:.0} % unseen)",
+                    x.observed_fraction * 100.0,
+                    x.textured_fraction * 100.0,
+                    (1.0 - x.observed_fraction).max(0.0) * 100.0
+                ),
                 format!("{:.2}", x.area_m2),
             ]
         })
@@ -97,10 +102,48 @@ fn coverage_rows(o: &RunOutcome) -> Vec<(String, String)> {
     vec![
         (
             "thermal frames fused".into(),
-            format!("{} of {}", f.used_frames, f.thermal_frames),
+            format!(
+                "{} of {}{}",
+                f.used_frames,
+                f.thermal_frames,
+                f.skipped
+                    .iter()
+                    .map(|(why, n)| format!("; {n} left out: {why}"))
+                    .collect::<String>()
+            ),
+        ),
+        ("thermal clock".into(), f.clock.describe()),
+        (
+            "poses dropped (jumped away from their neighbours' motion and back)".into(),
+            format!(
+                "{} of {}{}",
+                f.pose_check.dropped,
+                f.pose_check.poses,
+                f.pose_check
+                    .examples
+                    .iter()
+                    .map(|d| format!("; at {:.3} s, {:.2} m and {:.1}° off", d.t, d.off_m, d.off_deg))
+                    .collect::<String>()
+            ),
+        ),
+        (
+            "depth frame per thermal frame within".into(),
+            format!("{:.0} ms", f.sync_tolerance_used_s * 1000.0),
         ),
         ("voxels".into(), f.voxels.to_string()),
         ("ICP refinements accepted".into(), icp_summary(f)),
+        (
+            "thermal texturing on the room model".into(),
+            s.texture.as_ref().map_or("off".into(), |t| {
+                format!(
+                    "{} frames cast, {} pixels used, {} hidden by something nearer than the model, {} texels the cloud left empty filled",
+                    t.frames,
+                    t.pixels_used,
+                    t.pixels_occluded,
+                    t.texels_filled.iter().sum::<usize>()
+                )
+            }),
+        ),
         (
             "cloud points on no surface".into(),
             format!("{:.0} %", s.unassigned_fraction * 100.0),

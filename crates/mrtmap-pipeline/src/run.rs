@@ -633,8 +633,21 @@ pub fn run(
         ));
     }
     let (fused, fusion) = fuse_stage(&rec, out, p, force, progress)?;
+    if fusion.clock.offset_s != 0.0 && !fusion.skipped.keys().any(|k| k.contains("pose")) {
+        // The recording's count was of the stamps as recorded; on the depth clock they have poses.
+        warnings.retain(|w| !w.contains("thermal frames have no pose"));
+    }
     for (why, n) in &fusion.skipped {
         warnings.push(format!("fusion skipped {n} thermal frames: {why}"));
+    }
+    if fusion.clock.weak && fusion.clock.source == mrtmap_scan::clock::OffsetSource::Estimated {
+        warnings.push(format!("fusion: {}", fusion.clock.describe()));
+    }
+    if fusion.pose_check.dropped > 0 {
+        warnings.push(format!(
+            "fusion dropped {} of {} poses that jumped away from their neighbours' motion and back (the pose source relocalising or losing track); the trajectory is interpolated across them",
+            fusion.pose_check.dropped, fusion.pose_check.poses
+        ));
     }
     let (segmented, segment) = segment_stage(&rec, out, p, force, progress)?;
     warnings.extend(

@@ -413,7 +413,14 @@ pub fn render_html(d: &ReportData) -> String {
     plain_table(
         &mut o,
         "Surfaces",
-        &["id", "kind", "T (°C)", "± (K)", "observed", "area (m²)"],
+        &[
+            "id",
+            "kind",
+            "T (°C)",
+            "± (K)",
+            "seen (by thermal texturing only; unseen)",
+            "area (m²)",
+        ],
         &d.surfaces,
     );
     plain_table(

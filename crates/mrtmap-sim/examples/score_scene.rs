@@ -1,5 +1,5 @@
 //! Scores a segmented scene.json against the truth of the simulated recording.
-//! `cargo run --release -p mrtmap-sim --example score_scene -- RECORDING SCENE.json`
+//! `cargo run --release -p mrtmap-sim --example score_scene -- RECORDING SCENE.json [--json]`
 #![allow(clippy::unwrap_used, clippy::print_stdout)]
 
 fn main() {
@@ -10,6 +10,10 @@ fn main() {
     .unwrap();
     let scene = mrtmap_radiation::RadiantScene::load(std::path::Path::new(&args[2])).unwrap();
     let s = mrtmap_sim::score_scene(&scene, &truth).unwrap();
+    if args.iter().any(|a| a == "--json") {
+        println!("{}", serde_json::to_string(&s).unwrap());
+        return;
+    }
     for x in &s.surfaces {
         println!(
             "surface {:<9} -> {:<8} angle {:6.3}° offset {:6.1} mm  ΔT {:+.3} K",

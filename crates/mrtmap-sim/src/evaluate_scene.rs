@@ -37,6 +37,12 @@ pub struct FeatureScore {
     pub iou: f64,
     /// Found − true temperature (K).
     pub temperature_error_k: Option<f64>,
+    /// The true feature's area (m²).
+    #[serde(default)]
+    pub truth_area_m2: f64,
+    /// The matched feature's area (m²).
+    #[serde(default)]
+    pub area_m2: Option<f64>,
 }
 
 /// MRT at a validation point.
@@ -63,6 +69,9 @@ pub struct SceneScore {
     pub features: Vec<FeatureScore>,
     /// Found features matching no true feature.
     pub spurious_features: Vec<String>,
+    /// Their areas (m²), in the same order.
+    #[serde(default)]
+    pub spurious_areas_m2: Vec<f64>,
     /// MRT at the validation points.
     pub points: Vec<PointScore>,
 }
@@ -151,6 +160,8 @@ fn feature_scores(
             iou: best.map_or(0.0, |b| b.0),
             temperature_error_k: best
                 .map(|(_, ff)| ff.temperature.kelvin() - tf.temperature.kelvin()),
+            truth_area_m2: t_area,
+            area_m2: best.map(|(_, ff)| polygon::area_3d(&ff.polygon)),
         });
     }
     out
@@ -228,18 +239,19 @@ pub fn score_scene(found: &RadiantScene, truth: &Truth) -> Result<SceneScore, cr
             features.extend(feature_scores(ts, fs, &mut matched_found));
         }
     }
-    let spurious = found
+    let (spurious, spurious_areas_m2) = found
         .surfaces
         .iter()
         .flat_map(|s| s.features.iter())
         .filter(|f| !matched_found.contains(&f.id))
-        .map(|f| f.id.clone())
-        .collect();
+        .map(|f| (f.id.clone(), polygon::area_3d(&f.polygon)))
+        .unzip();
     Ok(SceneScore {
         surfaces,
         corner_max_error_m: corner_error(found, &t_scene),
         features,
         spurious_features: spurious,
+        spurious_areas_m2,
         points: point_scores(found, truth)?,
     })
 }

@@ -152,6 +152,12 @@ pub fn print_run(o: &mrtmap_pipeline::run::RunOutcome, out: &std::path::Path, se
         );
     }
     print_stages(&o.stages);
+    outln!(
+        "{} of {} thermal frames fused; {}",
+        o.fusion.used_frames,
+        o.fusion.thermal_frames,
+        o.fusion.clock.describe()
+    );
     for m in &o.maps {
         print_map(&m.summary);
     }
