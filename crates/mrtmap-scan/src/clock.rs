@@ -74,6 +74,10 @@ pub struct ClockSearch {
     /// Below this relative rise of the mismatch 50 ms either side of its minimum, the offset is
     /// called weakly constrained.
     pub weak_contrast: f64,
+    /// The rise must be this many times the curve's own noise.
+    pub min_signal_to_noise: f64,
+    /// Fewer frames than this (about 3.5 s of a Lepton) give no estimate.
+    pub min_frames: usize,
 }
 
 impl Default for ClockSearch {
@@ -86,6 +90,8 @@ impl Default for ClockSearch {
             stride: 0,
             voxel_m: 0.05,
             weak_contrast: 0.05,
+            min_signal_to_noise: 8.0,
+            min_frames: 30,
         }
     }
 }
@@ -104,9 +110,13 @@ pub struct ClockReport {
     /// The mismatch's relative rise 50 ms either side of the minimum: how sharply the scan
     /// constrains the offset.
     pub contrast: f64,
-    /// Whether the scan constrains the offset only weakly (too little turning, or a minimum at
-    /// the search's edge).
+    /// Whether the scan constrains the offset only weakly (too few frames, too little turning,
+    /// a curve whose noise rivals its rise, or a minimum at the search's edge): the offset is then
+    /// not applied.
     pub weak: bool,
+    /// The weak estimate that was not applied (s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unapplied_s: Option<f64>,
 }
 
 /// One sampled frame, ready to be projected at any offset.
@@ -355,11 +365,30 @@ pub fn estimate_offset(
     } else {
         around.iter().sum::<f64>() / around.len() as f64 / best.1.max(1e-12) - 1.0
     };
-    // A minimum at the search's edge is no estimate: the stamps are left as they are.
-    report.offset_s = if at_edge { 0.0 } else { offset };
+    // The curve's own noise: the median distance of each fine sample from the mean of its two
+    // neighbours (a smooth V is straight there, except at its vertex). The rise 50 ms either side
+    // must stand well clear of it, and enough frames must have been compared.
+    let fine: Vec<[f64; 2]> = curve
+        .iter()
+        .copied()
+        .filter(|c| (c[0] - best.0).abs() <= search.coarse_step_s + 1e-9)
+        .collect();
+    let mut bumps: Vec<f64> = fine
+        .windows(3)
+        .filter(|w| (w[2][0] - w[0][0] - 2.0 * h).abs() < 1e-9)
+        .map(|w| (w[1][1] - 0.5 * (w[0][1] + w[2][1])).abs())
+        .collect();
+    bumps.sort_by(f64::total_cmp);
+    let noise = bumps.get(bumps.len() / 2).copied().unwrap_or(0.0);
+    let signal = rise * best.1;
+    let too_noisy = signal < search.min_signal_to_noise * noise;
+    let too_few = report.frames < search.min_frames;
     report.curve = curve;
     report.contrast = rise;
-    report.weak = at_edge || rise < search.weak_contrast;
+    report.weak = at_edge || too_noisy || too_few || rise < search.weak_contrast;
+    // A weak minimum is no estimate: the stamps are left as they are, and the report says so.
+    report.offset_s = if report.weak { 0.0 } else { offset };
+    report.unapplied_s = report.weak.then_some(offset);
     report
 }
 
@@ -414,20 +443,22 @@ impl ClockReport {
             OffsetSource::Estimated if self.frames < 3 => {
                 "thermal clock offset not estimated: too few frames with depth and poses; stamps used as recorded".into()
             }
-            OffsetSource::Estimated if self.weak && self.offset_s == 0.0 => format!(
-                "thermal clock offset not found within ±{:.0} ms (the frames agree best at the search's edge); stamps used as recorded: give it as [thermal] time_offset_s in rig.toml",
-                self.curve.last().map_or(250.0, |c| c[0] * 1000.0)
+            OffsetSource::Estimated if self.weak => format!(
+                "thermal clock offset not applied: the scan fixes it only weakly ({} frames compared{}; best guess {:+.0} ms); stamps used as recorded: give it as [thermal] time_offset_s in rig.toml, or scan longer with some turning",
+                self.frames,
+                if self.frames < ClockSearch::default().min_frames {
+                    ", too few"
+                } else {
+                    ""
+                },
+                self.unapplied_s.unwrap_or(0.0) * 1000.0
             ),
             OffsetSource::Estimated => format!(
-                "thermal clock offset {ms:+.1} ms, estimated from {} frames (the stamps are {:.0} ms {}); {}",
+                "thermal clock offset {ms:+.1} ms, estimated from {} frames (the stamps are {:.0} ms {}); the frames' mismatch rises {:.0} % 50 ms either side",
                 self.frames,
                 ms.abs(),
                 if ms < 0.0 { "late" } else { "early" },
-                if self.weak {
-                    format!("weakly constrained: the frames' mismatch rises only {:.1} % 50 ms either side (a scan that turns faster fixes it better)", self.contrast * 100.0)
-                } else {
-                    format!("the frames' mismatch rises {:.0} % 50 ms either side", self.contrast * 100.0)
-                }
+                self.contrast * 100.0
             ),
         }
     }

@@ -34,12 +34,28 @@ pub fn scan_seeded(
     seed: u64,
     out: &Path,
 ) -> Room {
+    scan_glass(room, noise, drift, seconds, depth_scale, seed, None, out)
+}
+
+/// [`scan_seeded`] with glass on, off or the noise level's default (`None`).
+#[allow(clippy::too_many_arguments)]
+pub fn scan_glass(
+    room: &str,
+    noise: NoiseLevel,
+    drift: Drift,
+    seconds: f64,
+    depth_scale: f64,
+    seed: u64,
+    glass: Option<bool>,
+    out: &Path,
+) -> Room {
     let mut cfg = SimConfig {
         seconds,
         noise,
         drift,
         seed,
         truth_rays: 1_000,
+        glass,
         ..SimConfig::default()
     };
     cfg.depth_camera = cfg.depth_camera.scaled(depth_scale);

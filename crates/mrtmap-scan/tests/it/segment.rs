@@ -1,6 +1,8 @@
 use mrtmap_geometry::nalgebra::Isometry3;
 use mrtmap_io::{Recording, Trajectory};
-use mrtmap_scan::segment::{MaskInput, SegmentParams, refined_poses, segment};
+use mrtmap_scan::segment::{
+    MaskInput, SegmentParams, TextureInput, refined_poses, segment_textured,
+};
 use mrtmap_sim::{Drift, NoiseLevel, SceneScore, Truth, score_scene};
 
 use crate::common::*;
@@ -27,7 +29,7 @@ fn run_seeded(
     mrtmap_scan::segment::SegmentReport,
     Isometry3<f64>,
 ) {
-    run_at(room, noise, seconds, seed, 0.5)
+    run_at(room, noise, seconds, seed, 0.5, None)
 }
 
 /// [`run_seeded`] with the depth camera's resolution scaled by `depth_scale` (every pixel at
@@ -38,6 +40,7 @@ fn run_at(
     seconds: f64,
     seed: u64,
     depth_scale: f64,
+    glass: Option<bool>,
 ) -> (
     SceneScore,
     mrtmap_scan::segment::SegmentReport,
@@ -45,13 +48,14 @@ fn run_at(
 ) {
     let dir = tempfile::tempdir().unwrap();
     let rec_dir = dir.path().join("scan");
-    scan_seeded(
+    scan_glass(
         room,
         noise,
         Drift::NONE,
         seconds,
         depth_scale,
         seed,
+        glass,
         &rec_dir,
     );
     let rec = Recording::open(&rec_dir).unwrap();
@@ -68,7 +72,21 @@ fn run_at(
         world_from_depth: &pose_fn,
     };
     let cams: Vec<Isometry3<f64>> = poses.poses.clone();
-    let seg = segment(&fused.cloud, &cams, Some(&masks), &SegmentParams::default()).unwrap();
+    // As `mrtmap run` does: the thermal frames cast onto the room model fill what the depth
+    // camera did not see (glass).
+    let texture = TextureInput {
+        recording: &rec,
+        frames: &fused.frames,
+        vignetting_k: fused.report.radiometric.vignetting_k,
+    };
+    let seg = segment_textured(
+        &fused.cloud,
+        &cams,
+        Some(&masks),
+        Some(&texture),
+        &SegmentParams::default(),
+    )
+    .unwrap();
     let truth: Truth =
         serde_json::from_str(&std::fs::read_to_string(rec_dir.join("truth.json")).unwrap())
             .unwrap();
@@ -205,11 +223,13 @@ fn the_room_frame_does_not_depend_on_where_the_walk_started() {
 }
 
 /// A walk that broke the outline before it was found from cells on the floor plan (L-shaped room,
-/// seed 5: "the walls do not close"), with realistic noise: every wall found from its own
-/// points, corners within 5 cm, MRT at A–D within 0.2 K.
+/// seed 5: "the walls do not close"), with realistic depth noise and panes that return depth:
+/// every wall found from its own points, corners within 5 cm, MRT at A–D within 0.2 K. (With
+/// glass that gives no depth the window wall keeps too few points: 47 mm and 1.75° off, corners
+/// 140 mm; docs/segmentation.md's known limits.)
 #[test]
 fn a_realistic_walk_of_another_seed_closes_the_l_shaped_outline() {
-    let (s, report, _) = run_seeded("l-shaped", NoiseLevel::Realistic, 30.0, 5);
+    let (s, report, _) = run_at("l-shaped", NoiseLevel::Realistic, 30.0, 5, 0.5, Some(false));
     closes_within("l-shaped, seed 5", &s, &report, 6);
     println!("l-shaped seed 5: {:?}", s.points);
 }
@@ -236,9 +256,12 @@ fn closes_within(
 /// full resolution: the bay closes with its three walls (its slanted walls' spread and the floor
 /// seen beyond its front wall cut it off before), corners within 5 cm, MRT at A–D within 0.2 K.
 /// (At half resolution, whose depth noise is twice as thick, the outline does not hold yet.)
+/// The window's pane returns depth here: with glass that gives no depth the bay's front wall,
+/// a 1 m wall that is half window, is not seen as a wall and is inferred at the floor's edge
+/// (docs/segmentation.md's known limits).
 #[test]
 fn a_bay_window_closes_with_its_three_walls() {
-    let (s, report, _) = run_at("bay.toml", NoiseLevel::Realistic, 30.0, 1, 1.0);
+    let (s, report, _) = run_at("bay.toml", NoiseLevel::Realistic, 30.0, 1, 1.0, Some(false));
     closes_within("bay window", &s, &report, 8);
     println!("bay window: {:?}", s.points);
 }
