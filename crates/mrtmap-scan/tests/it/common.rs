@@ -34,10 +34,12 @@ pub fn scan_seeded(
     seed: u64,
     out: &Path,
 ) -> Room {
-    scan_glass(room, noise, drift, seconds, depth_scale, seed, None, out)
+    scan_glass(room, noise, drift, seconds, depth_scale, seed, true, out)
 }
 
-/// [`scan_seeded`] with glass on, off or the noise level's default (`None`).
+/// [`scan_seeded`] with the field effects of real rigs (glass that gives no depth, late thermal
+/// stamps, the bolometer's time constant) as the noise level has them (`true`), or without them
+/// (`false`: the idealised rig of the simulator before issue 36).
 #[allow(clippy::too_many_arguments)]
 pub fn scan_glass(
     room: &str,
@@ -46,7 +48,7 @@ pub fn scan_glass(
     seconds: f64,
     depth_scale: f64,
     seed: u64,
-    glass: Option<bool>,
+    field_effects: bool,
     out: &Path,
 ) -> Room {
     let mut cfg = SimConfig {
@@ -55,9 +57,13 @@ pub fn scan_glass(
         drift,
         seed,
         truth_rays: 1_000,
-        glass,
         ..SimConfig::default()
     };
+    if !field_effects {
+        cfg.glass = Some(false);
+        cfg.thermal_lag_s = Some(0.0);
+        cfg.thermal_noise.time_constant_s = 0.0;
+    }
     cfg.depth_camera = cfg.depth_camera.scaled(depth_scale);
     // A preset, or a room of bench/rooms by its file name.
     let room = match preset(room) {
