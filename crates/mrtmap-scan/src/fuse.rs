@@ -216,6 +216,9 @@ pub struct IcpReport {
 /// Time spent per phase (s), summed over threads for the parallel phases.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Timing {
+    /// Setting the thermal clock: the pose check and the offset search (wall).
+    #[serde(default)]
+    pub clock: f64,
     /// Reading and decoding images, back-projecting depth (CPU seconds).
     pub read_cpu: f64,
     /// ICP (wall).
@@ -863,6 +866,7 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
         ..Default::default()
     };
     report.icp.enabled = params.icp.enabled;
+    let clock_s = t_start.elapsed().as_secs_f64();
     let mut fuser = Fuser {
         rec,
         params,
@@ -879,7 +883,10 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
         poses: Vec::new(),
         frames: Vec::new(),
         anchor: Vec::new(),
-        timing: Timing::default(),
+        timing: Timing {
+            clock: clock_s,
+            ..Timing::default()
+        },
         done: 0,
         calibrator: Calibrator::default(),
     };

@@ -167,6 +167,7 @@ pub fn camera_rays(cam: &PinholeCamera, ss: u32) -> Vec<Vector3<f64>> {
 /// Renders a depth image (raw units at `scale` per metre), from `rays` (see [`camera_rays`] with 1),
 /// with `noise`'s depth noise and, when given, `glass`'s glass model (each independent of the
 /// other; without it panes return depth like a wall).
+#[allow(clippy::too_many_arguments)]
 pub fn render_depth<R: Rng>(
     renderer: &RoomRenderer,
     cam: &PinholeCamera,

@@ -102,6 +102,9 @@ pub struct TextureReport {
     pub pixels_on_furniture: u64,
     /// Texels the cloud had left empty that texturing filled, per surface index.
     pub texels_filled: Vec<usize>,
+    /// Time it took (s, wall).
+    #[serde(default)]
+    pub seconds: f64,
 }
 
 /// Ray–triangle intersection (Möller–Trumbore): the distance along `d`.
@@ -219,6 +222,7 @@ pub(crate) fn texture(
     texel_m: f64,
     params: &TextureParams,
 ) -> (Textured, TextureReport) {
+    let t0 = std::time::Instant::now();
     let rec = input.recording;
     let cam: &PinholeCamera = &rec.rig.thermal;
     let (w, h) = (cam.width as usize, cam.height as usize);
@@ -339,6 +343,7 @@ pub(crate) fn texture(
         out.temp_k.push(swt / sw);
         out.pixels.push(n);
     }
+    report.seconds = t0.elapsed().as_secs_f64();
     (out, report)
 }
 
