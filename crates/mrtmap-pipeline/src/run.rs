@@ -71,10 +71,7 @@ pub fn fuse_into(
     );
     write_cloud_ply(&out.join("cloud.ply"), &fused.cloud, &comment, &[])?;
     write_json(&out.join("fusion.json"), &fused.report)?;
-    let traj = Trajectory {
-        stamps: fused.poses.iter().map(|p| p.0).collect(),
-        poses: fused.poses.iter().map(|p| p.1).collect(),
-    };
+    let traj = fused.trajectory();
     write_atomic(
         &out.join("poses.txt"),
         traj.to_tum("world_from_depth of each fused thermal frame's depth frame, after ICP")

@@ -144,15 +144,7 @@ fn samples(
         .iter()
         .enumerate()
         .filter_map(|(i, th)| {
-            let k = depth_t.partition_point(|&t| t < th.t);
-            let d = [k.checked_sub(1), (k < depth_t.len()).then_some(k)]
-                .into_iter()
-                .flatten()
-                .min_by(|&a, &b| {
-                    (depth_t[a] - th.t)
-                        .abs()
-                        .total_cmp(&(depth_t[b] - th.t).abs())
-                })?;
+            let d = crate::sync::nearest(&depth_t, th.t)?;
             let ok = (depth_t[d] - th.t).abs() <= tolerance_s
                 && traj.interpolate(depth_t[d], limits).is_some()
                 && traj.interpolate(th.t - search.range_s, limits).is_some()

@@ -335,6 +335,16 @@ struct Refinement {
     degenerate_dofs: usize,
 }
 
+impl Fused {
+    /// The refined poses as a trajectory (`poses.txt`).
+    pub fn trajectory(&self) -> mrtmap_io::Trajectory {
+        mrtmap_io::Trajectory {
+            stamps: self.poses.iter().map(|p| p.0).collect(),
+            poses: self.poses.iter().map(|p| p.1).collect(),
+        }
+    }
+}
+
 /// A prepared frame.
 struct Prepared {
     thermal_index: usize,

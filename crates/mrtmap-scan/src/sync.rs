@@ -54,15 +54,7 @@ pub fn pair_frames(
         .iter()
         .enumerate()
         .map(|(i, th)| {
-            let k = depth_t.partition_point(|&t| t < th.t);
-            let best = [k.checked_sub(1), (k < depth_t.len()).then_some(k)]
-                .into_iter()
-                .flatten()
-                .min_by(|&a, &b| {
-                    (depth_t[a] - th.t)
-                        .abs()
-                        .total_cmp(&(depth_t[b] - th.t).abs())
-                });
+            let best = nearest(&depth_t, th.t);
             let depth = match best {
                 Some(d) if (depth_t[d] - th.t).abs() <= tolerance_s => {
                     if rec.trajectory.interpolate(th.t, limits).is_some()
@@ -78,4 +70,13 @@ pub fn pair_frames(
             Pairing { thermal: i, depth }
         })
         .collect()
+}
+
+/// The index of the time in `times` (sorted) nearest `t`.
+pub(crate) fn nearest(times: &[f64], t: f64) -> Option<usize> {
+    let k = times.partition_point(|&x| x < t);
+    [k.checked_sub(1), (k < times.len()).then_some(k)]
+        .into_iter()
+        .flatten()
+        .min_by(|&a, &b| (times[a] - t).abs().total_cmp(&(times[b] - t).abs()))
 }

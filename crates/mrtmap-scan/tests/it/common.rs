@@ -21,23 +21,10 @@ pub fn scan_scaled(
     depth_scale: f64,
     out: &Path,
 ) -> Room {
-    scan_seeded(room, noise, drift, seconds, depth_scale, 1, out)
+    scan_glass(room, noise, drift, seconds, depth_scale, 1, true, out)
 }
 
-/// [`scan_scaled`] with the walk of `seed`.
-pub fn scan_seeded(
-    room: &str,
-    noise: NoiseLevel,
-    drift: Drift,
-    seconds: f64,
-    depth_scale: f64,
-    seed: u64,
-    out: &Path,
-) -> Room {
-    scan_glass(room, noise, drift, seconds, depth_scale, seed, true, out)
-}
-
-/// [`scan_seeded`] with the field effects of real rigs (glass that gives no depth, late thermal
+/// [`scan_scaled`] with the walk of `seed` and the field effects of real rigs (glass that gives no depth, late thermal
 /// stamps, the bolometer's time constant) as the noise level has them (`true`), or without them
 /// (`false`: the idealised rig of the simulator before issue 36).
 #[allow(clippy::too_many_arguments)]

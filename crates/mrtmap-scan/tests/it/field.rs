@@ -169,10 +169,7 @@ fn a_window_without_depth_is_found_by_thermal_texturing() {
     let window = room.features.iter().find(|f| f.label == "window").unwrap();
     let rec = Recording::open(&rec_dir).unwrap();
     let fused = fuse(&rec, &params(true), &|_, _| {});
-    let poses = Trajectory {
-        stamps: fused.poses.iter().map(|x| x.0).collect(),
-        poses: fused.poses.iter().map(|x| x.1).collect(),
-    };
+    let poses = fused.trajectory();
     let pose_fn = refined_poses(&rec, &poses);
     let masks = MaskInput {
         recording: &rec,

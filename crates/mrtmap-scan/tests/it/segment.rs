@@ -1,5 +1,5 @@
 use mrtmap_geometry::nalgebra::Isometry3;
-use mrtmap_io::{Recording, Trajectory};
+use mrtmap_io::Recording;
 use mrtmap_scan::segment::{
     MaskInput, SegmentParams, TextureInput, refined_poses, segment_textured,
 };
@@ -62,10 +62,7 @@ fn run_at(
     let mut p = params(true);
     p.depth.stride = if depth_scale < 1.0 { 1 } else { 2 };
     let fused = mrtmap_scan::fuse(&rec, &p, &|_, _| {});
-    let poses = Trajectory {
-        stamps: fused.poses.iter().map(|x| x.0).collect(),
-        poses: fused.poses.iter().map(|x| x.1).collect(),
-    };
+    let poses = fused.trajectory();
     let pose_fn = refined_poses(&rec, &poses);
     let masks = MaskInput {
         recording: &rec,
