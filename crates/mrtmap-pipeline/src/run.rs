@@ -200,9 +200,20 @@ pub fn segment_into(
         .world_from_room
         .to_isometry()
         .unwrap_or_else(Isometry3::identity);
+    // What the cameras saw, texturing's samples included: a contact reading on a window (glass
+    // gives no depth, so the cloud has nothing there) is compared with what texturing found.
+    let mut seen = cloud.clone();
+    seen.positions.extend_from_slice(&seg.textured.positions);
+    seen.normals.extend_from_slice(&seg.textured.normals);
+    seen.temperature_k
+        .extend_from_slice(&seg.textured.temperature_k);
+    seen.temperature_std_k
+        .extend_from_slice(&seg.textured.temperature_std_k);
+    seen.observations
+        .extend_from_slice(&seg.textured.observations);
     let found = find_level(
         &level.references,
-        &cloud,
+        &seen,
         &world_from_room,
         mean_temperature_c(&seg.scene),
         level.camera_accuracy_k,

@@ -264,6 +264,10 @@ pub struct Segmentation {
     pub surface_id: Vec<i32>,
     /// Feature index of each cloud point (−1 for none), counting features over all surfaces.
     pub feature_id: Vec<i32>,
+    /// Thermal texturing's samples (texels the cloud left empty), as points: what the camera
+    /// saw where the depth camera did not (a contact reading on a window is checked against
+    /// these). Empty without texturing.
+    pub textured: ThermalCloud,
     /// The report.
     pub report: SegmentReport,
 }
@@ -1017,10 +1021,25 @@ pub fn segment_textured(
         inferred_walls,
         texture: texture_report,
     };
+    let f32x3 = |v: [f64; 3]| [v[0] as f32, v[1] as f32, v[2] as f32];
+    let textured = ThermalCloud {
+        positions: pts.pos[cloud_points..]
+            .iter()
+            .map(|q| f32x3([q.x, q.y, q.z]))
+            .collect(),
+        normals: pts.nrm[cloud_points..]
+            .iter()
+            .map(|n| f32x3([n.x, n.y, n.z]))
+            .collect(),
+        temperature_k: pts.temp[cloud_points..].iter().map(|t| *t as f32).collect(),
+        temperature_std_k: vec![0.0; pts.pos.len() - cloud_points],
+        observations: pts.obs[cloud_points..].to_vec(),
+    };
     Ok(Segmentation {
         scene,
         surface_id,
         feature_id,
+        textured,
         report,
     })
 }
