@@ -159,7 +159,7 @@ fn min_3x3(zbuf: &[f64], w: usize, h: usize) -> Vec<f64> {
 /// An observation's weight: incidence (cosine, tapering to zero at the limit beyond 60°),
 /// distance (inverse square beyond the full-weight distance), place in the image (the edges
 /// half) and thermal contrast around the pixel (mixed pixels count less).
-fn weight(
+pub(crate) fn weight(
     cos: f64,
     distance_m: f64,
     px: &Point2<f64>,

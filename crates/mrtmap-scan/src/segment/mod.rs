@@ -300,6 +300,24 @@ struct Points {
 }
 
 impl Points {
+    /// Its points from index `first` on (texturing's samples) as a cloud.
+    fn cloud_from(&self, first: usize) -> ThermalCloud {
+        let f32x3 = |v: [f64; 3]| [v[0] as f32, v[1] as f32, v[2] as f32];
+        ThermalCloud {
+            positions: self.pos[first..]
+                .iter()
+                .map(|q| f32x3([q.x, q.y, q.z]))
+                .collect(),
+            normals: self.nrm[first..]
+                .iter()
+                .map(|n| f32x3([n.x, n.y, n.z]))
+                .collect(),
+            temperature_k: self.temp[first..].iter().map(|t| *t as f32).collect(),
+            temperature_std_k: vec![0.0; self.pos.len() - first],
+            observations: self.obs[first..].to_vec(),
+        }
+    }
+
     fn of(cloud: &ThermalCloud) -> Self {
         Self {
             pos: cloud
@@ -851,6 +869,10 @@ fn fill_from_texture(
 
 /// Segments the cloud into a radiant scene; with `texture`, the thermal frames are also cast onto
 /// the room model found, and what the cloud did not cover takes their temperatures.
+///
+/// Longer than 120 lines: it is docs/segmentation.md's steps in their order, one call each, and
+/// the state they hand on (points, members, geometry, analyses, votes) would otherwise travel in
+/// a struct that exists only to be split again (issue 38 moves the steps into files of their own).
 pub fn segment_textured(
     cloud: &ThermalCloud,
     camera_poses: &[Isometry3<f64>],
@@ -938,15 +960,56 @@ pub fn segment_textured(
         &mut warnings,
     );
     if let Some(t) = &texture_report {
-        for (summary, filled) in summaries.iter_mut().zip(&t.texels_filled) {
-            let area = *filled as f64 * p.texel_m * p.texel_m;
-            summary.textured_fraction =
-                (area / summary.area_m2.max(1e-9)).min(summary.observed_fraction);
-        }
+        t.set_fractions(&mut summaries, p.texel_m);
     }
     let mut feature_id = found.feature_id;
     feature_id.truncate(cloud_points);
     let (occluders, furniture_summaries) = build_furniture(&furniture, furniture_votes, &mut ids);
+    let world_from_room = frame.world_from_room;
+    let scene = room_scene(surfaces, occluders, &up, &world_from_room)?;
+    let inferred_walls = wall_warnings(&env, &geoms, &frame, &mut warnings);
+    let n = env.floor_corners.len();
+    let report = SegmentReport {
+        up: [up.x, up.y, up.z],
+        world_from_room: FramePose::from_isometry(&world_from_room),
+        planes: plane_rows(&env),
+        floor_corners: (0..n)
+            .map(|k| {
+                arr(&(world_from_room.inverse() * env.floor_corners[(frame.first_index + k) % n]))
+            })
+            .collect(),
+        room: frame,
+        height_m,
+        surfaces: summaries,
+        features: found.summaries,
+        furniture: furniture_summaries,
+        unassigned_fraction: unassigned as f64 / cloud_points.max(1) as f64,
+        dropped: analyses
+            .iter()
+            .flat_map(|a| a.dropped.iter().cloned())
+            .collect(),
+        masks: mask_summary,
+        warnings,
+        inferred_walls,
+        texture: texture_report,
+    };
+    let textured = pts.cloud_from(cloud_points);
+    Ok(Segmentation {
+        scene,
+        surface_id,
+        feature_id,
+        textured,
+        report,
+    })
+}
+
+/// The scene in the room's frame, from surfaces and occluders in the world's.
+fn room_scene(
+    surfaces: Vec<SurfaceFile>,
+    occluders: Vec<OccluderFile>,
+    up: &Unit<Vector3<f64>>,
+    world_from_room: &Isometry3<f64>,
+) -> Result<RadiantScene, SegmentError> {
     let in_world = SceneFile {
         format: SCENE_FORMAT.into(),
         up: Some([up.x, up.y, up.z]),
@@ -955,12 +1018,22 @@ pub fn segment_textured(
         surfaces,
         occluders,
     };
-    let world_from_room = frame.world_from_room;
     let mut in_room = in_world.transformed(&world_from_room.inverse());
     in_room.up = Some([0.0, 0.0, 1.0]);
-    in_room.world_from_room = Some(FramePose::from_isometry(&world_from_room));
-    let scene = RadiantScene::new(&in_room)?;
+    in_room.world_from_room = Some(FramePose::from_isometry(world_from_room));
+    Ok(RadiantScene::new(&in_room)?)
+}
+
+/// Walls never seen (inferred) and seen only in part, and corners outside x, y ≥ 0: warnings,
+/// each naming where the wall runs; returns the inferred walls' ids.
+fn wall_warnings(
+    env: &Envelope,
+    geoms: &[SurfaceGeom],
+    frame: &room::RoomFrame,
+    warnings: &mut Vec<String>,
+) -> Vec<String> {
     let mut inferred_walls = Vec::new();
+    let world_from_room = frame.world_from_room;
     let n_walls = env.floor_corners.len();
     // Where wall k runs, in the room's frame: from corner k to corner k + 1 (numbered as in the
     // report's corner table).
@@ -996,52 +1069,7 @@ pub fn segment_textured(
             frame.origin_corner, frame.outside_quadrant
         ));
     }
-    let n = env.floor_corners.len();
-    let report = SegmentReport {
-        up: [up.x, up.y, up.z],
-        world_from_room: FramePose::from_isometry(&world_from_room),
-        planes: plane_rows(&env),
-        floor_corners: (0..n)
-            .map(|k| {
-                arr(&(world_from_room.inverse() * env.floor_corners[(frame.first_index + k) % n]))
-            })
-            .collect(),
-        room: frame,
-        height_m,
-        surfaces: summaries,
-        features: found.summaries,
-        furniture: furniture_summaries,
-        unassigned_fraction: unassigned as f64 / cloud_points.max(1) as f64,
-        dropped: analyses
-            .iter()
-            .flat_map(|a| a.dropped.iter().cloned())
-            .collect(),
-        masks: mask_summary,
-        warnings,
-        inferred_walls,
-        texture: texture_report,
-    };
-    let f32x3 = |v: [f64; 3]| [v[0] as f32, v[1] as f32, v[2] as f32];
-    let textured = ThermalCloud {
-        positions: pts.pos[cloud_points..]
-            .iter()
-            .map(|q| f32x3([q.x, q.y, q.z]))
-            .collect(),
-        normals: pts.nrm[cloud_points..]
-            .iter()
-            .map(|n| f32x3([n.x, n.y, n.z]))
-            .collect(),
-        temperature_k: pts.temp[cloud_points..].iter().map(|t| *t as f32).collect(),
-        temperature_std_k: vec![0.0; pts.pos.len() - cloud_points],
-        observations: pts.obs[cloud_points..].to_vec(),
-    };
-    Ok(Segmentation {
-        scene,
-        surface_id,
-        feature_id,
-        textured,
-        report,
-    })
+    inferred_walls
 }
 
 /// A unit vector from an array.

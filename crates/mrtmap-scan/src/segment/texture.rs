@@ -114,6 +114,17 @@ pub struct TextureReport {
     pub seconds: f64,
 }
 
+impl TextureReport {
+    /// Each surface's share seen by texturing only (its texels filled), at most its observed share.
+    pub(crate) fn set_fractions(&self, surfaces: &mut [super::SurfaceSummary], texel_m: f64) {
+        for (summary, filled) in surfaces.iter_mut().zip(&self.texels_filled) {
+            let area = *filled as f64 * texel_m * texel_m;
+            summary.textured_fraction =
+                (area / summary.area_m2.max(1e-9)).min(summary.observed_fraction);
+        }
+    }
+}
+
 /// Ray–triangle intersection (Möller–Trumbore): the distance along `d`.
 fn ray_triangle(o: &Point3<f64>, d: &Vector3<f64>, tri: [&Point3<f64>; 3]) -> Option<f64> {
     let e1 = tri[1] - tri[0];
@@ -233,6 +244,92 @@ fn distance_to_outline(q: &Point2<f64>, poly: &[Point2<f64>]) -> f64 {
 /// Per-texel sums: (Σw, Σw·T, pixels).
 type TexelSums = HashMap<(usize, i64, i64), (f64, f64, u32)>;
 
+/// What every frame's cast shares: the model, the thermal camera's pixel rays, the settings.
+struct Caster<'a> {
+    input: &'a TextureInput<'a>,
+    surfaces: &'a [ModelSurface<'a>],
+    boxes: &'a [[Point3<f64>; 8]],
+    texel_m: f64,
+    params: &'a TextureParams,
+    rays: Vec<Vector3<f64>>,
+}
+
+impl Caster<'_> {
+    /// One frame's pixels cast onto the model: per-texel sums of the texels the cloud left empty,
+    /// and the pixels (used, hidden by something nearer, on furniture). `None` when its images
+    /// cannot be read or the thermal image is not the rig's size.
+    fn frame(&self, f: &FusedFrame) -> Option<(TexelSums, [u64; 3])> {
+        let rec = self.input.recording;
+        let cam = &rec.rig.thermal;
+        let (w, h) = (cam.width as usize, cam.height as usize);
+        let raw = rec.read_thermal(rec.thermal.get(f.thermal)?).ok()?;
+        let img = ThermalImage::from_raw(&raw, rec.rig.thermal_encoding);
+        if img.width as usize != w || img.height as usize != h {
+            return None;
+        }
+        let depth = rec.read_depth(rec.depth.get(f.depth)?).ok()?;
+        let wt = from_pose7(&f.world_from_thermal);
+        let depth_from_world = from_pose7(&f.world_from_depth).inverse();
+        let o = Point3::from(wt.translation.vector);
+        let cos_max = self.params.max_incidence_deg.to_radians().cos();
+        // The fusion's observation weights (incidence, distance, image position); mixed pixels
+        // are left out here rather than weighted.
+        let observation = crate::observe::ObservationParams::default();
+        let rmax2 = (cam.cx.powi(2) + cam.cy.powi(2)).max(1e-9);
+        let mut sums = TexelSums::new();
+        let mut counts = [0u64; 3];
+        for v in 0..h {
+            for u in 0..w {
+                let d = wt.rotation * self.rays[v * w + u];
+                let (s, t) = match cast(self.surfaces, self.boxes, &o, &d) {
+                    Some(ModelHit::Surface(s, t)) => (s, t),
+                    Some(ModelHit::Furniture) => {
+                        counts[2] += 1;
+                        continue;
+                    }
+                    None => continue,
+                };
+                let m = &self.surfaces[s];
+                let cos = m.frame.normal.dot(&d).abs();
+                if cos < cos_max || contrast(&img, u, v) > self.params.edge_drop_k {
+                    continue;
+                }
+                let x = o + d * t;
+                // The occlusion test: what the depth camera measured along its own line of
+                // sight to this point.
+                let xd = depth_from_world * x;
+                if xd.z > 0.0
+                    && let Some(px) = rec.rig.depth.project(&xd)
+                    && let Some(z) = measured_depth(&depth, rec.rig.depth_scale, px.x, px.y)
+                    && z < xd.z - (0.05 + 0.03 * xd.z + 0.0125 * xd.z * xd.z)
+                {
+                    counts[1] += 1;
+                    continue;
+                }
+                let q = m.frame.to_2d(&x);
+                let key = (
+                    ((q.x - m.texel_origin.x) / self.texel_m).floor() as i64,
+                    ((q.y - m.texel_origin.y) / self.texel_m).floor() as i64,
+                );
+                if m.covered.contains(&key) {
+                    continue;
+                }
+                let px = Point2::new(u as f64, v as f64);
+                let rho = ((px.x - cam.cx).powi(2) + (px.y - cam.cy).powi(2)) / rmax2;
+                let temp =
+                    f64::from(img.kelvin[v * w + u]) - f.offset_k - self.input.vignetting_k * rho;
+                let wgt = crate::observe::weight(cos, t, &px, 0.0, cam, &observation);
+                let e = sums.entry((s, key.0, key.1)).or_insert((0.0, 0.0, 0));
+                e.0 += wgt;
+                e.1 += wgt * temp;
+                e.2 += 1;
+                counts[0] += 1;
+            }
+        }
+        Some((sums, counts))
+    }
+}
+
 /// Casts the frames' thermal pixels onto the model; returns a sample for every texel the cloud
 /// left empty and enough pixels saw.
 pub(crate) fn texture(
@@ -243,85 +340,26 @@ pub(crate) fn texture(
     params: &TextureParams,
 ) -> (Textured, TextureReport) {
     let t0 = std::time::Instant::now();
-    let rec = input.recording;
-    let cam: &PinholeCamera = &rec.rig.thermal;
+    let cam: &PinholeCamera = &input.recording.rig.thermal;
     let (w, h) = (cam.width as usize, cam.height as usize);
-    let rays: Vec<Vector3<f64>> = (0..h)
-        .flat_map(|v| (0..w).map(move |u| (u, v)))
-        .map(|(u, v)| cam.unproject(&Point2::new(u as f64, v as f64)).normalize())
-        .collect();
-    let rmax2 = (cam.cx.powi(2) + cam.cy.powi(2)).max(1e-9);
+    let caster = Caster {
+        input,
+        surfaces,
+        boxes,
+        texel_m,
+        params,
+        rays: (0..h)
+            .flat_map(|v| (0..w).map(move |u| (u, v)))
+            .map(|(u, v)| cam.unproject(&Point2::new(u as f64, v as f64)).normalize())
+            .collect(),
+    };
     let n = input.frames.len();
     let take = params.max_frames.min(n);
     let picked: Vec<&FusedFrame> = (0..take)
         .map(|j| &input.frames[j * n / take.max(1)])
         .collect();
-    let cos_max = params.max_incidence_deg.to_radians().cos();
-    let per_frame: Vec<(TexelSums, [u64; 3])> = picked
-        .par_iter()
-        .filter_map(|f| {
-            let raw = rec.read_thermal(rec.thermal.get(f.thermal)?).ok()?;
-            let img = ThermalImage::from_raw(&raw, rec.rig.thermal_encoding);
-            if img.width as usize != w || img.height as usize != h {
-                return None;
-            }
-            let depth = rec.read_depth(rec.depth.get(f.depth)?).ok()?;
-            let wt = from_pose7(&f.world_from_thermal);
-            let depth_from_world = from_pose7(&f.world_from_depth).inverse();
-            let o = Point3::from(wt.translation.vector);
-            let mut sums = TexelSums::new();
-            let mut counts = [0u64; 3];
-            for v in 0..h {
-                for u in 0..w {
-                    let d = wt.rotation * rays[v * w + u];
-                    let (s, t) = match cast(surfaces, boxes, &o, &d) {
-                        Some(ModelHit::Surface(s, t)) => (s, t),
-                        Some(ModelHit::Furniture) => {
-                            counts[2] += 1;
-                            continue;
-                        }
-                        None => continue,
-                    };
-                    let m = &surfaces[s];
-                    let cos = m.frame.normal.dot(&d).abs();
-                    if cos < cos_max || contrast(&img, u, v) > params.edge_drop_k {
-                        continue;
-                    }
-                    let x = o + d * t;
-                    // The occlusion test: what the depth camera measured along its own line of
-                    // sight to this point.
-                    let xd = depth_from_world * x;
-                    if xd.z > 0.0
-                        && let Some(px) = rec.rig.depth.project(&xd)
-                        && let Some(z) = measured_depth(&depth, rec.rig.depth_scale, px.x, px.y)
-                        && z < xd.z - (0.05 + 0.03 * xd.z + 0.0125 * xd.z * xd.z)
-                    {
-                        counts[1] += 1;
-                        continue;
-                    }
-                    let q = m.frame.to_2d(&x);
-                    let key = (
-                        ((q.x - m.texel_origin.x) / texel_m).floor() as i64,
-                        ((q.y - m.texel_origin.y) / texel_m).floor() as i64,
-                    );
-                    if m.covered.contains(&key) {
-                        continue;
-                    }
-                    let rho = ((u as f64 - cam.cx).powi(2) + (v as f64 - cam.cy).powi(2)) / rmax2;
-                    let temp =
-                        f64::from(img.kelvin[v * w + u]) - f.offset_k - input.vignetting_k * rho;
-                    let dist_w = (2.0 / t.max(2.0)).powi(2);
-                    let wgt = cos * dist_w * (1.0 - 0.5 * rho.min(1.0));
-                    let e = sums.entry((s, key.0, key.1)).or_insert((0.0, 0.0, 0));
-                    e.0 += wgt;
-                    e.1 += wgt * temp;
-                    e.2 += 1;
-                    counts[0] += 1;
-                }
-            }
-            Some((sums, counts))
-        })
-        .collect();
+    let per_frame: Vec<(TexelSums, [u64; 3])> =
+        picked.par_iter().filter_map(|f| caster.frame(f)).collect();
     let mut report = TextureReport {
         frames: per_frame.len(),
         texels_filled: vec![0; surfaces.len()],
