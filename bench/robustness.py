@@ -16,7 +16,10 @@ and over the nodes at least 10 cm from the room's furniture (a node on a bookcas
 a place a globe can measure). With --score-scene (the mrtmap-sim example `score_scene`) each row
 also scores the features against the truth: every window found (temperature error, found area
 over true area), features of over 0.2 m² matching no true feature; and from fusion.json the
-thermal clock offset found against the truth's -(lag + time constant), and the frames used. With --keep the
+thermal clock offset found against the truth's -(lag + time constant), and the frames used. Where the
+recording has simulated contact readings, each row also gives their own error's effect on the level
+(the simulated thermometer has sigma 0.1 K, so with two readings a walk in twenty is 0.2 K off from
+the readings alone) and the grid's worst error with exact readings. With --keep the
 recordings stay in WORKDIR and a later study reuses them (only the pipeline runs again)."""
 import argparse
 import json
@@ -113,6 +116,28 @@ def features_and_clock(score_bin, rec, run):
     return out
 
 
+def reference_level(rec):
+    """What the simulated contact thermometer's own reading errors do to the level: the level
+    fit's change at temperature T (K) when the readings are replaced by the truth
+    (radiometric_truth.json's references), as a function of T (the pipeline's fit, weighted least
+    squares camera = a + b*true, is linear in the readings: two readings on temperatures 2 K or
+    more apart fix offset and gain, one (or close ones) the offset alone). None without them."""
+    try:
+        refs = json.load(open(os.path.join(rec, "radiometric_truth.json"))).get("references") or []
+    except OSError:
+        return None
+    if not refs:
+        return None
+    xs = [r["true_c"] for r in refs]
+    es = [r["temperature_c"] - r["true_c"] for r in refs]
+    mx, me = sum(xs) / len(xs), sum(es) / len(es)
+    sxx = sum((x - mx) ** 2 for x in xs)
+    if len(refs) >= 2 and max(xs) - min(xs) >= 2.0:
+        slope = sum((x - mx) * (e - me) for x, e in zip(xs, es)) / sxx
+        return lambda t: me + slope * (t - mx)
+    return lambda t: me
+
+
 def one(mrtmap, work, room, seed, noise, drift, secs, keep, camera, reuse_fusion=False,
         depth_hz=None, glass="auto", score_bin=None):
     name = f"{room_label(room)}-s{seed}-{noise}-{drift}-cam{camera}"
@@ -155,6 +180,15 @@ def one(mrtmap, work, room, seed, noise, drift, secs, keep, camera, reuse_fusion
                  if v is not None and not near]
         pts = {p["name"]: (None if v is None else round(v[0] - p["mrt_c"], 3))
                for p, v in zip(truth["points"], got[len(nodes):])}
+        level = reference_level(rec)
+        if level is not None:
+            # The grid's error with the readings' own errors taken out: what the pipeline would
+            # have given from exact contact readings (to first order: the MRT of a node moves
+            # with the level at the node's temperature).
+            exact = [(v[0] - n["mrt_c"]) - level(n["mrt_c"]) for v, n in zip(got, nodes)
+                     if v is not None]
+            row["references_level_k"] = round(level(sum(n["mrt_c"] for n in nodes) / len(nodes)), 3)
+            row["exact_refs_max_abs_k"] = max(abs(x) for x in exact) if exact else None
         row.update({
             "nodes": len(g), "refused": len(nodes) - len(g),
             "max_abs_k": max(abs(x) for x in g) if g else None,
@@ -212,6 +246,9 @@ def main():
                                 f"{row['clear_rmse_k']:.3f} K), "
                                 f"{row['refused']} nodes refused, "
                                 f"{100 * row['within_2se']:.0f} % within 2σ; " +
+                                (f"readings' own error {row['references_level_k']:+.3f} K, "
+                                 f"grid max with exact readings {row['exact_refs_max_abs_k']:.3f} K; "
+                                 if row.get("exact_refs_max_abs_k") is not None else "") +
                                 " ".join(f"{k} {v:+.3f}" if v is not None else f"{k} —"
                                          for k, v in row["points_k"].items()) +
                                 f"; clock {row['clock_error_ms']:+.1f} ms"
@@ -237,10 +274,12 @@ def main():
         rmse = max((r["rmse_k"] for r in ok), default=float("nan"))
         times = sorted(r["run_s"] for r in rs)
         cover = min((r["within_2se"] for r in ok), default=float("nan"))
+        exact = [r["exact_refs_max_abs_k"] for r in ok if r.get("exact_refs_max_abs_k") is not None]
         print(f"  {room:<16} {noise:<9} {drift:<8} {len(rs):>3} scans, {len(rs) - len(ok)} failed, "
               f"max |Δ| {worst:.3f} K, RMSE {rmse:.3f} K (clear of furniture: {clear:.3f}, "
               f"{clear_rmse:.3f} K), at least {100 * cover:.0f} % of nodes within 2σ, "
-              f"run {times[len(times) // 2]:.1f} s")
+              f"run {times[len(times) // 2]:.1f} s" +
+              (f"; with exact contact readings max |Δ| {max(exact):.3f} K" if exact else ""))
     json.dump(rows, open(os.path.join(a.work, "robustness.json"), "w"), indent=1)
 
 
