@@ -96,6 +96,9 @@ pub fn pmv_ppd(inp: &PmvInputs) -> Result<Pmv, PhysicsError> {
         -50.0,
         150.0,
     )?;
+    // The metabolic rate first: the relative air speed is derived from it (v + 0.3 (met − 1)),
+    // and `--met 50` should be refused as a metabolic rate.
+    let met = in_range("metabolic rate (met)", inp.met, 0.1, 10.0)?;
     let vr = in_range(
         "relative air speed (m/s)",
         inp.relative_air_speed_m_s,
@@ -108,7 +111,6 @@ pub fn pmv_ppd(inp: &PmvInputs) -> Result<Pmv, PhysicsError> {
         0.0,
         100.0,
     )?;
-    let met = in_range("metabolic rate (met)", inp.met, 0.1, 10.0)?;
     let clo = in_range("clothing (clo)", inp.clo, 0.0, 5.0)?;
     let wme = in_range("external work (met)", inp.external_work_met, 0.0, 10.0)?;
 

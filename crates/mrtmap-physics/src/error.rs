@@ -13,7 +13,7 @@ pub enum PhysicsError {
         value: f64,
     },
     /// An input lies outside the range where the formula applies.
-    #[error("{name} = {value} is outside the valid range {min}…{max}")]
+    #[error("{name} = {} is outside the valid range {min}…{max}", short(*value))]
     OutOfRange {
         /// The input's name.
         name: &'static str,
@@ -62,5 +62,43 @@ pub(crate) fn in_range(
         })
     } else {
         Ok(value)
+    }
+}
+
+/// A number as people write it: at most six significant digits, no trailing zeros
+/// (14.799999999999999 → "14.8").
+pub fn short(v: f64) -> String {
+    if !v.is_finite() || v == 0.0 {
+        return format!("{v}");
+    }
+    let digits = (5 - v.abs().log10().floor() as i32).clamp(0, 12) as usize;
+    let s = format!("{v:.digits$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_in_messages_are_short() {
+        assert_eq!(short(14.799999999999999), "14.8");
+        assert_eq!(short(50.0), "50");
+        assert_eq!(short(-0.00012345678), "-0.000123457");
+        assert_eq!(short(123456789.0), "123456789");
+        let e = PhysicsError::OutOfRange {
+            name: "relative air speed (m/s)",
+            value: 0.1 + 0.3 * 49.0,
+            min: 0.0,
+            max: 10.0,
+        };
+        assert_eq!(
+            e.to_string(),
+            "relative air speed (m/s) = 14.8 is outside the valid range 0…10"
+        );
     }
 }

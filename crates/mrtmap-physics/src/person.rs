@@ -32,6 +32,15 @@ impl Posture {
         }
     }
 
+    /// Height of the top of the head above the floor (m): a 1.75 m standing adult, 1.30 m
+    /// seated (ISO 7726's reference heights for the head: 1.7 and 1.1 m, plus the crown).
+    pub fn head_height_m(self) -> f64 {
+        match self {
+            Self::Seated => 1.3,
+            Self::Standing => 1.75,
+        }
+    }
+
     /// Height at which radiant asymmetry is judged: the abdomen (m; ISO 7726 / ASHRAE 55).
     pub fn abdomen_height_m(self) -> f64 {
         match self {

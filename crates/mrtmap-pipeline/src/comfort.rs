@@ -433,6 +433,7 @@ pub fn make_comfort_maps(
                 title: title.clone(),
                 unit: unit.into(),
                 values,
+                neutral: (q == Quantity::Pmv).then_some(0.0),
             }),
         };
         let png = render_png(&input)?;

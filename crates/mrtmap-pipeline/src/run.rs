@@ -614,6 +614,20 @@ pub fn check_out_dir(out: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Refuses an output folder that is the recording folder itself: the outputs would be written
+/// among its frames and lists (and a later run would read them as the recording's).
+pub fn check_out_apart(recording: &Path, out: &Path) -> Result<()> {
+    if let (Ok(a), Ok(b)) = (recording.canonicalize(), out.canonicalize())
+        && a == b
+    {
+        return Err(Error::source(
+            out,
+            "is the recording folder itself, so the outputs would be written among its frames: choose another --out (such as a folder beside it)",
+        ));
+    }
+    Ok(())
+}
+
 /// Runs fuse → segment → maps on the recording folder `recording` into `out`.
 pub fn run(
     recording: &Path,
@@ -624,6 +638,7 @@ pub fn run(
 ) -> Result<RunOutcome> {
     p.check()?;
     check_out_dir(out)?;
+    check_out_apart(recording, out)?;
     let mut rec = Recording::open(recording)?;
     let mut warnings: Vec<String> = rec
         .warnings
@@ -632,13 +647,8 @@ pub fn run(
         .map(|w| format!("recording: {w}"))
         .collect();
     let tracked = track_stage(&mut rec, out, p, force, progress)?;
-    if let Some((_, t)) = &tracked
-        && t.lost > 0
-    {
-        warnings.push(format!(
-            "tracking lost {} of {} colour frames",
-            t.lost, t.frames
-        ));
+    if let Some((_, t)) = &tracked {
+        warnings.extend(t.warnings());
     }
     let (fused, fusion) = fuse_stage(&rec, out, p, force, progress)?;
     if fusion.clock.offset_s != 0.0 && !fusion.skipped.keys().any(|k| k.contains("pose")) {

@@ -246,6 +246,29 @@ impl ComfortSection {
         {
             return Err(bad("facing_deg", f, "finite degrees"));
         }
+        // Air a room's occupants breathe: a typo (500 for 50, °F for °C) is refused, not mapped.
+        let airs = [
+            ("[air] temperature_c", air.temperature_c),
+            ("[comfort] air_temperature_c", self.air_temperature_c),
+        ]
+        .into_iter()
+        .filter_map(|(k, v)| v.map(|v| (k, v)))
+        .chain(
+            self.air_temperature_profile
+                .iter()
+                .map(|h| ("[comfort] air_temperature_profile", h[1])),
+        );
+        for (key, t) in airs {
+            if !(AIR_RANGE_C.0..=AIR_RANGE_C.1).contains(&t) {
+                return Err(Error::setting(
+                    format!("{key} = {t}"),
+                    format!(
+                        "is outside {}…{} °C, the air of a room people occupy (in °C, not °F)",
+                        AIR_RANGE_C.0, AIR_RANGE_C.1
+                    ),
+                ));
+            }
+        }
         let p = &self.air_temperature_profile;
         if p.windows(2).any(|w| w[1][0] <= w[0][0]) || p.iter().flatten().any(|x| !x.is_finite()) {
             return Err(Error::setting(
@@ -262,6 +285,9 @@ impl ComfortSection {
         Ok(())
     }
 }
+
+/// The air temperatures accepted (°C): a room people occupy.
+pub const AIR_RANGE_C: (f64, f64) = (-30.0, 60.0);
 
 /// The frame a point is given in: one choice for `--frame` and `[[points]] frame`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]

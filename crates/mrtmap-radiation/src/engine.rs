@@ -212,6 +212,25 @@ pub enum MrtError {
         /// Σ F.
         sum: f64,
     },
+    /// A person centred at the point would reach through the floor or the ceiling.
+    #[error(
+        "a {posture} person centred at ({:.2}, {:.2}, {:.2}) would have their {part} {where_}: a {posture} person's body centre is {centre_m:.2} m above their feet and {head_m:.2} m under their crown; place the centre at {centre_m:.2} m above the floor (or give a posture that fits)",
+        point[0], point[1], point[2]
+    )]
+    PersonDoesNotFit {
+        /// The body centre.
+        point: [f64; 3],
+        /// "seated" or "standing".
+        posture: &'static str,
+        /// "feet" or "head".
+        part: &'static str,
+        /// Where that part would be.
+        where_: String,
+        /// Body centre above the feet (m).
+        centre_m: f64,
+        /// Crown above the body centre (m).
+        head_m: f64,
+    },
     /// The point is not in the room.
     #[error("point ({:.2}, {:.2}, {:.2}) is {where_}: the room spans {room}", point[0], point[1], point[2])]
     OutsideRoom {

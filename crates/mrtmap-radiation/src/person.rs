@@ -155,6 +155,38 @@ impl MrtEngine<'_> {
         Ok(())
     }
 
+    /// Refuses a person whose feet (2 cm above them) or crown would lie outside the room.
+    fn check_body(
+        &self,
+        centre: &Point3<f64>,
+        posture: Posture,
+        up: &Vector3<f64>,
+    ) -> Result<(), MrtError> {
+        let (below, above) = (
+            posture.centre_height_m(),
+            posture.head_height_m() - posture.centre_height_m(),
+        );
+        for (part, q) in [
+            ("feet", centre - up * (below - 0.02)),
+            ("head", centre + up * above),
+        ] {
+            if let Err(MrtError::OutsideRoom { where_, .. }) = self.check_inside(&q) {
+                return Err(MrtError::PersonDoesNotFit {
+                    point: [centre.x, centre.y, centre.z],
+                    posture: match posture {
+                        Posture::Seated => "seated",
+                        Posture::Standing => "standing",
+                    },
+                    part,
+                    where_,
+                    centre_m: below,
+                    head_m: above,
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// Radiant temperature and its standard error from ray factors; refuses an open scene
     /// (factors short of what a closed room gives) unless open scenes are allowed.
     fn radiant_from_rays(
@@ -196,6 +228,7 @@ impl MrtEngine<'_> {
     ) -> Result<PersonMrt, MrtError> {
         self.check_place(centre)?;
         let [up, x, y] = axes(self)?;
+        self.check_body(centre, posture, &up)?;
         let hits = self.ray_hits(centre, &self.ray_settings(), stream);
         let weight = person_weight(posture, facing, up, x, y);
         let r = self.ray_factors(&hits, &weight);

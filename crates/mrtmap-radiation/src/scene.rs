@@ -559,17 +559,99 @@ impl Occluder {
         }
     }
 
-    /// Whether `p` lies inside or on a face, to a micrometre (boxes only; meshes answer false): a
-    /// point on a face has no radiant temperature (half its sphere is the furniture's inside).
+    /// Whether `p` lies inside or on a face, to a micrometre: a point on a face has no radiant
+    /// temperature (half its sphere is the furniture's inside). A box by its bounds; a closed mesh
+    /// (every edge shared by two triangles, as segmentation's furniture boxes in the room's
+    /// frame are) by the parity of a ray's crossings; an open mesh has no inside (false).
     pub fn contains(&self, p: &Point3<f64>) -> bool {
         const ON: f64 = 1e-6;
         match &self.shape {
             OccluderShape::Box { min, max } => {
                 (0..3).all(|i| p[i] >= min[i] - ON && p[i] <= max[i] + ON)
             }
-            OccluderShape::Mesh { .. } => false,
+            OccluderShape::Mesh {
+                vertices,
+                triangles,
+            } => {
+                if !closed(triangles) {
+                    return false;
+                }
+                let tris: Vec<Tri> = triangles
+                    .iter()
+                    .map(|t| [vertices[t[0]], vertices[t[1]], vertices[t[2]]])
+                    .collect();
+                if tris.iter().any(|t| distance_to_triangle(p, t) <= ON) {
+                    return true;
+                }
+                // A direction no face or edge of a room's furniture lies along.
+                let d = Vector3::new(0.5773, 0.5781, 0.5766).normalize();
+                tris.iter().filter(|t| crosses(p, &d, t)).count() % 2 == 1
+            }
         }
     }
+}
+
+/// Whether every edge of `triangles` is shared by exactly two of them.
+fn closed(triangles: &[[usize; 3]]) -> bool {
+    let mut edges: std::collections::HashMap<(usize, usize), u32> =
+        std::collections::HashMap::new();
+    for t in triangles {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            *edges.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    !edges.is_empty() && edges.values().all(|&n| n == 2)
+}
+
+/// Whether the ray from `o` along `d` crosses triangle `t` (Möller–Trumbore, t > 0).
+fn crosses(o: &Point3<f64>, d: &Vector3<f64>, t: &Tri) -> bool {
+    let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
+    let h = d.cross(&e2);
+    let a = e1.dot(&h);
+    if a.abs() < 1e-15 {
+        return false;
+    }
+    let f = 1.0 / a;
+    let s = o - t[0];
+    let u = f * s.dot(&h);
+    if !(0.0..=1.0).contains(&u) {
+        return false;
+    }
+    let q = s.cross(&e1);
+    let v = f * d.dot(&q);
+    if v < 0.0 || u + v > 1.0 {
+        return false;
+    }
+    f * e2.dot(&q) > 0.0
+}
+
+/// The distance from `p` to triangle `t`.
+fn distance_to_triangle(p: &Point3<f64>, t: &Tri) -> f64 {
+    let n = (t[1] - t[0]).cross(&(t[2] - t[0]));
+    let area2 = n.norm();
+    if area2 < 1e-18 {
+        return f64::INFINITY;
+    }
+    let n = n / area2;
+    let h = (p - t[0]).dot(&n);
+    let q = p - n * h;
+    // Inside the triangle: the distance to its plane; else to its nearest edge.
+    let inside = (0..3).all(|k| {
+        let (a, b) = (t[k], t[(k + 1) % 3]);
+        (b - a).cross(&(q - a)).dot(&n) >= 0.0
+    });
+    if inside {
+        return h.abs();
+    }
+    (0..3)
+        .map(|k| {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            let ab = b - a;
+            let s = ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
+            (p - (a + ab * s)).norm()
+        })
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// A validated radiant scene.
@@ -1212,5 +1294,44 @@ impl RadiantScene {
             }
         }
         out
+    }
+}
+
+#[cfg(test)]
+mod containment_tests {
+    use super::*;
+    use mrtmap_geometry::nalgebra::{Isometry3, Translation3, UnitQuaternion};
+
+    /// A desk 1.26 × 0.95 × 0.75 m turned 0.02° (as segmentation writes furniture: a mesh in the
+    /// room's frame): a point inside it, and one on its top, are inside; one above it, one
+    /// beside it, are not; the same triangles with one missing (an open mesh) have no inside.
+    #[test]
+    fn a_closed_mesh_contains_the_points_inside_it() {
+        let turn = Isometry3::from_parts(
+            Translation3::new(0.434, 2.546, 0.0),
+            UnitQuaternion::from_euler_angles(0.0, 0.0, 0.02f64.to_radians()),
+        );
+        let corners =
+            mrtmap_geometry::box_corners(&Point3::origin(), &Point3::new(1.26, 0.95, 0.75));
+        let vertices: Vec<Point3<f64>> = corners.iter().map(|c| turn * c).collect();
+        let triangles: Vec<[usize; 3]> = mrtmap_geometry::BOX_TRIANGLES.to_vec();
+        let desk = |triangles: Vec<[usize; 3]>| Occluder {
+            id: "desk-1".into(),
+            label: "desk".into(),
+            temperature: Temperature::from_celsius(21.2),
+            emissivity: 0.95,
+            shape: OccluderShape::Mesh {
+                vertices: vertices.clone(),
+                triangles,
+            },
+        };
+        let closed = desk(triangles.clone());
+        assert!(closed.contains(&Point3::new(1.0, 3.0, 0.4)));
+        assert!(closed.contains(&(turn * Point3::new(0.5, 0.5, 0.75))));
+        assert!(!closed.contains(&Point3::new(1.0, 3.0, 0.8)));
+        assert!(!closed.contains(&Point3::new(2.0, 3.0, 0.4)));
+        assert!(!closed.contains(&Point3::new(1.0, 1.0, 0.4)));
+        let open = desk(triangles[1..].to_vec());
+        assert!(!open.contains(&Point3::new(1.0, 3.0, 0.4)));
     }
 }

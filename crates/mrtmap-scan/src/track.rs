@@ -152,6 +152,34 @@ pub struct TrackReport {
     pub seconds: f64,
     /// Against the recording's true poses (groundtruth.txt), when it has them.
     pub accuracy: Option<TrajectoryError>,
+    /// Colour frames left out because their size is not the rig's colour camera's (a frame of
+    /// another stream or camera mode recorded among them): how many, and the first one's file
+    /// and size.
+    #[serde(default)]
+    pub wrong_size: usize,
+    /// The first wrong-size frame: its file and its width and height.
+    #[serde(default)]
+    pub wrong_size_first: Option<(String, u32, u32)>,
+}
+
+impl TrackReport {
+    /// What the user must know: frames lost, frames left out for their size.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        if self.lost > 0 {
+            out.push(format!(
+                "tracking lost {} of {} colour frames",
+                self.lost, self.frames
+            ));
+        }
+        if let Some((path, w, h)) = &self.wrong_size_first {
+            out.push(format!(
+                "{} colour frame(s) left out because their size is not the rig's colour camera's, the first {path} ({w}×{h}); check rig.toml's [colour] width and height or remove those frames from rgb.txt",
+                self.wrong_size
+            ));
+        }
+        out
+    }
 }
 
 /// Absolute trajectory error (TUM's definition: poses associated by time, rigidly aligned).
@@ -224,6 +252,8 @@ struct Features {
     /// The depth frame's points and normals in the colour camera's frame (every 4th pixel), for
     /// depth-only tracking where the corners do not suffice.
     cloud: Option<std::sync::Arc<DepthPoints>>,
+    /// The frame's size when it is not the rig's colour camera's (the frame is left out).
+    wrong_size: Option<(u32, u32)>,
 }
 
 impl Features {
@@ -826,6 +856,12 @@ pub fn track(
                 why: why.to_string(),
             })?
             .to_luma8();
+        if grey.dimensions() != (cams.colour.width, cams.colour.height) {
+            return Ok(Features {
+                wrong_size: Some(grey.dimensions()),
+                ..Features::default()
+            });
+        }
         let mut cloud = None;
         let depth = match nearest_depth(e.t) {
             Some(k) => {
@@ -873,6 +909,13 @@ pub fn track(
             .collect::<Result<_, _>>()?;
         for (i, f) in (start..end).zip(feats) {
             progress(i + 1, n);
+            if let Some((w, h)) = f.wrong_size {
+                report.wrong_size += 1;
+                report
+                    .wrong_size_first
+                    .get_or_insert_with(|| (rec.path_of(&rec.rgb[i]).display().to_string(), w, h));
+                continue;
+            }
             corners_sum += f.px.len();
             report.unsynced += f.zmap.is_none() as usize;
             let t_now = rec.rgb[i].t;

@@ -829,6 +829,9 @@ pub struct MapArgs {
     /// are mapped unless --quantity is given.
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
+    /// Air temperature (°C) for operative temperature, PMV and PPD ([air] temperature_c).
+    #[arg(long, allow_negative_numbers = true)]
+    pub air_c: Option<f64>,
     /// Output folder for mrt_grid.csv, mrt_map.png, mrt_map.svg and summary.json.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
@@ -856,7 +859,7 @@ pub struct MrtArgs {
     pub person: Option<PostureArg>,
     /// Which way the person faces, degrees from +x towards +y (0 = +x, 90 = +y); without it,
     /// any way (fp averaged over azimuth).
-    #[arg(long, allow_negative_numbers = true, requires = "person")]
+    #[arg(long, allow_negative_numbers = true, requires = "person", value_parser = parse_facing)]
     pub facing: Option<f64>,
     /// Also the plane radiant temperatures of a small element's six faces and the radiant
     /// asymmetries (vertical, and the worst horizontal pair every 15°) with ISO 7730's PD and category.
@@ -991,6 +994,16 @@ fn parse_point(s: &str) -> Result<[f64; 3], String> {
     Ok([v[0], v[1], v[2]])
 }
 
+/// A heading in degrees, any finite number, as 0…360° (400 is 40°).
+pub(crate) fn parse_facing(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(d) if d.is_finite() => Ok(d.rem_euclid(360.0)),
+        _ => Err(format!(
+            "expected a heading in degrees from +x towards +y (0 = +x, 90 = +y), got '{s}'"
+        )),
+    }
+}
+
 /// "AxB" (also "A×B") as two numbers; `bad` says what was expected.
 fn parse_pair(s: &str, bad: &dyn Fn() -> String) -> Result<(usize, usize), String> {
     let (a, b) = s.split_once(['x', 'X', '×']).ok_or_else(bad)?;
@@ -1054,5 +1067,11 @@ mod tests {
         assert_eq!(parse_mark("A=1,2"), Ok(("A".into(), vec![1.0, 2.0])));
         assert!(parse_mark("=1,2").is_err());
         assert!(parse_mark("A=1").is_err());
+        // Issue 41: NaN blamed missing walls; 400 was echoed as 400°.
+        assert_eq!(parse_facing("400"), Ok(40.0));
+        assert_eq!(parse_facing("-90"), Ok(270.0));
+        let nan = parse_facing("NaN").unwrap_err();
+        assert!(nan.contains("degrees") && nan.contains("NaN"), "{nan}");
+        assert!(parse_facing("inf").is_err());
     }
 }

@@ -179,3 +179,34 @@ fn a_person_outside_the_room_or_in_an_open_scene_is_refused() {
         .unwrap();
     assert!(ok.angle_factor_sum < 0.9);
 }
+
+/// A standing person whose body centre is 1 cm under the 2.7 m ceiling (issue 41: answered), or
+/// a seated one centred 0.3 m above the floor, does not fit: refused, naming the part and the
+/// height to use; standing at 1.0 m and seated at 0.6 m are answered.
+#[test]
+fn a_person_reaching_through_the_ceiling_or_the_floor_is_refused() {
+    let s = warm_ceiling();
+    let e = MrtEngine::new(&s, rays(4000)).unwrap();
+    let err = e
+        .person_at(
+            &Point3::new(2.5, 2.0, 2.69),
+            Posture::Standing,
+            Facing::Any,
+            0,
+        )
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("standing person") && err.contains("head") && err.contains("1.00 m"),
+        "{err}"
+    );
+    let err = e
+        .person_at(&Point3::new(2.5, 2.0, 0.3), Posture::Seated, Facing::Any, 0)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("feet") && err.contains("0.60 m"), "{err}");
+    for (z, posture) in [(1.0, Posture::Standing), (0.6, Posture::Seated)] {
+        e.person_at(&Point3::new(2.5, 2.0, z), posture, Facing::Any, 0)
+            .unwrap();
+    }
+}

@@ -65,6 +65,10 @@ pub struct MapQuantity {
     pub unit: String,
     /// Values at nodes (i, j, value); nodes without a value are left empty.
     pub values: Vec<(usize, usize, f64)>,
+    /// The value at the palette's middle, for a quantity with a neutral point (PMV: 0): the
+    /// scale is then symmetric about it, so a cool map is blue however narrow its range (a map
+    /// from −0.8 to −0.6 was drawn from blue to red).
+    pub neutral: Option<f64>,
 }
 
 /// Colour of a value `t` in 0…1 on the map's palette (blue cold → red warm).
@@ -188,8 +192,16 @@ struct Scale {
 }
 
 impl Scale {
-    /// The range of the computed nodes, widened to at least 0.1 K.
-    fn of(ok: &[Node]) -> Self {
+    /// The range of the computed nodes, widened to at least 0.1 K; with a `neutral` value,
+    /// symmetric about it (at least ±0.5).
+    fn of(ok: &[Node], neutral: Option<f64>) -> Self {
+        if let Some(n) = neutral {
+            let m = ok.iter().map(|x| (x.3 - n).abs()).fold(0.5f64, f64::max);
+            return Self {
+                vmin: n - m,
+                vmax: n + m,
+            };
+        }
         let (vmin, vmax) = ok
             .iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
@@ -849,7 +861,7 @@ fn draw<DB: DrawingBackend>(
     let body = root.margin(70, 10, 10, 10);
     let (map_area, bar_area) = body.split_horizontally(w as i32 - 20 - 140);
     let ok = nodes_of(input);
-    let scale = Scale::of(&ok);
+    let scale = Scale::of(&ok, input.quantity.as_ref().and_then(|q| q.neutral));
     let mut chart = build_chart(&map_area, input.field)?;
     draw_cells(&mut chart, input.field, &ok, scale)?;
     let contours = draw_contours(&mut chart, input, &ok, scale)?;
@@ -899,4 +911,30 @@ pub fn render_svg(input: &MapInput<'_>) -> Result<String, ReportError> {
         draw(&root, input)?;
     }
     Ok(s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A PMV map from −0.8 to −0.6 (issue 41: its −0.6 end was drawn red): with PMV's neutral 0
+    /// at the palette's middle both ends fall on the cool half; without it, the range's top
+    /// is the warm end.
+    #[test]
+    fn a_cool_pmv_map_is_coloured_cool() {
+        let nodes: Vec<Node> = [-0.8, -0.7, -0.6]
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| (i, 0, Point2::new(i as f64, 0.0), v))
+            .collect();
+        let pmv = Scale::of(&nodes, Some(0.0));
+        assert!((pmv.vmin + 0.8).abs() < 1e-12 && (pmv.vmax - 0.8).abs() < 1e-12);
+        for n in &nodes {
+            let c = palette(pmv.norm(n.3));
+            assert!(c.2 > c.0, "{} is drawn {c:?}", n.3);
+        }
+        let plain = Scale::of(&nodes, None);
+        let top = palette(plain.norm(-0.6));
+        assert!(top.0 > top.2, "{top:?}");
+    }
 }

@@ -71,6 +71,39 @@ fn a_recording_without_poses_or_colour_is_refused_naming_trajectory_txt() {
     assert!(err.contains("rgb.txt"), "{err}");
 }
 
+/// One colour frame 860 × 701 and one 160 × 120 among the rig's size (issue 41: an index out of
+/// bounds, exit 101; a small frame silently counted as lost): both are left out, counted and
+/// named, and the rest is tracked.
+#[test]
+fn colour_frames_of_another_size_are_left_out_and_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec_dir = dir.path().join("scan");
+    pose_less_walk(2.0, NoiseLevel::None, &rec_dir);
+    let rec = Recording::open(&rec_dir).unwrap();
+    let (big, small) = (rec.path_of(&rec.rgb[5]), rec.path_of(&rec.rgb[9]));
+    image::GrayImage::from_fn(860, 701, |x, y| {
+        image::Luma([((x * 7 + y * 3) % 251) as u8])
+    })
+    .save(&big)
+    .unwrap();
+    image::GrayImage::from_pixel(160, 120, image::Luma([90]))
+        .save(&small)
+        .unwrap();
+    let (_, report) = track(&rec, &TrackParams::default(), &|_, _| {}).unwrap();
+    assert_eq!(report.wrong_size, 2, "{report:?}");
+    let first = report.wrong_size_first.clone().expect("named");
+    assert_eq!((first.1, first.2), (860, 701));
+    assert!(
+        first
+            .0
+            .ends_with(big.file_name().unwrap().to_str().unwrap())
+    );
+    assert!(report.tracked + 2 + report.lost + report.unsynced >= report.frames);
+    assert!(report.tracked * 10 >= report.frames * 8, "{report:?}");
+    let w = report.warnings().join(" ");
+    assert!(w.contains("860×701") && w.contains("rig.toml"), "{w}");
+}
+
 fn icl_nuim() -> Option<PathBuf> {
     let dir = std::env::var_os("MRTMAP_DATA_DIR")
         .map(PathBuf::from)

@@ -18,6 +18,7 @@ pub fn run(a: &FuseArgs) -> anyhow::Result<()> {
         time_offset: a.time_offset.clone(),
     };
     let params = settings.params()?;
+    mrtmap_pipeline::run::check_out_apart(&a.recording, &a.out)?;
     let prepared = prepare(&a.recording, &a.out, &a.src.options())?;
     if let Some(c) = &prepared.conversion {
         print_conversion(c);

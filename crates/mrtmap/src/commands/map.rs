@@ -20,6 +20,9 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
     if !a.quantities.is_empty() {
         project.map.quantities = a.quantities.clone();
     }
+    if a.air_c.is_some() {
+        project.air.temperature_c = a.air_c;
+    }
     let person = Quantity::person(&project.map.quantities);
     project.comfort.check(&project.air, &person)?;
     let (scene, source) = load_scene(a.scene.scene.as_deref())?;

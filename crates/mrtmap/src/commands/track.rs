@@ -8,6 +8,7 @@ use crate::cli::TrackArgs;
 use crate::output::Bar;
 
 pub fn run(a: &TrackArgs) -> anyhow::Result<()> {
+    mrtmap_pipeline::run::check_out_apart(&a.recording, &a.out)?;
     let rec = Recording::open(&a.recording)?;
     for w in &rec.warnings {
         eprintln!("warning: {w}");
@@ -21,6 +22,9 @@ pub fn run(a: &TrackArgs) -> anyhow::Result<()> {
     let bar = Bar::new(" frames");
     let (traj, r) = track_into(&rec, &params, &a.out, &bar)?;
     bar.finish();
+    for w in r.warnings() {
+        eprintln!("warning: {w}");
+    }
     outln!(
         "tracked {} of {} colour frames in {:.1} s: {} keyframes, {} loop closures accepted of {} tried, {} frames lost, {} found again, {} placed by depth alone",
         r.tracked,

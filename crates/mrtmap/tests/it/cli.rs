@@ -796,3 +796,96 @@ fn validate_can_take_the_level_from_named_globe_readings() {
         "has no reading labelled 'nope' to calibrate with",
     );
 }
+
+/// Issue 41's first-contact cases that need no scan: each is refused in one sentence that names
+/// the input, or answered as it should be.
+#[test]
+fn first_contact_inputs_are_refused_or_answered_plainly() {
+    let dir = tempfile::tempdir().unwrap();
+    // A point inside a desk written as a mesh (as segmentation writes furniture) was answered.
+    let mut v: Value = serde_json::from_str(mrtmap_radiation::EXAMPLE_OFFICE_JSON).unwrap();
+    let c = |x: f64, y: f64, z: f64| serde_json::json!([x, y, z]);
+    let (lo, hi) = ([1.0, 1.0, 0.0], [2.2, 1.8, 0.75]);
+    let vertices: Vec<Value> = (0..8)
+        .map(|i| {
+            c(
+                if i & 1 == 0 { lo[0] } else { hi[0] },
+                if i & 2 == 0 { lo[1] } else { hi[1] },
+                if i & 4 == 0 { lo[2] } else { hi[2] },
+            )
+        })
+        .collect();
+    v["occluders"] = serde_json::json!([{ "id": "desk-1", "label": "desk", "temperature_c": 21.0,
+        "vertices": vertices, "triangles": mrtmap_geometry::BOX_TRIANGLES.to_vec() }]);
+    let scene = dir.path().join("mesh-desk.json");
+    std::fs::write(&scene, serde_json::to_string(&v).unwrap()).unwrap();
+    let scene = scene.to_str().unwrap();
+    fails_with(
+        &["mrt", "--scene", scene, "--at", "1.5,1.4,0.6"],
+        "inside the furniture 'desk-1'",
+    );
+    ok_json(&["mrt", "--scene", scene, "--at", "1.5,1.4,1.1", "--json"]);
+    // A standing person centred 1 cm under the ceiling.
+    fails_with(
+        &["mrt", "--at", "2,2,2.69", "--person", "standing"],
+        "would have their head",
+    );
+    // --facing NaN blamed missing walls; 400° was echoed as 400°.
+    fails_with(
+        &[
+            "mrt", "--at", "2,2,0.6", "--person", "seated", "--facing", "NaN",
+        ],
+        "expected a heading in degrees",
+    );
+    let v = ok_json(&[
+        "mrt", "--at", "2,2,0.6", "--person", "seated", "--facing", "400", "--json",
+    ]);
+    assert!(v.to_string().contains("40"), "{v}");
+    assert!(!v.to_string().contains("400"), "{v}");
+    // --met 50 was refused as a relative air speed of 14.799999999999999.
+    fails_with(
+        &["comfort", "--ta", "22", "--tr", "22", "--met", "50"],
+        "metabolic rate (met) = 50 is outside",
+    );
+    // [air] temperature_c = 500 wrote a blank PMV map.
+    let toml = dir.path().join("project.toml");
+    std::fs::write(&toml, "[air]\ntemperature_c = 500\n").unwrap();
+    let out = dir.path().join("map");
+    fails_with(
+        &[
+            "map",
+            "--config",
+            toml.to_str().unwrap(),
+            "--quantity",
+            "pmv",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        "[air] temperature_c = 500 is outside",
+    );
+    // map --air-c was suggested and did not exist.
+    let done = crate::mrtmap(&[
+        "map",
+        "--quantity",
+        "pmv",
+        "--air-c",
+        "22",
+        "--grid",
+        "4x4",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        done.status.success(),
+        "{}",
+        String::from_utf8_lossy(&done.stderr)
+    );
+    assert!(out.join("pmv.png").is_file());
+    // --out pointing at the recording itself.
+    let rec = dir.path().join("rec");
+    std::fs::create_dir_all(&rec).unwrap();
+    let r = rec.to_str().unwrap();
+    for cmd in ["run", "fuse", "track"] {
+        fails_with(&[cmd, r, "--out", r], "is the recording folder itself");
+    }
+}
