@@ -137,7 +137,15 @@ pub struct Level {
     pub std_k: f64,
     /// The readings and how each was used.
     pub references: Vec<ReferenceUse>,
+    /// What changes what the numbers mean: readings left out, a gain not fitted.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
+
+/// The largest gain error of a thermal camera that a fit may find (|β − 1|): radiometric cameras
+/// are off mostly in offset, by a few per cent in gain. Two readings implying more disagree with
+/// each other (a typo: a wall read 40 instead of 20.9 gave a gain of 0.34 and a map 17 K warm).
+pub const MAX_GAIN_ERROR: f64 = 0.1;
 
 /// The camera's fused temperature around a point (°C): within 5 cm, else 10 cm; `None` unseen.
 fn camera_at(cloud: &ThermalCloud, p: &Point3<f64>) -> Option<(f64, f64)> {
@@ -210,7 +218,19 @@ pub fn find_level(
             PointFrame::Room => world_from_room * Point3::from(r.xyz),
         };
         let seen = camera_at(cloud, &p);
-        if let Some((c, se)) = seen {
+        // A reading farther from what the camera saw there than the camera can be off (its
+        // stated accuracy, and the reading's own 3σ) is not a reading of that surface.
+        let implausible = seen.and_then(|(c, _)| {
+            let off = (c - r.temperature_c).abs();
+            (off > camera_accuracy_k + 3.0 * r.std_k).then(|| {
+                format!(
+                    "disagrees with what the camera saw there ({c:.1} °C) by {off:.1} K, more than the camera's stated accuracy ({camera_accuracy_k} K): left out; check the reading (a typo?) and its coordinates"
+                )
+            })
+        });
+        if let Some((c, se)) = seen
+            && implausible.is_none()
+        {
             pts.push((r.temperature_c, c, r.std_k.hypot(se), uses.len()));
         }
         uses.push(ReferenceUse {
@@ -218,10 +238,11 @@ pub fn find_level(
             reference_c: r.temperature_c,
             camera_c: seen.map(|s| s.0),
             residual_k: None,
-            used: seen.is_some(),
-            note: seen
-                .is_none()
-                .then(|| "the scan saw no surface within 10 cm of this point".into()),
+            used: seen.is_some() && implausible.is_none(),
+            note: implausible.or_else(|| {
+                seen.is_none()
+                    .then(|| "the scan saw no surface within 10 cm of this point".into())
+            }),
         });
     }
     let span = |p: &[(f64, f64, f64, usize)]| {
@@ -265,6 +286,15 @@ pub fn find_level(
             pts.remove(k);
         }
     }
+    let mut warnings: Vec<String> = uses
+        .iter()
+        .filter(|u| !u.used)
+        .filter_map(|u| {
+            u.note
+                .as_ref()
+                .map(|n| format!("reference '{}' ({} °C): {n}", u.label, u.reference_c))
+        })
+        .collect();
     if pts.is_empty() {
         return Level {
             basis: "camera".into(),
@@ -273,9 +303,27 @@ pub fn find_level(
             offset_at_mean_k: 0.0,
             std_k: camera_accuracy_k,
             references: uses,
+            warnings,
         };
     }
-    let ((alpha, beta, std_k), gain) = solve(&pts);
+    let ((mut alpha, mut beta, mut std_k), mut gain) = solve(&pts);
+    if gain && (beta - 1.0).abs() > MAX_GAIN_ERROR {
+        let q: Vec<(f64, f64, f64)> = pts.iter().map(|x| (x.0, x.1, x.2)).collect();
+        warnings.push(format!(
+            "the reference readings imply a camera gain of {beta:.2}, while a thermal camera's is within {:.0} % of 1: they disagree with each other, so only the offset is fitted (check the readings: a typo?)",
+            100.0 * MAX_GAIN_ERROR
+        ));
+        (alpha, beta, std_k) = fit(&q, mean_c, false);
+        // The readings disagree by more than their stated uncertainty: the offset's does too.
+        let spread = q
+            .iter()
+            .map(|x| (x.1 - alpha) - x.0)
+            .map(|r| r * r)
+            .sum::<f64>()
+            / q.len() as f64;
+        std_k = std_k.hypot(spread.sqrt());
+        gain = false;
+    }
     for u in &mut uses {
         if let Some(c) = u.camera_c {
             u.residual_k = Some((c - alpha) / beta - u.reference_c);
@@ -292,6 +340,7 @@ pub fn find_level(
         offset_at_mean_k: alpha + (beta - 1.0) * mean_c,
         std_k,
         references: uses,
+        warnings,
     }
 }
 
@@ -385,6 +434,49 @@ mod tests {
         );
         let none = find_level(&[], &c, &id, 20.0, 5.0);
         assert_eq!((none.basis.as_str(), none.std_k), ("camera", 5.0));
+    }
+
+    /// Issue 41: a wall read 40 instead of 20.9 gave a gain of 0.34 and a map 17 K warm, without a
+    /// word. A reading farther from the camera than its accuracy is left out with a warning; two
+    /// readings implying an implausible gain fit the offset alone, with a warning.
+    #[test]
+    fn a_typo_in_a_reading_is_left_out_and_an_implausible_gain_is_not_fitted() {
+        let c = cloud([10.0, 20.0, 30.0], 1.0, 1.0);
+        let id = Isometry3::identity();
+        let l = find_level(
+            &[reading("window", 0.0, 10.0), reading("wall", 5.0, 40.0)],
+            &c,
+            &id,
+            20.0,
+            5.0,
+        );
+        let wall = l.references.iter().find(|r| r.label == "wall").unwrap();
+        assert!(!wall.used, "{wall:?}");
+        assert_eq!(l.basis, "references (offset)");
+        assert!((l.correct(21.0) - 20.0).abs() < 1e-3, "{l:?}");
+        assert!(
+            l.warnings
+                .iter()
+                .any(|w| w.contains("'wall'") && w.contains("typo")),
+            "{:?}",
+            l.warnings
+        );
+        // Both within the camera's accuracy, but 5 K apart where the camera saw 10 K apart.
+        let l = find_level(
+            &[reading("window", 0.0, 12.0), reading("wall", 5.0, 17.0)],
+            &c,
+            &id,
+            20.0,
+            5.0,
+        );
+        assert_eq!(l.basis, "references (offset)", "{l:?}");
+        assert!((l.beta - 1.0).abs() < 1e-12);
+        assert!(
+            l.warnings.iter().any(|w| w.contains("gain of 2.00")),
+            "{:?}",
+            l.warnings
+        );
+        assert!(l.std_k > 1.5, "{}", l.std_k);
     }
 
     #[test]

@@ -219,6 +219,22 @@ pub fn segment_into(
         level.camera_accuracy_k,
     );
     apply_level(&mut seg.scene, &found);
+    // segment.json's tables at the same level as scene.json (the report's Surfaces and Features
+    // tables showed the camera's uncorrected temperatures beside corrected maps).
+    for x in &mut seg.report.surfaces {
+        x.temperature_c = x.temperature_c.map(|c| found.correct(c));
+        x.temperature_std_k /= found.beta.abs();
+    }
+    for f in &mut seg.report.features {
+        f.temperature_c = found.correct(f.temperature_c);
+        f.contrast_k /= found.beta;
+    }
+    for f in &mut seg.report.furniture {
+        f.temperature_c = found.correct(f.temperature_c);
+    }
+    seg.report
+        .warnings
+        .extend(found.warnings.iter().map(|w| format!("level: {w}")));
     write_json(&out.join("level.json"), &found)?;
     write_atomic(
         &out.join("scene.json"),

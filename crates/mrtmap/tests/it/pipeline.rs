@@ -491,6 +491,24 @@ fn camera_errors_are_self_calibrated_and_anchored_by_references() {
     assert_eq!(level["basis"], "references (offset and gain)", "{level}");
     let beta = level["beta"].as_f64().unwrap();
     assert!((beta - 1.02).abs() < 0.01, "gain {beta}");
+    // segment.json's tables (the report's Surfaces table) are at scene.json's level (issue 41:
+    // they showed the camera's uncorrected temperatures).
+    let seg = read_json(&run.join("segment/segment.json"));
+    let sc = read_json(&run.join("segment/scene.json"));
+    let floor_of = |v: &Value| {
+        v["surfaces"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|s| s["id"] == "floor")
+            .and_then(|s| s["temperature_c"].as_f64())
+            .unwrap()
+    };
+    let (a, b) = (floor_of(&seg), floor_of(&sc));
+    assert!(
+        (a - b).abs() < 1e-6,
+        "segment.json floor {a} °C, scene.json {b} °C"
+    );
     // MRT at the validation points against the truth.
     let t = read_json(&with.join("truth.json"));
     let scene = run.join("segment/scene.json");
