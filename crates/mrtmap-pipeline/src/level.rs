@@ -2,8 +2,11 @@
 //! camera's offset (one reading) and gain (two or more on different temperatures); without any,
 //! the level is the camera's and its stated absolute accuracy goes into every ±.
 //!
-//! A recording may hold `references.csv` (`label,x,y,z,temperature_c[,std_k]`, x, y, z in the frame
-//! of trajectory.txt; `#` comments); project.toml may add `[[references]]` (room frame by default).
+//! A recording may hold `references.csv` (`label,x,y,z,temperature_c[,std_k][,frame]`; x, y, z
+//! in the room frame, what a person with a tape measures from the origin corner, unless `frame`
+//! says `scan`, the frame of trajectory.txt; `#` comments); project.toml may add
+//! `[[references]]` (room frame by default). Room-frame readings are placed once segmentation has
+//! found the room frame, as `[[points]]` are.
 //! The camera's reading at a reference is the fused cloud's around it (within 5 cm, else 10 cm).
 //! The fit is weighted least squares camera = α + β·true; with three or more readings, the one whose
 //! leave-one-out residual is largest beyond max(3σ, 0.5 K) (judged against an offset alone, with
@@ -70,7 +73,7 @@ pub fn read_references(path: &Path) -> Result<Vec<Reference>> {
                     return Err(bad(
                         k + 1,
                         format!(
-                            "the header has no column '{need}' (needs label,x,y,z,temperature_c and optionally std_k)"
+                            "the header has no column '{need}' (needs label,x,y,z,temperature_c and optionally std_k and frame)"
                         ),
                     ));
                 }
@@ -93,12 +96,24 @@ pub fn read_references(path: &Path) -> Result<Vec<Reference>> {
         if !(std_k > 0.0 && std_k < 50.0) {
             return Err(bad(k + 1, format!("std_k {std_k} is outside 0…50 K")));
         }
+        let frame = match col("frame").map(|f| f.to_lowercase()).as_deref() {
+            None | Some("") | Some("room") => PointFrame::Room,
+            Some("scan") => PointFrame::Scan,
+            Some(other) => {
+                return Err(bad(
+                    k + 1,
+                    format!(
+                        "frame '{other}' is neither room (x, y along the floor from the room frame's origin corner, z above the floor) nor scan (the frame of trajectory.txt)"
+                    ),
+                ));
+            }
+        };
         out.push(Reference {
             label: col("label").map_or(String::new(), |s| s.to_string()),
             xyz: [num("x")?, num("y")?, num("z")?],
             temperature_c: num("temperature_c")?,
             std_k,
-            frame: PointFrame::Scan,
+            frame,
         });
     }
     Ok(out)
@@ -500,7 +515,22 @@ mod tests {
         let r = read_references(&p).unwrap();
         assert_eq!(
             (r[0].xyz, r[0].std_k, r[0].frame),
-            ([1.0, 2.0, 3.0], 0.05, PointFrame::Scan)
+            ([1.0, 2.0, 3.0], 0.05, PointFrame::Room)
         );
+        // The recording format's example: the room frame by default, or as the column says.
+        std::fs::write(
+            &p,
+            "label,x,y,z,temperature_c,frame\nfloor,1.83,0.42,0.00,20.6,room\nwall x0,-1.30,0.95,0.41,21.0,scan\nw,1,2,3,20,\n",
+        )
+        .unwrap();
+        let r = read_references(&p).unwrap();
+        let frames: Vec<PointFrame> = r.iter().map(|x| x.frame).collect();
+        assert_eq!(
+            frames,
+            [PointFrame::Room, PointFrame::Scan, PointFrame::Room]
+        );
+        std::fs::write(&p, "label,x,y,z,temperature_c,frame\nw,1,2,3,20,world\n").unwrap();
+        let e = read_references(&p).unwrap_err().to_string();
+        assert!(e.contains(":2: frame 'world' is neither room"), "{e}");
     }
 }

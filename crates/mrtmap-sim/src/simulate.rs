@@ -608,12 +608,12 @@ fn write_camera_truth(
     let refs = reference_readings(room, cfg.references, cfg.reference_std_k, cfg.seed);
     if !refs.is_empty() {
         let mut csv = String::from(
-            "# contact-thermometer readings of surface points (x, y, z in the frame of trajectory.txt)\nlabel,x,y,z,temperature_c,std_k\n",
+            "# contact-thermometer readings of surface points (x, y, z in the frame of trajectory.txt: frame scan)\nlabel,x,y,z,temperature_c,std_k,frame\n",
         );
         for r in &refs {
             let p = world_from_room * Point3::from(r.xyz_room);
             csv.push_str(&format!(
-                "{},{:.4},{:.4},{:.4},{:.3},{}\n",
+                "{},{:.4},{:.4},{:.4},{:.3},{},scan\n",
                 r.label, p.x, p.y, p.z, r.temperature_c, r.std_k
             ));
         }

@@ -559,9 +559,10 @@ pub struct SegmentArgs {
     /// by default the start of the longest wall with the room at x, y ≥ 0.
     #[arg(long, value_name = "N")]
     pub origin_corner: Option<usize>,
-    /// Contact-thermometer readings (label,x,y,z,temperature_c[,std_k], x, y, z in the frame of
-    /// trajectory.txt) that fix the temperatures' absolute level (one: offset; two or more on
-    /// different temperatures: gain too).
+    /// Contact-thermometer readings (label,x,y,z,temperature_c[,std_k][,frame]; x, y, z in the
+    /// room frame unless the frame column says scan, the frame of trajectory.txt) that fix the
+    /// temperatures' absolute level (one: offset; two or more on different temperatures: gain
+    /// too).
     #[arg(long, value_name = "CSV")]
     pub references: Option<PathBuf>,
 }

@@ -509,6 +509,59 @@ fn camera_errors_are_self_calibrated_and_anchored_by_references() {
         (a - b).abs() < 1e-6,
         "segment.json floor {a} °C, scene.json {b} °C"
     );
+    // The same readings in the room's frame (references.csv's default: what a tape measures),
+    // placed after segmentation: the camera's readings there are the same.
+    use mrtmap_geometry::nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion};
+    let w = &sc["world_from_room"];
+    let f = |k: &str, i: usize| w[k][i].as_f64().unwrap();
+    let world_from_room = Isometry3::from_parts(
+        Translation3::new(
+            f("translation", 0),
+            f("translation", 1),
+            f("translation", 2),
+        ),
+        UnitQuaternion::from_quaternion(Quaternion::new(
+            f("rotation_xyzw", 3),
+            f("rotation_xyzw", 0),
+            f("rotation_xyzw", 1),
+            f("rotation_xyzw", 2),
+        )),
+    );
+    let csv = std::fs::read_to_string(with.join("references.csv")).unwrap();
+    assert!(csv.contains(",frame\n"), "{csv}");
+    let mut room_csv = String::from("label,x,y,z,temperature_c,std_k\n");
+    for line in csv.lines().filter(|l| l.ends_with(",scan")) {
+        let c: Vec<&str> = line.split(',').collect();
+        let p: Vec<f64> = c[1..4].iter().map(|v| v.parse().unwrap()).collect();
+        let q = world_from_room.inverse() * Point3::new(p[0], p[1], p[2]);
+        room_csv += &format!("{},{},{},{},{},{}\n", c[0], q.x, q.y, q.z, c[4], c[5]);
+    }
+    let room_refs = dir.path().join("room-references.csv");
+    std::fs::write(&room_refs, room_csv).unwrap();
+    let again = dir.path().join("segment-room");
+    ok(&[
+        "segment",
+        run.join("fuse").to_str().unwrap(),
+        "--recording",
+        with.to_str().unwrap(),
+        "--references",
+        room_refs.to_str().unwrap(),
+        "--out",
+        again.to_str().unwrap(),
+    ]);
+    let room_level = read_json(&again.join("level.json"));
+    let refs = level["references"].as_array().unwrap();
+    assert_eq!(refs.len(), 2);
+    for (x, y) in refs
+        .iter()
+        .zip(room_level["references"].as_array().unwrap())
+    {
+        let (cx, cy) = (
+            x["camera_c"].as_f64().unwrap(),
+            y["camera_c"].as_f64().unwrap(),
+        );
+        assert!((cx - cy).abs() < 1e-6, "{x} vs {y}");
+    }
     // MRT at the validation points against the truth.
     let t = read_json(&with.join("truth.json"));
     let scene = run.join("segment/scene.json");
