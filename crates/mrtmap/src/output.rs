@@ -67,14 +67,32 @@ impl Bar {
     }
 }
 
+impl Bar {
+    /// The counts shown now (done, of).
+    #[cfg(test)]
+    fn counts(&self) -> (u64, u64) {
+        (self.0.position(), self.0.length().unwrap_or(0))
+    }
+}
+
 impl mrtmap_pipeline::Progress for Bar {
     fn begin(&self, what: &str) {
+        // A new stage starts empty: the last stage's count under a new length read "522/1".
+        self.0.set_position(0);
+        self.0.set_length(0);
         self.0.set_message(what.to_string());
     }
 
     fn advance(&self, done: u64, total: u64) {
-        self.0.set_length(total);
-        self.0.set_position(done);
+        // Position first when it falls, length first when it grows: never more done than in all.
+        let done = done.min(total);
+        if done < self.0.position() {
+            self.0.set_position(done);
+            self.0.set_length(total);
+        } else {
+            self.0.set_length(total);
+            self.0.set_position(done);
+        }
     }
 }
 
@@ -232,5 +250,26 @@ pub fn print_missing(missing: &[String]) {
         for m in missing {
             outln!("  - {m}");
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mrtmap_pipeline::Progress;
+
+    /// Issue 41: after fusing 522 frames the next stage's bar read "522/1".
+    #[test]
+    fn a_new_stage_starts_its_bar_empty() {
+        let bar = Bar::new(" frames");
+        bar.begin("fusing");
+        bar.advance(522, 522);
+        assert_eq!(bar.counts(), (522, 522));
+        bar.begin("segmenting");
+        assert_eq!(bar.counts(), (0, 0));
+        bar.advance(0, 1);
+        assert_eq!(bar.counts(), (0, 1));
+        bar.advance(5, 3);
+        assert_eq!(bar.counts(), (3, 3));
     }
 }
