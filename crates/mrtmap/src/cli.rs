@@ -383,12 +383,13 @@ pub struct RunArgs {
 /// `mrtmap demo`.
 #[derive(Debug, Args)]
 pub struct DemoArgs {
-    /// Output folder (the recording goes in DIR/recording, the run in DIR/run); about 450 MB for
-    /// the default 60 s scan, 2.4 GB with --full. The default folder is git-ignored in mrtmap's
+    /// Output folder (the recording goes in DIR/recording, the run in DIR/run); about 580 MB for
+    /// the default 60 s scan, 160 MB for 15 s, 3 GB with --full. The default folder is git-ignored in mrtmap's
     /// own repository.
     #[arg(long, value_name = "DIR", default_value = "mrtmap-demo")]
     pub out: PathBuf,
-    /// Length of the simulated scan (s).
+    /// Length of the simulated scan (s): 15 at least (a shorter walk has not seen the whole
+    /// room).
     #[arg(long, default_value_t = 60.0)]
     pub seconds: f64,
     /// Simulate the seed paper's full 343 s scan (overrides --seconds).

@@ -889,3 +889,16 @@ fn first_contact_inputs_are_refused_or_answered_plainly() {
         fails_with(&[cmd, r, "--out", r], "is the recording folder itself");
     }
 }
+
+/// Issue 41: `demo --seconds 10` failed after 34 s ("the room's outline does not close"); it is
+/// refused at once, saying the shortest walk.
+#[test]
+fn a_demo_too_short_to_see_the_room_is_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("demo");
+    fails_with(
+        &["demo", "--seconds", "10", "--out", out.to_str().unwrap()],
+        "--seconds 10 is outside 15…3600",
+    );
+    assert!(!out.exists());
+}
