@@ -266,7 +266,7 @@ impl Walk {
     }
 
     /// One loop's duration (s).
-    fn loop_time(&self) -> f64 {
+    pub fn loop_time(&self) -> f64 {
         self.perimeter / self.params.speed_m_s
     }
 
@@ -299,6 +299,42 @@ impl Walk {
             }
             all == 0 || ok as f64 >= CENTROID_COVERAGE * all as f64
         })
+    }
+
+    /// How long (s) the walk takes until every wall has been in view (the plan's test of
+    /// [`Self::faces_the_centroid`], sweeps left out, on the headings the walk takes); `None`
+    /// when not within `max_s`.
+    pub fn seconds_to_see_every_wall(&self, max_s: f64) -> Option<f64> {
+        let points = wall_points(&self.plan);
+        let mut seen = vec![0u32; points.len()];
+        let covered = |seen: &[u32]| {
+            (0..self.plan.len()).all(|wall| {
+                let (mut all, mut ok) = (0usize, 0usize);
+                for (w, s) in points.iter().zip(seen) {
+                    if w.wall == wall {
+                        all += 1;
+                        ok += usize::from(*s >= CENTROID_STEPS);
+                    }
+                }
+                all == 0 || ok as f64 >= CENTROID_COVERAGE * all as f64
+            })
+        };
+        let steps = (max_s / PLAN_STEP_S).ceil() as usize;
+        for k in 0..=steps {
+            let t = k as f64 * PLAN_STEP_S;
+            let (p, yaw) = (self.position(t), self.heading_at(t));
+            for (j, bearing) in visible(&self.plan, &points, p) {
+                if wrapped(bearing, yaw).abs() <= PLAN_HALF_FOV
+                    && (points[j].at - p).norm() <= CENTROID_RANGE_M
+                {
+                    seen[j] += 1;
+                }
+            }
+            if covered(&seen) {
+                return Some(t);
+            }
+        }
+        None
     }
 
     /// The heading every [`PLAN_STEP_S`] over [`HEADING_SPAN_S`], planned for coverage: at each
