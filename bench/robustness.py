@@ -5,6 +5,7 @@ pipeline, and compare the map with the truth.
     robustness.py MRTMAP WORKDIR [--rooms office,l-shaped,radiant-ceiling] [--seeds 1-10]
                   [--noise realistic,none] [--drift none] [--seconds 60]
                   [--camera-errors auto|none|realistic] [--depth-hz 30] [--glass auto|on|off]
+                  [--thermal-lag-ms MS] [--thermal-time-constant-ms MS]
                   [--score-scene BIN] [--keep]
 
 Prints one row per scan and a summary per room and noise; writes WORKDIR/robustness.json. Each
@@ -139,12 +140,16 @@ def reference_level(rec):
 
 
 def one(mrtmap, work, room, seed, noise, drift, secs, keep, camera, reuse_fusion=False,
-        depth_hz=None, glass="auto", score_bin=None):
+        depth_hz=None, glass="auto", score_bin=None, lag_ms=None, tau_ms=None):
     name = f"{room_label(room)}-s{seed}-{noise}-{drift}-cam{camera}"
     if depth_hz:
         name += f"-d{depth_hz}"
     if glass != "auto":
         name += f"-glass{glass}"
+    if lag_ms is not None:
+        name += f"-lag{lag_ms:g}"
+    if tau_ms is not None:
+        name += f"-tau{tau_ms:g}"
     rec, run = os.path.join(work, name), os.path.join(work, name + ".run")
     row = {"room": room_label(room), "seed": seed, "noise": noise, "drift": drift,
            "camera_errors": camera}
@@ -152,6 +157,8 @@ def one(mrtmap, work, room, seed, noise, drift, secs, keep, camera, reuse_fusion
     if not os.path.exists(os.path.join(rec, "truth.json")):
         shutil.rmtree(rec + ".partial", ignore_errors=True)
         extra = (["--depth-hz", str(depth_hz)] if depth_hz else []) + ["--glass", glass]
+        extra += ["--thermal-lag-ms", str(lag_ms)] if lag_ms is not None else []
+        extra += ["--thermal-time-constant-ms", str(tau_ms)] if tau_ms is not None else []
         subprocess.run([mrtmap, "simulate", "--room", room, "--seed", str(seed), "--noise", noise,
                         "--drift", drift, "--camera-errors", camera, "--seconds", str(secs),
                         "--out", rec] + extra,
@@ -222,6 +229,10 @@ def main():
     ap.add_argument("--depth-hz", type=float, default=None,
                     help="the simulated depth camera's frame rate (default: the simulator's 30 Hz)")
     ap.add_argument("--glass", default="auto", help="the simulator's glass: auto, on, off")
+    ap.add_argument("--thermal-lag-ms", type=float, default=None,
+                    help="the thermal stamps' lag (default: the simulator's, drawn with realistic noise)")
+    ap.add_argument("--thermal-time-constant-ms", type=float, default=None,
+                    help="the bolometer's time constant (default: the simulator's)")
     ap.add_argument("--score-scene", default=None,
                     help="the mrtmap-sim example score_scene, to score features against the truth")
     ap.add_argument("--keep", action="store_true")
@@ -236,7 +247,7 @@ def main():
                 for seed in seeds(a.seeds):
                     row = one(a.mrtmap, a.work, room, seed, noise, drift, a.seconds, a.keep,
                               a.camera_errors, a.reuse_fusion, a.depth_hz, a.glass,
-                              a.score_scene)
+                              a.score_scene, a.thermal_lag_ms, a.thermal_time_constant_ms)
                     rows.append(row)
                     if "error" in row:
                         desc = "FAILED: " + row["error"]
