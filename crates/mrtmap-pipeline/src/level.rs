@@ -53,6 +53,11 @@ fn default_std() -> f64 {
 /// Reads `references.csv`; errors name the file and line.
 pub fn read_references(path: &Path) -> Result<Vec<Reference>> {
     let text = std::fs::read_to_string(path).map_err(|e| mrtmap_io::FileError::io(path, e))?;
+    parse_references(&text, path)
+}
+
+/// Parses references.csv text; errors name `path` and the line.
+pub fn parse_references(text: &str, path: &Path) -> Result<Vec<Reference>> {
     let bad = |line: usize, msg: String| Error::Config {
         path: path.to_path_buf(),
         line,

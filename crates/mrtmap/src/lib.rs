@@ -26,3 +26,14 @@ pub fn report_error(e: &anyhow::Error) -> ExitCode {
     eprintln!("error: {e:#}");
     ExitCode::FAILURE
 }
+
+/// Ctrl-C: says what is left (outputs are written whole or not at all, and finished stages are
+/// reused), then exits as a shell expects of an interrupted program (130).
+pub fn on_interrupt_say_what_is_left() {
+    let _ = ctrlc::set_handler(|| {
+        eprintln!(
+            "\ninterrupted: every file already written is complete (outputs are written whole or not at all); run the same command again and the stages that finished are reused"
+        );
+        std::process::exit(130);
+    });
+}

@@ -2,4 +2,5 @@
 //! through the trait, stages reused while their inputs are unchanged.
 #![allow(clippy::unwrap_used)]
 
+mod inputs;
 mod run;

@@ -864,7 +864,7 @@ fn first_contact_inputs_are_refused_or_answered_plainly() {
         "[air] temperature_c = 500 is outside",
     );
     // map --air-c was suggested and did not exist.
-    let done = crate::mrtmap(&[
+    let done = mrtmap(&[
         "map",
         "--quantity",
         "pmv",
@@ -901,4 +901,32 @@ fn a_demo_too_short_to_see_the_room_is_refused_at_once() {
         "--seconds 10 is outside 15…3600",
     );
     assert!(!out.exists());
+}
+
+/// Issue 41: Ctrl-C ended a run without a word. Interrupted, the program says what is left and
+/// exits with 130, as a shell expects.
+#[cfg(unix)]
+#[test]
+fn ctrl_c_says_what_is_left() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("demo");
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_mrtmap"))
+        .args(["demo", "--seconds", "15", "--out", out.to_str().unwrap()])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let sent = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(sent.success());
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(130), "{err}");
+    assert!(
+        err.contains("interrupted: every file already written is complete"),
+        "{err}"
+    );
 }
