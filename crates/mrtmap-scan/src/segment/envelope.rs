@@ -252,14 +252,31 @@ fn floor_and_ceiling(
         .iter()
         .map(|f| height(&mean_of(cloud.points, &f.inliers), &up0))
         .collect();
-    let floor = *big
-        .iter()
-        .min_by(|&&a, &&b| heights[a].total_cmp(&heights[b]))
-        .ok_or(SegmentError::NoFloor)?;
     let ceiling = *big
         .iter()
         .max_by(|&&a, &&b| heights[a].total_cmp(&heights[b]))
         .ok_or(SegmentError::NoCeiling)?;
+    // The floor: the lowest large plane among those at least 1.5 m under the ceiling, "large"
+    // judged against them alone. A short walk that looks up more than down sees the floor less
+    // than a fifth as much as the ceiling; judged against the ceiling, the floor was then not
+    // large, the ceiling was both, and the scan was refused for want of a ceiling.
+    let below: Vec<usize> = horizontal
+        .iter()
+        .copied()
+        .filter(|&k| heights[k] <= heights[ceiling] - 1.5)
+        .collect();
+    let largest_below = below.iter().map(|&k| planes[k].points).max().unwrap_or(0);
+    let floor = below
+        .iter()
+        .copied()
+        .filter(|&k| planes[k].points * 5 >= largest_below)
+        .min_by(|&a, &b| heights[a].total_cmp(&heights[b]))
+        .or_else(|| {
+            big.iter()
+                .copied()
+                .min_by(|&a, &b| heights[a].total_cmp(&heights[b]))
+        })
+        .ok_or(SegmentError::NoFloor)?;
     if floor == ceiling || heights[ceiling] - heights[floor] < 1.5 {
         return Err(SegmentError::NoCeiling);
     }
@@ -711,6 +728,18 @@ mod tests {
             weighted.iter().all(|z| (z + 0.2 / 95.0).abs() < 1e-6),
             "weighted by observations: {weighted:?}"
         );
+    }
+
+    /// A short walk that looked up more than down: the floor holds an eighth of the ceiling's
+    /// points. It was not "large" against the ceiling, which became floor and ceiling at once, and
+    /// the scan was refused for want of a ceiling.
+    #[test]
+    fn a_floor_seen_far_less_than_the_ceiling_is_still_the_floor() {
+        let (pts, mut planes) = box_room(&[]);
+        planes[0].inliers = planes[0].inliers.iter().step_by(8).copied().collect();
+        planes[0].points = planes[0].inliers.len();
+        assert!(planes[0].points * 5 < planes[1].points);
+        corners_are_the_box(&envelope_of(&pts, planes), 1e-3);
     }
 
     #[test]

@@ -108,11 +108,13 @@ pub enum SegmentError {
     #[error("no camera poses to estimate up from (poses.txt of the fusion is empty)")]
     NoPoses,
     /// No horizontal plane below the rest.
-    #[error("no floor found: no large horizontal plane (is the floor in the scan?)")]
+    #[error(
+        "no floor found: no large horizontal plane; scan again tilting the camera down to the floor every few seconds as you walk (a scan must see the floor, the ceiling and every wall: about one slow loop of the room)"
+    )]
     NoFloor,
     /// No ceiling.
     #[error(
-        "no ceiling found: no large horizontal plane at least 1.5 m above the floor (is the ceiling in the scan?)"
+        "no ceiling found: no large horizontal plane at least 1.5 m above the floor; scan again tilting the camera up to the ceiling every few seconds as you walk (a scan must see the floor, the ceiling and every wall: about one slow loop of the room)"
     )]
     NoCeiling,
     /// No walls.
