@@ -35,7 +35,9 @@ pub use plane::{Plane, RansacParams, intersect_three, ransac_plane};
 pub use polygon::{Containment, NotSimple, PlaneFrame};
 #[cfg(feature = "embree")]
 pub use ray::EmbreeRayCaster;
-pub use ray::{BOX_TRIANGLES, BvhRayCaster, RayCaster, RayHit, Tri, box_corners, box_triangles};
+pub use ray::{
+    BOX_TRIANGLES, BvhRayCaster, RayCaster, RayHit, Tri, box_corners, box_triangles, ray_triangle,
+};
 pub use sampling::DirectionSet;
 pub use solid_angle::{
     clip_polygon_to_halfspace, plane_view_factor, polygon_solid_angle, sphere_view_factor,

@@ -270,6 +270,31 @@ pub fn box_corners(min: &Point3<f64>, max: &Point3<f64>) -> [Point3<f64>; 8] {
     })
 }
 
+/// Ray–triangle intersection (Möller–Trumbore): the distance along `d` (beyond 1e-6), if the ray
+/// meets the triangle (either side).
+pub fn ray_triangle(o: &Point3<f64>, d: &Vector3<f64>, tri: [&Point3<f64>; 3]) -> Option<f64> {
+    let e1 = tri[1] - tri[0];
+    let e2 = tri[2] - tri[0];
+    let p = d.cross(&e2);
+    let det = e1.dot(&p);
+    if det.abs() < 1e-12 {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = o - tri[0];
+    let u = s.dot(&p) * inv;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let q = s.cross(&e1);
+    let v = d.dot(&q) * inv;
+    if v < 0.0 || u + v > 1.0 {
+        return None;
+    }
+    let t = e2.dot(&q) * inv;
+    (t > 1e-6).then_some(t)
+}
+
 /// The twelve triangles of a box as indices into [`box_corners`], facing outwards.
 pub const BOX_TRIANGLES: [[usize; 3]; 12] = {
     // Faces as quads of corner indices, each split along its first diagonal.

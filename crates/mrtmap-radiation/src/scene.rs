@@ -585,7 +585,11 @@ impl Occluder {
                 }
                 // A direction no face or edge of a room's furniture lies along.
                 let d = Vector3::new(0.5773, 0.5781, 0.5766).normalize();
-                tris.iter().filter(|t| crosses(p, &d, t)).count() % 2 == 1
+                tris.iter()
+                    .filter(|t| mrtmap_geometry::ray_triangle(p, &d, [&t[0], &t[1], &t[2]]).is_some())
+                    .count()
+                    % 2
+                    == 1
             }
         }
     }
@@ -602,28 +606,6 @@ fn closed(triangles: &[[usize; 3]]) -> bool {
         }
     }
     !edges.is_empty() && edges.values().all(|&n| n == 2)
-}
-
-/// Whether the ray from `o` along `d` crosses triangle `t` (Möller–Trumbore, t > 0).
-fn crosses(o: &Point3<f64>, d: &Vector3<f64>, t: &Tri) -> bool {
-    let (e1, e2) = (t[1] - t[0], t[2] - t[0]);
-    let h = d.cross(&e2);
-    let a = e1.dot(&h);
-    if a.abs() < 1e-15 {
-        return false;
-    }
-    let f = 1.0 / a;
-    let s = o - t[0];
-    let u = f * s.dot(&h);
-    if !(0.0..=1.0).contains(&u) {
-        return false;
-    }
-    let q = s.cross(&e1);
-    let v = f * d.dot(&q);
-    if v < 0.0 || u + v > 1.0 {
-        return false;
-    }
-    f * e2.dot(&q) > 0.0
 }
 
 /// The distance from `p` to triangle `t`.

@@ -275,36 +275,14 @@ impl Walk {
     /// are within [`PLAN_HALF_FOV`] of the heading, [`CENTROID_RANGE_M`] of the walker and in
     /// sight for [`CENTROID_STEPS`] steps or more.
     pub fn faces_the_centroid(&self) -> bool {
-        let points = wall_points(&self.plan);
-        let mut seen = vec![0u32; points.len()];
         let steps = (self.loop_time() / PLAN_STEP_S).ceil() as usize;
-        for k in 0..steps {
-            let t = k as f64 * PLAN_STEP_S;
-            let (p, yaw) = (self.position(t), self.target_heading(t));
-            for (j, bearing) in visible(&self.plan, &points, p) {
-                if wrapped(bearing, yaw).abs() <= PLAN_HALF_FOV
-                    && (points[j].at - p).norm() <= CENTROID_RANGE_M
-                {
-                    seen[j] += 1;
-                }
-            }
-        }
-        (0..self.plan.len()).all(|wall| {
-            let (mut all, mut ok) = (0usize, 0usize);
-            for (w, s) in points.iter().zip(&seen) {
-                if w.wall == wall {
-                    all += 1;
-                    ok += usize::from(*s >= CENTROID_STEPS);
-                }
-            }
-            all == 0 || ok as f64 >= CENTROID_COVERAGE * all as f64
-        })
+        self.steps_to_see_every_wall(steps, &|t| self.target_heading(t))
+            .is_some()
     }
 
-    /// How long (s) the walk takes until every wall has been in view (the plan's test of
-    /// [`Self::faces_the_centroid`], sweeps left out, on the headings the walk takes); `None`
-    /// when not within `max_s`.
-    pub fn seconds_to_see_every_wall(&self, max_s: f64) -> Option<f64> {
+    /// The first step (of `steps`, every [`PLAN_STEP_S`]) at which every wall has been in view
+    /// (the test of [`Self::faces_the_centroid`]) with the walker looking along `heading(t)`.
+    fn steps_to_see_every_wall(&self, steps: usize, heading: &dyn Fn(f64) -> f64) -> Option<usize> {
         let points = wall_points(&self.plan);
         let mut seen = vec![0u32; points.len()];
         let covered = |seen: &[u32]| {
@@ -319,10 +297,9 @@ impl Walk {
                 all == 0 || ok as f64 >= CENTROID_COVERAGE * all as f64
             })
         };
-        let steps = (max_s / PLAN_STEP_S).ceil() as usize;
-        for k in 0..=steps {
+        for k in 0..steps {
             let t = k as f64 * PLAN_STEP_S;
-            let (p, yaw) = (self.position(t), self.heading_at(t));
+            let (p, yaw) = (self.position(t), heading(t));
             for (j, bearing) in visible(&self.plan, &points, p) {
                 if wrapped(bearing, yaw).abs() <= PLAN_HALF_FOV
                     && (points[j].at - p).norm() <= CENTROID_RANGE_M
@@ -331,10 +308,19 @@ impl Walk {
                 }
             }
             if covered(&seen) {
-                return Some(t);
+                return Some(k);
             }
         }
         None
+    }
+
+    /// How long (s) the walk takes until every wall has been in view (the plan's test of
+    /// [`Self::faces_the_centroid`], sweeps left out, on the headings the walk takes); `None`
+    /// when not within `max_s`.
+    pub fn seconds_to_see_every_wall(&self, max_s: f64) -> Option<f64> {
+        let steps = (max_s / PLAN_STEP_S).ceil() as usize + 1;
+        self.steps_to_see_every_wall(steps, &|t| self.heading_at(t))
+            .map(|k| k as f64 * PLAN_STEP_S)
     }
 
     /// The heading every [`PLAN_STEP_S`] over [`HEADING_SPAN_S`], planned for coverage: at each

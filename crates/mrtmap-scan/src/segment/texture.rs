@@ -19,7 +19,7 @@ use std::collections::{HashMap, HashSet};
 
 use mrtmap_geometry::camera::PinholeCamera;
 use mrtmap_geometry::nalgebra::{Point2, Point3, Vector3};
-use mrtmap_geometry::{BOX_TRIANGLES, PlaneFrame};
+use mrtmap_geometry::{BOX_TRIANGLES, PlaneFrame, ray_triangle};
 use mrtmap_io::Recording;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -132,29 +132,6 @@ impl TextureReport {
     }
 }
 
-/// Ray–triangle intersection (Möller–Trumbore): the distance along `d`.
-fn ray_triangle(o: &Point3<f64>, d: &Vector3<f64>, tri: [&Point3<f64>; 3]) -> Option<f64> {
-    let e1 = tri[1] - tri[0];
-    let e2 = tri[2] - tri[0];
-    let p = d.cross(&e2);
-    let det = e1.dot(&p);
-    if det.abs() < 1e-12 {
-        return None;
-    }
-    let inv = 1.0 / det;
-    let s = o - tri[0];
-    let u = s.dot(&p) * inv;
-    if !(0.0..=1.0).contains(&u) {
-        return None;
-    }
-    let q = s.cross(&e1);
-    let v = d.dot(&q) * inv;
-    if v < 0.0 || u + v > 1.0 {
-        return None;
-    }
-    let t = e2.dot(&q) * inv;
-    (t > 1e-6).then_some(t)
-}
 
 /// What a ray hits first: a surface (index, distance) or furniture.
 enum ModelHit {
