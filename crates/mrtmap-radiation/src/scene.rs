@@ -586,7 +586,9 @@ impl Occluder {
                 // A direction no face or edge of a room's furniture lies along.
                 let d = Vector3::new(0.5773, 0.5781, 0.5766).normalize();
                 tris.iter()
-                    .filter(|t| mrtmap_geometry::ray_triangle(p, &d, [&t[0], &t[1], &t[2]]).is_some())
+                    .filter(|t| {
+                        mrtmap_geometry::ray_triangle(p, &d, [&t[0], &t[1], &t[2]]).is_some()
+                    })
                     .count()
                     % 2
                     == 1

@@ -132,7 +132,6 @@ impl TextureReport {
     }
 }
 
-
 /// What a ray hits first: a surface (index, distance) or furniture.
 enum ModelHit {
     Surface(usize, f64),
