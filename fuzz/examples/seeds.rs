@@ -58,6 +58,22 @@ fn messages(wire: Wire) -> Vec<(&'static str, &'static str, Vec<u8>)> {
 }
 
 fn main() {
+    // The hand-written inputs: the formats' own examples.
+    put(
+        "references_csv",
+        "example",
+        b"# readings\nlabel,x,y,z,temperature_c,std_k,frame\nfloor,1.83,0.42,0.00,20.6,0.1,room\nwall x0,-1.30,0.95,0.41,21.0,0.2,scan\n",
+    );
+    put(
+        "globe_csv",
+        "example",
+        b"label,x,y,z,globe_c,air_c,air_speed_m_s,diameter_m,emissivity\nA,0.75,1.40,1.10,19.94,21.0,0.1,0.15,0.95\n\"B, by the door\",2.1,1.8,1.1,20.7,21,0.1,0.15,0.95\n",
+    );
+    put(
+        "project_toml",
+        "example",
+        b"[air]\ntemperature_c = 21.0\nspeed_m_s = 0.1\n\n[map]\nheights_m = [1.1, 0.6]\ngrid = [20, 20]\nquantities = [\"pmv\"]\n\n[comfort]\nmet = 1.2\nclo = 0.7\nposture = \"seated\"\n\n[[points]]\nname = \"A\"\nxyz = [0.75, 1.4, 1.1]\n",
+    );
     for (i, (_, _, m)) in messages(Wire::Ros1).into_iter().enumerate() {
         put("ros_msg", &format!("ros1-{i}"), &m);
     }
