@@ -221,17 +221,22 @@ fn fit(pts: &[(f64, f64, f64)], at_c: f64, gain: bool) -> (f64, f64, f64) {
     (alpha, beta, var.sqrt() / beta.abs())
 }
 
-/// The level from `refs` (in the scan's frame, or the room's through `world_from_room`) seen in
-/// `cloud`, for a scene whose mean temperature is `mean_c`; `camera_accuracy_k` when none is usable.
-pub fn find_level(
+/// A reading seen by the camera (true, camera, σ, index into the uses) for the fit.
+type Seen = (f64, f64, f64, usize);
+
+/// Each reading placed and compared with what the camera saw around it: its use (unseen, or
+/// farther from the camera than the camera can be off: its stated accuracy, at least 1 K since
+/// the fused temperature at a point carries blur and placement too, plus the reading's own 3σ)
+/// and, when usable, its point for the fit.
+fn judge_readings(
     refs: &[Reference],
     cloud: &ThermalCloud,
     world_from_room: &Isometry3<f64>,
-    mean_c: f64,
     camera_accuracy_k: f64,
-) -> Level {
+) -> (Vec<ReferenceUse>, Vec<Seen>) {
+    let allowed = camera_accuracy_k.max(1.0);
     let mut uses: Vec<ReferenceUse> = Vec::new();
-    let mut pts: Vec<(f64, f64, f64, usize)> = Vec::new();
+    let mut pts: Vec<Seen> = Vec::new();
     for r in refs {
         let p = match r.frame {
             PointFrame::Scan => Point3::from(r.xyz),
@@ -242,9 +247,9 @@ pub fn find_level(
         // stated accuracy, and the reading's own 3σ) is not a reading of that surface.
         let implausible = seen.and_then(|(c, _)| {
             let off = (c - r.temperature_c).abs();
-            (off > camera_accuracy_k + 3.0 * r.std_k).then(|| {
+            (off > allowed + 3.0 * r.std_k).then(|| {
                 format!(
-                    "disagrees with what the camera saw there ({c:.1} °C) by {off:.1} K, more than the camera's stated accuracy ({camera_accuracy_k} K): left out; check the reading (a typo?) and its coordinates"
+                    "disagrees with what the camera saw there ({c:.1} °C) by {off:.1} K, more than the camera can be off ({allowed} K): left out; check the reading (a typo?) and its coordinates"
                 )
             })
         });
@@ -265,6 +270,19 @@ pub fn find_level(
             }),
         });
     }
+    (uses, pts)
+}
+
+/// The level from `refs` (in the scan's frame, or the room's through `world_from_room`) seen in
+/// `cloud`, for a scene whose mean temperature is `mean_c`; `camera_accuracy_k` when none is usable.
+pub fn find_level(
+    refs: &[Reference],
+    cloud: &ThermalCloud,
+    world_from_room: &Isometry3<f64>,
+    mean_c: f64,
+    camera_accuracy_k: f64,
+) -> Level {
+    let (mut uses, mut pts) = judge_readings(refs, cloud, world_from_room, camera_accuracy_k);
     let span = |p: &[(f64, f64, f64, usize)]| {
         p.iter().map(|x| x.0).fold(f64::NEG_INFINITY, f64::max)
             - p.iter().map(|x| x.0).fold(f64::INFINITY, f64::min)
