@@ -153,4 +153,60 @@ fn main() {
             data: (0..192).map(|i| 29_000 + i).collect(),
         }).expect("encodes"),
     );
+    recording_seeds();
+}
+
+/// Packs a folder for the recording target: name length, name, 4-byte length, bytes, repeated.
+fn pack(dir: &Path, skip: &[&str]) -> Vec<u8> {
+    let mut out = Vec::new();
+    let mut names = Vec::new();
+    for e in std::fs::read_dir(dir).expect("folder").flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            for f in std::fs::read_dir(&p).expect("folder").flatten() {
+                names.push(f.path());
+            }
+        } else {
+            names.push(p);
+        }
+    }
+    names.sort();
+    for p in names {
+        let name = p.strip_prefix(dir).expect("inside").to_string_lossy().into_owned();
+        if skip.contains(&name.as_str()) {
+            continue;
+        }
+        let bytes = std::fs::read(&p).expect("file");
+        out.push(name.len() as u8);
+        out.extend(name.as_bytes());
+        out.extend((bytes.len() as u32).to_le_bytes());
+        out.extend(bytes);
+    }
+    out
+}
+
+/// A one-second simulated recording at small sizes (64×48 depth and colour, 40×30 thermal), with
+/// poses and without; the leading 0 is "no edit operations".
+fn recording_seeds() {
+    let room = mrtmap_sim::preset("office").expect("preset").expect("valid");
+    let mut cfg = mrtmap_sim::SimConfig {
+        seconds: 1.0,
+        truth_rays: 200,
+        noise: mrtmap_sim::NoiseLevel::Realistic,
+        references: 2,
+        ..mrtmap_sim::SimConfig::default()
+    };
+    cfg.depth_camera = cfg.depth_camera.scaled(0.1);
+    cfg.thermal_camera = cfg.thermal_camera.scaled(0.25);
+    let dir = std::env::temp_dir().join(format!("mrtmap-fuzz-seed-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    mrtmap_sim::simulate(&room, &cfg, &dir, &|_, _| {}).expect("simulate");
+    let skip = ["truth.json", "radiometric_truth.json", "groundtruth.txt"];
+    let mut with = vec![0u8];
+    with.extend(pack(&dir, &skip));
+    put("recording", "sim", &with);
+    let mut without = vec![0u8];
+    without.extend(pack(&dir, &[&skip[..], &["trajectory.txt"]].concat()));
+    put("recording", "sim-no-poses", &without);
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -40,6 +40,8 @@ pub struct DemoSettings {
     pub air_speed_m_s: f64,
     /// Depth image size.
     pub depth_size: (usize, usize),
+    /// Depth frame rate (Hz).
+    pub depth_hz: f64,
     /// The thermal camera's radiometric errors.
     pub radiometric: RadiometricModel,
     /// Contact-thermometer readings written to references.csv.
@@ -78,16 +80,39 @@ pub struct DemoOutcome {
     pub grid: GridError,
 }
 
-/// The shortest demo walk of `room` (s): one and a half times the time the walk takes until every
-/// wall has been in view (the simulator's own coverage test on the floor plan), at least 15 s, in
-/// whole 5 s (3600 s when it never does). Measured on 2026-12-03: the office maps within 0.09 K from 15 s; the L-shaped room's
-/// 15 s walk missed two walls and its 25 s walk placed a wall 0.7 m short (0.44 K).
-pub fn shortest_walk_s(room: &mrtmap_sim::Room, seed: u64) -> f64 {
-    let walk = mrtmap_sim::Walk::new(room, mrtmap_sim::WalkParams::default(), seed);
+/// Walking speeds the demo may choose, slowest first (m/s): a careful scan walks at 0.5 m/s; a
+/// shorter one walks faster, up to a brisk 1 m/s, so that it still sees every wall.
+pub const DEMO_SPEEDS_M_S: [f64; 6] = [0.5, 0.6, 0.7, 0.8, 0.9, 1.0];
+
+/// The shortest demo walk of `room` at `speed_m_s` (s): one and a half times the time the walk
+/// takes until every wall has been in view (the simulator's own coverage test on the floor plan),
+/// at least 15 s, in whole 5 s (3600 s when it never does). Measured on 2026-12-03 at 0.5 m/s: the
+/// office maps within 0.09 K from 15 s; the L-shaped room's 15 s walk missed two walls and its
+/// 25 s walk placed a wall 0.7 m short (0.44 K).
+pub fn shortest_walk_s(room: &mrtmap_sim::Room, seed: u64, speed_m_s: f64) -> f64 {
+    let params = mrtmap_sim::WalkParams {
+        speed_m_s,
+        ..mrtmap_sim::WalkParams::default()
+    };
+    let walk = mrtmap_sim::Walk::new(room, params, seed);
     let t = walk.seconds_to_see_every_wall(3600.0).unwrap_or(3600.0);
     // Half as long again: in view on the plan is not yet seen up to the ceiling, often enough
     // for a wall to be placed from its own points.
     (1.5 * t / 5.0).ceil().clamp(3.0, 720.0) * 5.0
+}
+
+/// The slowest of [`DEMO_SPEEDS_M_S`] at which a walk of `seconds` sees every wall of `room`, or
+/// the shortest walk at the fastest speed.
+pub fn walk_speed_for(
+    room: &mrtmap_sim::Room,
+    seed: u64,
+    seconds: f64,
+) -> std::result::Result<f64, f64> {
+    DEMO_SPEEDS_M_S
+        .iter()
+        .copied()
+        .find(|&v| shortest_walk_s(room, seed, v) <= seconds)
+        .ok_or_else(|| shortest_walk_s(room, seed, DEMO_SPEEDS_M_S[DEMO_SPEEDS_M_S.len() - 1]))
 }
 
 /// Simulates the scan into `out/recording` unless it holds this simulation already.
@@ -97,16 +122,22 @@ fn simulate_stage(
     progress: &dyn Progress,
 ) -> Result<(StageOutcome, String)> {
     let room = load_room(&s.room)?;
-    let shortest = shortest_walk_s(&room, s.seed);
-    if !(s.seconds >= shortest && s.seconds <= 3600.0) {
-        return Err(Error::setting(
-            format!("--seconds {}", s.seconds),
-            format!(
-                "is outside {shortest:.0}…3600 s: the simulated walk loops the {} room at 0.5 m/s and needs {shortest:.0} s to see every wall (a shorter walk leaves part of the room unseen, and points there are outside the room found); give --seconds {shortest:.0} or more",
-                room.file.name
-            ),
-        ));
-    }
+    let speed = match walk_speed_for(&room, s.seed, s.seconds) {
+        Ok(v) if s.seconds <= 3600.0 => v,
+        found => {
+            let fastest = DEMO_SPEEDS_M_S[DEMO_SPEEDS_M_S.len() - 1];
+            let shortest = found
+                .err()
+                .unwrap_or(shortest_walk_s(&room, s.seed, fastest));
+            return Err(Error::setting(
+                format!("--seconds {}", s.seconds),
+                format!(
+                    "is outside {shortest:.0}…3600 s: the simulated walk loops the {} room, at 0.5 m/s or up to {fastest} m/s when short, and needs {shortest:.0} s to see every wall (a shorter walk leaves part of the room unseen, and points there are outside the room found); give --seconds {shortest:.0} or more",
+                    room.file.name
+                ),
+            ));
+        }
+    };
     let rec_dir = out.join("recording");
     let mut cfg = SimConfig {
         seconds: s.seconds,
@@ -114,6 +145,11 @@ fn simulate_stage(
         noise: s.noise,
         radiometric: s.radiometric,
         references: s.references,
+        depth_hz: s.depth_hz,
+        walk: mrtmap_sim::WalkParams {
+            speed_m_s: speed,
+            ..mrtmap_sim::WalkParams::default()
+        },
         ..SimConfig::default()
     };
     set_depth_size(&mut cfg, s.depth_size)?;
@@ -123,6 +159,7 @@ fn simulate_stage(
         .setting("seed", &s.seed)
         .setting("noise", &s.noise)
         .setting("depth_size", &s.depth_size)
+        .setting("depth_hz", &s.depth_hz)
         .setting("radiometric", &s.radiometric)
         .setting("references", &s.references);
     let stage = Stage {
@@ -132,7 +169,7 @@ fn simulate_stage(
     };
     let outcome = run_or_reuse(&stage, fingerprint, s.force, || {
         progress.begin(&format!(
-            "simulating {:.0} s of scanning the {} room",
+            "simulating {:.0} s of scanning the {} room (walking at {speed:.1} m/s)",
             s.seconds, room.file.name
         ));
         simulate(&room, &cfg, &rec_dir, &|d, t| progress.advance(d, t))?;

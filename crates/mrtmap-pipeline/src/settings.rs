@@ -717,6 +717,12 @@ impl Project {
                 "must be 0 (no raster) or between 0.03 and 2 m",
             ));
         }
+        if self.room.origin_corner == Some(0) {
+            return Err(Error::setting(
+                "--origin-corner 0 ([room] origin_corner)".to_string(),
+                "corners are numbered from 1, as on the report's map; leave it out for the default",
+            ));
+        }
         self.comfort.check(&self.air, &self.map.quantities)?;
         self.mrt.check()?;
         Ok(())
@@ -746,6 +752,19 @@ mod tests {
         assert_eq!(line, 3, "unknown keys are refused with their line");
         assert!(msg.contains("gird"), "{msg}");
         assert!(Project::parse("[mrt]\nmethod = \"fast\"\n").is_err());
+    }
+
+    #[test]
+    fn corner_zero_is_refused_before_any_stage_runs() {
+        let p = Project::parse("[room]\norigin_corner = 0\n").unwrap();
+        let e = p.check().unwrap_err().to_string();
+        assert!(e.contains("origin_corner") && e.contains("from 1"), "{e}");
+        assert!(
+            Project::parse("[room]\norigin_corner = 2\n")
+                .unwrap()
+                .check()
+                .is_ok()
+        );
     }
 
     #[test]

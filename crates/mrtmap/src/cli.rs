@@ -383,14 +383,14 @@ pub struct RunArgs {
 /// `mrtmap demo`.
 #[derive(Debug, Args)]
 pub struct DemoArgs {
-    /// Output folder (the recording goes in DIR/recording, the run in DIR/run); about 580 MB for
-    /// the default 60 s scan, 160 MB for 15 s, 3 GB with --full. The default folder is git-ignored in mrtmap's
-    /// own repository.
+    /// Output folder (the recording goes in DIR/recording, the run in DIR/run); about 200 MB for
+    /// the default 30 s scan, 380 MB for 60 s, 2 GB with --full. The default folder is git-ignored
+    /// in mrtmap's own repository.
     #[arg(long, value_name = "DIR", default_value = "mrtmap-demo")]
     pub out: PathBuf,
-    /// Length of the simulated scan (s): 15 at least (a shorter walk has not seen the whole
-    /// room).
-    #[arg(long, default_value_t = 60.0)]
+    /// Length of the simulated scan (s): 15 at least for the office (a shorter walk has not seen
+    /// the whole room).
+    #[arg(long, default_value_t = 30.0)]
     pub seconds: f64,
     /// Simulate the seed paper's full 343 s scan (overrides --seconds).
     #[arg(long)]
@@ -407,6 +407,9 @@ pub struct DemoArgs {
     /// Depth image size of the simulated scan, WIDTHxHEIGHT (smaller runs faster).
     #[arg(long, default_value = "640x480", value_parser = parse_grid)]
     pub depth_size: (usize, usize),
+    /// Depth frame rate of the simulated scan (Hz); 15 Hz is what many D4xx rigs record.
+    #[arg(long, default_value_t = 15.0)]
+    pub depth_hz: f64,
     /// Random seed of the simulation.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,

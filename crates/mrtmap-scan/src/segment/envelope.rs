@@ -225,6 +225,44 @@ fn refit_cap(cloud: Cloud<'_>, plane: &Plane, p: &SegmentParams) -> Plane {
     fit
 }
 
+/// How far the cameras' mean up may be from the true up (degrees) for [`refine_up`] to correct it.
+const UP_CONE_DEG: f64 = 40.0;
+
+/// Up from the planes, starting from the cameras' mean up `up0`. That mean is only a guess: a
+/// short walk that looks up more in one direction than in another tilts it by tens of degrees
+/// (25° on a 15 s walk of the L-shaped preset at 1 m/s), and then neither floor nor ceiling passes
+/// as horizontal. Of the planes within [`UP_CONE_DEG`] of the guess, the one whose parallel family
+/// (the planes within `horizontal_deg` of it: floor, ceiling, table tops) holds the most points
+/// wins, the largest plane of that family first; its normal, turned towards the guess, is up.
+/// With no plane in the cone, the guess stands.
+fn refine_up(
+    planes: &[FoundPlane],
+    up0: Unit<Vector3<f64>>,
+    p: &SegmentParams,
+) -> Unit<Vector3<f64>> {
+    let cone = UP_CONE_DEG.to_radians().cos();
+    let cos_h = p.horizontal_deg.to_radians().cos();
+    let normal = |k: usize| planes[k].plane.normal;
+    let near: Vec<usize> = (0..planes.len())
+        .filter(|&k| normal(k).dot(&up0).abs() >= cone)
+        .collect();
+    let family = |c: usize| -> usize {
+        near.iter()
+            .filter(|&&k| normal(k).dot(&normal(c)).abs() > cos_h)
+            .map(|&k| planes[k].points)
+            .sum()
+    };
+    match near
+        .iter()
+        .copied()
+        .max_by_key(|&c| (family(c), planes[c].points))
+    {
+        Some(c) if normal(c).dot(&up0) < 0.0 => -normal(c),
+        Some(c) => normal(c),
+        None => up0,
+    }
+}
+
 /// Floor and ceiling: the lowest and highest large horizontal planes; up from the floor's normal,
 /// oriented like the cameras' up. Classifies the horizontal planes and orients the floor's normal
 /// up and the ceiling's down.
@@ -235,6 +273,7 @@ fn floor_and_ceiling(
     p: &SegmentParams,
 ) -> Result<Caps, SegmentError> {
     let cos_h = p.horizontal_deg.to_radians().cos();
+    let up0 = refine_up(planes, up0, p);
     let horizontal: Vec<usize> = (0..planes.len())
         .filter(|&k| planes[k].plane.normal.dot(&up0).abs() > cos_h)
         .collect();
@@ -651,6 +690,37 @@ mod tests {
             weights: &weights,
         };
         envelope(cloud, planes, Vector3::z_axis(), &SegmentParams::default()).expect("an envelope")
+    }
+
+    /// A short walk's cameras' mean up can be 25° off (the L-shaped preset's 15 s walk at 1 m/s):
+    /// neither floor nor ceiling was horizontal to it, and the scan was refused for want of a
+    /// ceiling. Up comes from the planes; a guess with no plane within 40° is still refused.
+    #[test]
+    fn up_comes_from_the_floor_and_ceiling_when_the_cameras_tilt_it() {
+        let (pts, planes) = box_room(&[]);
+        let nrm = normals_of(&pts, &planes);
+        let weights = vec![1.0; pts.len()];
+        let cloud = Cloud {
+            points: &pts,
+            normals: &nrm,
+            weights: &weights,
+        };
+        let tilted = |deg: f64| {
+            Unit::new_normalize(Vector3::new(
+                deg.to_radians().sin(),
+                0.0,
+                deg.to_radians().cos(),
+            ))
+        };
+        let p = SegmentParams::default();
+        let env = envelope(cloud, planes.clone(), tilted(25.0), &p).expect("an envelope");
+        assert!(env.up.dot(&Vector3::z()) > 0.9999, "{:?}", env.up);
+        corners_near_the_box(&env, 0.02);
+        // 50° from up towards a corner: over 50° from every plane, so the guess stands.
+        let (s50, c50) = (50f64.to_radians().sin(), 50f64.to_radians().cos());
+        let far = Unit::new_normalize(Vector3::new(s50 * 0.5f64.sqrt(), s50 * 0.5f64.sqrt(), c50));
+        assert_eq!(refine_up(&planes, far, &p), far);
+        assert!(envelope(cloud, planes, far, &p).is_err());
     }
 
     /// Four corners, each within `tol` of the box's, on the floor.

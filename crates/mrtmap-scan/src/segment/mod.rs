@@ -137,7 +137,7 @@ pub enum SegmentError {
     },
     /// The origin corner asked for does not exist.
     #[error(
-        "origin corner {given} does not exist: the room has {corners} corners, numbered 1…{corners}"
+        "origin corner {given} does not exist: the room has {corners} corners, numbered 1…{corners} on the report's map; give one of them or leave it out for the default (a run again reuses its fused cloud)"
     )]
     OriginCorner {
         /// The corner asked for.

@@ -18,14 +18,16 @@ pub fn run(a: &DemoArgs) -> anyhow::Result<()> {
         },
         air_speed_m_s: a.air_speed,
         depth_size: a.depth_size,
+        depth_hz: a.depth_hz,
         radiometric: a.camera.model(a.noise),
         references: a.camera.references(a.noise),
         force: a.force,
     };
-    // Measured (2026-12-03, with glass and late stamps): 15 s at 640×480 wrote 154 MB (depth
-    // 94 MB, colour 32, thermal 4, the run 20), 60 s 577 MB: about 20 MB for the run, 2.7 MB per
-    // second of scan plus 6.6 MB per second at 640×480 depth.
-    let pixels = (a.depth_size.0 * a.depth_size.1) as f64 / (640.0 * 480.0);
+    // Measured (2026-12-03, with glass and late stamps): 15 s at 640×480 and 30 Hz wrote 154 MB
+    // (depth 94 MB, colour 32, thermal 4, the run 20), 60 s 577 MB; at 15 Hz 30 s wrote 197 MB
+    // and 60 s 373 MB: about 20 MB for the run, 2.7 MB per second of scan plus 6.6 MB per second
+    // of 640×480 depth at 30 Hz.
+    let pixels = (a.depth_size.0 * a.depth_size.1) as f64 / (640.0 * 480.0) * a.depth_hz / 30.0;
     let estimate_mb = 20.0 + settings.seconds * (2.7 + 6.6 * pixels);
     eprintln!(
         "writing into {} (about {:.0} MB; remove it when done)",
