@@ -186,7 +186,7 @@ fn pack(dir: &Path, skip: &[&str]) -> Vec<u8> {
 }
 
 /// A one-second simulated recording at small sizes (64×48 depth and colour, 40×30 thermal), with
-/// poses and without; the leading 0 is "no edit operations".
+/// poses and without; the 25-byte header of zeros is "no edit operations".
 fn recording_seeds() {
     let room = mrtmap_sim::preset("office").expect("preset").expect("valid");
     let mut cfg = mrtmap_sim::SimConfig {
@@ -202,10 +202,10 @@ fn recording_seeds() {
     let _ = std::fs::remove_dir_all(&dir);
     mrtmap_sim::simulate(&room, &cfg, &dir, &|_, _| {}).expect("simulate");
     let skip = ["truth.json", "radiometric_truth.json", "groundtruth.txt"];
-    let mut with = vec![0u8];
+    let mut with = vec![0u8; 25];
     with.extend(pack(&dir, &skip));
     put("recording", "sim", &with);
-    let mut without = vec![0u8];
+    let mut without = vec![0u8; 25];
     without.extend(pack(&dir, &[&skip[..], &["trajectory.txt"]].concat()));
     put("recording", "sim-no-poses", &without);
     let _ = std::fs::remove_dir_all(&dir);

@@ -2,7 +2,7 @@
 //! files missing, truncated, corrupted or replaced by frames of another size: opening it, fusing
 //! it and tracking it answer or refuse, never panic, and what they count adds up.
 //!
-//! The input is a few edit operations followed by a packed folder (see `pack` in
+//! The input is a fixed header of up to four edit operations followed by a packed folder (see `pack` in
 //! examples/seeds.rs: name length, name, 4-byte length, bytes, repeated); the seed is a small
 //! simulated recording, so byte mutations exercise the parsers and the operations exercise
 //! structure: a stream without its files, a frame of another size, a file cut short.
@@ -41,20 +41,23 @@ fn unpack(mut b: &[u8]) -> Vec<(String, Vec<u8>)> {
     files
 }
 
+/// Bytes before the packed folder: a count and four operations.
+const HEADER: usize = 1 + 4 * 6;
+
 fn scratch() -> PathBuf {
     std::env::temp_dir().join(format!("mrtmap-fuzz-recording-{}", std::process::id()))
 }
 
 fuzz_target!(|data: &[u8]| {
-    // Up to four operations of 6 bytes: kind, file, a (u16), b (u16).
-    let Some((&n_ops, rest)) = data.split_first() else {
-        return;
-    };
-    let n_ops = (n_ops % 5) as usize;
-    if rest.len() < 6 * n_ops {
+    // A fixed header: how many of the four operations apply, then four operations of 6 bytes
+    // (kind, file, a (u16), b (u16)), so that the packed folder after it stays aligned whatever
+    // the header says.
+    if data.len() < HEADER {
         return;
     }
-    let (ops, packed) = rest.split_at(6 * n_ops);
+    let (header, packed) = data.split_at(HEADER);
+    let n_ops = (header[0] % 5) as usize;
+    let ops = &header[1..1 + 6 * n_ops];
     let mut files = unpack(packed);
     if files.is_empty() {
         return;

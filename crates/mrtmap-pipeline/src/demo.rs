@@ -358,3 +358,26 @@ pub fn demo(out: &Path, s: &DemoSettings, progress: &dyn Progress) -> Result<Dem
     write_demo_outputs(out, s, &d, &project, t0.elapsed().as_secs_f64())?;
     Ok(d)
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    /// Issue 41: a 15 s walk of each preset room must see every wall. The L-shaped room needs 30 s
+    /// at a careful 0.5 m/s, so a 15 s walk walks faster; a long walk stays careful; a walk too
+    /// short even at 1 m/s is refused with the shortest that would do.
+    #[test]
+    fn a_short_walk_walks_faster_to_see_every_wall() {
+        for name in ["office", "radiant-ceiling", "l-shaped"] {
+            let room = load_room(name).unwrap();
+            let v = walk_speed_for(&room, 1, 15.0).unwrap();
+            assert!((0.5..=1.0).contains(&v), "{name}: {v}");
+            assert_eq!(walk_speed_for(&room, 1, 60.0).unwrap(), 0.5, "{name}");
+            assert_eq!(walk_speed_for(&room, 1, 10.0), Err(15.0), "{name}");
+        }
+        let l = load_room("l-shaped").unwrap();
+        assert!(shortest_walk_s(&l, 1, 0.5) > 15.0);
+        assert!(walk_speed_for(&l, 1, 15.0).unwrap() > 0.5);
+    }
+}
