@@ -35,6 +35,7 @@ use rayon::prelude::*;
 /// Which distortion coefficients are estimated (the others stay zero).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum DistortionModel {
     /// No distortion.
     None,

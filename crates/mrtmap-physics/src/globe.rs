@@ -49,6 +49,7 @@ impl Default for Globe {
 /// Which convection regime a method uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Convection {
     /// Natural (free) convection.
     Natural,

@@ -16,6 +16,7 @@ use crate::error::{PhysicsError, finite, in_range};
 /// Seated or standing.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Posture {
     /// Seated: body centre 0.6 m above the floor.
     Seated,

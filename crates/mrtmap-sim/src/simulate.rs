@@ -30,6 +30,7 @@ use crate::walk::{Walk, WalkParams};
 /// How noisy the sensors are.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum NoiseLevel {
     /// Exact depth (to the millimetre), exact thermal (to the centikelvin), exact labels.
     None,

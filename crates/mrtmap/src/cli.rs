@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use mrtmap_pipeline::settings::{PointFrame, Quantity};
 use mrtmap_pipeline::{DirectionChoice, MethodChoice, MrtSection};
+use mrtmap_sim::NoiseLevel;
 
 /// Map the mean radiant temperature (MRT) of a room.
 ///
@@ -138,15 +139,6 @@ pub enum CompressionArg {
     Lz4,
 }
 
-/// RTAB-Map database schema to write.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum SchemaArg {
-    /// 0.23.
-    Current,
-    /// 0.20.
-    Legacy,
-}
-
 /// `mrtmap convert`.
 #[derive(Debug, Args)]
 #[command(after_long_help = "Examples:
@@ -173,8 +165,8 @@ pub struct ConvertArgs {
     pub compression: CompressionArg,
     /// Schema when writing an RTAB-Map-layout database (.db): current (0.23, RVL depth,
     /// optimised poses) or legacy (0.20, PNG depth, odometry only).
-    #[arg(long, value_enum, default_value_t = SchemaArg::Current)]
-    pub schema: SchemaArg,
+    #[arg(long, value_enum, default_value_t = mrtmap_sources::rtabmap::Schema::Current)]
+    pub schema: mrtmap_sources::rtabmap::Schema,
     /// Reading options.
     #[command(flatten)]
     pub src: SourceArgs,
@@ -233,21 +225,6 @@ pub struct ThermalArgs {
     pub humidity: Option<f64>,
 }
 
-/// Distortion coefficients to estimate.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum DistortionArg {
-    /// None.
-    None,
-    /// k1, k2.
-    Radial,
-    /// k1, k2, p1, p2 (k3 fixed at 0, OpenCV's advice for ordinary lenses).
-    RadialTangential,
-    /// k1, k2, p1, p2, k3 (OpenCV's default model).
-    Full,
-    /// k1, k2, or with p1, p2 when that predicts held-out views more than 1 % better.
-    Auto,
-}
-
 /// `mrtmap calibrate`.
 #[derive(Debug, Args)]
 #[command(after_long_help = "Examples:
@@ -283,10 +260,10 @@ pub struct CalibrateArgs {
     pub report: Option<PathBuf>,
     /// Distortion model of the colour camera (or of the --images camera).
     #[arg(long, value_enum, default_value = "auto")]
-    pub distortion: DistortionArg,
+    pub distortion: mrtmap_calib::DistortionModel,
     /// Distortion model of the thermal camera.
     #[arg(long, value_enum, default_value = "auto")]
-    pub thermal_distortion: DistortionArg,
+    pub thermal_distortion: mrtmap_calib::DistortionModel,
     /// Largest time difference (s) when pairing images by timestamp.
     #[arg(long, default_value_t = 0.05, value_name = "S")]
     pub max_dt: f64,
@@ -399,8 +376,8 @@ pub struct DemoArgs {
     #[arg(long, default_value = "office")]
     pub room: String,
     /// Sensor noise.
-    #[arg(long, value_enum, default_value_t = NoiseArg::Realistic)]
-    pub noise: NoiseArg,
+    #[arg(long, value_enum, default_value_t = NoiseLevel::Realistic)]
+    pub noise: NoiseLevel,
     /// Air speed at the simulated globes (m/s).
     #[arg(long, default_value_t = 0.1)]
     pub air_speed: f64,
@@ -467,11 +444,11 @@ pub struct CameraErrorArgs {
 
 impl CameraErrorArgs {
     /// The model these flags describe, with sensor noise `noise`.
-    pub fn model(&self, noise: NoiseArg) -> mrtmap_sim::RadiometricModel {
+    pub fn model(&self, noise: NoiseLevel) -> mrtmap_sim::RadiometricModel {
         use mrtmap_sim::RadiometricModel as M;
         let mut m = match (self.camera_errors, noise) {
-            (CameraErrorsArg::None, _) | (CameraErrorsArg::Auto, NoiseArg::None) => M::NONE,
-            (CameraErrorsArg::Realistic, _) | (CameraErrorsArg::Auto, NoiseArg::Realistic) => {
+            (CameraErrorsArg::None, _) | (CameraErrorsArg::Auto, NoiseLevel::None) => M::NONE,
+            (CameraErrorsArg::Realistic, _) | (CameraErrorsArg::Auto, NoiseLevel::Realistic) => {
                 M::REALISTIC
             }
         };
@@ -493,7 +470,7 @@ impl CameraErrorArgs {
     }
 
     /// How many reference readings to write.
-    pub fn references(&self, noise: NoiseArg) -> usize {
+    pub fn references(&self, noise: NoiseLevel) -> usize {
         self.references
             .unwrap_or(if self.model(noise).is_perfect() { 0 } else { 2 })
     }
@@ -640,15 +617,6 @@ impl AutoOnOff {
     }
 }
 
-/// Sensor noise of a simulation.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum NoiseArg {
-    /// Exact depth (to 1 mm), exact thermal (to 0.01 K), exact labels.
-    None,
-    /// D435i-like depth noise and invalid pixels, Lepton-like NETD and blur, detector-like labels.
-    Realistic,
-}
-
 /// SLAM drift of a simulation's trajectory.txt.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum DriftArg {
@@ -695,8 +663,8 @@ pub struct SimulateArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Sensor noise.
-    #[arg(long, value_enum, default_value_t = NoiseArg::Realistic)]
-    pub noise: NoiseArg,
+    #[arg(long, value_enum, default_value_t = NoiseLevel::Realistic)]
+    pub noise: NoiseLevel,
     /// SLAM drift in trajectory.txt (groundtruth.txt always has the true poses).
     #[arg(long, value_enum, default_value_t = DriftArg::None)]
     pub drift: DriftArg,
@@ -861,7 +829,7 @@ pub struct MrtArgs {
     /// floor seated, 1.0 m standing); angle factors from the projected-area factors of a seated or
     /// standing body.
     #[arg(long, value_enum)]
-    pub person: Option<PostureArg>,
+    pub person: Option<mrtmap_physics::Posture>,
     /// Which way the person faces, degrees from +x towards +y (0 = +x, 90 = +y); without it,
     /// any way (fp averaged over azimuth).
     #[arg(long, allow_negative_numbers = true, requires = "person", value_parser = parse_facing)]
@@ -873,24 +841,6 @@ pub struct MrtArgs {
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
-}
-
-/// Seated or standing.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum PostureArg {
-    /// Seated: body centre 0.6 m above the floor.
-    Seated,
-    /// Standing: body centre 1.0 m above the floor.
-    Standing,
-}
-
-impl From<PostureArg> for mrtmap_physics::Posture {
-    fn from(p: PostureArg) -> Self {
-        match p {
-            PostureArg::Seated => Self::Seated,
-            PostureArg::Standing => Self::Standing,
-        }
-    }
 }
 
 /// `mrtmap comfort`.
@@ -934,17 +884,6 @@ pub enum GlobeMethodArg {
     Mixed,
 }
 
-/// Convection regime for the ISO formulas.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum ConvectionArg {
-    /// The larger of natural and forced (ISO 7726).
-    Larger,
-    /// Natural convection only.
-    Natural,
-    /// Forced convection only.
-    Forced,
-}
-
 /// `mrtmap globe`.
 #[derive(Debug, Args)]
 #[command(group(clap::ArgGroup::new("reading").required(true).args(["tg", "tr"])))]
@@ -971,8 +910,8 @@ pub struct GlobeArgs {
     #[arg(long, value_enum, default_value_t = GlobeMethodArg::Iso)]
     pub method: GlobeMethodArg,
     /// Convection regime for the ISO formulas.
-    #[arg(long, value_enum, default_value_t = ConvectionArg::Larger)]
-    pub convection: ConvectionArg,
+    #[arg(long, value_enum, default_value_t = mrtmap_physics::Convection::Larger)]
+    pub convection: mrtmap_physics::Convection,
     /// Print JSON.
     #[arg(long)]
     pub json: bool,

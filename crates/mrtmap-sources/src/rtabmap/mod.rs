@@ -648,6 +648,7 @@ pub fn for_each_node(
 
 /// Which database schema [`write_database`] writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Schema {
     /// 0.23: RVL depth, optimised poses in Admin.
     Current,

@@ -4,24 +4,14 @@
 use std::path::Path;
 
 use anyhow::bail;
-use mrtmap_calib::{Board, DistortionModel, MonoResult, PairStatus, StereoOptions, StereoResult};
+use mrtmap_calib::{Board, MonoResult, PairStatus, StereoOptions, StereoResult};
 use mrtmap_geometry::camera::PinholeCamera;
 use mrtmap_pipeline::calibration::{
     ImageDetections, Seen, board, calibrate_images, calibrate_pairs, detect_images, detect_pairs,
     error_cell, found, status_text, write_mono_report, write_rig, write_stereo_report,
 };
 
-use crate::cli::{CalibrateArgs, DistortionArg};
-
-fn model(d: DistortionArg) -> DistortionModel {
-    match d {
-        DistortionArg::None => DistortionModel::None,
-        DistortionArg::Radial => DistortionModel::Radial,
-        DistortionArg::RadialTangential => DistortionModel::RadialTangential,
-        DistortionArg::Full => DistortionModel::Full,
-        DistortionArg::Auto => DistortionModel::Auto,
-    }
-}
+use crate::cli::CalibrateArgs;
 
 fn describe(name: &str, c: &PinholeCamera, m: &MonoResult, std: Option<&[f64]>) -> String {
     let d = c.distortion.to_array();
@@ -114,7 +104,7 @@ fn mono(a: &CalibrateArgs, board: &Board, dir: &Path) -> anyhow::Result<()> {
         d.size.0,
         d.size.1
     );
-    let r = calibrate_images(&d, board, model(a.distortion))?;
+    let r = calibrate_images(&d, board, a.distortion)?;
     print_mono(&d, &r);
     if let Some(rep) = &a.report {
         write_mono_report(rep, board, &d, &r)?;
@@ -147,8 +137,8 @@ fn stereo(a: &CalibrateArgs, board: &Board, dir: &Path) -> anyhow::Result<()> {
         d.thermal_size.1
     );
     let opts = StereoOptions {
-        model_rgb: model(a.distortion),
-        model_thermal: model(a.thermal_distortion),
+        model_rgb: a.distortion,
+        model_thermal: a.thermal_distortion,
         common_corners: a.common_corners,
     };
     let r = calibrate_pairs(&d, board, &opts)?;

@@ -5,9 +5,8 @@ use mrtmap_pipeline::Error;
 use mrtmap_pipeline::source::{ContainerOut, convert, write_container};
 use mrtmap_sources::ros::Container;
 use mrtmap_sources::ros::bag::Compression;
-use mrtmap_sources::rtabmap::Schema;
 
-use crate::cli::{CompressionArg, ConvertArgs, SchemaArg};
+use crate::cli::{CompressionArg, ConvertArgs};
 use crate::output::{print_conversion, print_plan};
 
 /// The container an output file name asks for, if any.
@@ -24,10 +23,7 @@ fn container_out(a: &ConvertArgs) -> Option<ContainerOut> {
         CompressionArg::Lz4 => Compression::Lz4,
     };
     Some(match ext.as_str() {
-        "db" => ContainerOut::RtabMap(match a.schema {
-            SchemaArg::Current => Schema::Current,
-            SchemaArg::Legacy => Schema::Legacy,
-        }),
+        "db" => ContainerOut::RtabMap(a.schema),
         "bag" => ContainerOut::Ros(Container::Bag, compression),
         "mcap" => ContainerOut::Ros(Container::Mcap, compression),
         "db3" => ContainerOut::Ros(Container::Db3, compression),

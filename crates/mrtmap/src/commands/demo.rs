@@ -1,9 +1,8 @@
 //! `mrtmap demo`: simulate the office scan, run the pipeline, compare with the exact truth.
 
 use mrtmap_pipeline::demo::{DemoSettings, demo};
-use mrtmap_sim::NoiseLevel;
 
-use crate::cli::{DemoArgs, NoiseArg};
+use crate::cli::DemoArgs;
 use crate::output::{Bar, print_run};
 
 pub fn run(a: &DemoArgs) -> anyhow::Result<()> {
@@ -12,10 +11,7 @@ pub fn run(a: &DemoArgs) -> anyhow::Result<()> {
         room: a.room.clone(),
         seconds: if a.full { 343.0 } else { a.seconds },
         seed: a.seed,
-        noise: match a.noise {
-            NoiseArg::None => NoiseLevel::None,
-            NoiseArg::Realistic => NoiseLevel::Realistic,
-        },
+        noise: a.noise,
         air_speed_m_s: a.air_speed,
         depth_size: a.depth_size,
         depth_hz: a.depth_hz,

@@ -1,11 +1,11 @@
 //! `mrtmap globe`: globe temperature ↔ MRT.
 
 use mrtmap_physics::{
-    Convection, Globe, GlobeMethod, GlobeReading, Temperature, globe_temperature, mrt_from_globe,
+    Globe, GlobeMethod, GlobeReading, Temperature, globe_temperature, mrt_from_globe,
 };
 use serde::Serialize;
 
-use crate::cli::{ConvectionArg, GlobeArgs, GlobeMethodArg};
+use crate::cli::{GlobeArgs, GlobeMethodArg};
 use crate::output::json;
 
 #[derive(Serialize)]
@@ -24,11 +24,7 @@ struct GlobeOut {
 }
 
 pub fn run(a: &GlobeArgs) -> anyhow::Result<()> {
-    let convection = match a.convection {
-        ConvectionArg::Larger => Convection::Larger,
-        ConvectionArg::Natural => Convection::Natural,
-        ConvectionArg::Forced => Convection::Forced,
-    };
+    let convection = a.convection;
     let method = match a.method {
         GlobeMethodArg::Iso => GlobeMethod::Iso { convection },
         GlobeMethodArg::IsoClosedForm => GlobeMethod::IsoClosedForm { convection },

@@ -112,7 +112,7 @@ pub fn run(a: &MrtArgs) -> anyhow::Result<()> {
         let at = to_scene_frame(*p, a.frame, &scene, &source)?;
         if let Some(posture) = a.person {
             let facing = a.facing.map_or(Facing::Any, Facing::Azimuth);
-            let r = engine.person_at(&at, posture.into(), facing, k as u64)?;
+            let r = engine.person_at(&at, posture, facing, k as u64)?;
             persons.push(person_out(&r, engine.patches()));
         } else {
             let r = engine.at(&at, k as u64)?;

@@ -4,9 +4,9 @@ use std::time::Instant;
 
 use mrtmap_pipeline::Progress;
 use mrtmap_pipeline::simulation::{load_room, set_depth_size};
-use mrtmap_sim::{Drift, NoiseLevel, SimConfig, ThermalNoise, simulate};
+use mrtmap_sim::{Drift, SimConfig, ThermalNoise, simulate};
 
-use crate::cli::{DriftArg, NoiseArg, SimulateArgs};
+use crate::cli::{DriftArg, SimulateArgs};
 use crate::output::Bar;
 
 pub fn run(a: &SimulateArgs) -> anyhow::Result<()> {
@@ -16,10 +16,7 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<()> {
         seed: a.seed,
         ..SimConfig::default()
     };
-    cfg.noise = match a.noise {
-        NoiseArg::None => NoiseLevel::None,
-        NoiseArg::Realistic => NoiseLevel::Realistic,
-    };
+    cfg.noise = a.noise;
     cfg.drift = match a.drift {
         DriftArg::None => Drift::NONE,
         DriftArg::Slam => Drift::SLAM,
