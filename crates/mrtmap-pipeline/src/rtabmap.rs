@@ -8,10 +8,10 @@ use std::path::Path;
 
 use mrtmap_geometry::nalgebra::{Isometry3, Matrix6};
 use mrtmap_io::{Image16, LayoutWriter, Recording, RgbCamera, Rig, read_image16};
-use mrtmap_scan::pose_graph::{Edge, optimise};
 use mrtmap_sources::ros::{self, Container};
 use mrtmap_sources::rtabmap::{self, Calibration, DbSummary};
 use mrtmap_sources::{SourceKind, resolve_source};
+use mrtmap_track::pose_graph::{Edge, optimise};
 
 use crate::cache::json_text;
 use crate::conversion::{Conversion, SourceOptions};

@@ -19,8 +19,8 @@ use mrtmap_scan::FusedFrame;
 use mrtmap_scan::segment::{
     MaskInput, SegmentParams, SegmentReport, TextureInput, refined_poses, segment_textured,
 };
-use mrtmap_scan::track::{TrackParams, TrackReport, track};
 use mrtmap_scan::{FuseParams, FusionReport, fuse};
+use mrtmap_track::{TrackParams, TrackReport, track};
 
 use crate::cache::{Fingerprint, Stage, StageOutcome, read_json, run_or_reuse, write_json};
 use crate::comfort::{ComfortSummary, comfort_title, make_comfort_maps};
@@ -422,7 +422,7 @@ fn track_stage(
     // Re-tracked (mode = "always"): in the recording's own world frame, the frame of its
     // references.csv and of the project's scan-frame points.
     rec.trajectory = if has_poses {
-        mrtmap_scan::track::expressed_in(&tracked, &rec.trajectory).unwrap_or(tracked)
+        mrtmap_track::expressed_in(&tracked, &rec.trajectory).unwrap_or(tracked)
     } else {
         tracked
     };

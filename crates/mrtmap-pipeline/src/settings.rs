@@ -379,8 +379,8 @@ impl Default for TrackSection {
 
 impl TrackSection {
     /// The tracker's parameters.
-    pub fn params(&self) -> mrtmap_scan::track::TrackParams {
-        mrtmap_scan::track::TrackParams {
+    pub fn params(&self) -> mrtmap_track::TrackParams {
+        mrtmap_track::TrackParams {
             loop_closure: self.loop_closure,
             ..Default::default()
         }

@@ -63,7 +63,7 @@ impl RayTable {
     }
 
     /// The unit-depth ray (z = 1) of pixel (u, v).
-    pub(crate) fn ray(&self, u: u32, v: u32) -> &Vector3<f64> {
+    pub fn ray(&self, u: u32, v: u32) -> &Vector3<f64> {
         &self.rays[(v * self.width + u) as usize]
     }
 }

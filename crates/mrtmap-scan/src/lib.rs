@@ -14,11 +14,9 @@ pub mod frame;
 mod fuse;
 pub mod observe;
 pub mod pose_check;
-pub mod pose_graph;
 pub mod radiometric;
 pub mod segment;
 mod sync;
-pub mod track;
 pub mod voxels;
 
 pub use fuse::{

@@ -138,7 +138,7 @@ fn a_recording_without_poses_is_tracked_then_mapped() {
     // The truth's validation points, carried into the tracked world, against the map.
     let tracked = mrtmap_io::Trajectory::read(&out.join("track").join("trajectory.txt")).unwrap();
     let truth_poses = mrtmap_io::Trajectory::read(&rec.join("groundtruth.txt")).unwrap();
-    let truth_from_est = mrtmap_scan::track::align(&tracked, &truth_poses).unwrap();
+    let truth_from_est = mrtmap_track::align(&tracked, &truth_poses).unwrap();
     let truth: mrtmap_sim::Truth =
         serde_json::from_str(&std::fs::read_to_string(rec.join("truth.json")).unwrap()).unwrap();
     for pt in &truth.points {

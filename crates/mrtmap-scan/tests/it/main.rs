@@ -6,4 +6,3 @@ mod field;
 mod fusion;
 mod parts;
 mod segment;
-mod track;

@@ -2,7 +2,7 @@
 
 use mrtmap_io::Recording;
 use mrtmap_pipeline::run::track_into;
-use mrtmap_scan::track::TrackParams;
+use mrtmap_track::TrackParams;
 
 use crate::cli::TrackArgs;
 use crate::output::Bar;

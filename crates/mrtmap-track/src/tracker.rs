@@ -36,8 +36,8 @@ use serde::{Deserialize, Serialize};
 
 use mrtmap_geometry::icp::{IcpParams, IcpTarget, icp_point_to_plane};
 
-use crate::frame::{DepthPoints, DepthSampling, RayTable, depth_points};
 use crate::pose_graph::{Edge, optimise};
+use mrtmap_scan::frame::{DepthPoints, DepthSampling, RayTable, depth_points};
 
 /// Tracking settings.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

@@ -11,7 +11,7 @@ use std::fmt::Write as _;
 use std::time::Instant;
 
 use mrtmap_geometry::nalgebra::{Isometry3, Matrix6, Quaternion, Translation3, UnitQuaternion};
-use mrtmap_scan::pose_graph::{Edge, optimise};
+use mrtmap_track::pose_graph::{Edge, optimise};
 
 fn pose(v: &[f64]) -> Isometry3<f64> {
     Isometry3::from_parts(

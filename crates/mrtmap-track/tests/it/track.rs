@@ -5,8 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use mrtmap_io::Recording;
-use mrtmap_scan::track::{TrackParams, track};
 use mrtmap_sim::{NoiseLevel, SimConfig, preset, simulate};
+use mrtmap_track::{TrackParams, track};
 
 fn pose_less_walk(seconds: f64, noise: NoiseLevel, out: &Path) {
     let room = preset("office").unwrap().unwrap();

@@ -1,0 +1,5 @@
+//! Integration tests of the tracker.
+
+#![allow(clippy::unwrap_used)]
+
+mod track;
