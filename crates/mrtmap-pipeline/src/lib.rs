@@ -17,6 +17,8 @@
 //!   conversion and the demo's simulation all use it.
 //! - [`progress`]: the [`Progress`] trait the CLI implements with progress bars.
 //! - [`source`], [`run`], [`maps`], [`report`], [`demo`], [`calibration`]: one job each.
+//! - [`points`]: MRT at points of a scene (a sphere's, a person's, the plane radiant
+//!   temperatures) from one call, [`points::mrt_at_points`].
 //!
 //! Everything here returns data and writes files; nothing prints.
 //!
@@ -43,6 +45,7 @@ pub mod demo;
 mod error;
 pub mod level;
 pub mod maps;
+pub mod points;
 pub mod progress;
 pub mod report;
 mod rtabmap;

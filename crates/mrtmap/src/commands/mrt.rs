@@ -1,90 +1,14 @@
 //! `mrtmap mrt`: MRT at points with view-factor tables.
 
-use mrtmap_physics::{AsymmetryKind, Posture};
-use mrtmap_radiation::{
-    AsymmetryVerdict, ENCLOSURE_TOLERANCE, Facing, PersonMrt, PointRecord, RadiantAsymmetry,
-};
+use mrtmap_physics::AsymmetryKind;
+use mrtmap_radiation::{AsymmetryVerdict, ENCLOSURE_TOLERANCE, Facing};
 use mrtmap_report::numbers::{fixed, uncertainty};
-use serde::Serialize;
 
-use mrtmap_pipeline::maps::{load_scene, to_scene_frame};
+use mrtmap_pipeline::maps::load_scene;
+use mrtmap_pipeline::points::{PersonAnswer, PlaneAnswer, PointAnswers, PointQuery, mrt_at_points};
 
 use crate::cli::MrtArgs;
 use crate::output::json;
-
-#[derive(Serialize)]
-struct MrtOut {
-    scene: String,
-    method: mrtmap_radiation::Method,
-    points: Vec<PointRecord>,
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    persons: Vec<PersonOut>,
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    planes: Vec<PlaneOut>,
-}
-
-/// A person's MRT at a point, for JSON.
-#[derive(Serialize)]
-struct PersonOut {
-    centre: [f64; 3],
-    posture: Posture,
-    facing: Facing,
-    mrt_c: f64,
-    std_error_k: f64,
-    angle_factor_sum: f64,
-    angle_factors: Vec<(String, f64)>,
-    rays: usize,
-}
-
-/// Plane radiant temperatures and asymmetry at a point, for JSON.
-#[derive(Serialize)]
-struct PlaneOut {
-    point: [f64; 3],
-    /// Faces up, down, +x, −x, +y, −y: T_pr (°C) and standard error (K).
-    faces: Vec<(String, f64, f64)>,
-    exact: bool,
-    vertical_k: f64,
-    horizontal_k: f64,
-    horizontal_warm_azimuth_deg: f64,
-    vertical: AsymmetryVerdict,
-    horizontal: AsymmetryVerdict,
-}
-
-const FACES: [&str; 6] = ["up", "down", "+x", "-x", "+y", "-y"];
-
-fn person_out(p: &PersonMrt, patches: &[mrtmap_radiation::Patch]) -> PersonOut {
-    PersonOut {
-        centre: [p.centre.x, p.centre.y, p.centre.z],
-        posture: p.posture,
-        facing: p.facing,
-        mrt_c: p.mrt.celsius(),
-        std_error_k: p.std_error_k,
-        angle_factor_sum: p.angle_factor_sum,
-        angle_factors: patches
-            .iter()
-            .zip(&p.angle_factors)
-            .map(|(pa, f)| (pa.id.clone(), *f))
-            .collect(),
-        rays: p.rays,
-    }
-}
-
-fn plane_out(a: &RadiantAsymmetry) -> PlaneOut {
-    PlaneOut {
-        point: [a.point.x, a.point.y, a.point.z],
-        faces: FACES
-            .iter()
-            .zip(&a.six)
-            .map(|(n, t)| (n.to_string(), t.temperature.celsius(), t.std_error_k))
-            .collect(),
-        exact: a.six.iter().all(|t| t.exact),
-        vertical_k: a.vertical_k,
-        horizontal_k: a.horizontal_k,
-        horizontal_warm_azimuth_deg: a.horizontal_warm_azimuth_deg,
-        vertical: a.vertical,
-        horizontal: a.horizontal,
-    }
-}
 
 fn verdict_text(v: &AsymmetryVerdict) -> String {
     let kind = match v.kind {
@@ -104,37 +28,26 @@ fn verdict_text(v: &AsymmetryVerdict) -> String {
 pub fn run(a: &MrtArgs) -> anyhow::Result<()> {
     let (scene, source) = load_scene(a.scene.scene.as_deref())?;
     let section = a.method.section();
-    let method = section.method(&scene)?;
-    let engine = section.engine(&scene)?;
-    let mut points = Vec::with_capacity(a.at.len());
-    let (mut persons, mut planes) = (Vec::new(), Vec::new());
-    for (k, p) in a.at.iter().enumerate() {
-        let at = to_scene_frame(*p, a.frame, &scene, &source)?;
-        if let Some(posture) = a.person {
-            let facing = a.facing.map_or(Facing::Any, Facing::Azimuth);
-            let r = engine.person_at(&at, posture, facing, k as u64)?;
-            persons.push(person_out(&r, engine.patches()));
-        } else {
-            let r = engine.at(&at, k as u64)?;
-            points.push(PointRecord::new(None, &r, engine.patches()));
-        }
-        if a.plane {
-            planes.push(plane_out(&engine.asymmetry_at(&at, k as u64)?));
-        }
-    }
+    let query = PointQuery {
+        at: a.at.clone(),
+        frame: a.frame,
+        person: a
+            .person
+            .map(|p| (p, a.facing.map_or(Facing::Any, Facing::Azimuth))),
+        planes: a.plane,
+    };
+    let answers = mrt_at_points(&scene, &source, &section, &query)?;
     if a.json {
-        out!(
-            "{}",
-            json(&MrtOut {
-                scene: source,
-                method,
-                points,
-                persons,
-                planes,
-            })?
-        );
+        out!("{}", json(&answers)?);
         return Ok(());
     }
+    let PointAnswers {
+        method_description,
+        points,
+        persons,
+        planes,
+        ..
+    } = answers;
     if a.person.is_some() || a.plane {
         print_person_and_planes(&source, &persons, &planes);
         if points.is_empty() {
@@ -142,7 +55,7 @@ pub fn run(a: &MrtArgs) -> anyhow::Result<()> {
         }
     }
     outln!("scene: {source}");
-    outln!("method: {}", method.describe(engine.ray_engine()));
+    outln!("method: {method_description}");
     for p in &points {
         outln!();
         outln!(
@@ -191,7 +104,7 @@ pub fn run(a: &MrtArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn print_person_and_planes(source: &str, persons: &[PersonOut], planes: &[PlaneOut]) {
+fn print_person_and_planes(source: &str, persons: &[PersonAnswer], planes: &[PlaneAnswer]) {
     outln!("scene: {source}");
     for p in persons {
         outln!();

@@ -1,0 +1,198 @@
+//! MRT at points of a scene: a small sphere's (with its view-factor table), a person's (with
+//! its angle factors) and the six plane radiant temperatures with the radiant asymmetry. What
+//! `mrtmap mrt` prints, and what a binding returns, from one call.
+
+use mrtmap_physics::Posture;
+use mrtmap_radiation::{
+    AsymmetryVerdict, Facing, PersonMrt, PointRecord, RadiantAsymmetry, RadiantScene,
+};
+use serde::Serialize;
+
+use crate::error::Result;
+use crate::maps::to_scene_frame;
+use crate::settings::{MrtSection, PointFrame};
+
+/// What to compute at the points.
+#[derive(Clone, Debug)]
+pub struct PointQuery {
+    /// The points (m), in `frame`.
+    pub at: Vec<[f64; 3]>,
+    /// Their frame: the room's, or the scan's (carried through the scene's `world_from_room`).
+    pub frame: PointFrame,
+    /// A person's MRT (posture and facing) instead of a small sphere's; the points are the body
+    /// centres.
+    pub person: Option<(Posture, Facing)>,
+    /// The six plane radiant temperatures and the radiant asymmetry as well.
+    pub planes: bool,
+}
+
+/// The answers, in the order of the points; `mrtmap mrt --json` writes this.
+#[derive(Clone, Debug, Serialize)]
+pub struct PointAnswers {
+    /// Where the scene came from.
+    pub scene: String,
+    /// How view factors were computed.
+    pub method: mrtmap_radiation::Method,
+    /// The method in words, with the ray engine used.
+    #[serde(skip)]
+    pub method_description: String,
+    /// A small sphere's MRT at each point (empty with a person).
+    pub points: Vec<PointRecord>,
+    /// A person's MRT at each point (empty without).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub persons: Vec<PersonAnswer>,
+    /// The plane radiant temperatures at each point (empty unless asked for).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub planes: Vec<PlaneAnswer>,
+}
+
+/// A person's MRT at a point.
+#[derive(Clone, Debug, Serialize)]
+pub struct PersonAnswer {
+    /// The body centre (room frame, m).
+    pub centre: [f64; 3],
+    /// Seated or standing.
+    pub posture: Posture,
+    /// Which way the person faces.
+    pub facing: Facing,
+    /// MRT (°C).
+    pub mrt_c: f64,
+    /// Its standard error (K).
+    pub std_error_k: f64,
+    /// The sum of the angle factors (about 0.99 for fp's projected areas; the MRT is normalised
+    /// by it).
+    pub angle_factor_sum: f64,
+    /// Each patch's angle factor.
+    pub angle_factors: Vec<(String, f64)>,
+    /// Rays cast.
+    pub rays: usize,
+}
+
+/// The plane radiant temperatures and the radiant asymmetry at a point.
+#[derive(Clone, Debug, Serialize)]
+pub struct PlaneAnswer {
+    /// The point (room frame, m).
+    pub point: [f64; 3],
+    /// Faces up, down, +x, −x, +y, −y: T_pr (°C) and standard error (K).
+    pub faces: Vec<(String, f64, f64)>,
+    /// All six from exact view factors (not rays).
+    pub exact: bool,
+    /// Vertical asymmetry (K).
+    pub vertical_k: f64,
+    /// The largest horizontal asymmetry (K).
+    pub horizontal_k: f64,
+    /// The azimuth of its warmer side (degrees).
+    pub horizontal_warm_azimuth_deg: f64,
+    /// ISO 7730's verdict on the vertical asymmetry.
+    pub vertical: AsymmetryVerdict,
+    /// ISO 7730's verdict on the horizontal asymmetry.
+    pub horizontal: AsymmetryVerdict,
+}
+
+/// The faces of [`PlaneAnswer::faces`], in order.
+pub const FACES: [&str; 6] = ["up", "down", "+x", "-x", "+y", "-y"];
+
+fn person_answer(p: &PersonMrt, patches: &[mrtmap_radiation::Patch]) -> PersonAnswer {
+    PersonAnswer {
+        centre: [p.centre.x, p.centre.y, p.centre.z],
+        posture: p.posture,
+        facing: p.facing,
+        mrt_c: p.mrt.celsius(),
+        std_error_k: p.std_error_k,
+        angle_factor_sum: p.angle_factor_sum,
+        angle_factors: patches
+            .iter()
+            .zip(&p.angle_factors)
+            .map(|(pa, f)| (pa.id.clone(), *f))
+            .collect(),
+        rays: p.rays,
+    }
+}
+
+fn plane_answer(a: &RadiantAsymmetry) -> PlaneAnswer {
+    PlaneAnswer {
+        point: [a.point.x, a.point.y, a.point.z],
+        faces: FACES
+            .iter()
+            .zip(&a.six)
+            .map(|(n, t)| (n.to_string(), t.temperature.celsius(), t.std_error_k))
+            .collect(),
+        exact: a.six.iter().all(|t| t.exact),
+        vertical_k: a.vertical_k,
+        horizontal_k: a.horizontal_k,
+        horizontal_warm_azimuth_deg: a.horizontal_warm_azimuth_deg,
+        vertical: a.vertical,
+        horizontal: a.horizontal,
+    }
+}
+
+/// Answers `q` on `scene` (read from `source`, which errors name) with the view-factor settings
+/// `mrt`. A point outside the room or inside its furniture is refused with an error naming it;
+/// the k-th point draws its rays from stream k, so answers do not depend on the other points.
+pub fn mrt_at_points(
+    scene: &RadiantScene,
+    source: &str,
+    mrt: &MrtSection,
+    q: &PointQuery,
+) -> Result<PointAnswers> {
+    let method = mrt.method(scene)?;
+    let engine = mrt.engine(scene)?;
+    let mut answers = PointAnswers {
+        scene: source.to_string(),
+        method_description: method.describe(engine.ray_engine()),
+        method,
+        points: Vec::new(),
+        persons: Vec::new(),
+        planes: Vec::new(),
+    };
+    for (k, p) in q.at.iter().enumerate() {
+        let at = to_scene_frame(*p, q.frame, scene, source)?;
+        if let Some((posture, facing)) = q.person {
+            let r = engine.person_at(&at, posture, facing, k as u64)?;
+            answers.persons.push(person_answer(&r, engine.patches()));
+        } else {
+            let r = engine.at(&at, k as u64)?;
+            answers
+                .points
+                .push(PointRecord::new(None, &r, engine.patches()));
+        }
+        if q.planes {
+            answers
+                .planes
+                .push(plane_answer(&engine.asymmetry_at(&at, k as u64)?));
+        }
+    }
+    Ok(answers)
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    /// The example office: a sphere's, a person's and the planes' answers at the same point, in
+    /// both frames; a point outside the room is refused.
+    #[test]
+    fn points_persons_and_planes_from_one_call() {
+        let scene = mrtmap_radiation::example_office();
+        let mrt = MrtSection::default();
+        let mut q = PointQuery {
+            at: vec![[2.0, 1.5, 1.1], [1.0, 1.0, 0.6]],
+            frame: PointFrame::Room,
+            person: None,
+            planes: true,
+        };
+        let a = mrt_at_points(&scene, "example", &mrt, &q).unwrap();
+        assert_eq!((a.points.len(), a.persons.len(), a.planes.len()), (2, 0, 2));
+        let sphere = a.points[0].mrt_c;
+        assert!((15.0..30.0).contains(&sphere), "{sphere}");
+        assert_eq!(a.planes[0].faces.len(), 6);
+        q.person = Some((Posture::Seated, Facing::Any));
+        q.planes = false;
+        let p = mrt_at_points(&scene, "example", &mrt, &q).unwrap();
+        assert_eq!((p.points.len(), p.persons.len()), (0, 2));
+        assert!((p.persons[0].mrt_c - sphere).abs() < 1.0);
+        q.at = vec![[20.0, 1.5, 1.1]];
+        assert!(mrt_at_points(&scene, "example", &mrt, &q).is_err());
+    }
+}
