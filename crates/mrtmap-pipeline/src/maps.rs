@@ -105,6 +105,67 @@ fn mark_records(
     Ok((records, map_marks))
 }
 
+/// What [`map_scene`] made: the MRT map and, when a person's quantities were asked for, the
+/// comfort maps beside it.
+pub struct SceneMaps {
+    /// The MRT map.
+    pub map: MapOutput,
+    /// The person's comfort maps.
+    pub comfort: Option<crate::comfort::ComfortOutput>,
+}
+
+/// What `mrtmap map` writes into `out`: the MRT over `spec`'s grid of `scene` (view factors by
+/// `project.mrt`) with `marks`, and the person's comfort maps that `project.map.quantities` asks
+/// for (the person and the air from `project`, checked before anything is computed).
+pub fn map_scene(
+    scene: &RadiantScene,
+    source: &str,
+    project: &crate::Project,
+    spec: GridSpec,
+    marks: &[Mark],
+    out: &Path,
+) -> Result<SceneMaps> {
+    let person = crate::settings::Quantity::person(&project.map.quantities);
+    project.comfort.check(&project.air, &person)?;
+    let map = make_map(scene, source, &project.mrt, spec, marks, out)?;
+    if person.is_empty() {
+        return Ok(SceneMaps { map, comfort: None });
+    }
+    let engine = project.mrt.engine(scene)?;
+    let frame = MapFrame::of_scene(scene).map_err(|e| Error::Map {
+        scene: source.to_string(),
+        source: e,
+    })?;
+    let xy_marks: Vec<(String, [f64; 2])> = marks
+        .iter()
+        .map(|mk| {
+            let uv = match mk.at {
+                MarkAt::Map(uv) => uv,
+                MarkAt::Scene(p) => {
+                    let q = frame.uv(&Point3::from(p));
+                    [q.x, q.y]
+                }
+            };
+            (mk.name.clone(), uv)
+        })
+        .collect();
+    let comfort = crate::comfort::make_comfort_maps(
+        &engine,
+        scene,
+        source,
+        ([spec.nx, spec.ny], spec.margin_m),
+        &project.comfort,
+        &project.air,
+        &person,
+        &xy_marks,
+        out,
+    )?;
+    Ok(SceneMaps {
+        map,
+        comfort: Some(comfort),
+    })
+}
+
 /// Computes the MRT map of `scene` (from `source`, for people) on `spec` with `marks`, and writes
 /// mrt_grid.csv, mrt_map.png, mrt_map.svg and summary.json into `out`. The height and the marks
 /// are checked against the room before anything is computed.
@@ -205,5 +266,37 @@ pub fn to_scene_frame(
                 "has no world_from_room (it was not written by segmentation), so points in the scan's frame cannot be placed in it: give them in its own frame",
             )),
         },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use crate::settings::Quantity;
+
+    /// `mrtmap map` from one call: the MRT map always; the comfort maps only when a person's
+    /// quantity is asked for, and then only with the air they need.
+    #[test]
+    fn a_scene_is_mapped_with_the_comfort_maps_asked_for() {
+        let scene = mrtmap_radiation::example_office();
+        let dir = tempfile::tempdir().unwrap();
+        let spec = GridSpec {
+            nx: 6,
+            ny: 5,
+            ..GridSpec::default()
+        };
+        let mut project = crate::Project::default();
+        let plain = map_scene(&scene, "example", &project, spec, &[], dir.path()).unwrap();
+        assert!(plain.comfort.is_none());
+        assert!(dir.path().join("mrt_grid.csv").exists());
+        project.map.quantities = vec![Quantity::Pmv];
+        project.air.temperature_c = None;
+        assert!(map_scene(&scene, "example", &project, spec, &[], dir.path()).is_err());
+        assert!(!dir.path().join("pmv.png").exists());
+        project.air.temperature_c = Some(21.0);
+        let both = map_scene(&scene, "example", &project, spec, &[], dir.path()).unwrap();
+        assert_eq!(both.comfort.unwrap().summary.nodes, 30);
+        assert!(dir.path().join("pmv.png").exists());
     }
 }

@@ -1,12 +1,11 @@
 //! `mrtmap map`: MRT over a grid, written as CSV, PNG, SVG and JSON; with `--quantity`, a
 //! person's comfort maps beside it.
 
-use mrtmap_geometry::nalgebra::Point3;
 use mrtmap_pipeline::Project;
-use mrtmap_pipeline::comfort::{make_comfort_maps, value_of};
-use mrtmap_pipeline::maps::{Mark, MarkAt, load_scene, make_map};
+use mrtmap_pipeline::comfort::value_of;
+use mrtmap_pipeline::maps::{Mark, MarkAt, load_scene, map_scene};
 use mrtmap_pipeline::settings::Quantity;
-use mrtmap_radiation::{GridSpec, MapFrame};
+use mrtmap_radiation::GridSpec;
 use mrtmap_report::numbers::{fixed, uncertainty};
 
 use crate::cli::MapArgs;
@@ -23,10 +22,8 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
     if a.air_c.is_some() {
         project.air.temperature_c = a.air_c;
     }
-    let person = Quantity::person(&project.map.quantities);
-    project.comfort.check(&project.air, &person)?;
     let (scene, source) = load_scene(a.scene.scene.as_deref())?;
-    let section = a.method.section();
+    project.mrt = a.method.section();
     let spec = GridSpec {
         nx: a.grid.0,
         ny: a.grid.1,
@@ -44,7 +41,8 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
             },
         })
         .collect();
-    let m = make_map(&scene, &source, &section, spec, &marks, &a.out)?;
+    let maps = map_scene(&scene, &source, &project, spec, &marks, &a.out)?;
+    let m = &maps.map;
     outln!("scene: {source}");
     outln!("method: {}", m.method);
     print_map(&m.summary);
@@ -53,35 +51,10 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
         m.summary.map.compute_secs,
         a.out.display()
     );
-    if person.is_empty() {
+    let Some(c) = &maps.comfort else {
         return Ok(());
-    }
-    let engine = section.engine(&scene)?;
-    let frame = MapFrame::of_scene(&scene)?;
-    let xy_marks: Vec<(String, [f64; 2])> = marks
-        .iter()
-        .map(|mk| {
-            let uv = match mk.at {
-                MarkAt::Map(uv) => uv,
-                MarkAt::Scene(p) => {
-                    let q = frame.uv(&Point3::from(p));
-                    [q.x, q.y]
-                }
-            };
-            (mk.name.clone(), uv)
-        })
-        .collect();
-    let c = make_comfort_maps(
-        &engine,
-        &scene,
-        &source,
-        ([spec.nx, spec.ny], spec.margin_m),
-        &project.comfort,
-        &project.air,
-        &person,
-        &xy_marks,
-        &a.out,
-    )?;
+    };
+    let person = Quantity::person(&project.map.quantities);
     let s = &c.summary;
     outln!();
     outln!(
