@@ -59,6 +59,8 @@ self_calibrate = true     # remove each frame's offset (FFC, drift) and the vign
 mode = "auto"             # the built-in RGB-D tracker: auto (when the recording has no poses),
                           # always (re-track even when it has them), never
 loop_closure = true
+use_imu = true            # predict each frame's rotation from imu.txt's gyro when there is one
+fast_threshold = 12       # FAST corner threshold (grey levels); lower finds more on weak texture
 
 [segment]
 feature_threshold_k = 0.3 # a texel differing from its surface's background by more is a feature
@@ -366,13 +368,20 @@ pub struct TrackSection {
     pub mode: TrackMode,
     /// Look for loop closures.
     pub loop_closure: bool,
+    /// Predict each frame's rotation from the recording's gyro (imu.txt) where it has one.
+    pub use_imu: bool,
+    /// FAST corner threshold (grey levels).
+    pub fast_threshold: u8,
 }
 
 impl Default for TrackSection {
     fn default() -> Self {
+        let t = mrtmap_track::TrackParams::default();
         Self {
             mode: TrackMode::Auto,
-            loop_closure: true,
+            loop_closure: t.loop_closure,
+            use_imu: t.use_imu,
+            fast_threshold: t.fast_threshold,
         }
     }
 }
@@ -382,6 +391,8 @@ impl TrackSection {
     pub fn params(&self) -> mrtmap_track::TrackParams {
         mrtmap_track::TrackParams {
             loop_closure: self.loop_closure,
+            use_imu: self.use_imu,
+            fast_threshold: self.fast_threshold,
             ..Default::default()
         }
     }
@@ -746,6 +757,7 @@ mod tests {
         assert_eq!(p.fuse, FuseSection::default());
         assert_eq!(p.segment, SegmentSection::default());
         assert_eq!(p.mrt, MrtSection::default());
+        assert_eq!(p.track, TrackSection::default());
         assert_eq!(p.points.len(), 1);
         assert_eq!(p.air.temperature_c, Some(21.0));
         let (line, msg) = Project::parse("[map]\n\ngird = [1, 2]\n").unwrap_err();

@@ -2,7 +2,7 @@
 
 use mrtmap_io::Recording;
 use mrtmap_pipeline::run::track_into;
-use mrtmap_track::TrackParams;
+use mrtmap_pipeline::settings::TrackSection;
 
 use crate::cli::TrackArgs;
 use crate::output::Bar;
@@ -13,12 +13,13 @@ pub fn run(a: &TrackArgs) -> anyhow::Result<()> {
     for w in &rec.warnings {
         eprintln!("warning: {w}");
     }
-    let params = TrackParams {
+    let params = TrackSection {
         loop_closure: !a.no_loops,
         use_imu: !a.no_imu,
         fast_threshold: a.fast_threshold,
-        ..TrackParams::default()
-    };
+        ..TrackSection::default()
+    }
+    .params();
     let bar = Bar::new(" frames");
     let (traj, r) = track_into(&rec, &params, &a.out, &bar)?;
     bar.finish();
