@@ -328,6 +328,19 @@ pub struct RoomSection {
     pub origin_corner: Option<usize>,
 }
 
+impl RoomSection {
+    /// Settings that need no cloud: corners are numbered from 1.
+    pub fn check(&self) -> Result<()> {
+        if self.origin_corner == Some(0) {
+            return Err(Error::setting(
+                "--origin-corner 0 ([room] origin_corner)".to_string(),
+                "is not a corner: corners are numbered from 1, as on the report's map; leave it out for the default",
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// `[air]`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -520,6 +533,18 @@ impl Default for SegmentSection {
 }
 
 impl SegmentSection {
+    /// Settings that need no cloud: the raster's texel.
+    pub fn check(&self) -> Result<()> {
+        let r = self.raster_m;
+        if !(r == 0.0 || (r.is_finite() && (0.03..=2.0).contains(&r))) {
+            return Err(Error::setting(
+                format!("--raster-m {r} ([segment] raster_m)"),
+                "must be 0 (no raster) or between 0.03 and 2 m",
+            ));
+        }
+        Ok(())
+    }
+
     /// The segmentation's parameters, with the room frame's origin corner.
     pub fn params(&self, room: &RoomSection) -> SegmentParams {
         SegmentParams {
@@ -721,19 +746,8 @@ impl Project {
             ));
         }
         self.fuse.params()?;
-        let r = self.segment.raster_m;
-        if !(r == 0.0 || (r.is_finite() && (0.03..=2.0).contains(&r))) {
-            return Err(Error::setting(
-                format!("[segment] raster_m = {r}"),
-                "must be 0 (no raster) or between 0.03 and 2 m",
-            ));
-        }
-        if self.room.origin_corner == Some(0) {
-            return Err(Error::setting(
-                "--origin-corner 0 ([room] origin_corner)".to_string(),
-                "corners are numbered from 1, as on the report's map; leave it out for the default",
-            ));
-        }
+        self.segment.check()?;
+        self.room.check()?;
         self.comfort.check(&self.air, &self.map.quantities)?;
         self.mrt.check()?;
         Ok(())
@@ -767,12 +781,24 @@ mod tests {
     }
 
     #[test]
-    fn corner_zero_is_refused_before_any_stage_runs() {
+    fn corner_zero_and_a_wild_raster_are_refused_before_any_stage_runs() {
         let p = Project::parse("[room]\norigin_corner = 0\n").unwrap();
         let e = p.check().unwrap_err().to_string();
         assert!(e.contains("origin_corner") && e.contains("from 1"), "{e}");
         assert!(
             Project::parse("[room]\norigin_corner = 2\n")
+                .unwrap()
+                .check()
+                .is_ok()
+        );
+        let p = Project::parse("[segment]\nraster_m = 5.0\n").unwrap();
+        let e = p.check().unwrap_err().to_string();
+        assert!(
+            e.contains("raster_m") && e.contains("between 0.03 and 2 m"),
+            "{e}"
+        );
+        assert!(
+            Project::parse("[segment]\nraster_m = 0.0\n")
                 .unwrap()
                 .check()
                 .is_ok()

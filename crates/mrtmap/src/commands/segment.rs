@@ -16,12 +16,6 @@ pub fn run(a: &SegmentArgs) -> anyhow::Result<()> {
             a.fused.display()
         );
     }
-    if !(a.raster_m == 0.0 || (a.raster_m.is_finite() && (0.03..=2.0).contains(&a.raster_m))) {
-        bail!(
-            "--raster-m {} must be 0 (no raster) or between 0.03 and 2 m",
-            a.raster_m
-        );
-    }
     let masks = match &a.masks {
         Some(dir) => {
             let r = Recording::open(dir)?;
@@ -43,6 +37,7 @@ pub fn run(a: &SegmentArgs) -> anyhow::Result<()> {
         masks: a.masks.is_some(),
         texture: recording.is_some(),
     };
+    section.check()?;
     let inputs = SegmentInputs {
         recording: recording.as_ref(),
         masks: section.masks,
@@ -51,6 +46,7 @@ pub fn run(a: &SegmentArgs) -> anyhow::Result<()> {
     let room = RoomSection {
         origin_corner: a.origin_corner,
     };
+    room.check()?;
     let level = LevelInputs {
         references: match &a.references {
             Some(f) => read_references(f)?,
