@@ -70,7 +70,11 @@ pub struct Thermal {
 }
 
 /// Operative temperature and PMV/PPD of a person at mean radiant temperature `tr_c` ± `tr_se_k`.
-pub fn thermal(air: &Air, tr_c: f64, tr_se_k: f64) -> std::result::Result<Thermal, String> {
+pub fn thermal(
+    air: &Air,
+    tr_c: f64,
+    tr_se_k: f64,
+) -> std::result::Result<Thermal, mrtmap_physics::PhysicsError> {
     let c = Temperature::from_celsius;
     let vr = relative_air_speed(air.speed_m_s, air.met);
     let pmv_at = |tr: f64| {
@@ -83,7 +87,6 @@ pub fn thermal(air: &Air, tr_c: f64, tr_se_k: f64) -> std::result::Result<Therma
             clo: air.clo,
             external_work_met: 0.0,
         })
-        .map_err(|e| e.to_string())
     };
     let to = |tr: f64| {
         operative_temperature(
@@ -93,7 +96,6 @@ pub fn thermal(air: &Air, tr_c: f64, tr_se_k: f64) -> std::result::Result<Therma
             OperativeMethod::Iso,
         )
         .map(|t| t.celsius())
-        .map_err(|e| e.to_string())
     };
     let h = 0.01;
     let (p, p_hi, p_lo) = (pmv_at(tr_c)?, pmv_at(tr_c + h)?, pmv_at(tr_c - h)?);

@@ -33,7 +33,7 @@ pub fn run(a: &ComfortArgs) -> anyhow::Result<()> {
         met: a.met,
         clo: a.clo,
     };
-    let t = thermal(&air, tr, 0.0).map_err(anyhow::Error::msg)?;
+    let t = thermal(&air, tr, 0.0)?;
     let out = Out {
         air,
         mrt_c: tr,
