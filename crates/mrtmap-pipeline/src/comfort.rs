@@ -326,6 +326,9 @@ pub struct ComfortOutput {
 
 /// Computes the person's quantities of `quantities` over the floor grid and at `marks` (map x, y
 /// with names), writing `<quantity>.csv`, `.png`, `.svg` and `comfort.json` into `out`.
+///
+/// Longer than 120 lines (127): the grid's nodes computed, then each quantity written; the second
+/// half belongs with the MRT map's writer, which issue 38's map redesign will share.
 #[allow(clippy::too_many_arguments)]
 pub fn make_comfort_maps(
     engine: &MrtEngine<'_>,

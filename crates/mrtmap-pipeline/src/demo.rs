@@ -108,11 +108,14 @@ pub fn walk_speed_for(
     seed: u64,
     seconds: f64,
 ) -> std::result::Result<f64, f64> {
-    DEMO_SPEEDS_M_S
-        .iter()
-        .copied()
-        .find(|&v| shortest_walk_s(room, seed, v) <= seconds)
-        .ok_or_else(|| shortest_walk_s(room, seed, DEMO_SPEEDS_M_S[DEMO_SPEEDS_M_S.len() - 1]))
+    let mut shortest = f64::INFINITY;
+    for v in DEMO_SPEEDS_M_S {
+        shortest = shortest_walk_s(room, seed, v);
+        if shortest <= seconds {
+            return Ok(v);
+        }
+    }
+    Err(shortest)
 }
 
 /// Simulates the scan into `out/recording` unless it holds this simulation already.
@@ -122,13 +125,14 @@ fn simulate_stage(
     progress: &dyn Progress,
 ) -> Result<(StageOutcome, String)> {
     let room = load_room(&s.room)?;
+    let fastest = DEMO_SPEEDS_M_S[DEMO_SPEEDS_M_S.len() - 1];
     let speed = match walk_speed_for(&room, s.seed, s.seconds) {
         Ok(v) if s.seconds <= 3600.0 => v,
         found => {
-            let fastest = DEMO_SPEEDS_M_S[DEMO_SPEEDS_M_S.len() - 1];
-            let shortest = found
-                .err()
-                .unwrap_or(shortest_walk_s(&room, s.seed, fastest));
+            let shortest = match found {
+                Err(t) => t,
+                Ok(_) => shortest_walk_s(&room, s.seed, fastest),
+            };
             return Err(Error::setting(
                 format!("--seconds {}", s.seconds),
                 format!(

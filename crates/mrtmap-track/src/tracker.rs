@@ -797,6 +797,11 @@ fn rotation_deg(t: &Isometry3<f64>) -> f64 {
 
 /// Tracks the recording's colour frames; returns world_from_depth at the colour frames' times (the
 /// first frame's depth camera is the world) and what was done.
+///
+/// Longer than 120 lines (315): one sequential loop over the colour frames whose state (the
+/// reference keyframe, velocity, lost/relocalised counts, keyframe graph, about twelve locals)
+/// every step reads and writes. Splitting it needs that state gathered into a tracker struct
+/// first (issue 38); until then the steps are marked by comments in the loop.
 pub fn track(
     rec: &Recording,
     params: &TrackParams,

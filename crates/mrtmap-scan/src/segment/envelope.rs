@@ -419,6 +419,10 @@ const UNOBSERVED_MARGIN_M: f64 = 0.3;
 /// finds the outline of walls on the floor plan (`outline`) and computes the corners. The walls
 /// become planes of their own, appended to `planes`; vertical planes found by RANSAC on a wall
 /// are replaced by it.
+///
+/// Longer than 120 lines: it is three steps in order (the outline chosen between two height
+/// bands, the walls' planes, the RANSAC planes reclassified against them) sharing the floor frame
+/// and the wall points; splitting them out is issue 38's segmentation work, not done yet.
 pub fn envelope(
     cloud: Cloud<'_>,
     mut planes: Vec<FoundPlane>,

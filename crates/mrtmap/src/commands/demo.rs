@@ -23,8 +23,10 @@ pub fn run(a: &DemoArgs) -> anyhow::Result<()> {
     // (depth 94 MB, colour 32, thermal 4, the run 20), 60 s 577 MB; at 15 Hz 30 s wrote 197 MB
     // and 60 s 373 MB: about 20 MB for the run, 2.7 MB per second of scan plus 6.6 MB per second
     // of 640×480 depth at 30 Hz.
-    let pixels = (a.depth_size.0 * a.depth_size.1) as f64 / (640.0 * 480.0) * a.depth_hz / 30.0;
-    let estimate_mb = 20.0 + settings.seconds * (2.7 + 6.6 * pixels);
+    // Depth data per second against 640×480 at 30 Hz.
+    let depth_share =
+        (a.depth_size.0 * a.depth_size.1) as f64 / (640.0 * 480.0) * a.depth_hz / 30.0;
+    let estimate_mb = 20.0 + settings.seconds * (2.7 + 6.6 * depth_share);
     eprintln!(
         "writing into {} (about {:.0} MB; remove it when done)",
         a.out.display(),
