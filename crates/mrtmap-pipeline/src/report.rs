@@ -15,10 +15,12 @@ use crate::run::{ComfortResult, RunOutcome};
 use crate::settings::Project;
 
 /// What ± covers, in words.
-const WHAT_PLUS_MINUS_COVERS: &str = "view-factor sampling, the fused surface temperatures' random error and the \
-     uncertainty of their common level (the references' fit, or the camera's stated accuracy: a \
-     common offset passes one to one into MRT); not emissivity or the room's geometry: check \
-     against a black globe (mrtmap validate)";
+const WHAT_PLUS_MINUS_COVERS: &str = "five parts in quadrature: view-factor sampling, the fused surface \
+     temperatures' random error, the point's placement relative to the surfaces (the MRT's gradient \
+     times [mrt] placement_std_m), the areas the scan never saw (each unseen patch anywhere between \
+     the temperatures seen around it) and the uncertainty of the temperatures' common level (the \
+     references' fit, or the camera's stated accuracy: a common offset passes one to one into MRT); \
+     not emissivity or the room's shape: check against a black globe (mrtmap validate)";
 
 fn surface_rows(s: &SegmentReport) -> Vec<[String; 6]> {
     s.surfaces
@@ -156,6 +158,21 @@ fn coverage_rows(o: &RunOutcome) -> Vec<(String, String)> {
                 .and_then(|m| m.summary.map.field.as_ref())
                 .map_or("—".into(), |f| {
                     format!("{} K", uncertainty(f.max_std_error_k, 3))
+                }),
+        ),
+        (
+            "its parts, the largest of each on the map".into(),
+            o.maps
+                .first()
+                .and_then(|m| m.summary.map.field.as_ref())
+                .map_or("—".into(), |f| {
+                    let parts: Vec<String> = f
+                        .max_std_error_parts
+                        .named()
+                        .iter()
+                        .map(|(name, v)| format!("{name} {}", uncertainty(*v, 3)))
+                        .collect();
+                    format!("{} K", parts.join(", "))
                 }),
         ),
         ("what ± covers".into(), WHAT_PLUS_MINUS_COVERS.into()),

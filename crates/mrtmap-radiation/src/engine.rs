@@ -23,6 +23,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::bounds::RoomBounds;
+use crate::raster::UnseenShare;
 use crate::scene::{RadiantScene, SurfaceKind};
 
 /// Tolerance on Σ F above 1 before the exact engine declares that surfaces hide each other.
@@ -293,8 +294,7 @@ pub struct PointMrt {
     pub point: Point3<f64>,
     /// Mean radiant temperature.
     pub mrt: Temperature,
-    /// Total standard error (K): sampling, temperature and placement uncertainties combined in
-    /// quadrature.
+    /// Total standard error (K): its five parts below combined in quadrature.
     pub std_error_k: f64,
     /// Part of the error from Monte Carlo sampling (0 for exact).
     pub sampling_std_error_k: f64,
@@ -304,6 +304,13 @@ pub struct PointMrt {
     /// [`MrtEngine::with_placement_std`]): the MRT's gradient there times the placement's standard
     /// deviation; 0 when no placement uncertainty is set.
     pub placement_std_error_k: f64,
+    /// Part of the error from the surfaces' areas the scan never saw (their rasters' unseen
+    /// patches): each patch's view factor times its temperature's spread over the range its seen
+    /// surroundings allow, patches combined in quadrature.
+    pub unseen_std_error_k: f64,
+    /// Part of the error from the camera's absolute level (the scene's
+    /// `temperature_level_std_k`: a common error of every temperature moves the MRT one to one).
+    pub level_std_error_k: f64,
     /// View factor per patch (order of [`patches`]).
     pub view_factors: Vec<f64>,
     /// Standard error per view factor (0 for exact).
@@ -312,6 +319,13 @@ pub struct PointMrt {
     pub view_factor_sum: f64,
     /// Rays traced (0 for exact).
     pub rays: usize,
+}
+
+/// What a point sees of the rasters: every patch's temperature (rastered surfaces at their
+/// texels' average) and, per unseen patch, the surface patch it lies on and its share.
+pub(crate) struct Seen {
+    pub(crate) temperatures: Vec<Temperature>,
+    pub(crate) unseen: Vec<(usize, UnseenShare)>,
 }
 
 enum Owner {
@@ -569,20 +583,28 @@ impl<'a> MrtEngine<'a> {
             return Err(MrtError::NotEnclosed { point: arr(p), sum });
         }
         let seen = self.seen_temperatures(p, &|_| 1.0);
+        let temps = seen.as_ref().map(|s| s.temperatures.as_slice());
         let m = self
-            .radiant_of(&f, seen.as_deref())
+            .radiant_of(&f, temps)
             .map_err(|source| MrtError::Physics {
                 point: arr(p),
                 source,
             })?;
-        let sampling = self.sampling_error(&replicate_f, seen.as_deref());
+        let sampling = self.sampling_error(&replicate_f, temps);
+        let unseen = self.unseen_error(&f, seen.as_ref(), m.temperature);
+        let level = self.scene.temperature_level_std_k;
         Ok(PointMrt {
             point: *p,
             mrt: m.temperature,
-            std_error_k: sampling.hypot(m.std_from_temperatures_k),
+            std_error_k: sampling
+                .hypot(m.std_from_temperatures_k)
+                .hypot(unseen)
+                .hypot(level),
             sampling_std_error_k: sampling,
             temperature_std_error_k: m.std_from_temperatures_k,
             placement_std_error_k: 0.0,
+            unseen_std_error_k: unseen,
+            level_std_error_k: level,
             view_factor_sum: f.iter().sum(),
             view_factors: f,
             view_factor_std_errors: se,
@@ -597,22 +619,63 @@ impl<'a> MrtEngine<'a> {
         &self,
         p: &Point3<f64>,
         weight: &dyn Fn(&Vector3<f64>) -> f64,
-    ) -> Option<Vec<Temperature>> {
+    ) -> Option<Seen> {
         if self.scene.surfaces.iter().all(|s| s.raster.is_none()) {
             return None;
         }
         let mut t: Vec<Temperature> = self.patches.iter().map(|pa| pa.temperature).collect();
+        let mut unseen = Vec::new();
         for (si, s) in self.scene.surfaces.iter().enumerate() {
-            if let Some(seen) = s.raster.as_ref().and_then(|r| r.seen_from(p, weight)) {
-                t[self.surface_patch[si]] = seen;
+            if let Some((seen, shares)) = s
+                .raster
+                .as_ref()
+                .and_then(|r| r.seen_with_unseen(p, weight))
+            {
+                let k = self.surface_patch[si];
+                t[k] = seen;
+                unseen.extend(shares.into_iter().map(|u| (k, u)));
             }
         }
-        Some(t)
+        Some(Seen {
+            temperatures: t,
+            unseen,
+        })
+    }
+
+    /// The unseen-areas part of a radiant temperature `tr` from factors `f` (K): each unseen
+    /// patch's share of its surface's factor, times dTr/dT at its filled temperature, times its
+    /// spread over the range allowed; patches in quadrature.
+    pub(crate) fn unseen_error(&self, f: &[f64], seen: Option<&Seen>, tr: Temperature) -> f64 {
+        let Some(seen) = seen else { return 0.0 };
+        if seen.unseen.is_empty() {
+            return 0.0;
+        }
+        let total: f64 = self
+            .patches
+            .iter()
+            .zip(f)
+            .map(|(pa, &f)| pa.emissivity * f.max(0.0))
+            .sum();
+        if total <= 0.0 {
+            return 0.0;
+        }
+        let tr3 = tr.kelvin().powi(3);
+        seen.unseen
+            .iter()
+            .map(|(k, u)| {
+                let fj = f[*k].max(0.0) * u.share;
+                let dtr_dt =
+                    self.patches[*k].emissivity * fj * u.filled.kelvin().powi(3) / (tr3 * total);
+                (dtr_dt * u.std_k).powi(2)
+            })
+            .sum::<f64>()
+            .sqrt()
     }
 
     /// The radiant temperature of factors `f` per patch: (Σ εFT⁴ / Σ εF)^¼ (normalised, so factors
     /// that sum short of 1, like a person's, weigh what is seen), with the error from the patches'
-    /// temperature uncertainties. `seen` overrides the patches' temperatures (rasters).
+    /// temperature uncertainties (the camera's level not included). `seen` overrides the patches'
+    /// temperatures (rasters).
     pub(crate) fn radiant_of(
         &self,
         f: &[f64],
@@ -631,12 +694,7 @@ impl<'a> MrtEngine<'a> {
                 temperature_std_k: pa.temperature_std_k,
             })
             .collect();
-        let mut m = mean_radiant_temperature(&src)?;
-        // A common level error moves every temperature, and so the MRT, one to one.
-        m.std_from_temperatures_k = m
-            .std_from_temperatures_k
-            .hypot(self.scene.temperature_level_std_k);
-        Ok(m)
+        mean_radiant_temperature(&src)
     }
 
     /// The sampling standard error (K) of a radiant temperature from its replicates' factors.

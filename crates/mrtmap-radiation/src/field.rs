@@ -185,6 +185,59 @@ pub struct FieldSummary {
     pub mean_c: f64,
     /// Largest standard error (K).
     pub max_std_error_k: f64,
+    /// The largest of each of the standard error's parts over the nodes (K).
+    #[serde(default)]
+    pub max_std_error_parts: StdErrorParts,
+}
+
+/// A standard error's parts (K), which combine in quadrature into the total.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct StdErrorParts {
+    /// Monte Carlo sampling of the view factors.
+    pub sampling_k: f64,
+    /// The surfaces' temperatures (their random error).
+    pub temperatures_k: f64,
+    /// Where the point lies relative to the surfaces.
+    pub placement_k: f64,
+    /// Areas the scan never saw.
+    pub unseen_k: f64,
+    /// The camera's absolute level.
+    pub level_k: f64,
+}
+
+impl StdErrorParts {
+    /// The parts of `r`.
+    pub fn of(r: &PointMrt) -> Self {
+        Self {
+            sampling_k: r.sampling_std_error_k,
+            temperatures_k: r.temperature_std_error_k,
+            placement_k: r.placement_std_error_k,
+            unseen_k: r.unseen_std_error_k,
+            level_k: r.level_std_error_k,
+        }
+    }
+
+    /// Each part with its name for people, in order.
+    pub fn named(&self) -> [(&'static str, f64); 5] {
+        [
+            ("sampling", self.sampling_k),
+            ("surface temperatures", self.temperatures_k),
+            ("placement", self.placement_k),
+            ("unseen areas", self.unseen_k),
+            ("camera level", self.level_k),
+        ]
+    }
+
+    /// The larger of each part.
+    pub fn max(self, o: Self) -> Self {
+        Self {
+            sampling_k: self.sampling_k.max(o.sampling_k),
+            temperatures_k: self.temperatures_k.max(o.temperatures_k),
+            placement_k: self.placement_k.max(o.placement_k),
+            unseen_k: self.unseen_k.max(o.unseen_k),
+            level_k: self.level_k.max(o.level_k),
+        }
+    }
 }
 
 /// A value at a place.
@@ -335,6 +388,10 @@ impl MrtField {
             max: ext(max),
             mean_c: ok.iter().map(|x| x.1.mrt.celsius()).sum::<f64>() / ok.len() as f64,
             max_std_error_k: ok.iter().map(|x| x.1.std_error_k).fold(0.0, f64::max),
+            max_std_error_parts: ok
+                .iter()
+                .map(|x| StdErrorParts::of(x.1))
+                .fold(StdErrorParts::default(), StdErrorParts::max),
         })
     }
 

@@ -34,9 +34,10 @@ pub use engine::{
 };
 pub use field::{
     Extreme, FieldError, FieldSummary, GridLayout, GridNode, GridSpec, MapFrame, MrtField,
+    StdErrorParts,
 };
 pub use person::{AsymmetryVerdict, Facing, PersonMrt, PlaneRadiant, RadiantAsymmetry};
-pub use raster::{MAX_TEXELS, Raster, RasterFile, Texel};
+pub use raster::{MAX_TEXELS, Raster, RasterFile, Texel, UnseenPatch, UnseenShare};
 pub use scene::{
     BoxFile, FEATURE_PLANE_TOLERANCE_M, Feature, FeatureFile, FramePose, MAX_COORDINATE_M,
     Occluder, OccluderFile, OccluderShape, PLANARITY_TOLERANCE_M, RadiantScene, SCENE_FORMAT,
@@ -105,6 +106,12 @@ pub struct PointRecord {
     /// was set).
     #[serde(default)]
     pub placement_std_error_k: f64,
+    /// From the areas the scan never saw (K; 0 for a scene without unseen patches).
+    #[serde(default)]
+    pub unseen_std_error_k: f64,
+    /// From the camera's absolute level (K; the scene's `temperature_level_std_k`).
+    #[serde(default)]
+    pub level_std_error_k: f64,
     /// Σ F.
     pub view_factor_sum: f64,
     /// Rays traced (0 for exact).
@@ -124,6 +131,8 @@ impl PointRecord {
             sampling_std_error_k: r.sampling_std_error_k,
             temperature_std_error_k: r.temperature_std_error_k,
             placement_std_error_k: r.placement_std_error_k,
+            unseen_std_error_k: r.unseen_std_error_k,
+            level_std_error_k: r.level_std_error_k,
             view_factor_sum: r.view_factor_sum,
             rays: r.rays,
             view_factors: patches

@@ -208,14 +208,22 @@ impl MrtEngine<'_> {
             });
         }
         let seen = self.seen_temperatures(p, weight);
+        let temps = seen.as_ref().map(|s| s.temperatures.as_slice());
         let m = self
-            .radiant_of(&r.factors, seen.as_deref())
+            .radiant_of(&r.factors, temps)
             .map_err(|source| MrtError::Physics {
                 point: [p.x, p.y, p.z],
                 source,
             })?;
-        let sampling = self.sampling_error(&r.replicates, seen.as_deref());
-        Ok((m.temperature, sampling.hypot(m.std_from_temperatures_k)))
+        let sampling = self.sampling_error(&r.replicates, temps);
+        let unseen = self.unseen_error(&r.factors, seen.as_ref(), m.temperature);
+        Ok((
+            m.temperature,
+            sampling
+                .hypot(m.std_from_temperatures_k)
+                .hypot(unseen)
+                .hypot(self.scene().temperature_level_std_k),
+        ))
     }
 
     /// The MRT of a person whose body centre is at `centre`; `stream` selects the random stream.
@@ -290,16 +298,21 @@ impl MrtEngine<'_> {
                     }
                     let weight = |d: &Vector3<f64>| 4.0 * n.dot(d).max(0.0);
                     let seen = self.seen_temperatures(p, &weight);
-                    let m = self.radiant_of(&f, seen.as_deref()).map_err(|source| {
-                        MrtError::Physics {
+                    let temps = seen.as_ref().map(|s| s.temperatures.as_slice());
+                    let m = self
+                        .radiant_of(&f, temps)
+                        .map_err(|source| MrtError::Physics {
                             point: [p.x, p.y, p.z],
                             source,
-                        }
-                    })?;
+                        })?;
+                    let unseen = self.unseen_error(&f, seen.as_ref(), m.temperature);
                     return Ok(PlaneRadiant {
                         normal: n,
                         temperature: m.temperature,
-                        std_error_k: m.std_from_temperatures_k,
+                        std_error_k: m
+                            .std_from_temperatures_k
+                            .hypot(unseen)
+                            .hypot(self.scene().temperature_level_std_k),
                         exact: true,
                     });
                 }

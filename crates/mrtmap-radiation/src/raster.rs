@@ -39,6 +39,43 @@ pub struct RasterFile {
     /// Texels not observed, whose temperature was filled from their neighbours (indices).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub filled: Vec<usize>,
+    /// Patches of texels the scan never saw, each with the temperatures its seen surroundings
+    /// allow: they enter every MRT's standard error as its unseen-areas part.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub unseen: Vec<UnseenPatch>,
+}
+
+/// Texels of a raster the scan never saw: their temperatures in the raster are filled in, and the
+/// truth may lie anywhere in `range_c`, the temperatures seen around them.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UnseenPatch {
+    /// The texels (indices, as in `filled`).
+    pub texels: Vec<usize>,
+    /// The lowest and highest temperature the patch may have (°C).
+    pub range_c: [f64; 2],
+}
+
+/// How much of a surface, as seen from a point, is one unseen patch.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UnseenShare {
+    /// The patch's share of the surface's weighted solid angle (0…1).
+    pub share: f64,
+    /// The temperature the raster gives the patch, seen from the point.
+    pub filled: Temperature,
+    /// The patch's standard deviation about `filled` (K): the root mean square of T − filled for
+    /// T uniform over the patch's range.
+    pub std_k: f64,
+}
+
+/// √E[(T − f)²] for T uniform on [lo, hi] (K).
+fn uniform_rms_about(lo: f64, hi: f64, f: f64) -> f64 {
+    if hi - lo < 1e-9 {
+        return (lo - f).abs();
+    }
+    (((hi - f).powi(3) - (lo - f).powi(3)) / (3.0 * (hi - lo)))
+        .max(0.0)
+        .sqrt()
 }
 
 /// One texel clipped to its surface's outline.
@@ -61,6 +98,8 @@ pub struct Raster {
     pub file: RasterFile,
     /// The texels with a temperature that overlap the surface, clipped to it.
     pub texels: Vec<Texel>,
+    /// For each of `texels`, the unseen patch it belongs to (index into `file.unseen`).
+    pub patch_of: Vec<Option<usize>>,
 }
 
 fn bad(id: &str, detail: String) -> SceneError {
@@ -108,6 +147,40 @@ impl Raster {
                 id,
                 format!("filled names texel {i}, but there are {n}"),
             ));
+        }
+        let mut patch_of_index: Vec<Option<usize>> = vec![None; n];
+        for (k, patch) in r.unseen.iter().enumerate() {
+            let [lo, hi] = patch.range_c;
+            let range = TEMPERATURE_RANGE_C.0..=TEMPERATURE_RANGE_C.1;
+            if !(lo.is_finite() && hi.is_finite() && lo <= hi)
+                || !range.contains(&lo)
+                || !range.contains(&hi)
+            {
+                return Err(bad(
+                    id,
+                    format!(
+                        "unseen patch {k}: range_c [{lo}, {hi}] must be two temperatures, low then high, within {}…{} °C",
+                        TEMPERATURE_RANGE_C.0, TEMPERATURE_RANGE_C.1
+                    ),
+                ));
+            }
+            for &i in &patch.texels {
+                match patch_of_index.get_mut(i) {
+                    None => {
+                        return Err(bad(
+                            id,
+                            format!("unseen patch {k} names texel {i}, but there are {n}"),
+                        ));
+                    }
+                    Some(Some(other)) => {
+                        return Err(bad(
+                            id,
+                            format!("texel {i} is in unseen patches {other} and {k}"),
+                        ));
+                    }
+                    Some(slot) => *slot = Some(k),
+                }
+            }
         }
         let (u, v, o) = (
             Vector3::from(r.u),
@@ -175,9 +248,11 @@ impl Raster {
                 "no texel with a temperature overlaps the surface".into(),
             ));
         }
+        let patch_of = texels.iter().map(|t| patch_of_index[t.index]).collect();
         Ok(Self {
             file: r.clone(),
             texels,
+            patch_of,
         })
     }
 
@@ -185,6 +260,10 @@ impl Raster {
     pub fn map_celsius(&mut self, f: impl Fn(f64) -> f64) {
         for t in self.file.temperature_c.iter_mut().flatten() {
             *t = f(*t);
+        }
+        for p in &mut self.file.unseen {
+            let (a, b) = (f(p.range_c[0]), f(p.range_c[1]));
+            p.range_c = [a.min(b), a.max(b)];
         }
         for t in &mut self.texels {
             if let Some(c) = self.file.temperature_c[t.index] {
@@ -200,8 +279,19 @@ impl Raster {
         p: &Point3<f64>,
         weight: &dyn Fn(&Vector3<f64>) -> f64,
     ) -> Option<Temperature> {
+        self.seen_with_unseen(p, weight).map(|s| s.0)
+    }
+
+    /// As [`Self::seen_from`], with each unseen patch's share of what the point sees of the
+    /// surface (one entry per patch of `file.unseen`, in order).
+    pub fn seen_with_unseen(
+        &self,
+        p: &Point3<f64>,
+        weight: &dyn Fn(&Vector3<f64>) -> f64,
+    ) -> Option<(Temperature, Vec<UnseenShare>)> {
         let (mut num, mut den) = (0.0, 0.0);
-        for t in &self.texels {
+        let mut per_patch = vec![(0.0f64, 0.0f64); self.file.unseen.len()];
+        for (t, patch) in self.texels.iter().zip(&self.patch_of) {
             let omega = polygon_solid_angle(p, &t.polygon).abs();
             if omega <= 0.0 {
                 continue;
@@ -212,7 +302,34 @@ impl Raster {
             } * omega;
             num += w * t.t4;
             den += w;
+            if let Some(k) = patch {
+                per_patch[*k].0 += w;
+                per_patch[*k].1 += w * t.t4;
+            }
         }
-        (den > 0.0).then(|| Temperature::from_fourth_power(num / den))
+        if den <= 0.0 {
+            return None;
+        }
+        let shares = per_patch
+            .iter()
+            .zip(&self.file.unseen)
+            .map(|(&(w, wt4), patch)| {
+                if w <= 0.0 {
+                    return UnseenShare {
+                        share: 0.0,
+                        filled: Temperature::from_celsius(patch.range_c[0]),
+                        std_k: 0.0,
+                    };
+                }
+                let filled = Temperature::from_fourth_power(wt4 / w);
+                let c = filled.celsius();
+                UnseenShare {
+                    share: w / den,
+                    filled,
+                    std_k: uniform_rms_about(patch.range_c[0], patch.range_c[1], c),
+                }
+            })
+            .collect();
+        Some((Temperature::from_fourth_power(num / den), shares))
     }
 }

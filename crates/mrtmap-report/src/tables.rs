@@ -4,25 +4,39 @@ use mrtmap_radiation::{FieldSummary, MrtField};
 use serde::{Deserialize, Serialize};
 
 /// `mrt_grid.csv`: one row per grid node inside the floor: x, y, z (scene frame), mrt_c,
-/// std_error_k, then i, j (grid indices) and u_m, v_m (map coordinates). A node that could not be
-/// computed (inside an occluder) has empty mrt_c and std_error_k and the reason in `note`.
+/// std_error_k, then i, j (grid indices) and u_m, v_m (map coordinates), then the standard
+/// error's five parts (Monte Carlo sampling, the surfaces' temperatures, placement, unseen areas,
+/// the camera's level; they combine in quadrature into std_error_k). A node that could not be
+/// computed (inside an occluder) has empty values and the reason in `note`.
 pub fn grid_csv(field: &MrtField) -> String {
-    let mut s = String::from("x,y,z,mrt_c,std_error_k,i,j,u_m,v_m,note\n");
+    let mut s = String::from(
+        "x,y,z,mrt_c,std_error_k,i,j,u_m,v_m,sampling_std_error_k,temperature_std_error_k,placement_std_error_k,unseen_std_error_k,level_std_error_k,note\n",
+    );
     for n in &field.nodes {
-        let (m, e, note) = match &n.result {
+        let (m, e, parts, note) = match &n.result {
             Ok(r) => (
                 format!("{:.4}", r.mrt.celsius()),
                 format!("{:.4}", r.std_error_k),
+                [
+                    r.sampling_std_error_k,
+                    r.temperature_std_error_k,
+                    r.placement_std_error_k,
+                    r.unseen_std_error_k,
+                    r.level_std_error_k,
+                ]
+                .map(|x| format!("{x:.4}"))
+                .join(","),
                 String::new(),
             ),
             Err(err) => (
                 String::new(),
                 String::new(),
+                ",,,,".to_string(),
                 format!("\"{}\"", err.to_string().replace('"', "'")),
             ),
         };
         s.push_str(&format!(
-            "{:.4},{:.4},{:.4},{m},{e},{},{},{:.4},{:.4},{note}\n",
+            "{:.4},{:.4},{:.4},{m},{e},{},{},{:.4},{:.4},{parts},{note}\n",
             n.point.x, n.point.y, n.point.z, n.i, n.j, n.uv.x, n.uv.y
         ));
     }

@@ -1,7 +1,7 @@
 //! Temperature rasters: a rastered surface radiates as its texels would as surfaces of their own.
 
 use mrtmap_geometry::nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
-use mrtmap_radiation::{Method, MrtEngine, RadiantScene, RasterFile, SceneFile};
+use mrtmap_radiation::{Method, MrtEngine, RadiantScene, RasterFile, SceneFile, UnseenPatch};
 
 use crate::common::*;
 
@@ -25,6 +25,7 @@ fn raster() -> RasterFile {
             .map(|i| Some(stratified((i / cols) as f64 * 0.3 + 0.15)))
             .collect(),
         filled: vec![],
+        unseen: vec![],
     }
 }
 
@@ -130,5 +131,123 @@ fn a_bad_raster_is_refused_with_the_surface_and_the_rule() {
             e.contains("surface 'wall-s': raster") && e.contains(msg),
             "{msg}: {e}"
         );
+    }
+}
+
+/// Wall-s with a 1.2 × 0.9 m patch (columns 5–8, rows 3–5) never seen: its texels are filled at
+/// 19 °C, and what was seen around it allows 17…25 °C.
+fn with_unseen(range_c: [f64; 2]) -> SceneFile {
+    let mut f = with_raster();
+    let r = f.surfaces[2].raster.as_mut().unwrap();
+    let texels: Vec<usize> = (3..6)
+        .flat_map(|row| (5..9).map(move |col| row * 14 + col))
+        .collect();
+    for &i in &texels {
+        r.temperature_c[i] = Some(19.0);
+    }
+    r.filled = texels.clone();
+    r.unseen = vec![UnseenPatch { texels, range_c }];
+    f
+}
+
+#[test]
+fn an_unseen_patch_adds_what_its_range_could_do_to_the_mrt() {
+    let p = Point3::new(2.0, 0.8, 1.2);
+    let s = scene(&with_unseen([17.0, 25.0]));
+    let r = MrtEngine::new(&s, Method::Exact)
+        .unwrap()
+        .at(&p, 0)
+        .unwrap();
+    // The truth: the patch at each temperature of its range, evenly; the part is the RMS of what
+    // that does to the MRT about the filled map's.
+    let at = |t: f64| {
+        let mut f = with_unseen([17.0, 25.0]);
+        let ras = f.surfaces[2].raster.as_mut().unwrap();
+        for &i in &ras.unseen[0].texels.clone() {
+            ras.temperature_c[i] = Some(t);
+        }
+        mrt(&scene(&f), p)
+    };
+    let n = 400;
+    let ms: f64 = (0..n)
+        .map(|k| 17.0 + 8.0 * (k as f64 + 0.5) / n as f64)
+        .map(|t| (at(t) - r.mrt.celsius()).powi(2))
+        .sum::<f64>()
+        / n as f64;
+    let truth = ms.sqrt();
+    assert!(
+        (r.unseen_std_error_k - truth).abs() < 0.02 * truth,
+        "unseen part {} vs {truth}",
+        r.unseen_std_error_k
+    );
+    assert!(truth > 0.1, "the patch matters here: {truth} K");
+    // The parts make the total.
+    let total = r
+        .sampling_std_error_k
+        .hypot(r.temperature_std_error_k)
+        .hypot(r.placement_std_error_k)
+        .hypot(r.unseen_std_error_k)
+        .hypot(r.level_std_error_k);
+    assert!((r.std_error_k - total).abs() < 1e-12);
+    // A patch whose surroundings pin it to its filled temperature adds nothing; one the point
+    // cannot see (behind the wall's plane) neither.
+    let pinned = scene(&with_unseen([19.0, 19.0]));
+    let r0 = MrtEngine::new(&pinned, Method::Exact)
+        .unwrap()
+        .at(&p, 0)
+        .unwrap();
+    assert!(r0.unseen_std_error_k < 1e-12, "{}", r0.unseen_std_error_k);
+    // Farther away, it matters less.
+    let far = MrtEngine::new(&s, Method::Exact)
+        .unwrap()
+        .at(&Point3::new(2.0, 2.5, 1.2), 0)
+        .unwrap();
+    assert!(far.unseen_std_error_k < 0.5 * r.unseen_std_error_k);
+    // The camera's level is its own part.
+    let mut leveled = with_unseen([17.0, 25.0]);
+    leveled.temperature_level_std_k = Some(0.3);
+    let rl = MrtEngine::new(&scene(&leveled), Method::Exact)
+        .unwrap()
+        .at(&p, 0)
+        .unwrap();
+    assert_eq!(rl.level_std_error_k, 0.3);
+    assert!((rl.temperature_std_error_k - r.temperature_std_error_k).abs() < 1e-12);
+}
+
+#[test]
+fn unseen_patches_that_break_the_rules_are_refused() {
+    for (patches, expect) in [
+        (
+            vec![UnseenPatch {
+                texels: vec![3, 500],
+                range_c: [18.0, 20.0],
+            }],
+            "names texel 500",
+        ),
+        (
+            vec![UnseenPatch {
+                texels: vec![3],
+                range_c: [21.0, 20.0],
+            }],
+            "low then high",
+        ),
+        (
+            vec![
+                UnseenPatch {
+                    texels: vec![3, 4],
+                    range_c: [18.0, 20.0],
+                },
+                UnseenPatch {
+                    texels: vec![4],
+                    range_c: [18.0, 20.0],
+                },
+            ],
+            "texel 4 is in unseen patches 0 and 1",
+        ),
+    ] {
+        let mut f = with_raster();
+        f.surfaces[2].raster.as_mut().unwrap().unseen = patches;
+        let err = RadiantScene::new(&f).unwrap_err().to_string();
+        assert!(err.contains(expect) && err.contains("wall-s"), "{err}");
     }
 }

@@ -17,7 +17,7 @@ use mrtmap_geometry::polygon::{
 };
 use mrtmap_geometry::shape2d::{clip_convex, convex_hull, min_area_rectangle, simplify_closed};
 use mrtmap_physics::{RadiantAverage, Temperature, ZERO_CELSIUS_K};
-use mrtmap_radiation::RasterFile;
+use mrtmap_radiation::{RasterFile, UnseenPatch};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -702,13 +702,14 @@ fn feature(
 
 /// The host's temperature and its uncertainty: its background texels only (the features' are
 /// subtracted, Algorithm 1), one texel clear of every feature's region (border texels mix both)
-/// and outside every feature's outline (`in_outline`).
+/// and outside every feature's outline (`in_outline`); the spread counts again for the
+/// `unseen_share` of the surface.
 fn host_temperature(
     g: &Grid,
     cells: &[usize],
     in_feature: &[bool],
     in_outline: &[bool],
-    observed_fraction: f64,
+    unseen_share: f64,
 ) -> Option<(f64, f64)> {
     let (nx, ny) = (g.nx, g.ny);
     let near_feature = |c: usize| {
@@ -726,7 +727,7 @@ fn host_temperature(
     let m = host_avg.mean()?;
     let sigma = host_avg.std_dev_k().unwrap_or(0.0);
     let n = host_avg.count().max(1) as f64;
-    let std = ((sigma * sigma) / n + ((1.0 - observed_fraction) * sigma).powi(2)).sqrt();
+    let std = ((sigma * sigma) / n + (unseen_share * sigma).powi(2)).sqrt();
     Some((m.kelvin(), std))
 }
 
@@ -835,17 +836,22 @@ pub fn analyse_surface(
             }
         })
         .collect();
-    if let Some((t, std)) =
-        host_temperature(&g, &cells, &in_feature, &in_outline, observed_fraction)
-    {
-        out.temperature_k = Some(t);
-        out.temperature_std_k = std;
-    }
     if p.raster_m > 0.0 {
         // The raster leaves out what the features' outlines cover: a feature's texels outside
         // its outline (a window whose upper corner was never seen, outlined as the rectangle
         // seen in full) radiate from the raster at their own temperature.
         out.raster = background_raster(&g, &in_outline, &bg, frame, p.raster_m);
+    }
+    // With a raster, what was not seen is in its unseen patches (each bounded by what was seen
+    // around it); without one, the host's temperature carries it.
+    let unseen_share = if out.raster.is_some() {
+        0.0
+    } else {
+        1.0 - observed_fraction
+    };
+    if let Some((t, std)) = host_temperature(&g, &cells, &in_feature, &in_outline, unseen_share) {
+        out.temperature_k = Some(t);
+        out.temperature_std_k = std;
     }
     out
 }
@@ -955,6 +961,7 @@ fn background_raster(
         }
     }
     filled.sort_unstable();
+    let unseen = unseen_patches(g, in_feature, k, cols, rows, &on_surface);
     let o = frame.to_3d(&g.lo);
     Some(RasterFile {
         texel_m: k as f64 * g.t,
@@ -968,7 +975,100 @@ fn background_raster(
             .map(|t| t.map(|t| t - ZERO_CELSIUS_K))
             .collect(),
         filled,
+        unseen,
     })
+}
+
+/// How far around an unseen patch the seen texels bound its temperature (m).
+const UNSEEN_SURROUNDINGS_M: f64 = 0.5;
+
+/// The raster's texels (`k` × `k` analysis texels each, `cols` × `rows`) that the scan never saw
+/// (under a quarter of their analysis texels observed, and mostly outside every feature's outline
+/// `in_feature`, where the feature's temperature applies), grouped into 8-connected patches, each
+/// with the range of the temperatures seen within [`UNSEEN_SURROUNDINGS_M`] of it (features
+/// included: a panel may continue into what was not seen), else anywhere on the surface.
+fn unseen_patches(
+    g: &Grid,
+    in_feature: &[bool],
+    k: usize,
+    cols: usize,
+    rows: usize,
+    on_surface: &[bool],
+) -> Vec<UnseenPatch> {
+    let cells_of = |r: usize| {
+        let (col, row) = (r % cols, r / cols);
+        (row * k..((row + 1) * k).min(g.ny))
+            .flat_map(move |j| (col * k..((col + 1) * k).min(g.nx)).map(move |i| j * g.nx + i))
+    };
+    let unseen: Vec<bool> = (0..cols * rows)
+        .map(|r| {
+            if !on_surface[r] {
+                return false;
+            }
+            let (mut inside, mut seen, mut feature) = (0usize, 0usize, 0usize);
+            for c in cells_of(r).filter(|&c| g.inside[c]) {
+                inside += 1;
+                seen += usize::from(g.observed(c));
+                feature += usize::from(in_feature[c]);
+            }
+            inside > 0 && seen * 4 < inside && feature * 2 < inside
+        })
+        .collect();
+    let observed_range = |cells: &mut dyn Iterator<Item = usize>| {
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for c in cells.filter(|&c| g.inside[c] && g.observed(c)) {
+            let t = g.kelvin(c);
+            lo = lo.min(t);
+            hi = hi.max(t);
+        }
+        (lo <= hi).then_some((lo, hi))
+    };
+    let ring = (UNSEEN_SURROUNDINGS_M / g.t).ceil() as usize;
+    let mut done = vec![false; cols * rows];
+    let mut out = Vec::new();
+    for start in 0..cols * rows {
+        if !unseen[start] || done[start] {
+            continue;
+        }
+        let mut texels = vec![start];
+        done[start] = true;
+        let mut next = 0;
+        while next < texels.len() {
+            let r = texels[next];
+            next += 1;
+            let (col, row) = (r % cols, r / cols);
+            for rr in row.saturating_sub(1)..(row + 2).min(rows) {
+                for cc in col.saturating_sub(1)..(col + 2).min(cols) {
+                    let q = rr * cols + cc;
+                    if unseen[q] && !done[q] {
+                        done[q] = true;
+                        texels.push(q);
+                    }
+                }
+            }
+        }
+        texels.sort_unstable();
+        // The patch's box in analysis texels, grown by the surroundings.
+        let (mut i0, mut j0, mut i1, mut j1) = (usize::MAX, usize::MAX, 0, 0);
+        for &r in &texels {
+            let (col, row) = (r % cols, r / cols);
+            i0 = i0.min(col * k);
+            j0 = j0.min(row * k);
+            i1 = i1.max(((col + 1) * k).min(g.nx));
+            j1 = j1.max(((row + 1) * k).min(g.ny));
+        }
+        let (i0, j0) = (i0.saturating_sub(ring), j0.saturating_sub(ring));
+        let (i1, j1) = ((i1 + ring).min(g.nx), (j1 + ring).min(g.ny));
+        let range = observed_range(&mut (j0..j1).flat_map(|j| (i0..i1).map(move |i| j * g.nx + i)))
+            .or_else(|| observed_range(&mut (0..g.nx * g.ny)));
+        if let Some((lo, hi)) = range {
+            out.push(UnseenPatch {
+                texels,
+                range_c: [lo - ZERO_CELSIUS_K, hi - ZERO_CELSIUS_K],
+            });
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -1002,11 +1102,6 @@ mod tests {
         );
     }
 
-    /// A 10 × 4 m wall at 19.8 °C with a 9 °C window 8 × 2.4 m (x 1…9, z 0.8…3.2) whose upper
-    /// end the walk never saw (as on a 10 × 7 m hall's walk 2): the feature's outline is the
-    /// rectangle seen in full (x 1…7.5), and wherever else the window was seen the scene radiates
-    /// cold from the raster (it radiated the wall's 19.8 °C when the raster left out the whole
-    /// cold region).
     /// A `w` × `h` m wall in the plane y = 0 from the origin: its frame and outline.
     fn wall_in_y0(w: f64, h: f64) -> (PlaneFrame, Vec<Point2<f64>>) {
         use mrtmap_geometry::nalgebra::{Unit, Vector3};
@@ -1172,6 +1267,11 @@ mod tests {
         assert_eq!(near_in_row, vec![0, 26, 27]);
     }
 
+    /// A 10 × 4 m wall at 19.8 °C with a 9 °C window 8 × 2.4 m (x 1…9, z 0.8…3.2) whose upper
+    /// end the walk never saw (as on a 10 × 7 m hall's walk 2): the feature's outline is the
+    /// rectangle seen in full (x 1…7.5), and wherever else the window was seen the scene radiates
+    /// cold from the raster (it radiated the wall's 19.8 °C when the raster left out the whole
+    /// cold region).
     #[test]
     fn a_window_seen_in_part_radiates_cold_wherever_it_was_seen() {
         use mrtmap_geometry::nalgebra::Vector3;
@@ -1246,6 +1346,82 @@ mod tests {
                 radiates - ZERO_CELSIUS_K
             );
         }
+    }
+
+    /// A 4 × 2.5 m wall at 18 °C with a 30 °C panel (x 1…2, z 1…2) and two holes the walk never
+    /// saw: one 0.6 m square beside the panel (x 2.3…2.9), one far from it (x 3.2…3.8, z 0.2…0.6).
+    /// Each is an unseen patch covering its hole, bounded by what was seen around it: the panel's
+    /// 30 °C may continue into the first, the second is pinned near 18 °C; the panel is seen, so
+    /// none of its texels is unseen.
+    #[test]
+    fn unseen_holes_become_patches_bounded_by_their_surroundings() {
+        let hole_a = |x: f64, z: f64| (2.3..2.9).contains(&x) && (1.2..1.8).contains(&z);
+        let hole_b = |x: f64, z: f64| (3.2..3.8).contains(&x) && (0.2..0.6).contains(&z);
+        let panel = |x: f64, z: f64| (1.0..2.0).contains(&x) && (1.0..2.0).contains(&z);
+        let (mut pos, mut temp) = (Vec::new(), Vec::new());
+        for i in 0..400 {
+            for j in 0..250 {
+                let (x, z) = ((i as f64 + 0.5) * 0.01, (j as f64 + 0.5) * 0.01);
+                if hole_a(x, z) || hole_b(x, z) {
+                    continue;
+                }
+                pos.push(Point3::new(x, 0.0, z));
+                temp.push(ZERO_CELSIUS_K + if panel(x, z) { 30.0 } else { 18.0 });
+            }
+        }
+        let (frame, host) = wall_in_y0(4.0, 2.5);
+        let idx: Vec<usize> = (0..pos.len()).collect();
+        let ones = vec![1.0; pos.len()];
+        let a = analyse_surface(
+            &frame,
+            &host,
+            &idx,
+            (&pos, &temp, &ones),
+            false,
+            &SegmentParams::default(),
+        );
+        assert_eq!(a.features.len(), 1, "the panel: {:?}", a.dropped);
+        let r = a.raster.as_ref().expect("a raster");
+        assert_eq!(r.unseen.len(), 2, "{:?}", r.unseen);
+        let centre = |t: usize| {
+            use mrtmap_geometry::nalgebra::Vector3;
+            let (c, row) = ((t % r.cols) as f64 + 0.5, (t / r.cols) as f64 + 0.5);
+            let p = Point3::from(r.origin)
+                + Vector3::from(r.u) * (c * r.texel_m)
+                + Vector3::from(r.v) * (row * r.texel_m);
+            (p.x, p.z)
+        };
+        for patch in &r.unseen {
+            let (x, z) = centre(patch.texels[0]);
+            let area = patch.texels.len() as f64 * r.texel_m * r.texel_m;
+            let near_panel = x < 3.0;
+            let hole_area = if near_panel { 0.36 } else { 0.24 };
+            assert!(
+                area >= 0.5 * hole_area && area <= 1.6 * hole_area,
+                "patch at ({x:.2}, {z:.2}): {area:.2} m² for a {hole_area} m² hole"
+            );
+            for &t in &patch.texels {
+                let (x, z) = centre(t);
+                assert!(!panel(x, z), "a panel texel ({x:.2}, {z:.2}) is not unseen");
+            }
+            let [lo, hi] = patch.range_c;
+            assert!((lo - 18.0).abs() < 0.3, "{:?}", patch.range_c);
+            if near_panel {
+                assert!(
+                    hi > 29.0,
+                    "the panel's 30 °C is beside it: {:?}",
+                    patch.range_c
+                );
+            } else {
+                assert!(
+                    hi < 18.5,
+                    "only the wall's 18 °C around it: {:?}",
+                    patch.range_c
+                );
+            }
+        }
+        // The host's temperature no longer carries the unseen share: the raster's patches do.
+        assert!(a.temperature_std_k < 0.05, "{}", a.temperature_std_k);
     }
 
     /// A stratified wall (18 °C at mid-height, 0.8 K/m) with a 14 °C window over a quarter of it.
