@@ -152,9 +152,11 @@ impl Raster {
         for (k, patch) in r.unseen.iter().enumerate() {
             let [lo, hi] = patch.range_c;
             let range = TEMPERATURE_RANGE_C.0..=TEMPERATURE_RANGE_C.1;
-            if !(lo.is_finite() && hi.is_finite() && lo <= hi)
-                || !range.contains(&lo)
-                || !range.contains(&hi)
+            if !(lo.is_finite()
+                && hi.is_finite()
+                && lo <= hi
+                && range.contains(&lo)
+                && range.contains(&hi))
             {
                 return Err(bad(
                     id,
