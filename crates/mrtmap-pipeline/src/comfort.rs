@@ -406,6 +406,7 @@ pub fn make_comfort_maps(
         u: layout.u,
         v: layout.v,
         nodes: Vec::new(),
+        unseen: Vec::new(),
     };
     let map_marks: Vec<MapMark> = marks
         .iter()

@@ -175,6 +175,24 @@ fn coverage_rows(o: &RunOutcome) -> Vec<(String, String)> {
                     format!("{} K", parts.join(", "))
                 }),
         ),
+        (
+            "unseen areas that matter most for the map".into(),
+            o.maps
+                .first()
+                .and_then(|m| m.summary.map.field.as_ref())
+                .map_or("—".into(), |f| {
+                    if f.unseen_patches.is_empty() {
+                        "none: every surface was seen where the map can see it".into()
+                    } else {
+                        f.unseen_patches
+                            .iter()
+                            .take(5)
+                            .map(mrtmap_report::unseen_line)
+                            .collect::<Vec<_>>()
+                            .join("; ")
+                    }
+                }),
+        ),
         ("what ± covers".into(), WHAT_PLUS_MINUS_COVERS.into()),
     ]
 }

@@ -311,6 +311,8 @@ pub struct PointMrt {
     /// Part of the error from the camera's absolute level (the scene's
     /// `temperature_level_std_k`: a common error of every temperature moves the MRT one to one).
     pub level_std_error_k: f64,
+    /// Each unseen patch's part of `unseen_std_error_k` (those the point sees).
+    pub unseen_parts: Vec<UnseenPart>,
     /// View factor per patch (order of [`patches`]).
     pub view_factors: Vec<f64>,
     /// Standard error per view factor (0 for exact).
@@ -321,11 +323,23 @@ pub struct PointMrt {
     pub rays: usize,
 }
 
+/// One unseen patch's part of a point's standard error.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UnseenPart {
+    /// The surface (index into the scene's surfaces).
+    pub surface: usize,
+    /// The patch (index into the surface raster's `unseen`).
+    pub patch: usize,
+    /// Its part of the standard error (K).
+    pub std_error_k: f64,
+}
+
 /// What a point sees of the rasters: every patch's temperature (rastered surfaces at their
 /// texels' average) and, per unseen patch, the surface patch it lies on and its share.
 pub(crate) struct Seen {
     pub(crate) temperatures: Vec<Temperature>,
-    pub(crate) unseen: Vec<(usize, UnseenShare)>,
+    /// (surface index, its patch index, the unseen patch's index in the raster, its share).
+    pub(crate) unseen: Vec<(usize, usize, usize, UnseenShare)>,
 }
 
 enum Owner {
@@ -591,7 +605,7 @@ impl<'a> MrtEngine<'a> {
                 source,
             })?;
         let sampling = self.sampling_error(&replicate_f, temps);
-        let unseen = self.unseen_error(&f, seen.as_ref(), m.temperature);
+        let (unseen, unseen_parts) = self.unseen_error(&f, seen.as_ref(), m.temperature);
         let level = self.scene.temperature_level_std_k;
         Ok(PointMrt {
             point: *p,
@@ -605,6 +619,7 @@ impl<'a> MrtEngine<'a> {
             placement_std_error_k: 0.0,
             unseen_std_error_k: unseen,
             level_std_error_k: level,
+            unseen_parts,
             view_factor_sum: f.iter().sum(),
             view_factors: f,
             view_factor_std_errors: se,
@@ -633,7 +648,7 @@ impl<'a> MrtEngine<'a> {
             {
                 let k = self.surface_patch[si];
                 t[k] = seen;
-                unseen.extend(shares.into_iter().map(|u| (k, u)));
+                unseen.extend(shares.into_iter().enumerate().map(|(j, u)| (si, k, j, u)));
             }
         }
         Some(Seen {
@@ -645,31 +660,42 @@ impl<'a> MrtEngine<'a> {
     /// The unseen-areas part of a radiant temperature `tr` from factors `f` (K): each unseen
     /// patch's share of its surface's factor, times dTr/dT at its filled temperature, times its
     /// spread over the range allowed; patches in quadrature.
-    pub(crate) fn unseen_error(&self, f: &[f64], seen: Option<&Seen>, tr: Temperature) -> f64 {
-        let Some(seen) = seen else { return 0.0 };
-        if seen.unseen.is_empty() {
-            return 0.0;
-        }
+    pub(crate) fn unseen_error(
+        &self,
+        f: &[f64],
+        seen: Option<&Seen>,
+        tr: Temperature,
+    ) -> (f64, Vec<UnseenPart>) {
+        let Some(seen) = seen else {
+            return (0.0, Vec::new());
+        };
         let total: f64 = self
             .patches
             .iter()
             .zip(f)
             .map(|(pa, &f)| pa.emissivity * f.max(0.0))
             .sum();
-        if total <= 0.0 {
-            return 0.0;
+        if seen.unseen.is_empty() || total <= 0.0 {
+            return (0.0, Vec::new());
         }
         let tr3 = tr.kelvin().powi(3);
-        seen.unseen
+        let parts: Vec<UnseenPart> = seen
+            .unseen
             .iter()
-            .map(|(k, u)| {
-                let fj = f[*k].max(0.0) * u.share;
+            .filter_map(|&(si, k, j, u)| {
+                let fj = f[k].max(0.0) * u.share;
                 let dtr_dt =
-                    self.patches[*k].emissivity * fj * u.filled.kelvin().powi(3) / (tr3 * total);
-                (dtr_dt * u.std_k).powi(2)
+                    self.patches[k].emissivity * fj * u.filled.kelvin().powi(3) / (tr3 * total);
+                let part = dtr_dt * u.std_k;
+                (part > 0.0).then_some(UnseenPart {
+                    surface: si,
+                    patch: j,
+                    std_error_k: part,
+                })
             })
-            .sum::<f64>()
-            .sqrt()
+            .collect();
+        let sum = parts.iter().map(|p| p.std_error_k.powi(2)).sum::<f64>();
+        (sum.sqrt(), parts)
     }
 
     /// The radiant temperature of factors `f` per patch: (Σ εFT⁴ / Σ εF)^¼ (normalised, so factors

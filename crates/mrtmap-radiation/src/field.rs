@@ -188,6 +188,10 @@ pub struct FieldSummary {
     /// The largest of each of the standard error's parts over the nodes (K).
     #[serde(default)]
     pub max_std_error_parts: StdErrorParts,
+    /// The unseen patches whose being unseen matters most for the map (at most
+    /// [`UNSEEN_LISTED`]), largest first.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub unseen_patches: Vec<UnseenImpact>,
 }
 
 /// A standard error's parts (K), which combine in quadrature into the total.
@@ -274,7 +278,32 @@ pub struct MrtField {
     pub v: Vec<f64>,
     /// Nodes inside the floor outline (row-major: j then i).
     pub nodes: Vec<GridNode>,
+    /// The scene's unseen patches by what their being unseen does to the map, largest first.
+    pub unseen: Vec<UnseenImpact>,
 }
+
+/// What one unseen patch of a surface does to a map: the largest part of a node's standard error
+/// it makes, and where.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct UnseenImpact {
+    /// The surface's id.
+    pub surface_id: String,
+    /// The patch (index into the surface raster's `unseen`).
+    pub patch: usize,
+    /// Its area (m²).
+    pub area_m2: f64,
+    /// Its centroid (scene frame).
+    pub centre: [f64; 3],
+    /// The temperatures seen around it (°C).
+    pub range_c: [f64; 2],
+    /// The largest part of a node's standard error it makes (K).
+    pub max_std_error_k: f64,
+    /// That node (scene frame).
+    pub at: [f64; 3],
+}
+
+/// How many unseen patches a map's summary lists.
+pub const UNSEEN_LISTED: usize = 10;
 
 fn linspace(a: f64, b: f64, n: usize) -> Vec<f64> {
     if n == 1 {
@@ -353,17 +382,20 @@ impl MrtField {
                     result,
                 }
             })
-            .collect();
+            .collect::<Vec<GridNode>>();
+        let unseen = unseen_impacts(engine, &nodes);
         Ok(Self {
             frame,
             spec,
             u,
             v,
             nodes,
+            unseen,
         })
     }
 
-    /// Extremes and mean; `None` when no node was computed.
+    /// Extremes and mean, and the unseen patches that matter most; `None` when no node was
+    /// computed.
     pub fn summary(&self) -> Option<FieldSummary> {
         let ok: Vec<(&GridNode, &PointMrt)> = self
             .nodes
@@ -392,6 +424,7 @@ impl MrtField {
                 .iter()
                 .map(|x| StdErrorParts::of(x.1))
                 .fold(StdErrorParts::default(), StdErrorParts::max),
+            unseen_patches: self.unseen.iter().take(UNSEEN_LISTED).cloned().collect(),
         })
     }
 
@@ -403,4 +436,41 @@ impl MrtField {
             .and_then(|n| n.result.as_ref().ok())
             .map(|r| r.mrt)
     }
+}
+
+/// Each unseen patch's largest part of a node's standard error over `nodes`, largest first.
+fn unseen_impacts(engine: &MrtEngine<'_>, nodes: &[GridNode]) -> Vec<UnseenImpact> {
+    let mut best: std::collections::BTreeMap<(usize, usize), (f64, Point3<f64>)> =
+        std::collections::BTreeMap::new();
+    for n in nodes {
+        let Ok(r) = &n.result else { continue };
+        for part in &r.unseen_parts {
+            let e = best
+                .entry((part.surface, part.patch))
+                .or_insert((0.0, n.point));
+            if part.std_error_k > e.0 {
+                *e = (part.std_error_k, n.point);
+            }
+        }
+    }
+    let scene = engine.scene();
+    let mut out: Vec<UnseenImpact> = best
+        .into_iter()
+        .filter_map(|((si, j), (k, at))| {
+            let s = scene.surfaces.get(si)?;
+            let raster = s.raster.as_ref()?;
+            let (area_m2, centre) = raster.unseen_extent(j)?;
+            Some(UnseenImpact {
+                surface_id: s.id.clone(),
+                patch: j,
+                area_m2,
+                centre: [centre.x, centre.y, centre.z],
+                range_c: raster.file.unseen.get(j)?.range_c,
+                max_std_error_k: k,
+                at: [at.x, at.y, at.z],
+            })
+        })
+        .collect();
+    out.sort_by(|a, b| b.max_std_error_k.total_cmp(&a.max_std_error_k));
+    out
 }

@@ -30,11 +30,11 @@ mod scene;
 pub use bounds::{Outside, ROOM_TOLERANCE_M, RoomBounds};
 pub use engine::{
     ENCLOSURE_TOLERANCE, EXACT_OVERLAP_TOLERANCE, Method, MonteCarlo, MrtEngine, MrtError, Patch,
-    PatchKind, PointMrt, patches,
+    PatchKind, PointMrt, UnseenPart, patches,
 };
 pub use field::{
     Extreme, FieldError, FieldSummary, GridLayout, GridNode, GridSpec, MapFrame, MrtField,
-    StdErrorParts,
+    StdErrorParts, UNSEEN_LISTED, UnseenImpact,
 };
 pub use person::{AsymmetryVerdict, Facing, PersonMrt, PlaneRadiant, RadiantAsymmetry};
 pub use raster::{MAX_TEXELS, Raster, RasterFile, Texel, UnseenPatch, UnseenShare};

@@ -216,7 +216,7 @@ impl MrtEngine<'_> {
                 source,
             })?;
         let sampling = self.sampling_error(&r.replicates, temps);
-        let unseen = self.unseen_error(&r.factors, seen.as_ref(), m.temperature);
+        let (unseen, _) = self.unseen_error(&r.factors, seen.as_ref(), m.temperature);
         Ok((
             m.temperature,
             sampling
@@ -305,7 +305,7 @@ impl MrtEngine<'_> {
                             point: [p.x, p.y, p.z],
                             source,
                         })?;
-                    let unseen = self.unseen_error(&f, seen.as_ref(), m.temperature);
+                    let (unseen, _) = self.unseen_error(&f, seen.as_ref(), m.temperature);
                     return Ok(PlaneRadiant {
                         normal: n,
                         temperature: m.temperature,

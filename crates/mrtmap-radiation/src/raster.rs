@@ -258,6 +258,20 @@ impl Raster {
         })
     }
 
+    /// Unseen patch `patch`'s area (m², clipped to the surface) and its centroid; `None` when none
+    /// of its texels overlaps the surface.
+    pub fn unseen_extent(&self, patch: usize) -> Option<(f64, Point3<f64>)> {
+        let (mut area, mut sum) = (0.0, Vector3::zeros());
+        for (t, k) in self.texels.iter().zip(&self.patch_of) {
+            if *k == Some(patch) {
+                let a = mrtmap_geometry::polygon::area_3d(&t.polygon);
+                area += a;
+                sum += t.centre.coords * a;
+            }
+        }
+        (area > 0.0).then(|| (area, Point3::from(sum / area)))
+    }
+
     /// Every texel's temperature (°C) through `f` (a camera's level carried to the truth).
     pub fn map_celsius(&mut self, f: impl Fn(f64) -> f64) {
         for t in self.file.temperature_c.iter_mut().flatten() {

@@ -1,6 +1,8 @@
 //! Grid CSV and map summary.
 
-use mrtmap_radiation::{FieldSummary, MrtField};
+use mrtmap_radiation::{FieldSummary, MrtField, UnseenImpact};
+
+use crate::numbers::{fixed, uncertainty};
 use serde::{Deserialize, Serialize};
 
 /// `mrt_grid.csv`: one row per grid node inside the floor: x, y, z (scene frame), mrt_c,
@@ -94,4 +96,27 @@ impl MapAxes {
             up: a(&p.normal),
         }
     }
+}
+
+/// One unseen patch for people: "ceiling, 0.51 m² around (2.10, 3.40, 3.00), 22.4…38.0 °C seen
+/// around it: up to 0.20 K at (2.50, 3.00, 1.10)" (the scene's frame; the room's for a scan).
+pub fn unseen_line(u: &UnseenImpact) -> String {
+    let p = |v: &[f64; 3]| {
+        format!(
+            "({}, {}, {})",
+            fixed(v[0], 2),
+            fixed(v[1], 2),
+            fixed(v[2], 2)
+        )
+    };
+    format!(
+        "{}, {:.2} m² around {}, {:.1}…{:.1} °C seen around it: up to {} K at {}",
+        u.surface_id,
+        u.area_m2,
+        p(&u.centre),
+        u.range_c[0],
+        u.range_c[1],
+        uncertainty(u.max_std_error_k, 2),
+        p(&u.at)
+    )
 }

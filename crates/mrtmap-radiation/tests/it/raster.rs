@@ -1,7 +1,10 @@
 //! Temperature rasters: a rastered surface radiates as its texels would as surfaces of their own.
 
 use mrtmap_geometry::nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
-use mrtmap_radiation::{Method, MrtEngine, RadiantScene, RasterFile, SceneFile, UnseenPatch};
+use mrtmap_radiation::{
+    GridSpec, MapFrame, Method, MrtEngine, MrtField, RadiantScene, RasterFile, SceneFile,
+    UnseenPatch,
+};
 
 use crate::common::*;
 
@@ -250,4 +253,38 @@ fn unseen_patches_that_break_the_rules_are_refused() {
         let err = RadiantScene::new(&f).unwrap_err().to_string();
         assert!(err.contains(expect) && err.contains("wall-s"), "{err}");
     }
+}
+
+#[test]
+fn a_map_lists_the_unseen_patch_where_it_matters_most() {
+    let s = scene(&with_unseen([17.0, 25.0]));
+    let e = MrtEngine::new(&s, Method::Exact).unwrap();
+    let field =
+        MrtField::compute(&e, MapFrame::of_scene(&s).unwrap(), GridSpec::default()).unwrap();
+    let sum = field.summary().unwrap();
+    assert_eq!(sum.unseen_patches.len(), 1, "{:?}", sum.unseen_patches);
+    let u = &sum.unseen_patches[0];
+    assert_eq!((u.surface_id.as_str(), u.patch), ("wall-s", 0));
+    // Columns 5-8 and rows 3-5 of 0.3 m texels: 1.2 × 0.9 m centred at x 2.1, z 1.35.
+    assert!((u.area_m2 - 1.08).abs() < 1e-9, "{}", u.area_m2);
+    assert!(
+        (u.centre[0] - 2.1).abs() < 1e-9
+            && u.centre[1].abs() < 1e-9
+            && (u.centre[2] - 1.35).abs() < 1e-9,
+        "{:?}",
+        u.centre
+    );
+    assert_eq!(u.range_c, [17.0, 25.0]);
+    // Its largest part is the largest unseen part of any node (there is one patch), at the node
+    // nearest to it.
+    let best = field
+        .nodes
+        .iter()
+        .filter_map(|n| n.result.as_ref().ok())
+        .max_by(|a, b| a.unseen_std_error_k.total_cmp(&b.unseen_std_error_k))
+        .unwrap();
+    assert!((u.max_std_error_k - best.unseen_std_error_k).abs() < 1e-12);
+    assert_eq!(u.at, [best.point.x, best.point.y, best.point.z]);
+    assert!(u.at[1] < 0.3 && (u.at[0] - 2.1).abs() < 0.4, "{:?}", u.at);
+    assert!((sum.max_std_error_parts.unseen_k - u.max_std_error_k).abs() < 1e-12);
 }

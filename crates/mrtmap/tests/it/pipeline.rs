@@ -221,6 +221,19 @@ fn report_numbers_match_the_csv_and_it_renders() {
         .filter_map(|l| l.split(',').nth(3)?.parse().ok())
         .collect();
     assert!(!mrt.is_empty());
+    // The ± in its five parts, which make the total.
+    assert!(csv.starts_with(
+        "x,y,z,mrt_c,std_error_k,i,j,u_m,v_m,sampling_std_error_k,temperature_std_error_k,placement_std_error_k,unseen_std_error_k,level_std_error_k,note"
+    ));
+    for l in csv.lines().skip(1) {
+        let v: Vec<f64> = l.split(',').filter_map(|x| x.parse().ok()).collect();
+        if v.len() == 14 {
+            let parts = v[9..14].iter().map(|x| x * x).sum::<f64>().sqrt();
+            assert!((parts - v[4]).abs() < 3e-4, "{l}");
+        }
+    }
+    assert!(html.contains("its parts, the largest of each on the map"));
+    assert!(html.contains("unseen areas that matter most for the map"));
     let (min, max) = mrt
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
