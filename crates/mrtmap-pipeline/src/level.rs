@@ -12,7 +12,8 @@
 //! leave-one-out residual is largest beyond max(3σ, 0.5 K) (judged against an offset alone, with
 //! 3 % gain slack, when only two others remain) is named and left out. The scene's temperatures
 //! become (T − α)/β, and the level's standard uncertainty at the scene's mean temperature is
-//! written as the scene's `temperature_level_std_k`.
+//! written as the scene's `temperature_level_std_k`; with the offset alone it holds the gain
+//! error left ([`GAIN_STD`] × the distance from the readings).
 
 use std::path::Path;
 
@@ -166,6 +167,12 @@ pub struct Level {
 /// are off mostly in offset, by a few per cent in gain. Two readings implying more disagree with
 /// each other (a typo: a wall read 40 instead of 20.9 gave a gain of 0.34 and a map 17 K warm).
 pub const MAX_GAIN_ERROR: f64 = 0.1;
+
+/// The standard uncertainty of a thermal camera's gain when the readings do not fix it (one
+/// reading, or several within 2 K of each other): radiometric cameras are off by a few per cent
+/// in gain (a Lepton 3.5's datasheet: ±5 % of the reading), so an offset fixed at a reading
+/// leaves 3 % of the distance from it, 0.25 K at a room 8 K warmer than the window read.
+pub const GAIN_STD: f64 = 0.03;
 
 /// The camera's fused temperature around a point (°C): within 5 cm, else 10 cm; `None` unseen.
 fn camera_at(cloud: &ThermalCloud, p: &Point3<f64>) -> Option<(f64, f64)> {
@@ -362,6 +369,12 @@ pub fn find_level(
         std_k = std_k.hypot(spread.sqrt());
         gain = false;
     }
+    if !gain {
+        // The offset holds at the readings; away from them the unfitted gain error grows.
+        let w: f64 = pts.iter().map(|p| 1.0 / (p.2 * p.2)).sum();
+        let at = pts.iter().map(|p| p.0 / (p.2 * p.2)).sum::<f64>() / w;
+        std_k = std_k.hypot(GAIN_STD * (mean_c - at).abs());
+    }
     for u in &mut uses {
         if let Some(c) = u.camera_c {
             u.residual_k = Some((c - alpha) / beta - u.reference_c);
@@ -430,6 +443,19 @@ mod tests {
         assert_eq!(one.basis, "references (offset)");
         assert!((one.correct(1.5 + 1.02 * 20.0) - 20.0).abs() < 1e-3);
         assert!((one.std_k - 0.1).abs() < 0.01, "{}", one.std_k);
+        // One reading of the window (10 °C) for a room at 20 °C: the camera's 2 % gain error is
+        // 0.2 K there, which the ± must hold (a 20 s walk whose wall reading the scan missed
+        // stated 0.10 K and was 0.28-0.34 K off).
+        let window = find_level(&[reading("w", 0.0, 10.0)], &c, &id, 20.0, 5.0);
+        assert_eq!(window.basis, "references (offset)");
+        let err = window.correct(1.5 + 1.02 * 20.0) - 20.0;
+        assert!((err - 0.2).abs() < 0.01, "{err}");
+        assert!(2.0 * window.std_k > err.abs(), "{}", window.std_k);
+        assert!(
+            (window.std_k - 0.1f64.hypot(0.3)).abs() < 0.01,
+            "{}",
+            window.std_k
+        );
         let two = find_level(
             &[reading("a", 0.0, 10.0), reading("b", 10.0, 30.0)],
             &c,
