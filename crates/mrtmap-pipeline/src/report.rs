@@ -63,7 +63,14 @@ fn feature_rows(s: &SegmentReport) -> Vec<[String; 6]> {
                 format!("{} ({}{share})", f.label, f.label_source),
                 format!("{:.2}", f.temperature_c),
                 signed(f.contrast_k, 2),
-                format!("{:.2}", f.area_m2),
+                if f.completed_m2 > 0.0 {
+                    format!(
+                        "{:.2} (completed: {:.2} not seen)",
+                        f.area_m2, f.completed_m2
+                    )
+                } else {
+                    format!("{:.2}", f.area_m2)
+                },
             ]
         })
         .collect()

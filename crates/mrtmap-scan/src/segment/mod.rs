@@ -197,6 +197,13 @@ pub struct FeatureSummary {
     pub contrast_k: f64,
     /// Area (m²).
     pub area_m2: f64,
+    /// The part of that area the scan never saw, completed from the shape of what it saw (m²).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub completed_m2: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 /// A piece of furniture of the result.
@@ -650,6 +657,12 @@ fn build_features(
                 if v.tie { " (a tie)" } else { "" }
             ));
         }
+        if f.completed_m2 > 0.0 {
+            warnings.push(format!(
+                "feature {id} ({label}): completed: {:.2} m² of its {:.2} m² not seen, taken from the shape of what was seen",
+                f.completed_m2, f.area_m2
+            ));
+        }
         for &i in &f.points {
             out.feature_id[i] = k as i32;
         }
@@ -674,6 +687,7 @@ fn build_features(
             temperature_c: f.temperature_k - ZERO_CELSIUS_K,
             contrast_k: f.contrast_k,
             area_m2: f.area_m2,
+            completed_m2: f.completed_m2,
         });
     }
     out
