@@ -41,6 +41,7 @@ pub mod cache;
 pub mod calibration;
 pub mod comfort;
 mod conversion;
+pub mod coverage;
 pub mod demo;
 mod error;
 pub mod level;

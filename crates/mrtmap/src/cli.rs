@@ -47,6 +47,9 @@ pub enum Command {
     Segment(SegmentArgs),
     /// The whole pipeline on a recording: fuse, segment, MRT maps and points, report.html.
     Run(RunArgs),
+    /// On site: is a scan good enough for a ±0.2 K map, and if not, where to point the camera (a
+    /// coarse run: walls never seen, each surface's coverage, the unseen areas that matter most).
+    Coverage(CoverageArgs),
     /// Simulate the office scan, run the pipeline and compare with the truth (the seed paper's table).
     Demo(DemoArgs),
     /// Compare a map with black-globe readings (ISO 7726 and mixed convection).
@@ -355,6 +358,34 @@ pub struct RunArgs {
     /// Air temperature for the report (°C) ([air] temperature_c).
     #[arg(long, allow_negative_numbers = true)]
     pub air_c: Option<f64>,
+}
+
+/// `mrtmap coverage`.
+#[derive(Debug, Args)]
+pub struct CoverageArgs {
+    /// The recording (any source `mrtmap run` takes).
+    pub recording: PathBuf,
+    /// How to read a bag, MCAP file or database.
+    #[command(flatten)]
+    pub src: SourceArgs,
+    /// Keep the coarse run here (fuse/, segment/, map-1.10m/); by default it goes to a temporary
+    /// folder that is removed.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// A project file (TOML): its settings, made coarse.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// The map's target (K, 2σ): the scan is good enough when what it did not see keeps the map
+    /// within it.
+    #[arg(
+        long = "target-k",
+        default_value_t = 0.2,
+        allow_negative_numbers = true
+    )]
+    pub target_k: f64,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// `mrtmap demo`.

@@ -4,6 +4,7 @@
 mod calibrate;
 mod comfort;
 mod convert;
+mod coverage;
 mod demo;
 mod example_scene;
 mod fuse;
@@ -36,6 +37,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Fuse(a) => fuse::run(&a),
         Command::Segment(a) => segment::run(&a),
         Command::Run(a) => run::run(&a),
+        Command::Coverage(a) => coverage::run(&a),
         Command::Demo(a) => demo::run(&a),
         Command::Validate(a) => validate::run(&a),
         Command::Calibrate(a) => calibrate::run(&a),

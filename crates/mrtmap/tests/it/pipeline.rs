@@ -648,3 +648,87 @@ fn camera_errors_are_self_calibrated_and_anchored_by_references() {
         "the report says the gain is unknown"
     );
 }
+
+/// `mrtmap coverage`: a coarse run judged by what the scan controls. The 20 s office walk saw
+/// every wall; its verdict follows what it did not see against the target asked for.
+#[test]
+fn coverage_says_whether_a_scan_is_good_enough_and_where_to_look() {
+    let out = tempfile::tempdir().unwrap();
+    let keep = out.path().join("cov");
+    let text = ok(&[
+        "coverage",
+        recording().to_str().unwrap(),
+        "--out",
+        keep.to_str().unwrap(),
+        "--json",
+    ]);
+    let c: Value = serde_json::from_str(&text).unwrap();
+    let surfaces = c["surfaces"].as_array().unwrap();
+    assert_eq!(surfaces.len(), 6, "{text}");
+    for s in surfaces {
+        let sum = s["seen_with_depth"].as_f64().unwrap()
+            + s["textured_only"].as_f64().unwrap()
+            + s["unseen"].as_f64().unwrap();
+        assert!((sum - 1.0).abs() < 1e-9, "{s}");
+        assert_eq!(s["inferred"], false);
+    }
+    let unseen = c["max_unseen_k"].as_f64().unwrap();
+    assert_eq!(
+        c["good_enough"].as_bool().unwrap(),
+        c["reasons"].as_array().unwrap().is_empty()
+    );
+    if 2.0 * unseen > 0.2 {
+        assert_eq!(c["good_enough"], false, "{text}");
+    }
+    // The coarse run is kept where asked: a 10 × 10 grid at 1.1 m.
+    let summary = read_json(&keep.join("map-1.10m/summary.json"));
+    assert_eq!(summary["grid"], serde_json::json!([10, 10]));
+    assert!((summary["max_std_error_parts"]["unseen_k"].as_f64().unwrap() - unseen).abs() < 1e-12);
+    // A target tighter than what was not seen allows: not good enough, and says why and where.
+    assert!(
+        unseen > 0.0,
+        "the walk leaves something unseen (under the desk): {text}"
+    );
+    let target = format!("{}", unseen);
+    let strict: Value = serde_json::from_str(&ok(&[
+        "coverage",
+        recording().to_str().unwrap(),
+        "--out",
+        keep.to_str().unwrap(),
+        "--target-k",
+        &target,
+        "--json",
+    ]))
+    .unwrap();
+    assert_eq!(strict["good_enough"], false);
+    assert!(
+        strict["reasons"][0]
+            .as_str()
+            .unwrap()
+            .contains("what the scan did not see"),
+        "{strict}"
+    );
+    assert!(
+        !strict["look_at"].as_array().unwrap().is_empty(),
+        "{strict}"
+    );
+    // Text for people, and a nonsense target refused.
+    let words = ok(&[
+        "coverage",
+        recording().to_str().unwrap(),
+        "--target-k",
+        &target,
+    ]);
+    assert!(
+        words.contains("not good enough for a ±") && words.contains("where to point the camera"),
+        "{words}"
+    );
+    let o = mrtmap(&[
+        "coverage",
+        recording().to_str().unwrap(),
+        "--target-k",
+        "-1",
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--target-k -1"));
+}

@@ -1,0 +1,194 @@
+//! On site, before leaving the room: is a scan good enough for a map within the target (±0.2 K by
+//! default), and if not, where to point the camera (`mrtmap coverage`).
+//!
+//! A coarse run of the whole pipeline: 5 cm voxels, no ICP (the pose source's poses as they are),
+//! every other depth pixel, a 10 × 10 grid at 1.1 m with a quarter of the rays and no placement
+//! term (where a globe stands is not the scan's doing). What it reads from the result is what the
+//! scan controls: the walls it never saw (placed at the floor's edge), each surface's coverage, and
+//! the unseen-areas part of the map's ± with the patches behind it. The level of the temperatures
+//! (contact readings) is named too, since without readings no scan is within 0.2 K.
+
+use std::path::Path;
+
+use mrtmap_radiation::UnseenImpact;
+use serde::Serialize;
+
+use crate::error::{Error, Result};
+use crate::progress::Progress;
+use crate::run::{RunOutcome, run};
+use crate::settings::Project;
+
+/// The target a scan is judged against by default (K, 2σ).
+pub const DEFAULT_TARGET_K: f64 = 0.2;
+
+/// One surface's coverage.
+#[derive(Clone, Debug, Serialize)]
+pub struct SurfaceCoverage {
+    /// Surface id.
+    pub id: String,
+    /// Its area (m²).
+    pub area_m2: f64,
+    /// Share seen with depth (the fused cloud).
+    pub seen_with_depth: f64,
+    /// Share seen by thermal texturing only (no depth there: glass, dark surfaces, dropouts).
+    pub textured_only: f64,
+    /// Share never seen.
+    pub unseen: f64,
+    /// Never seen at all: placed at the floor's edge.
+    pub inferred: bool,
+}
+
+/// The verdict on a scan.
+#[derive(Clone, Debug, Serialize)]
+pub struct Coverage {
+    /// The target (K, 2σ).
+    pub target_k: f64,
+    /// Whether the scan is good enough for a map within the target.
+    pub good_enough: bool,
+    /// Why not (empty when good enough), most important first.
+    pub reasons: Vec<String>,
+    /// Where to point the camera, most important first.
+    pub look_at: Vec<String>,
+    /// Each surface's coverage.
+    pub surfaces: Vec<SurfaceCoverage>,
+    /// The unseen patches by what they do to the map, largest first.
+    pub unseen_patches: Vec<UnseenImpact>,
+    /// The largest unseen-areas part of a node's ± (K, 1σ; NaN, written null, when the room
+    /// could not be put together).
+    pub max_unseen_k: f64,
+    /// What the temperatures' level rests on ("references (offset and gain)", …, "camera").
+    pub level_basis: String,
+    /// Its standard uncertainty (K).
+    pub level_std_k: f64,
+    /// Thermal frames fused, of those recorded.
+    pub frames: [usize; 2],
+}
+
+/// The coarse settings of a coverage check, from the project's.
+pub fn coarse(base: &Project) -> Project {
+    let mut p = base.clone();
+    p.fuse.voxel_m = p.fuse.voxel_m.max(0.05);
+    p.fuse.icp = false;
+    p.fuse.depth_stride = 2;
+    p.map.grid = [10, 10];
+    p.map.heights_m = vec![1.1];
+    p.map.quantities.clear();
+    p.mrt.rays = (p.mrt.rays / 4).max(1000);
+    p.mrt.placement_std_m = 0.0;
+    p.points.clear();
+    p
+}
+
+/// Runs the coarse pipeline on `recording` into `out` and judges the scan against `target_k`.
+pub fn coverage(
+    recording: &Path,
+    out: &Path,
+    base: &Project,
+    target_k: f64,
+    progress: &dyn Progress,
+) -> Result<Coverage> {
+    match run(recording, out, &coarse(base), false, progress) {
+        Ok(o) => Ok(judge(&o, target_k)),
+        // A room segmentation cannot close is the clearest "not good enough": say why and where.
+        Err(Error::Segment { source, .. }) => Ok(Coverage {
+            target_k,
+            good_enough: false,
+            reasons: vec![format!("the room could not be put together: {source}")],
+            look_at: Vec::new(),
+            surfaces: Vec::new(),
+            unseen_patches: Vec::new(),
+            max_unseen_k: f64::NAN,
+            level_basis: String::new(),
+            level_std_k: f64::NAN,
+            frames: [0, 0],
+        }),
+        Err(e) => Err(e),
+    }
+}
+
+/// The verdict on a run's outcome.
+pub fn judge(o: &RunOutcome, target_k: f64) -> Coverage {
+    let s = &o.segment;
+    let surfaces: Vec<SurfaceCoverage> = s
+        .surfaces
+        .iter()
+        .map(|x| {
+            let area_m2 = o
+                .scene
+                .surfaces
+                .iter()
+                .find(|y| y.id == x.id)
+                .map_or(0.0, |y| mrtmap_geometry::polygon::area_3d(&y.polygon));
+            let seen = x.observed_fraction.clamp(0.0, 1.0);
+            let textured = x.textured_fraction.clamp(0.0, seen);
+            SurfaceCoverage {
+                id: x.id.clone(),
+                area_m2,
+                seen_with_depth: seen - textured,
+                textured_only: textured,
+                unseen: 1.0 - seen,
+                inferred: s.inferred_walls.contains(&x.id),
+            }
+        })
+        .collect();
+    let field = o.maps.first().and_then(|m| m.summary.map.field.as_ref());
+    let unseen_patches = field.map_or(Vec::new(), |f| f.unseen_patches.clone());
+    let max_unseen_k = field.map_or(0.0, |f| f.max_std_error_parts.unseen_k);
+    let (level_basis, level_std_k) = o.level.as_ref().map_or_else(
+        || ("camera".to_string(), o.scene.temperature_level_std_k),
+        |l| (l.basis.clone(), l.std_k),
+    );
+    let mut reasons = Vec::new();
+    let mut look_at = Vec::new();
+    for w in surfaces.iter().filter(|x| x.inferred) {
+        reasons.push(format!(
+            "{} was never seen: it is placed at the floor's edge",
+            w.id
+        ));
+        look_at.push(format!("{}: the whole wall", w.id));
+    }
+    if 2.0 * max_unseen_k > target_k {
+        reasons.push(format!(
+            "what the scan did not see makes the map uncertain by up to ±{:.2} K (2σ) on its own",
+            2.0 * max_unseen_k
+        ));
+    }
+    for u in unseen_patches
+        .iter()
+        .filter(|u| 2.0 * u.max_std_error_k > 0.25 * target_k)
+        .take(5)
+    {
+        look_at.push(mrtmap_report::unseen_line(u));
+    }
+    if 2.0 * level_std_k > target_k {
+        reasons.push(if level_basis == "camera" {
+            format!(
+                "no contact reading was usable: the temperatures' level is the camera's (±{level_std_k:.1} K); read a wall and the coldest surface (references.csv)"
+            )
+        } else {
+            format!(
+                "the contact readings fix the temperatures' level to ±{:.2} K (2σ): add a reading on a surface at another temperature (a wall and the window)",
+                2.0 * level_std_k
+            )
+        });
+    }
+    let fused = o.fusion.used_frames;
+    let recorded = o.fusion.thermal_frames;
+    if recorded > 0 && fused * 2 < recorded {
+        reasons.push(format!(
+            "only {fused} of {recorded} thermal frames could be fused (see the run's warnings)"
+        ));
+    }
+    Coverage {
+        target_k,
+        good_enough: reasons.is_empty(),
+        reasons,
+        look_at,
+        surfaces,
+        unseen_patches,
+        max_unseen_k,
+        level_basis,
+        level_std_k,
+        frames: [fused, recorded],
+    }
+}
