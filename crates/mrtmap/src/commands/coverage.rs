@@ -101,6 +101,9 @@ fn print(c: &Coverage, secs: f64) {
             outln!("  - {r}");
         }
     }
+    for n in &c.notes {
+        outln!("note: {n}");
+    }
     if !c.look_at.is_empty() {
         outln!("where to point the camera, most important first:");
         for l in &c.look_at {
