@@ -1148,7 +1148,7 @@ fn background_raster(
         }
     }
     filled.sort_unstable();
-    let unseen = unseen_patches(g, in_feature, k, cols, rows, &on_surface);
+    let unseen = unseen_patches(g, in_feature, &near_feature, k, cols, rows, &on_surface);
     let o = frame.to_3d(&g.lo);
     Some(RasterFile {
         texel_m: k as f64 * g.t,
@@ -1172,11 +1172,18 @@ const UNSEEN_SURROUNDINGS_M: f64 = 0.5;
 /// The raster's texels (`k` × `k` analysis texels each, `cols` × `rows`) that the scan never saw
 /// (under a quarter of their analysis texels observed, and mostly outside every feature's outline
 /// `in_feature`, where the feature's temperature applies), grouped into 8-connected patches, each
-/// with the range of the temperatures seen within [`UNSEEN_SURROUNDINGS_M`] of it (features
-/// included: a panel may continue into what was not seen), else anywhere on the surface.
+/// with the range of the temperatures seen within [`UNSEEN_SURROUNDINGS_M`] of it, else anywhere
+/// on the surface. A feature's temperatures bound a patch only when the patch touches its outline
+/// (a window or a panel may continue into what was not seen); a feature whose edge was seen, with
+/// background beyond it, ends there, and its cells and their blur (`near_feature`) are left out:
+/// a 20 s office walk's 1.3 m² unseen patch of wall 0.4 m from the window's seen edge took the
+/// window's 11.4 °C as possible and stated ±1.45 K at the node beside it, where the error was
+/// 0.14 K.
+#[allow(clippy::too_many_arguments)]
 fn unseen_patches(
     g: &Grid,
     in_feature: &[bool],
+    near_feature: &[bool],
     k: usize,
     cols: usize,
     rows: usize,
@@ -1201,9 +1208,9 @@ fn unseen_patches(
             inside > 0 && seen * 4 < inside && feature * 2 < inside
         })
         .collect();
-    let observed_range = |cells: &mut dyn Iterator<Item = usize>| {
+    let observed_range = |cells: &mut dyn Iterator<Item = usize>, features: bool| {
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        for c in cells.filter(|&c| g.inside[c] && g.observed(c)) {
+        for c in cells.filter(|&c| g.inside[c] && g.observed(c) && (features || !near_feature[c])) {
             let t = g.kelvin(c);
             lo = lo.min(t);
             hi = hi.max(t);
@@ -1246,8 +1253,26 @@ fn unseen_patches(
         }
         let (i0, j0) = (i0.saturating_sub(ring), j0.saturating_sub(ring));
         let (i1, j1) = ((i1 + ring).min(g.nx), (j1 + ring).min(g.ny));
-        let range = observed_range(&mut (j0..j1).flat_map(|j| (i0..i1).map(move |i| j * g.nx + i)))
-            .or_else(|| observed_range(&mut (0..g.nx * g.ny)));
+        // Does the patch touch a feature's outline (one within a raster texel of an unseen
+        // cell of it: the patch's texels start where a raster texel is mostly unseen)?
+        let reach = k + 1;
+        let touches = texels.iter().flat_map(|&r| cells_of(r)).any(|c| {
+            let (i, j) = (c % g.nx, c / g.nx);
+            !g.observed(c)
+                && (j.saturating_sub(reach)..(j + reach + 1).min(g.ny)).any(|jj| {
+                    (i.saturating_sub(reach)..(i + reach + 1).min(g.nx))
+                        .any(|ii| in_feature[jj * g.nx + ii])
+                })
+        });
+        let around = |features: bool| {
+            observed_range(
+                &mut (j0..j1).flat_map(|j| (i0..i1).map(move |i| j * g.nx + i)),
+                features,
+            )
+        };
+        let range = around(touches)
+            .or_else(|| around(true))
+            .or_else(|| observed_range(&mut (0..g.nx * g.ny), true));
         if let Some((lo, hi)) = range {
             out.push(UnseenPatch {
                 texels,
@@ -1536,13 +1561,21 @@ mod tests {
     }
 
     /// A 4 × 2.5 m wall at 18 °C with a 30 °C panel (x 1…2, z 1…2) and two holes the walk never
-    /// saw: one 0.6 m square beside the panel (x 2.3…2.9), one far from it (x 3.2…3.8, z 0.2…0.6).
-    /// Each is an unseen patch covering its hole, bounded by what was seen around it: the panel's
-    /// 30 °C may continue into the first, the second is pinned near 18 °C; the panel is seen, so
-    /// none of its texels is unseen.
+    /// saw: one 0.6 m square by the panel (from x `a_from`), one far from it (x 3.2…3.8,
+    /// z 0.2…0.6). Each is an unseen patch covering its hole, bounded by what was seen around it:
+    /// the second is pinned near 18 °C; the panel's 30 °C may continue into the first when the
+    /// hole touches the panel (`a_from` 2.0), not when the panel's edge was seen with wall beyond
+    /// it (`a_from` 2.3). The panel is seen, so none of its texels is unseen.
     #[test]
     fn unseen_holes_become_patches_bounded_by_their_surroundings() {
-        let hole_a = |x: f64, z: f64| (2.3..2.9).contains(&x) && (1.2..1.8).contains(&z);
+        for (a_from, touches) in [(2.0, true), (2.3, false)] {
+            unseen_holes_by_a_panel(a_from, touches);
+        }
+    }
+
+    fn unseen_holes_by_a_panel(a_from: f64, touches: bool) {
+        let hole_a =
+            |x: f64, z: f64| (a_from..a_from + 0.6).contains(&x) && (1.2..1.8).contains(&z);
         let hole_b = |x: f64, z: f64| (3.2..3.8).contains(&x) && (0.2..0.6).contains(&z);
         let panel = |x: f64, z: f64| (1.0..2.0).contains(&x) && (1.0..2.0).contains(&z);
         let (mut pos, mut temp) = (Vec::new(), Vec::new());
@@ -1593,7 +1626,7 @@ mod tests {
             }
             let [lo, hi] = patch.range_c;
             assert!((lo - 18.0).abs() < 0.3, "{:?}", patch.range_c);
-            if near_panel {
+            if near_panel && touches {
                 assert!(
                     hi > 29.0,
                     "the panel's 30 °C is beside it: {:?}",
