@@ -382,14 +382,21 @@ fn run_on_an_mcap_file_maps_the_same_as_on_the_folder() {
     ]);
     let ga = std::fs::read_to_string(a.join("map-1.10m/mrt_grid.csv")).unwrap();
     let gb = std::fs::read_to_string(b.join("map-1.10m/mrt_grid.csv")).unwrap();
-    // The same map. Only the ± differs: the simulated rig states its camera's absolute accuracy
-    // (exact), which MCAP does not carry, so the converted scan assumes a Lepton's ±5 K.
+    // The same map. Only the ± differs, in its camera-level part: the simulated rig states its
+    // camera's absolute accuracy (exact), which MCAP does not carry, so the converted scan assumes
+    // a Lepton's ±5 K.
+    let header: Vec<&str> = ga.lines().next().unwrap().split(',').collect();
+    let differs = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (total, level) = (differs("std_error_k"), differs("level_std_error_k"));
     let without_se = |g: &str| -> Vec<String> {
         g.lines()
             .map(|l| {
-                let mut c: Vec<&str> = l.split(',').collect();
-                c.remove(4);
-                c.join(",")
+                l.split(',')
+                    .enumerate()
+                    .filter(|(k, _)| *k != total && *k != level)
+                    .map(|(_, c)| c)
+                    .collect::<Vec<_>>()
+                    .join(",")
             })
             .collect()
     };
