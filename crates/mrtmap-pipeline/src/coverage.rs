@@ -2,7 +2,7 @@
 //! default), and if not, where to point the camera (`mrtmap coverage`).
 //!
 //! A coarse run of the whole pipeline: 5 cm voxels, no ICP (the pose source's poses as they are),
-//! every other depth pixel, a 10 × 10 grid at 1.1 m with a quarter of the rays and no placement
+//! every fourth depth pixel, a 10 × 10 grid at 1.1 m with a quarter of the rays and no placement
 //! term (where a globe stands is not the scan's doing). What it reads from the result is what the
 //! scan controls: the walls it never saw (placed at the floor's edge), each surface's coverage, and
 //! the unseen-areas part of the map's ± with the patches behind it. The level of the temperatures
