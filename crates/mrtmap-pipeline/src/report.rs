@@ -204,6 +204,27 @@ fn coverage_rows(o: &RunOutcome) -> Vec<(String, String)> {
     ]
 }
 
+/// Each rastered surface drawn by what the scan saw of it, with its unseen share.
+fn coverage_drawings(o: &RunOutcome) -> Vec<(String, String)> {
+    o.scene
+        .surfaces
+        .iter()
+        .filter_map(|s| {
+            let r = &s.raster.as_ref()?.file;
+            let on: usize = r.temperature_c.iter().filter(|t| t.is_some()).count();
+            let unseen: usize = r.unseen.iter().map(|p| p.texels.len()).sum();
+            Some((
+                format!(
+                    "{}: {:.0} % never seen",
+                    s.id,
+                    100.0 * unseen as f64 / on.max(1) as f64
+                ),
+                mrtmap_report::coverage_svg(r),
+            ))
+        })
+        .collect()
+}
+
 /// The room frame in words, its corners and its walls (room frame, corner 1 first).
 #[allow(clippy::type_complexity)]
 fn room_rows(s: &SegmentReport) -> (String, Vec<[String; 3]>, Vec<[String; 4]>) {
@@ -521,6 +542,7 @@ pub fn report_data(o: &RunOutcome, title: &str, source: &str, p: &Project) -> Re
         features: feature_rows(&o.segment),
         furniture: furniture_rows(&o.segment),
         coverage: coverage_rows(o),
+        coverage_drawings: coverage_drawings(o),
         warnings: o.warnings.clone(),
         timing: timing_rows(&o.stages),
         parameters: p.to_toml(),

@@ -61,6 +61,8 @@ pub struct ReportData {
     pub furniture: Vec<[String; 4]>,
     /// Coverage and uncertainty.
     pub coverage: KeyValues,
+    /// Each surface's coverage drawn: (caption, inline SVG) (see [`crate::coverage_svg`]).
+    pub coverage_drawings: Vec<(String, String)>,
     /// Warnings.
     pub warnings: Vec<String>,
     /// Time per stage.
@@ -441,6 +443,22 @@ pub fn render_html(d: &ReportData) -> String {
         &["what", "value"],
         &key_value_rows(&d.coverage),
     );
+    if !d.coverage_drawings.is_empty() {
+        o.push_str(
+            "<h3>What the scan saw of each surface</h3><p><small>Each surface's 15 cm texels as seen \
+             facing it (walls upright): <span style=\"color:#5a8f3a\">■</span> seen, \
+             <span style=\"color:#999\">■</span> filled from its neighbours (next to a feature or an \
+             edge, where blur is left out, or behind furniture), <span style=\"color:#d62728\">■</span> never seen (an \
+             unseen patch: part of every MRT's ±).</small></p><div class=\"coverage\">",
+        );
+        for (caption, svg) in &d.coverage_drawings {
+            o.push_str(&format!(
+                "<figure style=\"display:inline-block;margin:4px 12px\">{svg}<figcaption>{}</figcaption></figure>",
+                esc(caption)
+            ));
+        }
+        o.push_str("</div>");
+    }
     plain_table(
         &mut o,
         "Time per stage",

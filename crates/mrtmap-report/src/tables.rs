@@ -1,6 +1,6 @@
 //! Grid CSV and map summary.
 
-use mrtmap_radiation::{FieldSummary, MrtField, UnseenImpact};
+use mrtmap_radiation::{FieldSummary, MrtField, RasterFile, UnseenImpact};
 
 use crate::numbers::{fixed, uncertainty};
 use serde::{Deserialize, Serialize};
@@ -119,4 +119,88 @@ pub fn unseen_line(u: &UnseenImpact) -> String {
         uncertainty(u.max_std_error_k, 2),
         p(&u.at)
     )
+}
+
+/// A surface's raster as a small inline SVG of what the scan saw: seen texels green, texels
+/// filled from their neighbours grey, texels of unseen patches red; row 0 at the bottom (a wall's
+/// floor edge). At most 240 × 160 px.
+pub fn coverage_svg(r: &RasterFile) -> String {
+    let (cols, rows) = (r.cols.max(1), r.rows.max(1));
+    let px = (240.0 / cols as f64)
+        .min(160.0 / rows as f64)
+        .clamp(1.0, 10.0);
+    let (w, h) = (cols as f64 * px, rows as f64 * px);
+    let mut state = vec![0u8; cols * rows];
+    for &i in &r.filled {
+        if let Some(s) = state.get_mut(i) {
+            *s = 1;
+        }
+    }
+    for p in &r.unseen {
+        for &i in &p.texels {
+            if let Some(s) = state.get_mut(i) {
+                *s = 2;
+            }
+        }
+    }
+    let mut out = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w:.0}\" height=\"{h:.0}\" viewBox=\"0 0 {w:.1} {h:.1}\">"
+    );
+    for (i, t) in r.temperature_c.iter().enumerate().take(cols * rows) {
+        if t.is_none() {
+            continue;
+        }
+        let colour = ["#5a8f3a", "#999999", "#d62728"][state[i] as usize];
+        let (c, row) = (i % cols, i / cols);
+        out.push_str(&format!(
+            "<rect x=\"{:.1}\" y=\"{:.1}\" width=\"{px:.1}\" height=\"{px:.1}\" fill=\"{colour}\"/>",
+            c as f64 * px,
+            h - (row + 1) as f64 * px
+        ));
+    }
+    out.push_str("</svg>");
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mrtmap_radiation::UnseenPatch;
+
+    #[test]
+    fn a_coverage_drawing_colours_each_texel_by_what_was_seen() {
+        let r = RasterFile {
+            texel_m: 0.15,
+            origin: [0.0; 3],
+            u: [1.0, 0.0, 0.0],
+            v: [0.0, 0.0, 1.0],
+            cols: 3,
+            rows: 2,
+            temperature_c: vec![
+                Some(20.0),
+                Some(20.0),
+                None,
+                Some(20.0),
+                Some(21.0),
+                Some(19.0),
+            ],
+            filled: vec![1, 4],
+            unseen: vec![UnseenPatch {
+                texels: vec![4, 5],
+                range_c: [19.0, 21.0],
+            }],
+        };
+        let svg = coverage_svg(&r);
+        assert_eq!(
+            svg.matches("<rect").count(),
+            5,
+            "the texel off the surface is not drawn"
+        );
+        assert_eq!(svg.matches("#5a8f3a").count(), 2, "seen: 0 and 3");
+        assert_eq!(svg.matches("#999999").count(), 1, "filled only: 1");
+        assert_eq!(svg.matches("#d62728").count(), 2, "unseen: 4 and 5");
+        // 10 px texels at most; row 0 at the bottom: texel 0 at y = h - px.
+        assert!(svg.contains("width=\"30\" height=\"20\""), "{svg}");
+        assert!(svg.contains("<rect x=\"0.0\" y=\"10.0\""), "{svg}");
+    }
 }

@@ -234,6 +234,8 @@ fn report_numbers_match_the_csv_and_it_renders() {
     }
     assert!(html.contains("its parts, the largest of each on the map"));
     assert!(html.contains("unseen areas that matter most for the map"));
+    assert!(html.contains("What the scan saw of each surface") && html.contains("<svg"));
+    assert!(html.contains("<figcaption>floor: "));
     let (min, max) = mrt
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
