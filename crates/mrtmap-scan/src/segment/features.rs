@@ -1148,7 +1148,7 @@ fn background_raster(
         }
     }
     filled.sort_unstable();
-    let unseen = unseen_patches(g, in_feature, &near_feature, k, cols, rows, &on_surface);
+    let unseen = unseen_patches(g, in_feature, &near_feature, bg, k, cols, rows, &on_surface);
     let o = frame.to_3d(&g.lo);
     Some(RasterFile {
         texel_m: k as f64 * g.t,
@@ -1173,7 +1173,9 @@ const UNSEEN_SURROUNDINGS_M: f64 = 0.5;
 /// (under a quarter of their analysis texels observed, and mostly outside every feature's outline
 /// `in_feature`, where the feature's temperature applies), grouped into 8-connected patches, each
 /// with the range of the temperatures seen within [`UNSEEN_SURROUNDINGS_M`] of it, else anywhere
-/// on the surface. A feature's temperatures bound a patch only when the patch touches its outline
+/// on the surface, as departures from the background model `bg` placed on the background over
+/// the patch (a stratified wall's gradient is known; a 20 s radiant-ceiling walk's unseen wall
+/// patches took its whole 2 K span as possible). A feature's temperatures bound a patch only when the patch touches its outline
 /// (a window or a panel may continue into what was not seen); a feature whose edge was seen, with
 /// background beyond it, ends there, and its cells and their blur (`near_feature`) are left out:
 /// a 20 s office walk's 1.3 m² unseen patch of wall 0.4 m from the window's seen edge took the
@@ -1184,6 +1186,7 @@ fn unseen_patches(
     g: &Grid,
     in_feature: &[bool],
     near_feature: &[bool],
+    bg: &Background,
     k: usize,
     cols: usize,
     rows: usize,
@@ -1208,10 +1211,15 @@ fn unseen_patches(
             inside > 0 && seen * 4 < inside && feature * 2 < inside
         })
         .collect();
+    // Temperatures seen are taken relative to the surface's background model (a wall's vertical
+    // gradient), and the range is placed on the background over the patch: a patch on a
+    // stratified wall follows the gradient as its neighbours do, and what is uncertain is how
+    // far it strays from it.
+    let bg_at = |c: usize| bg.a + bg.b * g.centre_of(c).y;
     let observed_range = |cells: &mut dyn Iterator<Item = usize>, features: bool| {
         let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
         for c in cells.filter(|&c| g.inside[c] && g.observed(c) && (features || !near_feature[c])) {
-            let t = g.kelvin(c);
+            let t = g.kelvin(c) - bg_at(c);
             lo = lo.min(t);
             hi = hi.max(t);
         }
@@ -1273,10 +1281,17 @@ fn unseen_patches(
         let range = around(touches)
             .or_else(|| around(true))
             .or_else(|| observed_range(&mut (0..g.nx * g.ny), true));
+        // The background over the patch's own cells.
+        let (n, sum) = texels
+            .iter()
+            .flat_map(|&r| cells_of(r))
+            .filter(|&c| g.inside[c])
+            .fold((0usize, 0.0), |(n, s), c| (n + 1, s + bg_at(c)));
+        let base = if n > 0 { sum / n as f64 } else { bg.a };
         if let Some((lo, hi)) = range {
             out.push(UnseenPatch {
                 texels,
-                range_c: [lo - ZERO_CELSIUS_K, hi - ZERO_CELSIUS_K],
+                range_c: [base + lo - ZERO_CELSIUS_K, base + hi - ZERO_CELSIUS_K],
             });
         }
     }
@@ -1722,6 +1737,46 @@ mod tests {
             (both.features[0].area_m2 - 2.2).abs() < 0.22,
             "{}",
             both.features[0].area_m2
+        );
+    }
+
+    /// A wall stratified by 0.8 K/m (18 °C at the floor, 20 °C at 2.5 m) with a 0.6 m hole the
+    /// walk never saw at mid-height: the seen surroundings span 1.3 K of height, but the wall's
+    /// gradient is known, so the patch is bounded by how far the wall strays from it (nowhere
+    /// here), placed on the gradient at the hole.
+    #[test]
+    fn an_unseen_patch_on_a_stratified_wall_follows_its_gradient() {
+        let hole = |x: f64, z: f64| (1.7..2.3).contains(&x) && (0.95..1.55).contains(&z);
+        let (mut pos, mut temp) = (Vec::new(), Vec::new());
+        for i in 0..400 {
+            for j in 0..250 {
+                let (x, z) = ((i as f64 + 0.5) * 0.01, (j as f64 + 0.5) * 0.01);
+                if !hole(x, z) {
+                    pos.push(Point3::new(x, 0.0, z));
+                    temp.push(ZERO_CELSIUS_K + 18.0 + 0.8 * z);
+                }
+            }
+        }
+        let (frame, host) = wall_in_y0(4.0, 2.5);
+        let idx: Vec<usize> = (0..pos.len()).collect();
+        let ones = vec![1.0; pos.len()];
+        let a = analyse_surface(
+            &frame,
+            &host,
+            &idx,
+            (&pos, &temp, &ones),
+            true,
+            &SegmentParams::default(),
+        );
+        let r = a.raster.as_ref().expect("a raster");
+        assert_eq!(r.unseen.len(), 1, "{:?}", r.unseen);
+        let [lo, hi] = r.unseen[0].range_c;
+        assert!(hi - lo < 0.1, "{:?}", r.unseen[0].range_c);
+        // The hole's middle (z 1.25 m) is at 19.0 °C.
+        assert!(
+            ((lo + hi) / 2.0 - 19.0).abs() < 0.1,
+            "{:?}",
+            r.unseen[0].range_c
         );
     }
 
