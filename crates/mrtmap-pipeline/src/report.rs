@@ -173,13 +173,7 @@ fn coverage_rows(o: &RunOutcome) -> Vec<(String, String)> {
                 .first()
                 .and_then(|m| m.summary.map.field.as_ref())
                 .map_or("—".into(), |f| {
-                    let parts: Vec<String> = f
-                        .max_std_error_parts
-                        .named()
-                        .iter()
-                        .map(|(name, v)| format!("{name} {}", uncertainty(*v, 3)))
-                        .collect();
-                    format!("{} K", parts.join(", "))
+                    mrtmap_report::parts_line(&f.max_std_error_parts, 3)
                 }),
         ),
         (

@@ -121,6 +121,17 @@ pub struct PointRecord {
 }
 
 impl PointRecord {
+    /// Its standard error's parts.
+    pub fn parts(&self) -> StdErrorParts {
+        StdErrorParts {
+            sampling_k: self.sampling_std_error_k,
+            temperatures_k: self.temperature_std_error_k,
+            placement_k: self.placement_std_error_k,
+            unseen_k: self.unseen_std_error_k,
+            level_k: self.level_std_error_k,
+        }
+    }
+
     /// The record of `r`, whose view factors follow `patches`.
     pub fn new(name: Option<String>, r: &PointMrt, patches: &[Patch]) -> Self {
         Self {

@@ -102,6 +102,48 @@ pub struct Raster {
     pub patch_of: Vec<Option<usize>>,
 }
 
+/// Each texel's unseen patch (index into `r.unseen`) over the `n` texels, checking the patches:
+/// ranges low then high within the scene's temperatures, texels that exist, in one patch at most.
+fn patch_of_texel(r: &RasterFile, id: &str, n: usize) -> Result<Vec<Option<usize>>, SceneError> {
+    let mut patch_of_index: Vec<Option<usize>> = vec![None; n];
+    for (k, patch) in r.unseen.iter().enumerate() {
+        let [lo, hi] = patch.range_c;
+        let range = TEMPERATURE_RANGE_C.0..=TEMPERATURE_RANGE_C.1;
+        if !(lo.is_finite()
+            && hi.is_finite()
+            && lo <= hi
+            && range.contains(&lo)
+            && range.contains(&hi))
+        {
+            return Err(bad(
+                id,
+                format!(
+                    "unseen patch {k}: range_c [{lo}, {hi}] must be two temperatures, low then high, within {}…{} °C",
+                    TEMPERATURE_RANGE_C.0, TEMPERATURE_RANGE_C.1
+                ),
+            ));
+        }
+        for &i in &patch.texels {
+            match patch_of_index.get_mut(i) {
+                None => {
+                    return Err(bad(
+                        id,
+                        format!("unseen patch {k} names texel {i}, but there are {n}"),
+                    ));
+                }
+                Some(Some(other)) => {
+                    return Err(bad(
+                        id,
+                        format!("texel {i} is in unseen patches {other} and {k}"),
+                    ));
+                }
+                Some(slot) => *slot = Some(k),
+            }
+        }
+    }
+    Ok(patch_of_index)
+}
+
 fn bad(id: &str, detail: String) -> SceneError {
     SceneError::BadRaster {
         id: id.into(),
@@ -148,42 +190,7 @@ impl Raster {
                 format!("filled names texel {i}, but there are {n}"),
             ));
         }
-        let mut patch_of_index: Vec<Option<usize>> = vec![None; n];
-        for (k, patch) in r.unseen.iter().enumerate() {
-            let [lo, hi] = patch.range_c;
-            let range = TEMPERATURE_RANGE_C.0..=TEMPERATURE_RANGE_C.1;
-            if !(lo.is_finite()
-                && hi.is_finite()
-                && lo <= hi
-                && range.contains(&lo)
-                && range.contains(&hi))
-            {
-                return Err(bad(
-                    id,
-                    format!(
-                        "unseen patch {k}: range_c [{lo}, {hi}] must be two temperatures, low then high, within {}…{} °C",
-                        TEMPERATURE_RANGE_C.0, TEMPERATURE_RANGE_C.1
-                    ),
-                ));
-            }
-            for &i in &patch.texels {
-                match patch_of_index.get_mut(i) {
-                    None => {
-                        return Err(bad(
-                            id,
-                            format!("unseen patch {k} names texel {i}, but there are {n}"),
-                        ));
-                    }
-                    Some(Some(other)) => {
-                        return Err(bad(
-                            id,
-                            format!("texel {i} is in unseen patches {other} and {k}"),
-                        ));
-                    }
-                    Some(slot) => *slot = Some(k),
-                }
-            }
-        }
+        let patch_of_index = patch_of_texel(r, id, n)?;
         let (u, v, o) = (
             Vector3::from(r.u),
             Vector3::from(r.v),

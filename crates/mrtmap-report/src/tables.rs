@@ -1,6 +1,6 @@
 //! Grid CSV and map summary.
 
-use mrtmap_radiation::{FieldSummary, MrtField, RasterFile, UnseenImpact};
+use mrtmap_radiation::{FieldSummary, MrtField, RasterFile, StdErrorParts, UnseenImpact};
 
 use crate::numbers::{fixed, uncertainty};
 use serde::{Deserialize, Serialize};
@@ -96,6 +96,17 @@ impl MapAxes {
             up: a(&p.normal),
         }
     }
+}
+
+/// A standard error's parts for people: "sampling 0.006, surface temperatures 0.002, …, camera
+/// level 0.115 K", each to its first digit (at least `min_decimals`).
+pub fn parts_line(p: &StdErrorParts, min_decimals: usize) -> String {
+    let parts: Vec<String> = p
+        .named()
+        .iter()
+        .map(|(name, v)| format!("{name} {}", uncertainty(*v, min_decimals)))
+        .collect();
+    format!("{} K", parts.join(", "))
 }
 
 /// One unseen patch for people: "ceiling, 0.51 m² around (2.10, 3.40, 3.00), 22.4…38.0 °C seen

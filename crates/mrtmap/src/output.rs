@@ -119,13 +119,10 @@ pub fn print_map(s: &Summary) {
                     f.skipped
                 );
             }
-            let parts: Vec<String> = f
-                .max_std_error_parts
-                .named()
-                .iter()
-                .map(|(name, v)| format!("{name} {}", uncertainty(*v, 3)))
-                .collect();
-            outln!("  its parts, the largest of each: {} K", parts.join(", "));
+            outln!(
+                "  its parts, the largest of each: {}",
+                mrtmap_report::parts_line(&f.max_std_error_parts, 3)
+            );
             for u in f.unseen_patches.iter().take(3) {
                 outln!("  not seen: {}", mrtmap_report::unseen_line(u));
             }

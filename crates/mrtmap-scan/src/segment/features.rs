@@ -1012,8 +1012,34 @@ pub fn analyse_surface(
         &bg,
         &near_edge,
     );
+    background_of(
+        &g,
+        &cells,
+        &in_feature,
+        &bg,
+        frame,
+        p,
+        observed_fraction,
+        &mut out,
+    );
+    out
+}
+
+/// The surface's background once its features are known: the raster (without the features'
+/// outlines) and the host's temperature and uncertainty, into `out`.
+#[allow(clippy::too_many_arguments)]
+fn background_of(
+    g: &Grid,
+    cells: &[usize],
+    in_feature: &[bool],
+    bg: &Background,
+    frame: &PlaneFrame,
+    p: &SegmentParams,
+    observed_fraction: f64,
+    out: &mut SurfaceAnalysis,
+) {
     // The texels inside a feature's outline.
-    let in_outline: Vec<bool> = (0..nx * ny)
+    let in_outline: Vec<bool> = (0..g.nx * g.ny)
         .map(|c| {
             g.inside[c] && {
                 let centre = g.centre_of(c);
@@ -1027,7 +1053,7 @@ pub fn analyse_surface(
         // The raster leaves out what the features' outlines cover: a feature's texels outside
         // its outline (a window whose upper corner was never seen, outlined as the rectangle
         // seen in full) radiate from the raster at their own temperature.
-        out.raster = background_raster(&g, &in_outline, &bg, frame, p.raster_m);
+        out.raster = background_raster(g, &in_outline, bg, frame, p.raster_m);
     }
     // With a raster, what was not seen is in its unseen patches (each bounded by what was seen
     // around it); without one, the host's temperature carries it.
@@ -1036,11 +1062,10 @@ pub fn analyse_surface(
     } else {
         1.0 - observed_fraction
     };
-    if let Some((t, std)) = host_temperature(&g, &cells, &in_feature, &in_outline, unseen_share) {
+    if let Some((t, std)) = host_temperature(g, cells, in_feature, &in_outline, unseen_share) {
         out.temperature_k = Some(t);
         out.temperature_std_k = std;
     }
-    out
 }
 
 /// The background's temperature raster at about `raster_m` (a whole number of analysis texels):
@@ -1575,6 +1600,39 @@ mod tests {
         }
     }
 
+    /// A `w` × `h` m wall in the plane y = 0 sampled every centimetre: `seen(x, z)` is the
+    /// temperature (°C) where the walk saw it, `None` where it did not; analysed with a linear
+    /// background when `linear`.
+    fn analyse_seen(
+        w: f64,
+        h: f64,
+        seen: impl Fn(f64, f64) -> Option<f64>,
+        linear: bool,
+    ) -> (PlaneFrame, SurfaceAnalysis) {
+        let (mut pos, mut temp) = (Vec::new(), Vec::new());
+        for i in 0..(w * 100.0).round() as usize {
+            for j in 0..(h * 100.0).round() as usize {
+                let (x, z) = ((i as f64 + 0.5) * 0.01, (j as f64 + 0.5) * 0.01);
+                if let Some(t) = seen(x, z) {
+                    pos.push(Point3::new(x, 0.0, z));
+                    temp.push(ZERO_CELSIUS_K + t);
+                }
+            }
+        }
+        let (frame, host) = wall_in_y0(w, h);
+        let idx: Vec<usize> = (0..pos.len()).collect();
+        let ones = vec![1.0; pos.len()];
+        let a = analyse_surface(
+            &frame,
+            &host,
+            &idx,
+            (&pos, &temp, &ones),
+            linear,
+            &SegmentParams::default(),
+        );
+        (frame, a)
+    }
+
     /// A 4 × 2.5 m wall at 18 °C with a 30 °C panel (x 1…2, z 1…2) and two holes the walk never
     /// saw: one 0.6 m square by the panel (from x `a_from`), one far from it (x 3.2…3.8,
     /// z 0.2…0.6). Each is an unseen patch covering its hole, bounded by what was seen around it:
@@ -1593,27 +1651,13 @@ mod tests {
             |x: f64, z: f64| (a_from..a_from + 0.6).contains(&x) && (1.2..1.8).contains(&z);
         let hole_b = |x: f64, z: f64| (3.2..3.8).contains(&x) && (0.2..0.6).contains(&z);
         let panel = |x: f64, z: f64| (1.0..2.0).contains(&x) && (1.0..2.0).contains(&z);
-        let (mut pos, mut temp) = (Vec::new(), Vec::new());
-        for i in 0..400 {
-            for j in 0..250 {
-                let (x, z) = ((i as f64 + 0.5) * 0.01, (j as f64 + 0.5) * 0.01);
-                if hole_a(x, z) || hole_b(x, z) {
-                    continue;
-                }
-                pos.push(Point3::new(x, 0.0, z));
-                temp.push(ZERO_CELSIUS_K + if panel(x, z) { 30.0 } else { 18.0 });
-            }
-        }
-        let (frame, host) = wall_in_y0(4.0, 2.5);
-        let idx: Vec<usize> = (0..pos.len()).collect();
-        let ones = vec![1.0; pos.len()];
-        let a = analyse_surface(
-            &frame,
-            &host,
-            &idx,
-            (&pos, &temp, &ones),
+        let (_, a) = analyse_seen(
+            4.0,
+            2.5,
+            |x, z| {
+                (!(hole_a(x, z) || hole_b(x, z))).then_some(if panel(x, z) { 30.0 } else { 18.0 })
+            },
             false,
-            &SegmentParams::default(),
         );
         assert_eq!(a.features.len(), 1, "the panel: {:?}", a.dropped);
         let r = a.raster.as_ref().expect("a raster");
@@ -1666,29 +1710,12 @@ mod tests {
         let panel = |x: f64, y: f64| (1.5..3.5).contains(&x) && (1.2..2.3).contains(&y);
         let stripe = |x: f64, y: f64| (2.3..2.6).contains(&x) && (0.9..2.6).contains(&y);
         let corner = |x: f64, y: f64| x > 3.0 && y > 1.9 && x < 4.0 && y < 2.8;
-        let (mut pos, mut temp) = (Vec::new(), Vec::new());
-        for i in 0..500 {
-            for j in 0..400 {
-                let (x, y) = ((i as f64 + 0.5) * 0.01, (j as f64 + 0.5) * 0.01);
-                if (stripe(x, y) && !stripe_seen) || (corner_unseen && corner(x, y)) {
-                    continue;
-                }
-                let hot = panel(x, y) && !stripe(x, y);
-                pos.push(Point3::new(x, 0.0, y));
-                temp.push(ZERO_CELSIUS_K + if hot { 38.0 } else { 22.4 });
-            }
-        }
-        let (frame, host) = wall_in_y0(5.0, 4.0);
-        let idx: Vec<usize> = (0..pos.len()).collect();
-        let ones = vec![1.0; pos.len()];
-        analyse_surface(
-            &frame,
-            &host,
-            &idx,
-            (&pos, &temp, &ones),
-            false,
-            &SegmentParams::default(),
-        )
+        let seen = |x: f64, y: f64| {
+            let unseen = (stripe(x, y) && !stripe_seen) || (corner_unseen && corner(x, y));
+            let hot = panel(x, y) && !stripe(x, y);
+            (!unseen).then_some(if hot { 38.0 } else { 22.4 })
+        };
+        analyse_seen(5.0, 4.0, seen, false).1
     }
 
     /// Issue 37: a 30 s scan found a 2.0 × 1.1 m panel as two "recessed lights" of 0.99 and
@@ -1747,26 +1774,11 @@ mod tests {
     #[test]
     fn an_unseen_patch_on_a_stratified_wall_follows_its_gradient() {
         let hole = |x: f64, z: f64| (1.7..2.3).contains(&x) && (0.95..1.55).contains(&z);
-        let (mut pos, mut temp) = (Vec::new(), Vec::new());
-        for i in 0..400 {
-            for j in 0..250 {
-                let (x, z) = ((i as f64 + 0.5) * 0.01, (j as f64 + 0.5) * 0.01);
-                if !hole(x, z) {
-                    pos.push(Point3::new(x, 0.0, z));
-                    temp.push(ZERO_CELSIUS_K + 18.0 + 0.8 * z);
-                }
-            }
-        }
-        let (frame, host) = wall_in_y0(4.0, 2.5);
-        let idx: Vec<usize> = (0..pos.len()).collect();
-        let ones = vec![1.0; pos.len()];
-        let a = analyse_surface(
-            &frame,
-            &host,
-            &idx,
-            (&pos, &temp, &ones),
+        let (_, a) = analyse_seen(
+            4.0,
+            2.5,
+            |x, z| (!hole(x, z)).then_some(18.0 + 0.8 * z),
             true,
-            &SegmentParams::default(),
         );
         let r = a.raster.as_ref().expect("a raster");
         assert_eq!(r.unseen.len(), 1, "{:?}", r.unseen);

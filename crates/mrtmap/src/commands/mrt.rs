@@ -67,14 +67,7 @@ pub fn run(a: &MrtArgs) -> anyhow::Result<()> {
             uncertainty(p.std_error_k, 2),
             p.view_factor_sum
         );
-        outln!(
-            "  ± in parts: sampling {}, surface temperatures {}, placement {}, unseen areas {}, camera level {} K",
-            uncertainty(p.sampling_std_error_k, 2),
-            uncertainty(p.temperature_std_error_k, 2),
-            uncertainty(p.placement_std_error_k, 2),
-            uncertainty(p.unseen_std_error_k, 2),
-            uncertainty(p.level_std_error_k, 2)
-        );
+        outln!("  ± in parts: {}", mrtmap_report::parts_line(&p.parts(), 2));
         if (p.view_factor_sum - 1.0).abs() > ENCLOSURE_TOLERANCE {
             outln!(
                 "  warning: the scene covers only {:.1} % of the view here (asked for with --allow-open): the MRT leaves the rest out",
