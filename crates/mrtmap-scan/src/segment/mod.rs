@@ -1093,7 +1093,7 @@ fn room_scene(
 /// 15 cm: a bookcase against a wall, a sofa on the floor): no point of the room sees them, so
 /// they are no part of any MRT's ±, while the patches' shares count solid angles without
 /// occlusion. On the L-shaped room's 60 s walks the wall behind the bookcase (0.58 m² never seen)
-/// made up to ±0.38 K at the node in front of the bookcase. Whether any texel was left out.
+/// made up to 0.38–0.42 K of the ± at the node in front of the bookcase (walks 1 and 2). Whether any texel was left out.
 fn hidden_by_furniture(file: &mut SceneFile, scene: &RadiantScene) -> bool {
     if scene.occluders.is_empty() {
         return false;
