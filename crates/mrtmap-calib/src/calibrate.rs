@@ -1102,9 +1102,6 @@ const BOOTSTRAP_DRAWS: usize = 64;
 /// pairs, and a small camera's focal length is not dragged by the other's), then the extrinsic
 /// and the board poses are fitted with the intrinsics fixed, as OpenCV's `stereoCalibrate` does
 /// with `CALIB_FIX_INTRINSIC`.
-///
-/// Longer than 120 lines (196): each camera's intrinsics, the pairing of views, the extrinsic's
-/// start and its fit, then the report, in order; splitting it (issue 38 lists it) is not done yet.
 pub fn calibrate_stereo(
     board: &Board,
     rgb_size: (u32, u32),
@@ -1122,7 +1119,6 @@ pub fn calibrate_stereo(
         (opts.model_rgb, opts.model_thermal),
         (PrincipalPoint::Choose, PrincipalPoint::Choose),
     )?;
-    let n = pairs.len();
     let mut status = initial_status(&rgb_dets, &th_dets);
     let cands = quarter_turns(board, &th_dets, &rgb_alone, &thermal_alone);
     let whole = |k: usize| full(board, &rgb_dets[k]) && full(board, &th_dets[k]);
@@ -1137,25 +1133,7 @@ pub fn calibrate_stereo(
         &mut status,
     );
     let idx: Vec<usize> = used.iter().map(|u| u.0).collect();
-    let common = |rgb: &[Corner], th: &[Corner]| -> (Vec<Corner>, Vec<Corner>) {
-        let has = |cs: &[Corner], c: &Corner| cs.iter().any(|d| d.i == c.i && d.j == c.j);
-        (
-            rgb.iter().filter(|c| has(th, c)).copied().collect(),
-            th.iter().filter(|c| has(rgb, c)).copied().collect(),
-        )
-    };
-    let (rgb_views, th_views): (Vec<Vec<Corner>>, Vec<Vec<Corner>>) = idx
-        .iter()
-        .map(|&k| {
-            let rgb = corners_of(&rgb_dets[k]).to_vec();
-            let th = th_labels[k].clone().unwrap_or_default();
-            if opts.common_corners {
-                common(&rgb, &th)
-            } else {
-                (rgb, th)
-            }
-        })
-        .unzip();
+    let (rgb_views, th_views) = pair_views(&idx, &rgb_dets, &th_labels, opts.common_corners);
     let prob = Stereo {
         board,
         rgb_size,
@@ -1178,14 +1156,7 @@ pub fn calibrate_stereo(
     // when the residuals are pixel noise; on a hand-made board they are the board's own
     // irregularity, and a joint fit lets the camera with more pixels drag the other's focal
     // length (the real foil-board pairs' thermal f: 152 px alone, 163 px jointly).
-    let mut refined = [rgb_alone.model.free(), thermal_alone.model.free()].concat();
-    for (k, m) in [(2, &rgb_alone), (11, &thermal_alone)] {
-        if m.principal_point_centred {
-            refined[k] = false;
-            refined[k + 1] = false;
-        }
-    }
-    refined.extend([true; 6]);
+    let refined = refinable(&rgb_alone, &thermal_alone);
     let resample = Resample {
         board,
         sizes: (rgb_size, thermal_size),
@@ -1203,27 +1174,8 @@ pub fn calibrate_stereo(
         joint.free = refined;
     }
     let boot = resample.std(&joint, &s);
-    let mut results: Vec<PairResult> = (0..n)
-        .map(|k| PairResult {
-            status: status[k].clone(),
-            rgb_corners: rgb_dets[k].as_ref().map_or(0, |d| d.corners.len()),
-            thermal_corners: th_dets[k].as_ref().map_or(0, |d| d.corners.len()),
-            rgb_error: None,
-            thermal_error: None,
-        })
-        .collect();
-    let (mut er_all, mut et_all) = (Vec::new(), Vec::new());
-    for v in 0..idx.len() {
-        let (er, et) = joint.errors(&s, v);
-        let r = &mut results[idx[v]];
-        r.rgb_error = Some(er);
-        r.thermal_error = Some(et);
-        if active[v] {
-            r.status = PairStatus::Used;
-            er_all.push(er);
-            et_all.push(et);
-        }
-    }
+    let (results, er_all, et_all) =
+        pair_results((&rgb_dets, &th_dets), &status, &joint, &s, &idx, &active);
     // The intrinsics' deviations are each camera's own (or the joint fit's); the extrinsic's the
     // larger of the fit's and the bootstrap's.
     let std = s.global_std.map(|fit| {
@@ -1234,58 +1186,15 @@ pub fn calibrate_stereo(
             v.extend(thermal_alone.std.map_or([0.0; 9], |a| a));
             v
         };
-        for k in 0..6 {
-            let b = boot.map_or(0.0, |b| b[k]);
-            v.push(fit[18 + k].max(b));
-        }
+        v.extend((0..6).map(|k| fit[18 + k].max(boot.map_or(0.0, |b| b[k]))));
         v
     });
     let e = iso(&s.global[18..24]);
-    let pp = |m: &MonoResult| {
-        let model = match (m.model, m.model_held_out_px) {
-            (DistortionModel::Radial, Some((r, t))) => {
-                format!("k1 k2 (held-out RMS {r:.3} px; with p1 p2 {t:.3} px, not 1 % better), ")
-            }
-            (DistortionModel::RadialTangential, Some((r, t))) => {
-                format!("k1 k2 p1 p2 (held-out RMS {t:.3} px; k1 k2 alone {r:.3} px), ")
-            }
-            _ => String::new(),
-        };
-        let point = match m.held_out_rms_px {
-            Some((free, centre)) => format!(
-                "principal point {} (held-out RMS {free:.3} px free, {centre:.3} px at the centre)",
-                if m.principal_point_centred {
-                    "at the image centre"
-                } else {
-                    "fitted"
-                }
-            ),
-            None => "principal point fitted (too few views to compare on held-out ones)".into(),
-        };
-        model + &point
-    };
-    let how = match (fixed_err, joint_err) {
-        (Some(f), Some(j)) => format!(
-            "{} (held-out pairs' thermal corners predicted from their colour view: RMS {f:.3} px fixed, {j:.3} px refined)",
-            if jointly {
-                "refined with the extrinsic"
-            } else {
-                "fixed in the extrinsic fit"
-            }
-        ),
-        _ => "fixed in the extrinsic fit (too few pairs to compare on held-out ones)".into(),
-    };
-    let model_choice = format!(
-        "intrinsics from each camera's own images ({} colour, {} thermal views), {how}; colour {}; thermal {}; extrinsic ± from {}",
-        rgb_alone.view_errors.iter().flatten().count(),
-        thermal_alone.view_errors.iter().flatten().count(),
-        pp(&rgb_alone),
-        pp(&thermal_alone),
-        if boot.is_some() {
-            "the fit and a bootstrap over the image pairs (both cameras recalibrated in each draw), whichever is larger"
-        } else {
-            "the fit (too few pairs for a bootstrap)"
-        }
+    let model_choice = model_choice(
+        (&rgb_alone, &thermal_alone),
+        (fixed_err, joint_err),
+        jointly,
+        boot.is_some(),
     );
     Ok(StereoResult {
         rgb: camera_from(rgb_size.0, rgb_size.1, &s.global[0..9]),
@@ -1300,6 +1209,139 @@ pub fn calibrate_stereo(
         thermal_labels: th_labels,
         model_choice,
     })
+}
+
+/// The parameters a joint fit refines: each camera's free distortion terms and its principal
+/// point unless it was put at the image centre, then the extrinsic.
+fn refinable(rgb_alone: &MonoResult, thermal_alone: &MonoResult) -> Vec<bool> {
+    let mut refined = [rgb_alone.model.free(), thermal_alone.model.free()].concat();
+    for (k, m) in [(2, rgb_alone), (11, thermal_alone)] {
+        if m.principal_point_centred {
+            refined[k] = false;
+            refined[k + 1] = false;
+        }
+    }
+    refined.extend([true; 6]);
+    refined
+}
+
+/// Each pair's result (corners, errors, status), and the used pairs' colour and thermal errors.
+fn pair_results(
+    (rgb_dets, th_dets): (&[Option<Detection>], &[Option<Detection>]),
+    status: &[PairStatus],
+    joint: &Joint<'_>,
+    s: &crate::lm::Solved,
+    idx: &[usize],
+    active: &[bool],
+) -> (Vec<PairResult>, Vec<ViewError>, Vec<ViewError>) {
+    let mut results: Vec<PairResult> = (0..status.len())
+        .map(|k| PairResult {
+            status: status[k].clone(),
+            rgb_corners: rgb_dets[k].as_ref().map_or(0, |d| d.corners.len()),
+            thermal_corners: th_dets[k].as_ref().map_or(0, |d| d.corners.len()),
+            rgb_error: None,
+            thermal_error: None,
+        })
+        .collect();
+    let (mut er_all, mut et_all) = (Vec::new(), Vec::new());
+    for v in 0..idx.len() {
+        let (er, et) = joint.errors(s, v);
+        let r = &mut results[idx[v]];
+        r.rgb_error = Some(er);
+        r.thermal_error = Some(et);
+        if active[v] {
+            r.status = PairStatus::Used;
+            er_all.push(er);
+            et_all.push(et);
+        }
+    }
+    (results, er_all, et_all)
+}
+
+/// Each camera's colour and thermal views of the pairs `idx`: all their corners, or only those
+/// both cameras found.
+fn pair_views(
+    idx: &[usize],
+    rgb_dets: &[Option<Detection>],
+    th_labels: &[Option<Vec<Corner>>],
+    common_corners: bool,
+) -> (Vec<Vec<Corner>>, Vec<Vec<Corner>>) {
+    let common = |rgb: &[Corner], th: &[Corner]| -> (Vec<Corner>, Vec<Corner>) {
+        let has = |cs: &[Corner], c: &Corner| cs.iter().any(|d| d.i == c.i && d.j == c.j);
+        (
+            rgb.iter().filter(|c| has(th, c)).copied().collect(),
+            th.iter().filter(|c| has(rgb, c)).copied().collect(),
+        )
+    };
+    idx.iter()
+        .map(|&k| {
+            let rgb = corners_of(&rgb_dets[k]).to_vec();
+            let th = th_labels[k].clone().unwrap_or_default();
+            if common_corners {
+                common(&rgb, &th)
+            } else {
+                (rgb, th)
+            }
+        })
+        .unzip()
+}
+
+/// How one camera's distortion model and principal point were chosen, in words.
+fn intrinsics_choice(m: &MonoResult) -> String {
+    let model = match (m.model, m.model_held_out_px) {
+        (DistortionModel::Radial, Some((r, t))) => {
+            format!("k1 k2 (held-out RMS {r:.3} px; with p1 p2 {t:.3} px, not 1 % better), ")
+        }
+        (DistortionModel::RadialTangential, Some((r, t))) => {
+            format!("k1 k2 p1 p2 (held-out RMS {t:.3} px; k1 k2 alone {r:.3} px), ")
+        }
+        _ => String::new(),
+    };
+    let point = match m.held_out_rms_px {
+        Some((free, centre)) => format!(
+            "principal point {} (held-out RMS {free:.3} px free, {centre:.3} px at the centre)",
+            if m.principal_point_centred {
+                "at the image centre"
+            } else {
+                "fitted"
+            }
+        ),
+        None => "principal point fitted (too few views to compare on held-out ones)".into(),
+    };
+    model + &point
+}
+
+/// How the stereo fit was made, in words: each camera's choices, intrinsics fixed or refined
+/// (with the held-out errors `(fixed, refined)` that chose), and where the extrinsic's ± is from.
+fn model_choice(
+    (rgb_alone, thermal_alone): (&MonoResult, &MonoResult),
+    (fixed_err, joint_err): (Option<f64>, Option<f64>),
+    jointly: bool,
+    bootstrap: bool,
+) -> String {
+    let how = match (fixed_err, joint_err) {
+        (Some(f), Some(j)) => format!(
+            "{} (held-out pairs' thermal corners predicted from their colour view: RMS {f:.3} px fixed, {j:.3} px refined)",
+            if jointly {
+                "refined with the extrinsic"
+            } else {
+                "fixed in the extrinsic fit"
+            }
+        ),
+        _ => "fixed in the extrinsic fit (too few pairs to compare on held-out ones)".into(),
+    };
+    format!(
+        "intrinsics from each camera's own images ({} colour, {} thermal views), {how}; colour {}; thermal {}; extrinsic ± from {}",
+        rgb_alone.view_errors.iter().flatten().count(),
+        thermal_alone.view_errors.iter().flatten().count(),
+        intrinsics_choice(rgb_alone),
+        intrinsics_choice(thermal_alone),
+        if bootstrap {
+            "the fit and a bootstrap over the image pairs (both cameras recalibrated in each draw), whichever is larger"
+        } else {
+            "the fit (too few pairs for a bootstrap)"
+        }
+    )
 }
 
 /// The board point seen at a colour pixel, through the board plane of a pose (camera_from_board).

@@ -326,9 +326,6 @@ pub struct ComfortOutput {
 
 /// Computes the person's quantities of `quantities` over the floor grid and at `marks` (map x, y
 /// with names), writing `<quantity>.csv`, `.png`, `.svg` and `comfort.json` into `out`.
-///
-/// Longer than 120 lines (127): the grid's nodes computed, then each quantity written; the second
-/// half belongs with the MRT map's writer, which issue 38's map redesign will share.
 #[allow(clippy::too_many_arguments)]
 pub fn make_comfort_maps(
     engine: &MrtEngine<'_>,
@@ -408,6 +405,29 @@ pub fn make_comfort_maps(
         nodes: Vec::new(),
         unseen: Vec::new(),
     };
+    let subtitle = format!(
+        "{source}; {}×{} grid; {} person rays per point",
+        grid[0],
+        grid[1],
+        engine.ray_settings().rays
+    );
+    let maps = write_maps(&field, scene, &nodes, marks, &subtitle, (&person, c), out)?;
+    let summary = summarise(&nodes, c, &person, mark_values, secs);
+    write_json(&out.join("comfort.json"), &summary)?;
+    Ok(ComfortOutput { summary, maps })
+}
+
+/// Writes each quantity's map (`<quantity>.png`, `.svg`, `.csv`) into `out`; returns (quantity,
+/// title, PNG) per map.
+fn write_maps(
+    field: &MrtField,
+    scene: &RadiantScene,
+    nodes: &[ComfortNode],
+    marks: &[(String, [f64; 2])],
+    subtitle: &str,
+    (person, c): (&[Quantity], &ComfortSection),
+    out: &Path,
+) -> Result<Vec<(Quantity, String, Vec<u8>)>> {
     let map_marks: Vec<MapMark> = marks
         .iter()
         .map(|(name, xy)| MapMark {
@@ -416,7 +436,7 @@ pub fn make_comfort_maps(
         })
         .collect();
     let mut maps = Vec::new();
-    for &q in &person {
+    for &q in person {
         let (title, unit) = title_of(q, c);
         let values: Vec<(usize, usize, f64)> = nodes
             .iter()
@@ -426,15 +446,10 @@ pub fn make_comfort_maps(
             })
             .collect();
         let input = MapInput {
-            field: &field,
+            field,
             scene,
             marks: &map_marks,
-            subtitle: format!(
-                "{source}; {}×{} grid; {} person rays per point",
-                grid[0],
-                grid[1],
-                engine.ray_settings().rays
-            ),
+            subtitle: subtitle.to_string(),
             quantity: Some(MapQuantity {
                 title: title.clone(),
                 unit: unit.into(),
@@ -450,13 +465,11 @@ pub fn make_comfort_maps(
         )?;
         mrtmap_io::write_atomic(
             &out.join(format!("{}.csv", q.name())),
-            quantity_csv(&field, &nodes, q).as_bytes(),
+            quantity_csv(field, nodes, q).as_bytes(),
         )?;
         maps.push((q, title, png));
     }
-    let summary = summarise(&nodes, c, &person, mark_values, secs);
-    write_json(&out.join("comfort.json"), &summary)?;
-    Ok(ComfortOutput { summary, maps })
+    Ok(maps)
 }
 
 /// One quantity over the grid as CSV: x, y, value, standard error, i, j, note.

@@ -339,6 +339,7 @@ fn test_pairs() -> Vec<TestPair> {
 }
 
 /// The cameras tracking uses.
+#[derive(Clone, Copy)]
 struct Cameras {
     colour: PinholeCamera,
     depth: PinholeCamera,
@@ -798,57 +799,79 @@ fn rotation_deg(t: &Isometry3<f64>) -> f64 {
 /// Tracks the recording's colour frames; returns world_from_depth at the colour frames' times (the
 /// first frame's depth camera is the world) and what was done.
 ///
-/// Longer than 120 lines (315): one sequential loop over the colour frames whose state (the
-/// reference keyframe, velocity, lost/relocalised counts, keyframe graph, about twelve locals)
-/// every step reads and writes. Splitting it needs that state gathered into a tracker struct
-/// first (issue 38); until then the steps are marked by comments in the loop.
+/// The frames are read in parallel chunks ([`FrameReader`]) and placed one after another by a
+/// [`Tracker`]: against the reference keyframe, else another keyframe (relocalisation), else by
+/// depth alone; then, when loops were closed, the keyframe graph is optimised.
 pub fn track(
     rec: &Recording,
     params: &TrackParams,
     progress: &dyn Fn(usize, usize),
 ) -> Result<(Trajectory, TrackReport), TrackError> {
     let t0 = Instant::now();
-    let rig = &rec.rig;
-    let Some(rgb) = rig.rgb else {
-        return Err(TrackError::NoColour(format!(
-            "{}: the rig has no [rgb] camera; tracking needs the colour camera's intrinsics and its pose in the depth camera",
-            rec.dir.join("rig.toml").display()
-        )));
-    };
-    if rec.rgb.is_empty() {
-        return Err(TrackError::NoColour(format!(
-            "{}: no colour frames (rgb.txt); tracking needs them",
-            rec.dir.display()
-        )));
-    }
-    let cams = Cameras {
-        colour: rgb.camera,
-        depth: rig.depth,
-        depth_scale: rig.depth_scale,
-        colour_from_depth: rgb.depth_from_rgb.inverse(),
-    };
-    let pairs = test_pairs();
+    let mut tracker = Tracker::new(rec, params)?;
+    let reader = FrameReader::new(rec, params, tracker.cams);
     let n = rec.rgb.len();
-    let mut report = TrackReport {
-        frames: n,
-        ..TrackReport::default()
-    };
-    let depth_t: Vec<f64> = rec.depth.iter().map(|e| e.t).collect();
-    let nearest_depth = |t: f64| -> Option<usize> {
+    let chunk = 16;
+    let mut start = 0;
+    while start < n {
+        let end = (start + chunk).min(n);
+        let feats: Vec<Features> = (start..end)
+            .into_par_iter()
+            .map(|i| reader.read(i))
+            .collect::<Result<_, _>>()?;
+        for (i, f) in (start..end).zip(feats) {
+            progress(i + 1, n);
+            tracker.step(i, f);
+        }
+        start = end;
+    }
+    tracker.optimise_graph();
+    tracker.finish(t0)
+}
+
+/// Reads a colour frame's corners with the depth frame nearest in time.
+struct FrameReader<'a> {
+    rec: &'a Recording,
+    params: &'a TrackParams,
+    cams: Cameras,
+    pairs: Vec<TestPair>,
+    depth_t: Vec<f64>,
+    rays: RayTable,
+    sampling: DepthSampling,
+}
+
+impl<'a> FrameReader<'a> {
+    fn new(rec: &'a Recording, params: &'a TrackParams, cams: Cameras) -> Self {
+        Self {
+            rec,
+            params,
+            cams,
+            pairs: test_pairs(),
+            depth_t: rec.depth.iter().map(|e| e.t).collect(),
+            rays: RayTable::new(&cams.depth),
+            sampling: DepthSampling {
+                stride: 4,
+                max_m: params.max_depth_m,
+                ..DepthSampling::default()
+            },
+        }
+    }
+
+    /// The depth frame nearest to time `t`, within the sync tolerance.
+    fn nearest_depth(&self, t: f64) -> Option<usize> {
+        let depth_t = &self.depth_t;
         let k = depth_t.partition_point(|&x| x < t);
         [k.checked_sub(1), (k < depth_t.len()).then_some(k)]
             .into_iter()
             .flatten()
             .min_by(|&a, &b| (depth_t[a] - t).abs().total_cmp(&(depth_t[b] - t).abs()))
-            .filter(|&k| (depth_t[k] - t).abs() <= params.sync_tolerance_s)
-    };
-    let rays = RayTable::new(&cams.depth);
-    let sampling = DepthSampling {
-        stride: 4,
-        max_m: params.max_depth_m,
-        ..DepthSampling::default()
-    };
-    let read = |i: usize| -> Result<Features, TrackError> {
+            .filter(|&k| (depth_t[k] - t).abs() <= self.params.sync_tolerance_s)
+    }
+
+    /// Colour frame `i`'s corners, their depth and the depth cloud (a frame of another size is
+    /// returned empty with `wrong_size`).
+    fn read(&self, i: usize) -> Result<Features, TrackError> {
+        let (rec, cams) = (self.rec, &self.cams);
         let e = &rec.rgb[i];
         let path = rec.path_of(e);
         let grey = image::ImageReader::open(&path)
@@ -868,254 +891,378 @@ pub fn track(
             });
         }
         let mut cloud = None;
-        let depth = match nearest_depth(e.t) {
+        let depth = match self.nearest_depth(e.t) {
             Some(k) => {
                 let img = rec.read_depth(&rec.depth[k])?;
-                let mut pts = depth_points(&img, &rays, cams.depth_scale, &sampling);
+                let mut pts = depth_points(&img, &self.rays, cams.depth_scale, &self.sampling);
                 for (p, n) in pts.points.iter_mut().zip(pts.normals.iter_mut()) {
                     *p = cams.colour_from_depth * *p;
                     *n = cams.colour_from_depth * *n;
                 }
                 cloud = Some(std::sync::Arc::new(pts));
                 Some((
-                    std::sync::Arc::new(depth_in_colour(&img, &cams, &rays)),
-                    depth_t[k] - e.t,
+                    std::sync::Arc::new(depth_in_colour(&img, cams, &self.rays)),
+                    self.depth_t[k] - e.t,
                 ))
             }
             None => None,
         };
-        let mut f = features(&grey, depth, &cams, &pairs, params);
+        let mut f = features(&grey, depth, cams, &self.pairs, self.params);
         f.cloud = cloud;
         Ok(f)
-    };
+    }
+}
 
-    let fx = cams.colour.fx;
-    let mut poses: Vec<Option<Isometry3<f64>>> = vec![None; n];
-    // Each tracked frame's keyframe and keyframe_from_frame, for the pose graph's correction.
-    let mut anchor: Vec<Option<(usize, Isometry3<f64>)>> = vec![None; n];
-    let mut kfs: Vec<Keyframe> = Vec::new();
-    let mut edges: Vec<Edge> = Vec::new();
-    // Motion per second (earlier_from_later over 1 s, body frame) and the last tracked frame.
-    let mut velocity = Twist::default();
-    let gyro = params
-        .use_imu
-        .then(|| Gyro::new(&rec.imu, &cams.colour_from_depth))
-        .flatten();
-    report.gyro_samples = gyro.as_ref().map_or(0, |g| g.t.len());
-    let mut last: Option<(usize, Isometry3<f64>)> = None;
-    let (mut corners_sum, mut inliers_sum, mut reproj_sum) = (0usize, 0usize, 0.0);
-    let chunk = 16;
-    let mut start = 0;
-    while start < n {
-        let end = (start + chunk).min(n);
-        let feats: Vec<Features> = (start..end)
-            .into_par_iter()
-            .map(read)
-            .collect::<Result<_, _>>()?;
-        for (i, f) in (start..end).zip(feats) {
-            progress(i + 1, n);
-            if let Some((w, h)) = f.wrong_size {
-                report.wrong_size += 1;
-                report
-                    .wrong_size_first
-                    .get_or_insert_with(|| (rec.path_of(&rec.rgb[i]).display().to_string(), w, h));
-                continue;
-            }
-            corners_sum += f.px.len();
-            report.unsynced += f.zmap.is_none() as usize;
-            let t_now = rec.rgb[i].t;
-            // The depth's points at the colour frame's time: colour(t) from colour(t + dt).
-            let motion = predict(&velocity, gyro.as_ref(), t_now, t_now + f.dt);
-            let xyz_now = f.moved(&motion, &cams.colour, params.max_depth_m);
-            let Some(kf) = kfs.last() else {
-                let with_depth = xyz_now.iter().flatten().count();
-                if with_depth < params.min_inliers {
-                    // Nothing to start from yet (no depth, or too few corners with depth).
-                    report.lost += 1;
-                    continue;
-                }
-                poses[i] = Some(Isometry3::identity());
-                anchor[i] = Some((0, Isometry3::identity()));
-                let target = f
-                    .cloud_at(&motion, 20_000)
-                    .map(|c| IcpTarget::new(c.points, c.normals));
-                kfs.push(Keyframe {
-                    feats: Features {
-                        zmap: None,
-                        cloud: None,
-                        ..f
-                    },
-                    xyz: xyz_now,
-                    with_depth,
-                    pose: Isometry3::identity(),
-                    target,
-                });
-                last = Some((i, Isometry3::identity()));
-                report.tracked += 1;
-                continue;
-            };
-            let predicted_world =
-                last.map(|(k, p)| p * predict(&velocity, gyro.as_ref(), rec.rgb[k].t, t_now));
-            let predicted = predicted_world.map(|w| w.inverse() * kf.pose);
-            let seed = i as u64;
-            let seen = Seen {
-                norm: &f.norm,
-                xyz: &xyz_now,
-            };
-            // The pose against keyframe `k`: guided by `guess` when given, else over the image.
-            let against = |k: &Keyframe, guess: Option<&Isometry3<f64>>| {
-                let m = match_features(&k.feats, &k.xyz, &f, guess, &cams.colour, params);
-                estimate(&k.xyz, seen, &m, guess, fx, params, seed)
-            };
-            let mut found = predicted
-                .as_ref()
-                .and_then(|pr| against(kf, Some(pr)))
-                .or_else(|| against(kf, None));
-            let mut reference = kfs.len() - 1;
-            if found.is_none() {
-                // Lost against the reference: try the other keyframes, newest first.
-                if let Some((k, fd)) =
-                    kfs.iter().enumerate().rev().skip(1).find_map(|(k, other)| {
-                        // An older keyframe's pose carries the drift since it was made: a frame
-                        // placed on it is a loop closure and needs a loop's evidence.
-                        against(other, None)
-                            .filter(|fd| fd.inliers >= params.loop_min_inliers)
-                            .map(|fd| (k, fd))
-                    })
-                {
-                    found = Some(fd);
-                    reference = k;
-                    report.relocalised += 1;
-                }
-            }
-            if found.is_none() {
-                // No corners to follow (a close-up of a plain surface, motion blur): the depth
-                // alone, registered on the reference keyframe's from the prediction.
-                found = predicted
-                    .as_ref()
-                    .and_then(|pr| depth_only(kf, &f, &motion, pr));
-                if found.is_some() {
-                    reference = kfs.len() - 1;
-                    report.depth_only += 1;
-                }
-            }
-            let Some(fd) = found else {
-                report.lost += 1;
-                continue;
-            };
-            let kref = &kfs[reference];
-            let kf_from_frame = fd.pose.inverse();
-            let world = kref.pose * kf_from_frame;
-            if let Some((k, p)) = last {
-                let dt = t_now - rec.rgb[k].t;
-                if dt > 1e-6 {
-                    velocity = Twist::from_motion(&(p.inverse() * world), dt);
-                }
-            }
-            poses[i] = Some(world);
-            anchor[i] = Some((reference, kf_from_frame));
-            last = Some((i, world));
-            report.tracked += 1;
-            inliers_sum += fd.inliers;
-            reproj_sum += fd.reprojection_px;
-            // A frame placed by depth alone (no inliers) starts a keyframe only by moving away.
-            let by_depth = fd.inliers == 0;
-            let new_kf = (!by_depth
-                && (fd.inliers as f64) < params.keyframe_inlier_ratio * kref.with_depth as f64)
-                || kf_from_frame.translation.vector.norm() > params.keyframe_move_m
-                || rotation_deg(&kf_from_frame) > params.keyframe_turn_deg
-                || reference != kfs.len() - 1;
-            if !new_kf {
-                continue;
-            }
-            // The motion model now holds this frame's velocity: move its depth again.
-            let motion = predict(&velocity, gyro.as_ref(), t_now, t_now + f.dt);
-            let xyz = f.moved(&motion, &cams.colour, params.max_depth_m);
-            let with_depth = xyz.iter().flatten().count();
-            let target = f
-                .cloud_at(&motion, 20_000)
-                .map(|c| IcpTarget::new(c.points, c.normals));
-            if with_depth < params.min_inliers && target.as_ref().is_none_or(|t| t.len() < 500) {
-                continue;
-            }
-            edges.push(Edge {
-                from: reference as i64,
-                to: kfs.len() as i64,
-                measured: kf_from_frame,
-                information: fd.information,
-            });
-            let id = kfs.len();
-            anchor[i] = Some((id, Isometry3::identity()));
-            kfs.push(Keyframe {
-                feats: Features {
-                    zmap: None,
-                    cloud: None,
-                    ..f
-                },
-                xyz,
-                with_depth,
-                pose: world,
-                target,
-            });
-            if params.loop_closure {
-                close_loops(&mut kfs, &mut edges, &cams, params, &mut report);
+/// How a frame was placed.
+enum Placed {
+    /// Against the reference keyframe.
+    Reference,
+    /// Against an older keyframe (the reference was lost).
+    Relocalised,
+    /// By its depth alone on the reference keyframe's.
+    DepthOnly,
+}
+
+/// The tracking state over the colour frames, in time order.
+struct Tracker<'a> {
+    rec: &'a Recording,
+    params: &'a TrackParams,
+    cams: Cameras,
+    gyro: Option<Gyro>,
+    /// world_from_colour of each tracked frame.
+    poses: Vec<Option<Isometry3<f64>>>,
+    /// Each tracked frame's keyframe and keyframe_from_frame, for the pose graph's correction.
+    anchor: Vec<Option<(usize, Isometry3<f64>)>>,
+    keyframes: Vec<Keyframe>,
+    edges: Vec<Edge>,
+    /// Motion per second (earlier_from_later over 1 s, body frame).
+    velocity: Twist,
+    /// The last tracked frame and its pose.
+    last: Option<(usize, Isometry3<f64>)>,
+    corners_sum: usize,
+    inliers_sum: usize,
+    reprojection_sum: f64,
+    report: TrackReport,
+}
+
+impl<'a> Tracker<'a> {
+    /// Checks that the recording can be tracked (a colour camera and frames) and sets up.
+    fn new(rec: &'a Recording, params: &'a TrackParams) -> Result<Self, TrackError> {
+        let Some(rgb) = rec.rig.rgb else {
+            return Err(TrackError::NoColour(format!(
+                "{}: the rig has no [rgb] camera; tracking needs the colour camera's intrinsics and its pose in the depth camera",
+                rec.dir.join("rig.toml").display()
+            )));
+        };
+        if rec.rgb.is_empty() {
+            return Err(TrackError::NoColour(format!(
+                "{}: no colour frames (rgb.txt); tracking needs them",
+                rec.dir.display()
+            )));
+        }
+        let cams = Cameras {
+            colour: rgb.camera,
+            depth: rec.rig.depth,
+            depth_scale: rec.rig.depth_scale,
+            colour_from_depth: rgb.depth_from_rgb.inverse(),
+        };
+        let gyro = params
+            .use_imu
+            .then(|| Gyro::new(&rec.imu, &cams.colour_from_depth))
+            .flatten();
+        let n = rec.rgb.len();
+        let report = TrackReport {
+            frames: n,
+            gyro_samples: gyro.as_ref().map_or(0, |g| g.t.len()),
+            ..TrackReport::default()
+        };
+        Ok(Self {
+            rec,
+            params,
+            cams,
+            gyro,
+            poses: vec![None; n],
+            anchor: vec![None; n],
+            keyframes: Vec::new(),
+            edges: Vec::new(),
+            velocity: Twist::default(),
+            last: None,
+            corners_sum: 0,
+            inliers_sum: 0,
+            reprojection_sum: 0.0,
+            report,
+        })
+    }
+
+    /// The motion from `t0` to `t1` (earlier_from_later) the tracker expects.
+    fn predict(&self, t0: f64, t1: f64) -> Isometry3<f64> {
+        predict(&self.velocity, self.gyro.as_ref(), t0, t1)
+    }
+
+    /// Places colour frame `i`, and makes it a keyframe when it has moved away from its
+    /// reference.
+    fn step(&mut self, i: usize, f: Features) {
+        if let Some((w, h)) = f.wrong_size {
+            self.report.wrong_size += 1;
+            let rec = self.rec;
+            self.report
+                .wrong_size_first
+                .get_or_insert_with(|| (rec.path_of(&rec.rgb[i]).display().to_string(), w, h));
+            return;
+        }
+        self.corners_sum += f.px.len();
+        self.report.unsynced += f.zmap.is_none() as usize;
+        let t_now = self.rec.rgb[i].t;
+        // The depth's points at the colour frame's time: colour(t) from colour(t + dt).
+        let motion = self.predict(t_now, t_now + f.dt);
+        let xyz_now = f.moved(&motion, &self.cams.colour, self.params.max_depth_m);
+        if self.keyframes.is_empty() {
+            self.start(i, f, xyz_now, &motion);
+            return;
+        }
+        let Some((reference, fd)) = self.locate(i, &f, &xyz_now, &motion) else {
+            self.report.lost += 1;
+            return;
+        };
+        let kf_from_frame = fd.pose.inverse();
+        let world = self.keyframes[reference].pose * kf_from_frame;
+        if let Some((k, p)) = self.last {
+            let dt = t_now - self.rec.rgb[k].t;
+            if dt > 1e-6 {
+                self.velocity = Twist::from_motion(&(p.inverse() * world), dt);
             }
         }
-        start = end;
+        self.poses[i] = Some(world);
+        self.anchor[i] = Some((reference, kf_from_frame));
+        self.last = Some((i, world));
+        self.report.tracked += 1;
+        self.inliers_sum += fd.inliers;
+        self.reprojection_sum += fd.reprojection_px;
+        // A frame placed by depth alone (no inliers) starts a keyframe only by moving away.
+        let by_depth = fd.inliers == 0;
+        let kref = &self.keyframes[reference];
+        let p = self.params;
+        let new_kf = (!by_depth
+            && (fd.inliers as f64) < p.keyframe_inlier_ratio * kref.with_depth as f64)
+            || kf_from_frame.translation.vector.norm() > p.keyframe_move_m
+            || rotation_deg(&kf_from_frame) > p.keyframe_turn_deg
+            || reference != self.keyframes.len() - 1;
+        if new_kf {
+            self.add_keyframe(i, f, reference, &fd, world);
+        }
     }
-    report.keyframes = kfs.len();
-    report.mean_corners = corners_sum as f64 / n.max(1) as f64;
-    report.mean_inliers = inliers_sum as f64 / report.tracked.max(1) as f64;
-    report.mean_reprojection_px = reproj_sum / report.tracked.max(1) as f64;
-    // The pose graph over keyframes, when loops were closed.
-    if report.loops_accepted > 0 {
-        let initial: BTreeMap<i64, Isometry3<f64>> = kfs
+
+    /// The first frame with enough corners with depth becomes the first keyframe, at the origin.
+    fn start(
+        &mut self,
+        i: usize,
+        f: Features,
+        xyz_now: Vec<Option<Point3<f64>>>,
+        motion: &Isometry3<f64>,
+    ) {
+        let with_depth = xyz_now.iter().flatten().count();
+        if with_depth < self.params.min_inliers {
+            // Nothing to start from yet (no depth, or too few corners with depth).
+            self.report.lost += 1;
+            return;
+        }
+        self.poses[i] = Some(Isometry3::identity());
+        self.anchor[i] = Some((0, Isometry3::identity()));
+        let target = f
+            .cloud_at(motion, 20_000)
+            .map(|c| IcpTarget::new(c.points, c.normals));
+        self.keyframes.push(Keyframe {
+            feats: Features {
+                zmap: None,
+                cloud: None,
+                ..f
+            },
+            xyz: xyz_now,
+            with_depth,
+            pose: Isometry3::identity(),
+            target,
+        });
+        self.last = Some((i, Isometry3::identity()));
+        self.report.tracked += 1;
+    }
+
+    /// Frame `i`'s pose against a keyframe (keyframe_from... as [`Found`]) and that keyframe:
+    /// the reference, guided by the prediction, else over the image; else another keyframe,
+    /// newest first; else the depth alone. `None`: lost.
+    fn locate(
+        &mut self,
+        i: usize,
+        f: &Features,
+        xyz_now: &[Option<Point3<f64>>],
+        motion: &Isometry3<f64>,
+    ) -> Option<(usize, Found)> {
+        let (p, cams, kfs) = (self.params, &self.cams, &self.keyframes);
+        let t_now = self.rec.rgb[i].t;
+        let newest = kfs.len() - 1;
+        let kf = &kfs[newest];
+        let predicted_world = self
+            .last
+            .map(|(k, pose)| pose * self.predict(self.rec.rgb[k].t, t_now));
+        let predicted = predicted_world.map(|w| w.inverse() * kf.pose);
+        let seen = Seen {
+            norm: &f.norm,
+            xyz: xyz_now,
+        };
+        // The pose against keyframe `k`: guided by `guess` when given, else over the image.
+        let against = |k: &Keyframe, guess: Option<&Isometry3<f64>>| {
+            let m = match_features(&k.feats, &k.xyz, f, guess, &cams.colour, p);
+            estimate(&k.xyz, seen, &m, guess, cams.colour.fx, p, i as u64)
+        };
+        let placed = predicted
+            .as_ref()
+            .and_then(|pr| against(kf, Some(pr)))
+            .or_else(|| against(kf, None))
+            .map(|fd| (newest, fd, Placed::Reference))
+            .or_else(|| {
+                // Lost against the reference: try the other keyframes, newest first. An older
+                // keyframe's pose carries the drift since it was made: a frame placed on it is a
+                // loop closure and needs a loop's evidence.
+                kfs.iter().enumerate().rev().skip(1).find_map(|(k, other)| {
+                    against(other, None)
+                        .filter(|fd| fd.inliers >= p.loop_min_inliers)
+                        .map(|fd| (k, fd, Placed::Relocalised))
+                })
+            })
+            .or_else(|| {
+                // No corners to follow (a close-up of a plain surface, motion blur): the depth
+                // alone, registered on the reference keyframe's from the prediction.
+                predicted
+                    .as_ref()
+                    .and_then(|pr| depth_only(kf, f, motion, pr))
+                    .map(|fd| (newest, fd, Placed::DepthOnly))
+            });
+        let (k, fd, how) = placed?;
+        match how {
+            Placed::Reference => {}
+            Placed::Relocalised => self.report.relocalised += 1,
+            Placed::DepthOnly => self.report.depth_only += 1,
+        }
+        Some((k, fd))
+    }
+
+    /// Frame `i`, placed at `world` on keyframe `reference` by `fd`, becomes a keyframe (when
+    /// its depth allows), linked to its reference, and loops are closed.
+    fn add_keyframe(
+        &mut self,
+        i: usize,
+        f: Features,
+        reference: usize,
+        fd: &Found,
+        world: Isometry3<f64>,
+    ) {
+        let t_now = self.rec.rgb[i].t;
+        // The motion model now holds this frame's velocity: move its depth again.
+        let motion = self.predict(t_now, t_now + f.dt);
+        let xyz = f.moved(&motion, &self.cams.colour, self.params.max_depth_m);
+        let with_depth = xyz.iter().flatten().count();
+        let target = f
+            .cloud_at(&motion, 20_000)
+            .map(|c| IcpTarget::new(c.points, c.normals));
+        if with_depth < self.params.min_inliers && target.as_ref().is_none_or(|t| t.len() < 500) {
+            return;
+        }
+        let id = self.keyframes.len();
+        self.edges.push(Edge {
+            from: reference as i64,
+            to: id as i64,
+            measured: fd.pose.inverse(),
+            information: fd.information,
+        });
+        self.anchor[i] = Some((id, Isometry3::identity()));
+        self.keyframes.push(Keyframe {
+            feats: Features {
+                zmap: None,
+                cloud: None,
+                ..f
+            },
+            xyz,
+            with_depth,
+            pose: world,
+            target,
+        });
+        if self.params.loop_closure {
+            close_loops(
+                &mut self.keyframes,
+                &mut self.edges,
+                &self.cams,
+                self.params,
+                &mut self.report,
+            );
+        }
+    }
+
+    /// The pose graph over the keyframes, when loops were closed; every frame follows its
+    /// keyframe.
+    fn optimise_graph(&mut self) {
+        if self.report.loops_accepted == 0 {
+            return;
+        }
+        let initial: BTreeMap<i64, Isometry3<f64>> = self
+            .keyframes
             .iter()
             .enumerate()
             .map(|(k, kf)| (k as i64, kf.pose))
             .collect();
-        if let Ok(opt) = optimise(&initial, &edges) {
-            report.graph_cost_before = opt.cost_before;
-            report.graph_cost_after = opt.cost_after;
-            for (k, kf) in kfs.iter_mut().enumerate() {
-                if let Some(p) = opt.poses.get(&(k as i64)) {
-                    kf.pose = *p;
-                }
-            }
-            for (pose, a) in poses.iter_mut().zip(&anchor) {
-                if let (Some(p), Some((k, rel))) = (pose.as_mut(), a) {
-                    *p = kfs[*k].pose * rel;
-                }
+        let Ok(opt) = optimise(&initial, &self.edges) else {
+            return;
+        };
+        self.report.graph_cost_before = opt.cost_before;
+        self.report.graph_cost_after = opt.cost_after;
+        for (k, kf) in self.keyframes.iter_mut().enumerate() {
+            if let Some(p) = opt.poses.get(&(k as i64)) {
+                kf.pose = *p;
             }
         }
-    }
-    let mut traj = Trajectory::default();
-    for (i, p) in poses.iter().enumerate() {
-        if let Some(p) = p {
-            traj.stamps.push(rec.rgb[i].t);
-            // world_from_depth = world_from_colour · colour_from_depth.
-            traj.poses.push(renormalised(&(p * cams.colour_from_depth)));
+        for (pose, a) in self.poses.iter_mut().zip(&self.anchor) {
+            if let (Some(p), Some((k, rel))) = (pose.as_mut(), a) {
+                *p = self.keyframes[*k].pose * rel;
+            }
         }
     }
-    // The first tracked frame's depth camera is the world.
-    if let Some(first) = traj.poses.first().copied() {
-        let inv = first.inverse();
-        for p in &mut traj.poses {
-            *p = renormalised(&(inv * *p));
+
+    /// The trajectory of the depth camera (the first tracked frame's is the world) and the
+    /// report; an error when too few frames were tracked.
+    fn finish(mut self, t0: Instant) -> Result<(Trajectory, TrackReport), TrackError> {
+        let n = self.rec.rgb.len();
+        let report = &mut self.report;
+        report.keyframes = self.keyframes.len();
+        report.mean_corners = self.corners_sum as f64 / n.max(1) as f64;
+        report.mean_inliers = self.inliers_sum as f64 / report.tracked.max(1) as f64;
+        report.mean_reprojection_px = self.reprojection_sum / report.tracked.max(1) as f64;
+        let mut traj = Trajectory::default();
+        for (i, p) in self.poses.iter().enumerate() {
+            if let Some(p) = p {
+                traj.stamps.push(self.rec.rgb[i].t);
+                // world_from_depth = world_from_colour · colour_from_depth.
+                traj.poses
+                    .push(renormalised(&(p * self.cams.colour_from_depth)));
+            }
         }
+        // The first tracked frame's depth camera is the world.
+        if let Some(first) = traj.poses.first().copied() {
+            let inv = first.inverse();
+            for p in &mut traj.poses {
+                *p = renormalised(&(inv * *p));
+            }
+        }
+        report.seconds = t0.elapsed().as_secs_f64();
+        if let Some(gt) = &self.rec.groundtruth {
+            report.accuracy = trajectory_error(&traj, gt);
+        }
+        if report.tracked < 2 || report.tracked * 2 < n {
+            return Err(TrackError::Failed {
+                tracked: report.tracked,
+                frames: n,
+                why: "too few corners or matches (a textureless view, motion blur, or colour and depth out of step); scan more slowly over textured surfaces, or record poses".into(),
+            });
+        }
+        Ok((traj, self.report))
     }
-    report.seconds = t0.elapsed().as_secs_f64();
-    if let Some(gt) = &rec.groundtruth {
-        report.accuracy = trajectory_error(&traj, gt);
-    }
-    if report.tracked < 2 || report.tracked * 2 < n {
-        return Err(TrackError::Failed {
-            tracked: report.tracked,
-            frames: n,
-            why: "too few corners or matches (a textureless view, motion blur, or colour and depth out of step); scan more slowly over textured surfaces, or record poses".into(),
-        });
-    }
-    Ok((traj, report))
 }
 
 /// A depth-only link's information in the units of [`information`]: as a weakly matched visual

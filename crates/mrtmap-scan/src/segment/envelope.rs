@@ -358,18 +358,35 @@ fn room_centre(points: &[Point3<f64>], caps: &Caps) -> Point3<f64> {
     centroid(&inside)
 }
 
-/// The points of vertical surfaces between two heights, on the floor plan: cloud indices, 2D
-/// positions and 2D unit normals.
+/// The points of vertical surfaces between two heights, on the floor plan.
+#[derive(Clone, Debug, Default)]
+struct VerticalPoints {
+    /// Their indices in the cloud.
+    index: Vec<usize>,
+    /// Their positions on the floor plan.
+    at: Vec<Point2<f64>>,
+    /// Their unit normals on the floor plan.
+    normal: Vec<Vector2<f64>>,
+}
+
+impl VerticalPoints {
+    /// The share of the wall from `a` to `b` (facing `inward`) that these points show
+    /// ([`observed_share`]).
+    fn observed(&self, a: &Point2<f64>, b: &Point2<f64>, inward: &Vector2<f64>, band: f64) -> f64 {
+        observed_share(a, b, inward, &self.at, &self.normal, band)
+    }
+}
+
+/// The points of vertical surfaces between two heights.
 fn vertical_points(
-    points: &[Point3<f64>],
-    normals: &[Vector3<f64>],
+    cloud: Cloud<'_>,
     frame: &PlaneFrame,
     (lo, hi): (f64, f64),
     p: &SegmentParams,
-) -> (Vec<usize>, Vec<Point2<f64>>, Vec<Vector2<f64>>) {
+) -> VerticalPoints {
     let sin_v = p.vertical_deg.to_radians().sin();
-    let mut out = (Vec::new(), Vec::new(), Vec::new());
-    for (i, (q, n)) in points.iter().zip(normals).enumerate() {
+    let mut out = VerticalPoints::default();
+    for (i, (q, n)) in cloud.points.iter().zip(cloud.normals).enumerate() {
         let h = frame.normal.dot(&(q - frame.origin));
         if h < lo || h > hi || n.dot(&frame.normal).abs() > sin_v {
             continue;
@@ -377,9 +394,9 @@ fn vertical_points(
         let Some(n2) = Vector2::new(frame.u.dot(n), frame.v.dot(n)).try_normalize(1e-6) else {
             continue;
         };
-        out.0.push(i);
-        out.1.push(frame.to_2d(q));
-        out.2.push(n2);
+        out.index.push(i);
+        out.at.push(frame.to_2d(q));
+        out.normal.push(n2);
     }
     out
 }
@@ -416,26 +433,21 @@ fn observed_share(
 const UNOBSERVED_MARGIN_M: f64 = 0.3;
 
 /// Classifies planes against an up estimate, picks floor and ceiling, refines up from the floor,
-/// finds the outline of walls on the floor plan (`outline`) and computes the corners. The walls
-/// become planes of their own, appended to `planes`; vertical planes found by RANSAC on a wall
-/// are replaced by it.
-///
-/// Longer than 120 lines: it is three steps in order (the outline chosen between two height
-/// bands, the walls' planes, the RANSAC planes reclassified against them) sharing the floor frame
-/// and the wall points; splitting them out is issue 38's segmentation work, not done yet.
+/// finds the outline of walls on the floor plan ([`choose_outline`]) and computes the corners.
+/// The walls become planes of their own ([`wall_planes`]), appended to `planes`; vertical planes
+/// found by RANSAC on a wall are replaced by it ([`reclassify_vertical`]).
 pub fn envelope(
     cloud: Cloud<'_>,
     mut planes: Vec<FoundPlane>,
     up0: Unit<Vector3<f64>>,
     p: &SegmentParams,
 ) -> Result<Envelope, SegmentError> {
-    let (points, normals) = (cloud.points, cloud.normals);
+    let points = cloud.points;
     let caps = floor_and_ceiling(cloud, &mut planes, up0, p)?;
     let up = caps.up;
     let centre = room_centre(points, &caps);
     // The horizontal frame: origin on the floor.
     let frame = PlaneFrame::new(planes[caps.floor].plane.project(&centre), up, &Vector3::x());
-    let h_room = caps.h_ceiling - caps.h_floor;
     let evidence: Vec<Point2<f64>> = planes[caps.floor]
         .inliers
         .iter()
@@ -443,127 +455,21 @@ pub fn envelope(
         .map(|&i| frame.to_2d(&points[i]))
         .collect();
     let op = OutlineParams::default();
-    // Walls reach the ceiling, furniture mostly does not: their points in the upper half of the
-    // room, and just below the ceiling. Of the two outlines, the one whose walls have less length
-    // without wall points along them (a wrong line leaves part of its wall unseen) when they
-    // differ by more than [`UNOBSERVED_MARGIN_M`]; otherwise the one with fewer walls inferred,
-    // then fewer walls (lines of noise add walls, they do not remove any).
-    let bands = [
-        (0.5 * h_room, h_room - 0.05),
-        (
-            h_room - p.wall_ceiling_gap_m.max(0.2 * h_room),
-            h_room - 0.05,
-        ),
-    ];
-    let mut result: Result<(outline::Outline, f64), OutlineError> = Err(OutlineError::NothingSeen);
-    let mut used = (Vec::new(), Vec::new(), Vec::new());
-    let score = |o: &outline::Outline| {
-        (
-            o.walls.iter().filter(|&&w| o.lines[w].inferred).count(),
-            o.walls.len(),
-        )
-    };
-    let all = vertical_points(points, normals, &frame, (0.05 * h_room, h_room - 0.05), p);
-    // The length of the outline's walls (m) along which no wall points were seen.
-    let unobserved = |o: &outline::Outline| {
-        let n = o.walls.len();
-        (0..n)
-            .map(|k| {
-                let (a, b) = (o.corners[k], o.corners[(k + 1) % n]);
-                (b - a).norm()
-                    * (1.0 - observed_share(&a, &b, &o.normals[k], &all.1, &all.2, op.band_m))
-            })
-            .sum::<f64>()
-    };
-    for band in bands {
-        let vp = vertical_points(points, normals, &frame, band, p);
-        let lines = outline::wall_lines(&vp.1, &vp.2, &op);
-        let this = outline::outline(lines, &evidence, &op).map(|o| {
-            let u = unobserved(&o);
-            (o, u)
-        });
-        let better = match (&this, &result) {
-            (Ok((a, ua)), Ok((b, ub))) => {
-                if (ua - ub).abs() > UNOBSERVED_MARGIN_M {
-                    ua < ub
-                } else {
-                    score(a) < score(b)
-                }
-            }
-            (Ok(_), Err(_)) => true,
-            _ => false,
-        };
-        if better || (result.is_err() && this.is_err()) {
-            result = this;
-            used = vp;
-        }
-    }
-    let mut out = result.map(|r| r.0).map_err(|e| match e {
-        OutlineError::NothingSeen => SegmentError::NoWalls,
-        OutlineError::Open(a, b) => SegmentError::OpenOutline {
-            from: arr(&frame.to_3d(&a)),
-            to: arr(&frame.to_3d(&b)),
-            length_m: (b - a).norm(),
-        },
-    })?;
-    let wall_weights: Vec<f64> = all.0.iter().map(|&i| cloud.weights[i]).collect();
-    outline::refine_walls(&mut out, &all.1, &all.2, &wall_weights, &op);
-    // The walls' planes, made exactly vertical, facing into the room.
-    let n = out.walls.len();
-    let to3 = |v: &Vector2<f64>| frame.u.as_ref() * v.x + frame.v.as_ref() * v.y;
-    let mut walls = Vec::with_capacity(n);
-    for k in 0..n {
-        let line = &out.lines[out.walls[k]];
-        let normal = Unit::new_normalize(to3(&out.normals[k]));
-        let plane = Plane::from_point_normal(&frame.to_3d(&out.corners[k]), normal);
-        let inliers: Vec<usize> = line.points.iter().map(|&i| used.0[i]).collect();
-        let (a, b) = (out.corners[k], out.corners[(k + 1) % n]);
-        walls.push((
-            FoundPlane {
-                plane,
-                points: inliers.len(),
-                inliers,
-                class: PlaneClass::Wall,
-            },
-            WallSeen {
-                inferred: line.inferred,
-                observed: observed_share(&a, &b, &out.normals[k], &all.1, &all.2, op.band_m),
-                length_m: (b - a).norm(),
-            },
-        ));
-    }
-    // Vertical RANSAC planes: dropped where they are a wall, otherwise other vertical surfaces.
-    let sin_v = p.vertical_deg.to_radians().sin();
-    let (floor_plane, ceiling_plane) = (caps.floor, caps.ceiling);
-    let mut kept = Vec::with_capacity(planes.len() + n);
-    let (mut floor, mut ceiling) = (0, 0);
-    for (k, mut f) in planes.into_iter().enumerate() {
-        if f.class == PlaneClass::Slanted && f.plane.normal.dot(&up).abs() <= sin_v {
-            let c = mean_of(points, &f.inliers);
-            let on_wall = walls.iter().any(|(w, _)| {
-                w.plane.normal.dot(&f.plane.normal).abs() > 10f64.to_radians().cos()
-                    && w.plane.distance(&c).abs() < 0.15
-            });
-            if on_wall {
-                continue;
-            }
-            f.class = PlaneClass::OtherVertical;
-        }
-        if k == floor_plane {
-            floor = kept.len();
-        }
-        if k == ceiling_plane {
-            ceiling = kept.len();
-        }
-        kept.push(f);
-    }
-    let first_wall = kept.len();
+    let h_room = caps.h_ceiling - caps.h_floor;
+    let all = vertical_points(cloud, &frame, (0.05 * h_room, h_room - 0.05), p);
+    let (mut out, used) = choose_outline(cloud, &frame, &evidence, &all, h_room, p)?;
+    let wall_weights: Vec<f64> = all.index.iter().map(|&i| cloud.weights[i]).collect();
+    outline::refine_walls(&mut out, &all.at, &all.normal, &wall_weights, &op);
+    let walls = wall_planes(&out, &frame, &used, &all, op.band_m);
+    let n = walls.len();
+    let (mut planes, floor, ceiling) =
+        reclassify_vertical(planes, &walls, (caps.floor, caps.ceiling), points, up, p);
+    let first_wall = planes.len();
     let mut seen = Vec::with_capacity(n);
     for (w, s) in walls {
-        kept.push(w);
+        planes.push(w);
         seen.push(s);
     }
-    let planes = kept;
     let wall_order: Vec<usize> = (first_wall..first_wall + n).collect();
     let corner3 = |k: usize, cap: &Plane| {
         let (a, b) = (
@@ -590,6 +496,154 @@ pub fn envelope(
         planes,
         frame,
     })
+}
+
+/// The room's outline, and the vertical points its lines were found from.
+///
+/// Walls reach the ceiling, furniture mostly does not: the lines come from the points in the
+/// upper half of the room, or from those just below the ceiling. Of the two outlines, the one
+/// whose walls have less length without wall points along them (`all`; a wrong line leaves part
+/// of its wall unseen) when they differ by more than [`UNOBSERVED_MARGIN_M`]; otherwise the one
+/// with fewer walls inferred, then fewer walls (lines of noise add walls, they do not remove
+/// any).
+fn choose_outline(
+    cloud: Cloud<'_>,
+    frame: &PlaneFrame,
+    evidence: &[Point2<f64>],
+    all: &VerticalPoints,
+    h_room: f64,
+    p: &SegmentParams,
+) -> Result<(outline::Outline, VerticalPoints), SegmentError> {
+    let op = OutlineParams::default();
+    let bands = [
+        (0.5 * h_room, h_room - 0.05),
+        (
+            h_room - p.wall_ceiling_gap_m.max(0.2 * h_room),
+            h_room - 0.05,
+        ),
+    ];
+    let score = |o: &outline::Outline| {
+        (
+            o.walls.iter().filter(|&&w| o.lines[w].inferred).count(),
+            o.walls.len(),
+        )
+    };
+    // The length of the outline's walls (m) along which no wall points were seen.
+    let unobserved = |o: &outline::Outline| {
+        let n = o.walls.len();
+        (0..n)
+            .map(|k| {
+                let (a, b) = (o.corners[k], o.corners[(k + 1) % n]);
+                (b - a).norm() * (1.0 - all.observed(&a, &b, &o.normals[k], op.band_m))
+            })
+            .sum::<f64>()
+    };
+    let mut result: Result<(outline::Outline, f64), OutlineError> = Err(OutlineError::NothingSeen);
+    let mut used = VerticalPoints::default();
+    for band in bands {
+        let vp = vertical_points(cloud, frame, band, p);
+        let lines = outline::wall_lines(&vp.at, &vp.normal, &op);
+        let this = outline::outline(lines, evidence, &op).map(|o| {
+            let u = unobserved(&o);
+            (o, u)
+        });
+        let better = match (&this, &result) {
+            (Ok((a, ua)), Ok((b, ub))) => {
+                if (ua - ub).abs() > UNOBSERVED_MARGIN_M {
+                    ua < ub
+                } else {
+                    score(a) < score(b)
+                }
+            }
+            (Ok(_), Err(_)) => true,
+            _ => false,
+        };
+        if better || (result.is_err() && this.is_err()) {
+            result = this;
+            used = vp;
+        }
+    }
+    let out = result.map(|r| r.0).map_err(|e| match e {
+        OutlineError::NothingSeen => SegmentError::NoWalls,
+        OutlineError::Open(a, b) => SegmentError::OpenOutline {
+            from: arr(&frame.to_3d(&a)),
+            to: arr(&frame.to_3d(&b)),
+            length_m: (b - a).norm(),
+        },
+    })?;
+    Ok((out, used))
+}
+
+/// The outline's walls as planes, made exactly vertical, facing into the room, each with its
+/// points (cloud indices of `used`) and what was seen of it (along `all`'s points).
+fn wall_planes(
+    out: &outline::Outline,
+    frame: &PlaneFrame,
+    used: &VerticalPoints,
+    all: &VerticalPoints,
+    band_m: f64,
+) -> Vec<(FoundPlane, WallSeen)> {
+    let n = out.walls.len();
+    let to3 = |v: &Vector2<f64>| frame.u.as_ref() * v.x + frame.v.as_ref() * v.y;
+    (0..n)
+        .map(|k| {
+            let line = &out.lines[out.walls[k]];
+            let normal = Unit::new_normalize(to3(&out.normals[k]));
+            let plane = Plane::from_point_normal(&frame.to_3d(&out.corners[k]), normal);
+            let inliers: Vec<usize> = line.points.iter().map(|&i| used.index[i]).collect();
+            let (a, b) = (out.corners[k], out.corners[(k + 1) % n]);
+            (
+                FoundPlane {
+                    plane,
+                    points: inliers.len(),
+                    inliers,
+                    class: PlaneClass::Wall,
+                },
+                WallSeen {
+                    inferred: line.inferred,
+                    observed: all.observed(&a, &b, &out.normals[k], band_m),
+                    length_m: (b - a).norm(),
+                },
+            )
+        })
+        .collect()
+}
+
+/// The RANSAC planes without those that are a wall: a vertical plane within 10° and 15 cm of a
+/// wall is dropped, other vertical planes become other vertical surfaces. Returns them with the
+/// floor's and the ceiling's new indices (`caps`: their old ones).
+fn reclassify_vertical(
+    planes: Vec<FoundPlane>,
+    walls: &[(FoundPlane, WallSeen)],
+    caps: (usize, usize),
+    points: &[Point3<f64>],
+    up: Unit<Vector3<f64>>,
+    p: &SegmentParams,
+) -> (Vec<FoundPlane>, usize, usize) {
+    let sin_v = p.vertical_deg.to_radians().sin();
+    let mut kept = Vec::with_capacity(planes.len() + walls.len());
+    let (mut floor, mut ceiling) = (0, 0);
+    for (k, mut f) in planes.into_iter().enumerate() {
+        if f.class == PlaneClass::Slanted && f.plane.normal.dot(&up).abs() <= sin_v {
+            let c = mean_of(points, &f.inliers);
+            let on_wall = walls.iter().any(|(w, _)| {
+                w.plane.normal.dot(&f.plane.normal).abs() > 10f64.to_radians().cos()
+                    && w.plane.distance(&c).abs() < 0.15
+            });
+            if on_wall {
+                continue;
+            }
+            f.class = PlaneClass::OtherVertical;
+        }
+        if k == caps.0 {
+            floor = kept.len();
+        }
+        if k == caps.1 {
+            ceiling = kept.len();
+        }
+        kept.push(f);
+    }
+    (kept, floor, ceiling)
 }
 
 fn arr(p: &Point3<f64>) -> [f64; 3] {

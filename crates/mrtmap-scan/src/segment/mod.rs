@@ -928,11 +928,8 @@ fn fill_from_texture(
 }
 
 /// Segments the cloud into a radiant scene; with `texture`, the thermal frames are also cast onto
-/// the room model found, and what the cloud did not cover takes their temperatures.
-///
-/// Longer than 120 lines: it is docs/segmentation.md's steps in their order, one call each, and
-/// the state they hand on (points, members, geometry, analyses, votes) would otherwise travel in
-/// a struct that exists only to be split again (issue 38 moves the steps into files of their own).
+/// the room model found, and what the cloud did not cover takes their temperatures. The steps
+/// of docs/segmentation.md in their order, one call each.
 pub fn segment_textured(
     cloud: &ThermalCloud,
     camera_poses: &[Isometry3<f64>],
@@ -979,20 +976,7 @@ pub fn segment_textured(
             p,
         )
     });
-    let analyses: Vec<features::SurfaceAnalysis> = geoms
-        .iter()
-        .enumerate()
-        .map(|(s, g)| {
-            features::analyse_surface(
-                &g.frame,
-                &polys2[s],
-                &members[s],
-                (&pts.pos, &pts.temp, &weights),
-                g.kind == SurfaceKind::Wall,
-                p,
-            )
-        })
-        .collect();
+    let analyses = analyse_surfaces(&geoms, &polys2, &members, (&pts, &weights), p);
     let all_features: Vec<(usize, &features::FoundFeature)> = analyses
         .iter()
         .enumerate()
@@ -1062,6 +1046,30 @@ pub fn segment_textured(
         textured,
         report,
     })
+}
+
+/// Each surface's temperatures and features from its member points ([`features::analyse_surface`]).
+fn analyse_surfaces(
+    geoms: &[SurfaceGeom],
+    polys2: &[Vec<Point2<f64>>],
+    members: &[Vec<usize>],
+    (pts, weights): (&Points, &[f64]),
+    p: &SegmentParams,
+) -> Vec<features::SurfaceAnalysis> {
+    geoms
+        .iter()
+        .enumerate()
+        .map(|(s, g)| {
+            features::analyse_surface(
+                &g.frame,
+                &polys2[s],
+                &members[s],
+                (&pts.pos, &pts.temp, weights),
+                g.kind == SurfaceKind::Wall,
+                p,
+            )
+        })
+        .collect()
 }
 
 /// The scene in the room's frame, from surfaces and occluders in the world's.

@@ -268,7 +268,8 @@ fn runs_along(
 }
 
 /// Wall lines from points on the floor plan with their (horizontal, unit) normals: a Hough
-/// transform on the normals' directions, then on the offsets along each direction.
+/// transform on the normals' directions ([`direction_peak`]), then on the offsets along each
+/// direction ([`lines_facing`]); weak lines and the spread of strong ones are dropped.
 pub fn wall_lines(
     pts: &[Point2<f64>],
     normals: &[Vector2<f64>],
@@ -282,23 +283,9 @@ pub fn wall_lines(
     let mut exhausted = [false; 360];
     let mut lines: Vec<WallLine> = Vec::new();
     for _ in 0..64 {
-        // The direction most free points face (1° bins, summed over ±3°).
-        let mut hist = [0usize; 360];
-        for (i, a) in angle.iter().enumerate() {
-            if free[i] {
-                hist[(*a as usize).min(359)] += 1;
-            }
-        }
-        let score = |b: usize| (0..7).map(|k| hist[(b + 360 + k - 3) % 360]).sum::<usize>();
-        let Some(peak) = (0..360)
-            .filter(|&b| !exhausted[b])
-            .max_by_key(|&b| (score(b), std::cmp::Reverse(b)))
-        else {
+        let Some(peak) = direction_peak(&angle, &free, &exhausted, p.min_points) else {
             break;
         };
-        if score(peak) < p.min_points {
-            break;
-        }
         let near: Vec<usize> = (0..pts.len())
             .filter(|&i| free[i] && angle_diff_deg(angle[i], peak as f64 + 0.5) <= p.normal_deg)
             .collect();
@@ -311,103 +298,13 @@ pub fn wall_lines(
                 let r = (peak as f64 + 0.5).to_radians();
                 Vector2::new(r.cos(), r.sin())
             });
-        // Offsets along it, 2 cm bins; peaks in turn.
-        let rho: Vec<f64> = near.iter().map(|&i| mean.dot(&pts[i].coords)).collect();
-        let lo = rho.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = rho.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        let nb = (((hi - lo) / 0.02).floor() as usize + 1).min(100_000);
-        let mut rh = vec![0usize; nb];
-        for r in &rho {
-            rh[(((r - lo) / 0.02) as usize).min(nb - 1)] += 1;
-        }
-        let half = (p.band_m / 0.02).round() as usize;
-        let window = |b: usize| {
-            rh[b.saturating_sub(half)..(b + half + 1).min(nb)]
-                .iter()
-                .sum::<usize>()
-        };
-        let mut used = vec![false; nb];
-        let mut found_any = false;
-        while let Some(b) = (0..nb)
-            .filter(|&b| !used[b])
-            .max_by_key(|&b| (window(b), std::cmp::Reverse(b)))
-        {
-            if window(b) < p.min_points {
-                break;
-            }
-            used[b.saturating_sub(2 * half)..(b + 2 * half + 1).min(nb)]
-                .iter_mut()
-                .for_each(|u| *u = true);
-            let r0 = lo + (b as f64 + 0.5) * 0.02;
-            let on: Vec<usize> = near
-                .iter()
-                .zip(&rho)
-                .filter(|(_, r)| (**r - r0).abs() <= p.band_m)
-                .map(|(i, _)| *i)
-                .collect();
-            let q: Vec<Point2<f64>> = on.iter().map(|&i| pts[i]).collect();
-            let Some((n, rho_fit)) = fit_line(&q, &mean) else {
-                continue;
-            };
-            let mut line = WallLine {
-                n,
-                rho: rho_fit,
-                points: Vec::new(),
-                inferred: false,
-                density: 0.0,
-                thickness: 0.0,
-            };
-            // A fused wall seen from afar is as thick as the depth noise there (25 cm and more):
-            // the line is the middle of its points within 30 cm, found by trimming at 2.5 robust
-            // standard deviations and refitting; its points lie within that spread.
-            let cos_n = p.normal_deg.to_radians().cos();
-            // The free points within `width` of a line whose normals agree with it.
-            let within = |line: &WallLine, width: f64| -> Vec<usize> {
-                (0..pts.len())
-                    .filter(|&i| {
-                        free[i]
-                            && line.distance(&pts[i]).abs() <= width
-                            && normals[i].dot(&line.n) >= cos_n
-                    })
-                    .collect()
-            };
-            let mut band = p.band_m;
-            for _ in 0..3 {
-                let near = within(&line, WIDE_M);
-                if near.len() < p.min_points {
-                    break;
-                }
-                let q: Vec<Point2<f64>> = near.iter().map(|&i| pts[i]).collect();
-                let Some((n, rho, cut)) = trimmed_fit(&q, None, (line.n, line.rho), (0.02, WIDE_M))
-                else {
-                    break;
-                };
-                band = cut.max(p.band_m);
-                line.n = n;
-                line.rho = rho;
-            }
-            // Its points: near the line with agreeing normals, in runs along it.
-            let cand = within(&line, band);
-            let (length, kept) = runs_along(&line, pts, &cand, p.min_length_m);
-            if kept.len() < p.min_points || length < p.min_length_m {
-                continue;
-            }
-            for &i in &kept {
-                free[i] = false;
-            }
-            line.density = kept.len() as f64 / (length / 0.1);
-            let mut r: Vec<f64> = kept.iter().map(|&i| line.distance(&pts[i]).abs()).collect();
-            r.sort_by(f64::total_cmp);
-            line.thickness = r[r.len() / 2];
-            line.points = kept;
-            found_any = true;
-            lines.push(line);
-        }
-        if !found_any {
+        let found = lines_facing((pts, normals), &near, &mean, &mut free, p);
+        if found.is_empty() {
             for k in 0..7 {
                 exhausted[(peak + 360 + k - 3) % 360] = true;
             }
         }
+        lines.extend(found);
         // Points of this direction on no line are spent either way.
         for &i in &near {
             if angle_diff_deg(angle[i], peak as f64 + 0.5) <= 3.5 {
@@ -429,6 +326,140 @@ pub fn wall_lines(
                 || (l.density >= 0.1 * densest && l.thickness <= 0.1))
     });
     drop_spread(merge_lines(lines, pts, p), pts)
+}
+
+/// The direction (1° bin) most free points face, summed over ±3°, among those not exhausted;
+/// `None` when fewer than `min_points` face any.
+fn direction_peak(
+    angle: &[f64],
+    free: &[bool],
+    exhausted: &[bool; 360],
+    min_points: usize,
+) -> Option<usize> {
+    let mut hist = [0usize; 360];
+    for (i, a) in angle.iter().enumerate() {
+        if free[i] {
+            hist[(*a as usize).min(359)] += 1;
+        }
+    }
+    let score = |b: usize| (0..7).map(|k| hist[(b + 360 + k - 3) % 360]).sum::<usize>();
+    (0..360)
+        .filter(|&b| !exhausted[b])
+        .max_by_key(|&b| (score(b), std::cmp::Reverse(b)))
+        .filter(|&peak| score(peak) >= min_points)
+}
+
+/// The lines facing `mean` among the points `near`: peaks of their offsets along it (2 cm bins)
+/// in turn, each placed by [`place_line`]; the points of each line found stop being free.
+fn lines_facing(
+    (pts, normals): (&[Point2<f64>], &[Vector2<f64>]),
+    near: &[usize],
+    mean: &Vector2<f64>,
+    free: &mut [bool],
+    p: &OutlineParams,
+) -> Vec<WallLine> {
+    let rho: Vec<f64> = near.iter().map(|&i| mean.dot(&pts[i].coords)).collect();
+    let lo = rho.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = rho.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let nb = (((hi - lo) / 0.02).floor() as usize + 1).min(100_000);
+    let mut rh = vec![0usize; nb];
+    for r in &rho {
+        rh[(((r - lo) / 0.02) as usize).min(nb - 1)] += 1;
+    }
+    let half = (p.band_m / 0.02).round() as usize;
+    let window = |b: usize| {
+        rh[b.saturating_sub(half)..(b + half + 1).min(nb)]
+            .iter()
+            .sum::<usize>()
+    };
+    let mut used = vec![false; nb];
+    let mut lines = Vec::new();
+    while let Some(b) = (0..nb)
+        .filter(|&b| !used[b])
+        .max_by_key(|&b| (window(b), std::cmp::Reverse(b)))
+    {
+        if window(b) < p.min_points {
+            break;
+        }
+        used[b.saturating_sub(2 * half)..(b + 2 * half + 1).min(nb)]
+            .iter_mut()
+            .for_each(|u| *u = true);
+        let r0 = lo + (b as f64 + 0.5) * 0.02;
+        let q: Vec<Point2<f64>> = near
+            .iter()
+            .zip(&rho)
+            .filter(|(_, r)| (**r - r0).abs() <= p.band_m)
+            .map(|(i, _)| pts[*i])
+            .collect();
+        let Some((n, rho_fit)) = fit_line(&q, mean) else {
+            continue;
+        };
+        if let Some(line) = place_line(n, rho_fit, (pts, normals), free, p) {
+            lines.push(line);
+        }
+    }
+    lines
+}
+
+/// A line started at normal `n` and offset `rho`, placed in the middle of its points and given
+/// them (they stop being free); `None` when too few or too short runs of points support it.
+///
+/// A fused wall seen from afar is as thick as the depth noise there (25 cm and more): the line is
+/// the middle of its points within 30 cm, found by trimming at 2.5 robust standard deviations
+/// and refitting; its points lie within that spread.
+fn place_line(
+    n: Vector2<f64>,
+    rho: f64,
+    (pts, normals): (&[Point2<f64>], &[Vector2<f64>]),
+    free: &mut [bool],
+    p: &OutlineParams,
+) -> Option<WallLine> {
+    let mut line = WallLine {
+        n,
+        rho,
+        points: Vec::new(),
+        inferred: false,
+        density: 0.0,
+        thickness: 0.0,
+    };
+    let cos_n = p.normal_deg.to_radians().cos();
+    // The free points within `width` of a line whose normals agree with it.
+    let within = |line: &WallLine, width: f64, free: &[bool]| -> Vec<usize> {
+        (0..pts.len())
+            .filter(|&i| {
+                free[i] && line.distance(&pts[i]).abs() <= width && normals[i].dot(&line.n) >= cos_n
+            })
+            .collect()
+    };
+    let mut band = p.band_m;
+    for _ in 0..3 {
+        let near = within(&line, WIDE_M, free);
+        if near.len() < p.min_points {
+            break;
+        }
+        let q: Vec<Point2<f64>> = near.iter().map(|&i| pts[i]).collect();
+        let Some((n, rho, cut)) = trimmed_fit(&q, None, (line.n, line.rho), (0.02, WIDE_M)) else {
+            break;
+        };
+        band = cut.max(p.band_m);
+        line.n = n;
+        line.rho = rho;
+    }
+    // Its points: near the line with agreeing normals, in runs along it.
+    let cand = within(&line, band, free);
+    let (length, kept) = runs_along(&line, pts, &cand, p.min_length_m);
+    if kept.len() < p.min_points || length < p.min_length_m {
+        return None;
+    }
+    for &i in &kept {
+        free[i] = false;
+    }
+    line.density = kept.len() as f64 / (length / 0.1);
+    let mut r: Vec<f64> = kept.iter().map(|&i| line.distance(&pts[i]).abs()).collect();
+    r.sort_by(f64::total_cmp);
+    line.thickness = r[r.len() / 2];
+    line.points = kept;
+    Some(line)
 }
 
 /// A point of a line lies among the points of stronger lines when one of theirs is this close (m).
@@ -707,7 +738,9 @@ fn clip_cell(cell: &Cell, line: &WallLine, k: usize, keep_positive: bool) -> Opt
 
 /// The room's outline from wall lines and where floor or ceiling was seen (`evidence`, points on
 /// the floor plan). Adds, along each wall direction, lines at the evidence's extreme extent where
-/// no wall was found there.
+/// no wall was found there ([`infer_lines`]); cuts the evidence's box by every line
+/// ([`Arrangement`]); keeps the cells the evidence fills and, of them, the connected region with
+/// the largest area; walks its boundary into walls ([`loop_walls`]) and drops slivers.
 pub fn outline(
     mut lines: Vec<WallLine>,
     evidence: &[Point2<f64>],
@@ -724,11 +757,52 @@ pub fn outline(
     let margin = Vector2::new(0.5, 0.5);
     let (lo, hi) = (lo - margin, hi + margin);
     let seen = Seen::new(evidence, lo, hi, p.cell_m);
-    // Inferred lines: along each line's normal (and its opposite), the extreme of the evidence in
-    // well-filled raster cells (the depth noise of a far wall scatters a few floor points beyond
-    // it; the floor seen ends densely at the wall).
-    // Only the directions of well-seen walls (a weak line's direction would cut a corner off).
-    let dense = seen.dense(evidence);
+    infer_lines(&mut lines, &seen.dense(evidence), p);
+    let arrangement = Arrangement::new(&lines, lo, hi);
+    let keep: Vec<bool> = arrangement
+        .cells
+        .iter()
+        .map(|c| {
+            let (share, total) = match seen.share(&c.poly, SPILL_M) {
+                (_, 0) => seen.share(&c.poly, 0.0),
+                inner => inner,
+            };
+            total > 0 && share >= KEEP_SHARE
+        })
+        .collect();
+    let region = arrangement
+        .largest_region(&keep)
+        .ok_or(OutlineError::NothingSeen)?;
+    let edges = arrangement.boundary(&region);
+    let outer = chain(&edges)
+        .into_iter()
+        .max_by(|a, b| loop_area(a, &edges).total_cmp(&loop_area(b, &edges)))
+        .ok_or(OutlineError::NothingSeen)?;
+    let mut walls = loop_walls(&outer, &edges)?;
+    drop_short_walls(&mut walls, &lines, p.min_length_m);
+    if walls.len() < 3 {
+        return Err(OutlineError::NothingSeen);
+    }
+    let normals = walls
+        .iter()
+        .map(|w| {
+            let d = (w.end - w.start).normalize();
+            Vector2::new(-d.y, d.x)
+        })
+        .collect();
+    Ok(Outline {
+        walls: walls.iter().map(|w| w.line).collect(),
+        corners: walls.iter().map(|w| w.start).collect(),
+        normals,
+        lines,
+    })
+}
+
+/// Adds inferred lines: along each well-seen line's normal (and its opposite), the extreme of the
+/// evidence in well-filled raster cells (`dense`; the depth noise of a far wall scatters a few
+/// floor points beyond it, the floor seen ends densely at the wall), where no line lies there.
+/// Only the directions of well-seen walls: a weak line's direction would cut a corner off.
+fn infer_lines(lines: &mut Vec<WallLine>, dense: &[Point2<f64>], p: &OutlineParams) {
     let found = lines.len();
     let densest = lines.iter().map(|l| l.density).fold(0.0, f64::max);
     for k in 0..found {
@@ -759,128 +833,151 @@ pub fn outline(
             }
         }
     }
-    let lines = lines;
-    // The arrangement.
-    let nl = lines.len();
-    let mut cells = vec![Cell {
-        poly: vec![lo, Point2::new(hi.x, lo.y), hi, Point2::new(lo.x, hi.y)],
-        edge_line: vec![None; 4],
-        side: vec![false; nl],
-    }];
-    for (k, line) in lines.iter().enumerate() {
-        cells = cells
-            .iter()
-            .flat_map(|c| [clip_cell(c, line, k, true), clip_cell(c, line, k, false)])
-            .flatten()
-            .collect();
-    }
-    let keep: Vec<bool> = cells
-        .iter()
-        .map(|c| {
-            let (share, total) = match seen.share(&c.poly, SPILL_M) {
-                (_, 0) => seen.share(&c.poly, 0.0),
-                inner => inner,
-            };
-            total > 0 && share >= KEEP_SHARE
-        })
-        .collect();
-    let index: std::collections::HashMap<&[bool], usize> = cells
-        .iter()
-        .enumerate()
-        .map(|(i, c)| (c.side.as_slice(), i))
-        .collect();
-    let neighbour = |i: usize, k: usize| {
-        let mut s = cells[i].side.clone();
-        s[k] = !s[k];
-        index.get(s.as_slice()).copied()
-    };
-    // The connected kept cells with the largest area.
-    let mut comp = vec![usize::MAX; cells.len()];
-    let mut best: Option<(f64, usize)> = None;
-    for start in 0..cells.len() {
-        if !keep[start] || comp[start] != usize::MAX {
-            continue;
+}
+
+/// The cells the lines cut a box into, each known by its side of every line.
+struct Arrangement {
+    cells: Vec<Cell>,
+    /// A cell's index by its sides.
+    index: std::collections::HashMap<Vec<bool>, usize>,
+}
+
+/// A connected set of kept cells: each cell's region (`usize::MAX` for none) and the largest's.
+struct Region {
+    of_cell: Vec<usize>,
+    root: usize,
+}
+
+/// A directed edge of a region's boundary, on wall line `line` (`None`: the search box's edge).
+#[derive(Clone, Copy, Debug)]
+struct BoundaryEdge {
+    from: Point2<f64>,
+    to: Point2<f64>,
+    line: Option<usize>,
+}
+
+/// One wall of the outline's loop: on wall line `line`, from `start` to `end`.
+#[derive(Clone, Copy, Debug)]
+struct LoopWall {
+    line: usize,
+    start: Point2<f64>,
+    end: Point2<f64>,
+}
+
+impl Arrangement {
+    /// The box `lo`–`hi` cut by every line.
+    fn new(lines: &[WallLine], lo: Point2<f64>, hi: Point2<f64>) -> Self {
+        let mut cells = vec![Cell {
+            poly: vec![lo, Point2::new(hi.x, lo.y), hi, Point2::new(lo.x, hi.y)],
+            edge_line: vec![None; 4],
+            side: vec![false; lines.len()],
+        }];
+        for (k, line) in lines.iter().enumerate() {
+            cells = cells
+                .iter()
+                .flat_map(|c| [clip_cell(c, line, k, true), clip_cell(c, line, k, false)])
+                .flatten()
+                .collect();
         }
-        let (mut stack, mut area) = (vec![start], 0.0);
-        comp[start] = start;
-        while let Some(i) = stack.pop() {
-            area += mrtmap_geometry::polygon::signed_area(&cells[i].poly);
-            for k in cells[i].edge_line.iter().flatten() {
-                if let Some(j) = neighbour(i, *k)
-                    && keep[j]
-                    && comp[j] == usize::MAX
-                {
-                    comp[j] = start;
-                    stack.push(j);
+        let index = cells
+            .iter()
+            .enumerate()
+            .map(|(i, c)| (c.side.clone(), i))
+            .collect();
+        Self { cells, index }
+    }
+
+    /// The cell across line `k` from cell `i`.
+    fn neighbour(&self, i: usize, k: usize) -> Option<usize> {
+        let mut s = self.cells[i].side.clone();
+        s[k] = !s[k];
+        self.index.get(&s).copied()
+    }
+
+    /// The connected kept cells with the largest area; `None` when none is kept.
+    fn largest_region(&self, keep: &[bool]) -> Option<Region> {
+        let cells = &self.cells;
+        let mut comp = vec![usize::MAX; cells.len()];
+        let mut best: Option<(f64, usize)> = None;
+        for start in 0..cells.len() {
+            if !keep[start] || comp[start] != usize::MAX {
+                continue;
+            }
+            let (mut stack, mut area) = (vec![start], 0.0);
+            comp[start] = start;
+            while let Some(i) = stack.pop() {
+                area += mrtmap_geometry::polygon::signed_area(&cells[i].poly);
+                for k in cells[i].edge_line.iter().flatten() {
+                    if let Some(j) = self.neighbour(i, *k)
+                        && keep[j]
+                        && comp[j] == usize::MAX
+                    {
+                        comp[j] = start;
+                        stack.push(j);
+                    }
+                }
+            }
+            if best.is_none_or(|b| area > b.0) {
+                best = Some((area, start));
+            }
+        }
+        best.map(|(_, root)| Region {
+            of_cell: comp,
+            root,
+        })
+    }
+
+    /// The region's boundary: each of its cells' edges whose neighbour across is not in it.
+    fn boundary(&self, region: &Region) -> Vec<BoundaryEdge> {
+        let inside = |i: usize| region.of_cell[i] == region.root;
+        let mut edges = Vec::new();
+        for (i, c) in self.cells.iter().enumerate() {
+            if !inside(i) {
+                continue;
+            }
+            for e in 0..c.poly.len() {
+                let outside = match c.edge_line[e] {
+                    None => true,
+                    Some(k) => self.neighbour(i, k).is_none_or(|j| !inside(j)),
+                };
+                if outside {
+                    edges.push(BoundaryEdge {
+                        from: c.poly[e],
+                        to: c.poly[(e + 1) % c.poly.len()],
+                        line: c.edge_line[e],
+                    });
                 }
             }
         }
-        if best.is_none_or(|b| area > b.0) {
-            best = Some((area, start));
+        edges
+    }
+}
+
+/// The walls of a boundary loop: consecutive edges on one line merged; an edge on the search
+/// box's frame (no wall line) means the outline does not close.
+fn loop_walls(outer: &[usize], edges: &[BoundaryEdge]) -> Result<Vec<LoopWall>, OutlineError> {
+    let mut runs: Vec<BoundaryEdge> = Vec::new();
+    for &e in outer {
+        let edge = edges[e];
+        match runs.last_mut() {
+            Some(last) if last.line == edge.line => last.to = edge.to,
+            _ => runs.push(edge),
         }
     }
-    let Some((_, root)) = best else {
-        return Err(OutlineError::NothingSeen);
-    };
-    // Boundary edges: a kept cell's edge whose neighbour across is not kept.
-    let mut edges: Vec<(Point2<f64>, Point2<f64>, Option<usize>)> = Vec::new();
-    for (i, c) in cells.iter().enumerate() {
-        if comp[i] != root {
-            continue;
-        }
-        for e in 0..c.poly.len() {
-            let (a, b) = (c.poly[e], c.poly[(e + 1) % c.poly.len()]);
-            let outside = match c.edge_line[e] {
-                None => true,
-                Some(k) => neighbour(i, k).is_none_or(|j| comp[j] != root),
-            };
-            if outside {
-                edges.push((a, b, c.edge_line[e]));
-            }
-        }
+    if runs.len() > 1 && runs[0].line == runs[runs.len() - 1].line {
+        let last = runs.pop().expect("more than one");
+        runs[0].from = last.from;
     }
-    let loops = chain(&edges);
-    let outer = loops
-        .into_iter()
-        .max_by(|a, b| loop_area(a, &edges).total_cmp(&loop_area(b, &edges)))
-        .ok_or(OutlineError::NothingSeen)?;
-    // Merge consecutive edges on one line.
-    let mut walls: Vec<(Option<usize>, Point2<f64>, Point2<f64>)> = Vec::new();
-    for &e in &outer {
-        let (a, b, l) = edges[e];
-        match walls.last_mut() {
-            Some(last) if last.0 == l => last.2 = b,
-            _ => walls.push((l, a, b)),
-        }
-    }
-    if walls.len() > 1 && walls[0].0 == walls[walls.len() - 1].0 {
-        let last = walls.pop().expect("more than one");
-        walls[0].1 = last.1;
-    }
-    if let Some(open) = walls.iter().find(|w| w.0.is_none()) {
-        return Err(OutlineError::Open(open.1, open.2));
-    }
-    let mut walls: Vec<(usize, Point2<f64>, Point2<f64>)> = walls
-        .into_iter()
-        .map(|w| (w.0.expect("checked above"), w.1, w.2))
-        .collect();
-    drop_short_walls(&mut walls, &lines, p.min_length_m);
-    if walls.len() < 3 {
-        return Err(OutlineError::NothingSeen);
-    }
-    let normals = walls
-        .iter()
-        .map(|w| {
-            let d = (w.2 - w.1).normalize();
-            Vector2::new(-d.y, d.x)
+    runs.into_iter()
+        .map(|r| match r.line {
+            Some(line) => Ok(LoopWall {
+                line,
+                start: r.from,
+                end: r.to,
+            }),
+            None => Err(OutlineError::Open(r.from, r.to)),
         })
-        .collect();
-    Ok(Outline {
-        walls: walls.iter().map(|w| w.0).collect(),
-        corners: walls.iter().map(|w| w.1).collect(),
-        normals,
-        lines,
-    })
+        .collect()
 }
 
 /// A wall's line is placed anew from its wall's points at every height between its corners with
@@ -1004,13 +1101,8 @@ const WEAK_MEET_M: f64 = 0.5;
 /// Walls shorter than `min_m` (slivers where lines of noise cross near a corner) are removed:
 /// the walls on either side are extended to meet, or, when those are parallel (a step), the
 /// weaker of them goes too and the stronger meets the next. So are short walls of weak lines
-/// between two well-seen walls that meet near them (see [`WEAK_MAX_M`]). The loop's walls are
-/// (line, start, end).
-fn drop_short_walls(
-    walls: &mut Vec<(usize, Point2<f64>, Point2<f64>)>,
-    lines: &[WallLine],
-    min_m: f64,
-) {
+/// between two well-seen walls that meet near them (see [`WEAK_MAX_M`]).
+fn drop_short_walls(walls: &mut Vec<LoopWall>, lines: &[WallLine], min_m: f64) {
     let support = |k: usize| {
         if lines[k].inferred {
             0
@@ -1018,38 +1110,38 @@ fn drop_short_walls(
             lines[k].points.len()
         }
     };
-    let weak = |walls: &[(usize, Point2<f64>, Point2<f64>)], i: usize| {
+    let weak = |walls: &[LoopWall], i: usize| {
         let n = walls.len();
         let (w, prev, next) = (&walls[i], &walls[(i + n - 1) % n], &walls[(i + 1) % n]);
-        let (l, lp, ln) = (&lines[w.0], &lines[prev.0], &lines[next.0]);
-        let mid = w.1 + (w.2 - w.1) / 2.0;
+        let (l, lp, ln) = (&lines[w.line], &lines[prev.line], &lines[next.line]);
+        let mid = w.start + (w.end - w.start) / 2.0;
         !l.inferred
             && !lp.inferred
             && !ln.inferred
-            && (w.2 - w.1).norm() < WEAK_MAX_M
+            && (w.end - w.start).norm() < WEAK_MAX_M
             && l.density < WEAK_DENSITY_SHARE * lp.density.min(ln.density)
             && meet(lp, ln).is_some_and(|c| (c - mid).norm() < WEAK_MEET_M)
     };
     while walls.len() > 3 {
         let n = walls.len();
         let Some(i) = (0..n)
-            .filter(|&i| (walls[i].2 - walls[i].1).norm() < min_m || weak(walls, i))
+            .filter(|&i| (walls[i].end - walls[i].start).norm() < min_m || weak(walls, i))
             .min_by(|&a, &b| {
-                (walls[a].2 - walls[a].1)
+                (walls[a].end - walls[a].start)
                     .norm()
-                    .total_cmp(&(walls[b].2 - walls[b].1).norm())
+                    .total_cmp(&(walls[b].end - walls[b].start).norm())
             })
         else {
             break;
         };
         let (prev, next) = ((i + n - 1) % n, (i + 1) % n);
-        let (lp, ln) = (walls[prev].0, walls[next].0);
-        let mid = walls[i].1 + (walls[i].2 - walls[i].1) / 2.0;
+        let (lp, ln) = (walls[prev].line, walls[next].line);
+        let mid = walls[i].start + (walls[i].end - walls[i].start) / 2.0;
         if let Some(c) = meet(&lines[lp], &lines[ln])
             && (c - mid).norm() < 1.0
         {
-            walls[prev].2 = c;
-            walls[next].1 = c;
+            walls[prev].end = c;
+            walls[next].start = c;
             walls.remove(i);
             continue;
         }
@@ -1064,15 +1156,15 @@ fn drop_short_walls(
         } else {
             (next + 1) % n
         };
-        let Some(c) = meet(&lines[walls[strong].0], &lines[walls[beyond].0]) else {
+        let Some(c) = meet(&lines[walls[strong].line], &lines[walls[beyond].line]) else {
             break;
         };
         if weak == prev {
-            walls[beyond].2 = c;
-            walls[strong].1 = c;
+            walls[beyond].end = c;
+            walls[strong].start = c;
         } else {
-            walls[strong].2 = c;
-            walls[beyond].1 = c;
+            walls[strong].end = c;
+            walls[beyond].start = c;
         }
         let (a, b) = if i > weak { (i, weak) } else { (weak, i) };
         walls.remove(a);
@@ -1081,8 +1173,8 @@ fn drop_short_walls(
         let mut k = 0;
         while walls.len() > 3 && k < walls.len() {
             let j = (k + 1) % walls.len();
-            if walls[k].0 == walls[j].0 {
-                walls[k].2 = walls[j].2;
+            if walls[k].line == walls[j].line {
+                walls[k].end = walls[j].end;
                 walls.remove(j);
             } else {
                 k += 1;
@@ -1092,7 +1184,7 @@ fn drop_short_walls(
 }
 
 /// Chains directed edges into loops by matching each edge's end with another's start.
-fn chain(edges: &[(Point2<f64>, Point2<f64>, Option<usize>)]) -> Vec<Vec<usize>> {
+fn chain(edges: &[BoundaryEdge]) -> Vec<Vec<usize>> {
     let mut used = vec![false; edges.len()];
     let mut loops = Vec::new();
     for start in 0..edges.len() {
@@ -1103,16 +1195,16 @@ fn chain(edges: &[(Point2<f64>, Point2<f64>, Option<usize>)]) -> Vec<Vec<usize>>
         let mut lp = vec![start];
         let mut cur = start;
         loop {
-            let end = edges[cur].1;
+            let end = edges[cur].to;
             let next = (0..edges.len())
                 .filter(|&j| !used[j] || j == start)
                 .min_by(|&a, &b| {
-                    (edges[a].0 - end)
+                    (edges[a].from - end)
                         .norm()
-                        .total_cmp(&(edges[b].0 - end).norm())
+                        .total_cmp(&(edges[b].from - end).norm())
                 });
             match next {
-                Some(j) if (edges[j].0 - end).norm() < 1e-6 => {
+                Some(j) if (edges[j].from - end).norm() < 1e-6 => {
                     if j == start {
                         loops.push(lp);
                         break;
@@ -1128,8 +1220,8 @@ fn chain(edges: &[(Point2<f64>, Point2<f64>, Option<usize>)]) -> Vec<Vec<usize>>
     loops
 }
 
-fn loop_area(lp: &[usize], edges: &[(Point2<f64>, Point2<f64>, Option<usize>)]) -> f64 {
-    let pts: Vec<Point2<f64>> = lp.iter().map(|&e| edges[e].0).collect();
+fn loop_area(lp: &[usize], edges: &[BoundaryEdge]) -> f64 {
+    let pts: Vec<Point2<f64>> = lp.iter().map(|&e| edges[e].from).collect();
     mrtmap_geometry::polygon::signed_area(&pts)
 }
 
