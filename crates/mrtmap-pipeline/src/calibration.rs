@@ -6,11 +6,17 @@ use std::path::{Path, PathBuf};
 
 use mrtmap_calib::report::{draw_corners, overlay, png};
 use mrtmap_calib::rig::{rig_toml, updated_rig};
-use mrtmap_calib::{
-    Board, DetectOptions, Detection, DistortionModel, Gray, ImagePair, MonoResult, PairInput,
-    PairStatus, StereoOptions, StereoResult, ViewError, calibrate_mono, calibrate_stereo,
-    detect_variants, find_pairs, list_images,
+/// The calibration's inputs and results (mrtmap-calib's types).
+pub use mrtmap_calib::{
+    Board, DistortionModel, GridSize, MonoResult, PairStatus, StereoOptions, StereoResult,
+    plausibility, synth::SynthOptions,
 };
+use mrtmap_calib::{
+    DetectOptions, Detection, Gray, ImagePair, PairInput, ViewError, calibrate_mono,
+    calibrate_stereo, detect_variants, find_pairs, list_images,
+};
+/// A camera's intrinsics.
+pub use mrtmap_geometry::camera::PinholeCamera;
 use mrtmap_io::{FileError, PoseFile, Rig, write_atomic};
 use rayon::prelude::*;
 use serde_json::json;
@@ -425,7 +431,7 @@ pub fn write_stereo_report(
         "rgb_alone": r.rgb_alone,
         "thermal_alone": r.thermal_alone,
         "pairs": pairs,
-        "warnings": mrtmap_calib::plausibility(r),
+        "warnings": plausibility(r),
         "model_choice": r.model_choice,
     });
     write_json(&rep.join("calibration.json"), &doc)?;
@@ -448,7 +454,7 @@ pub fn board(cols: u32, rows: u32, square_m: f64) -> Result<Board> {
 
 /// Renders synthetic board pairs of the default synthetic rig into `out` (rgb/, thermal/ as
 /// 16-bit centikelvin, truth.json); returns how many were written.
-pub fn simulate_boards(out: &Path, o: &mrtmap_calib::synth::SynthOptions) -> Result<usize> {
+pub fn simulate_boards(out: &Path, o: &SynthOptions) -> Result<usize> {
     use mrtmap_calib::synth::{SynthRig, render_pairs};
     use mrtmap_geometry::camera::PinholeCamera;
     let rig = SynthRig::default();

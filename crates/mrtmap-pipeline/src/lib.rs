@@ -46,6 +46,7 @@ pub mod demo;
 mod error;
 pub mod level;
 pub mod maps;
+pub mod parse;
 pub mod points;
 pub mod progress;
 pub mod report;
@@ -55,6 +56,16 @@ pub mod settings;
 pub mod simulation;
 pub mod source;
 pub mod validation;
+
+/// The file formats a front end reads or writes itself (mrtmap-io's): a recording, thermal image
+/// files, atomic writes, and I/O errors in words.
+pub mod files {
+    pub use mrtmap_io::flir::FlirOverrides;
+    pub use mrtmap_io::{
+        FileError, InterpolationLimits, Recording, Rig, ThermalOptions, encode_png16, io_words,
+        read_thermal_file, write_atomic,
+    };
+}
 
 pub use cache::{Fingerprint, Stage, StageOutcome, run_or_reuse};
 pub use error::{Error, Result};

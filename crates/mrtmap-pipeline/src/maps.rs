@@ -6,8 +6,10 @@ use std::time::Instant;
 
 use mrtmap_geometry::nalgebra::{Point2, Point3};
 use mrtmap_io::write_atomic;
+/// A map's grid (mrtmap-radiation's).
+pub use mrtmap_radiation::GridSpec;
 use mrtmap_radiation::{
-    GridSpec, MapFrame, Method, MrtEngine, MrtError, MrtField, PointRecord, RadiantScene,
+    MapFrame, Method, MrtEngine, MrtError, MrtField, PointRecord, RadiantScene,
 };
 use mrtmap_report::{MapAxes, MapInput, MapMark, MapSummary, grid_csv, render_png, render_svg};
 use serde::{Deserialize, Serialize};

@@ -2,10 +2,12 @@
 //! its angle factors) and the six plane radiant temperatures with the radiant asymmetry. What
 //! `mrtmap mrt` prints, and what a binding returns, from one call.
 
-use mrtmap_physics::Posture;
-use mrtmap_radiation::{
-    AsymmetryVerdict, Facing, PersonMrt, PointRecord, RadiantAsymmetry, RadiantScene,
-};
+/// A person's posture and the asymmetry kinds (mrtmap-physics' types).
+pub use mrtmap_physics::{AsymmetryKind, Posture};
+/// Which way a person faces, an asymmetry's verdict, the enclosure tolerance and the built-in
+/// example scene (mrtmap-radiation's).
+pub use mrtmap_radiation::{AsymmetryVerdict, ENCLOSURE_TOLERANCE, EXAMPLE_OFFICE_JSON, Facing};
+use mrtmap_radiation::{PersonMrt, PointRecord, RadiantAsymmetry, RadiantScene};
 use serde::Serialize;
 
 use crate::error::Result;

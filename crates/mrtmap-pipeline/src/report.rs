@@ -4,6 +4,8 @@ use std::path::Path;
 
 use mrtmap_report::numbers::{fixed, signed, uncertainty};
 use mrtmap_report::{KeyValues, ReportData, ReportMap};
+/// Numbers for people, and the ± parts and unseen patches in words (mrtmap-report's).
+pub use mrtmap_report::{numbers, parts_line, unseen_line};
 use mrtmap_scan::FusionReport;
 use mrtmap_scan::segment::SegmentReport;
 use serde::Serialize;
@@ -173,7 +175,7 @@ fn coverage_rows(o: &RunOutcome) -> Vec<(String, String)> {
                 .first()
                 .and_then(|m| m.summary.map.field.as_ref())
                 .map_or("—".into(), |f| {
-                    mrtmap_report::parts_line(&f.max_std_error_parts, 3)
+                    parts_line(&f.max_std_error_parts, 3)
                 }),
         ),
         (
@@ -188,7 +190,7 @@ fn coverage_rows(o: &RunOutcome) -> Vec<(String, String)> {
                         f.unseen_patches
                             .iter()
                             .take(5)
-                            .map(mrtmap_report::unseen_line)
+                            .map(unseen_line)
                             .collect::<Vec<_>>()
                             .join("; ")
                     }

@@ -17,8 +17,10 @@ use mrtmap_io::{Recording, Trajectory, read_cloud_ply, write_atomic, write_cloud
 use mrtmap_radiation::{GridSpec, RadiantScene};
 use mrtmap_scan::FusedFrame;
 use mrtmap_scan::segment::{
-    MaskInput, SegmentParams, SegmentReport, TextureInput, refined_poses, segment_textured,
+    MaskInput, SegmentParams, TextureInput, refined_poses, segment_textured,
 };
+/// What segmentation reports, and the label votes (mrtmap-scan's).
+pub use mrtmap_scan::segment::{SegmentReport, Votes};
 use mrtmap_scan::{FuseParams, FusionReport, fuse};
 use mrtmap_track::{TrackParams, TrackReport, track};
 

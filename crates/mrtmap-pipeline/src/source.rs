@@ -6,9 +6,14 @@
 use std::path::{Path, PathBuf};
 
 use mrtmap_io::{FileError, Recording, Rig, StreamEntry};
-use mrtmap_sources::ros::{self, Container, Plan, RosWriteOptions, Survey};
-use mrtmap_sources::rtabmap::{self, DbSummary, Schema};
-use mrtmap_sources::{SourceKind, resolve_source};
+/// What a source holds and how it is written (mrtmap-sources' types).
+pub use mrtmap_sources::SourceKind;
+use mrtmap_sources::resolve_source;
+pub use mrtmap_sources::ros::bag::Compression;
+use mrtmap_sources::ros::{self, RosWriteOptions, Survey};
+pub use mrtmap_sources::ros::{Container, Plan, PoseSource};
+use mrtmap_sources::rtabmap;
+pub use mrtmap_sources::rtabmap::{DbSummary, Schema};
 use serde::Serialize;
 
 use crate::cache::{Fingerprint, Stage, run_or_reuse};
@@ -213,7 +218,7 @@ pub fn convert(source: &Path, out: &Path, o: &SourceOptions) -> Result<Conversio
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ContainerOut {
     /// A RealSense-style ROS 1 bag, MCAP file or ROS 2 `.db3`.
-    Ros(Container, ros::bag::Compression),
+    Ros(Container, Compression),
     /// An RTAB-Map-layout database.
     RtabMap(Schema),
 }

@@ -3,8 +3,15 @@
 use std::path::{Path, PathBuf};
 
 use mrtmap_geometry::nalgebra::Point3;
+/// Globe ↔ MRT conversions (mrtmap-physics').
+pub use mrtmap_physics::{
+    Convection, Globe, GlobeFormula, GlobeMethod, GlobeReading, Temperature, globe_temperature,
+    mrt_from_globe,
+};
 use mrtmap_radiation::{Method, MonteCarlo, MrtEngine, RadiantScene};
 use mrtmap_report::{GlobeRow, ValidationRow, parse_globe_csv, validate, validation_csv};
+/// The ISO 7726 accuracy bounds a validation judges by (mrtmap-report's).
+pub use mrtmap_report::{ISO_DESIRED_K, ISO_REQUIRED_K};
 
 use crate::cache::write_json;
 use crate::error::{Error, Result};

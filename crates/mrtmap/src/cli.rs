@@ -3,9 +3,11 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use mrtmap_pipeline::parse::{parse_facing, parse_grid, parse_image_size, parse_mark, parse_point};
 use mrtmap_pipeline::settings::{PointFrame, Quantity};
+use mrtmap_pipeline::simulation::CameraErrorArgs;
+use mrtmap_pipeline::simulation::NoiseLevel;
 use mrtmap_pipeline::{DirectionChoice, MethodChoice, MrtSection};
-use mrtmap_sim::NoiseLevel;
 
 /// Map the mean radiant temperature (MRT) of a room.
 ///
@@ -168,8 +170,8 @@ pub struct ConvertArgs {
     pub compression: CompressionArg,
     /// Schema when writing an RTAB-Map-layout database (.db): current (0.23, RVL depth,
     /// optimised poses) or legacy (0.20, PNG depth, odometry only).
-    #[arg(long, value_enum, default_value_t = mrtmap_sources::rtabmap::Schema::Current)]
-    pub schema: mrtmap_sources::rtabmap::Schema,
+    #[arg(long, value_enum, default_value_t = mrtmap_pipeline::source::Schema::Current)]
+    pub schema: mrtmap_pipeline::source::Schema,
     /// Reading options.
     #[command(flatten)]
     pub src: SourceArgs,
@@ -249,7 +251,7 @@ pub struct CalibrateArgs {
     pub images: Option<PathBuf>,
     /// Inner corners per row and column, COLSxROWS (a board of 9×7 squares has 8x6).
     #[arg(long, value_name = "COLSxROWS")]
-    pub board: mrtmap_calib::GridSize,
+    pub board: mrtmap_pipeline::calibration::GridSize,
     /// Side of one square (m).
     #[arg(long, value_name = "M")]
     pub square_m: f64,
@@ -263,10 +265,10 @@ pub struct CalibrateArgs {
     pub report: Option<PathBuf>,
     /// Distortion model of the colour camera (or of the --images camera).
     #[arg(long, value_enum, default_value = "auto")]
-    pub distortion: mrtmap_calib::DistortionModel,
+    pub distortion: mrtmap_pipeline::calibration::DistortionModel,
     /// Distortion model of the thermal camera.
     #[arg(long, value_enum, default_value = "auto")]
-    pub thermal_distortion: mrtmap_calib::DistortionModel,
+    pub thermal_distortion: mrtmap_pipeline::calibration::DistortionModel,
     /// Largest time difference (s) when pairing images by timestamp.
     #[arg(long, default_value_t = 0.05, value_name = "S")]
     pub max_dt: f64,
@@ -426,93 +428,6 @@ pub struct DemoArgs {
     /// Rerun every stage.
     #[arg(long)]
     pub force: bool,
-}
-
-/// A simulated camera's radiometric errors.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum CameraErrorsArg {
-    /// Realistic with --noise realistic, none with --noise none.
-    Auto,
-    /// A perfect camera (the NETD and blur of --noise remain).
-    None,
-    /// A Lepton 3.5-like unit: offset 1.5 K, gain 2 %, FFC every 30–120 s (σ 0.3 K new offsets,
-    /// σ 0.3 K/min drift between them), vignetting −0.6 K at the corners, fixed pattern σ 0.08 K.
-    Realistic,
-}
-
-/// The thermal camera's radiometric errors in a simulation; each term can be set on its own.
-#[derive(Debug, Args, Clone)]
-pub struct CameraErrorArgs {
-    /// The camera's radiometric errors (the truth goes to radiometric_truth.json).
-    #[arg(long, value_enum, default_value_t = CameraErrorsArg::Auto)]
-    pub camera_errors: CameraErrorsArg,
-    /// This unit's constant offset (K).
-    #[arg(long, allow_negative_numbers = true)]
-    pub unit_offset_k: Option<f64>,
-    /// Relative gain error about 20 °C (0.02: contrasts 2 % too large).
-    #[arg(long, allow_negative_numbers = true)]
-    pub gain: Option<f64>,
-    /// Time between flat-field corrections, MIN,MAX seconds (0,0: none).
-    #[arg(long, value_name = "MIN,MAX", value_parser = parse_interval)]
-    pub ffc_interval_s: Option<[f64; 2]>,
-    /// σ of the offset each flat-field correction sets (K).
-    #[arg(long)]
-    pub ffc_offset_k: Option<f64>,
-    /// σ of the offset's drift between flat-field corrections (K per minute).
-    #[arg(long)]
-    pub drift_k_per_min: Option<f64>,
-    /// Vignetting: what the image corners read more than the centre (K).
-    #[arg(long, allow_negative_numbers = true)]
-    pub vignetting_k: Option<f64>,
-    /// σ of the per-pixel fixed pattern (K).
-    #[arg(long)]
-    pub fixed_pattern_k: Option<f64>,
-    /// Contact-thermometer readings of surface points to write to references.csv (default: 2 with
-    /// camera errors, 0 without).
-    #[arg(long)]
-    pub references: Option<usize>,
-}
-
-impl CameraErrorArgs {
-    /// The model these flags describe, with sensor noise `noise`.
-    pub fn model(&self, noise: NoiseLevel) -> mrtmap_sim::RadiometricModel {
-        use mrtmap_sim::RadiometricModel as M;
-        let mut m = match (self.camera_errors, noise) {
-            (CameraErrorsArg::None, _) | (CameraErrorsArg::Auto, NoiseLevel::None) => M::NONE,
-            (CameraErrorsArg::Realistic, _) | (CameraErrorsArg::Auto, NoiseLevel::Realistic) => {
-                M::REALISTIC
-            }
-        };
-        let set = |x: &mut f64, v: Option<f64>| {
-            if let Some(v) = v {
-                *x = v;
-            }
-        };
-        set(&mut m.unit_offset_k, self.unit_offset_k);
-        set(&mut m.gain, self.gain);
-        set(&mut m.ffc_offset_sigma_k, self.ffc_offset_k);
-        set(&mut m.drift_sigma_k_per_min, self.drift_k_per_min);
-        set(&mut m.vignetting_k, self.vignetting_k);
-        set(&mut m.fixed_pattern_sigma_k, self.fixed_pattern_k);
-        if let Some(i) = self.ffc_interval_s {
-            m.ffc_interval_s = i;
-        }
-        m
-    }
-
-    /// How many reference readings to write.
-    pub fn references(&self, noise: NoiseLevel) -> usize {
-        self.references
-            .unwrap_or(if self.model(noise).is_perfect() { 0 } else { 2 })
-    }
-}
-
-fn parse_interval(s: &str) -> Result<[f64; 2], String> {
-    let v = numbers(s, &[2], "MIN,MAX (two numbers in seconds)")?;
-    if !(v[0] >= 0.0 && v[1] >= v[0]) {
-        return Err(format!("expected 0 <= MIN <= MAX, got '{s}'"));
-    }
-    Ok([v[0], v[1]])
 }
 
 /// `mrtmap validate`.
@@ -860,7 +775,7 @@ pub struct MrtArgs {
     /// floor seated, 1.0 m standing); angle factors from the projected-area factors of a seated or
     /// standing body.
     #[arg(long, value_enum)]
-    pub person: Option<mrtmap_physics::Posture>,
+    pub person: Option<mrtmap_pipeline::points::Posture>,
     /// Which way the person faces, degrees from +x towards +y (0 = +x, 90 = +y); without it,
     /// any way (fp averaged over azimuth).
     #[arg(long, allow_negative_numbers = true, requires = "person", value_parser = parse_facing)]
@@ -941,8 +856,8 @@ pub struct GlobeArgs {
     #[arg(long, value_enum, default_value_t = GlobeMethodArg::Iso)]
     pub method: GlobeMethodArg,
     /// Convection regime for the ISO formulas.
-    #[arg(long, value_enum, default_value_t = mrtmap_physics::Convection::Larger)]
-    pub convection: mrtmap_physics::Convection,
+    #[arg(long, value_enum, default_value_t = mrtmap_pipeline::validation::Convection::Larger)]
+    pub convection: mrtmap_pipeline::validation::Convection,
     /// Print JSON.
     #[arg(long)]
     pub json: bool,
@@ -954,99 +869,4 @@ pub struct ExampleSceneArgs {
     /// Write to this file instead of standard output.
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
-}
-
-fn numbers(s: &str, n: &[usize], what: &str) -> Result<Vec<f64>, String> {
-    let v: Result<Vec<f64>, _> = s.split(',').map(|x| x.trim().parse::<f64>()).collect();
-    match v {
-        Ok(v) if n.contains(&v.len()) && v.iter().all(|x| x.is_finite()) => Ok(v),
-        _ => Err(format!("expected {what}, got '{s}'")),
-    }
-}
-
-fn parse_point(s: &str) -> Result<[f64; 3], String> {
-    let v = numbers(s, &[3], "X,Y,Z (three numbers in metres)")?;
-    Ok([v[0], v[1], v[2]])
-}
-
-/// A heading in degrees, any finite number, as 0…360° (400 is 40°).
-pub(crate) fn parse_facing(s: &str) -> Result<f64, String> {
-    match s.trim().parse::<f64>() {
-        Ok(d) if d.is_finite() => Ok(d.rem_euclid(360.0)),
-        _ => Err(format!(
-            "expected a heading in degrees from +x towards +y (0 = +x, 90 = +y), got '{s}'"
-        )),
-    }
-}
-
-/// "AxB" (also "A×B") as two numbers; `bad` says what was expected.
-fn parse_pair(s: &str, bad: &dyn Fn() -> String) -> Result<(usize, usize), String> {
-    let (a, b) = s.split_once(['x', 'X', '×']).ok_or_else(bad)?;
-    Ok((
-        a.trim().parse::<usize>().map_err(|_| bad())?,
-        b.trim().parse::<usize>().map_err(|_| bad())?,
-    ))
-}
-
-/// An image size WIDTHxHEIGHT, 1…16384 pixels a side.
-pub(crate) fn parse_image_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = parse_pair(s, &|| {
-        format!("expected WIDTHxHEIGHT such as 160x120, got '{s}'")
-    })?;
-    if w == 0 || h == 0 || w > 16384 || h > 16384 {
-        return Err(format!(
-            "an image of {w}×{h} pixels is outside 1…16384 a side"
-        ));
-    }
-    Ok((w as u32, h as u32))
-}
-
-pub(crate) fn parse_grid(s: &str) -> Result<(usize, usize), String> {
-    let (a, b) = parse_pair(s, &|| {
-        format!("expected COLSxROWS such as 20x20, got '{s}'")
-    })?;
-    if a == 0 || b == 0 || a * b > 1_000_000 {
-        return Err(format!(
-            "a grid of {a}×{b} nodes is not allowed (1 to 1,000,000 nodes)"
-        ));
-    }
-    Ok((a, b))
-}
-
-fn parse_mark(s: &str) -> Result<(String, Vec<f64>), String> {
-    let (name, rest) = s
-        .split_once('=')
-        .ok_or_else(|| format!("expected NAME=U,V or NAME=X,Y,Z, got '{s}'"))?;
-    if name.trim().is_empty() {
-        return Err(format!("the mark '{s}' has no name"));
-    }
-    Ok((
-        name.trim().to_string(),
-        numbers(rest, &[2, 3], "U,V or X,Y,Z after the name")?,
-    ))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn parsers_accept_and_refuse() {
-        assert_eq!(parse_grid("20x20"), Ok((20, 20)));
-        assert_eq!(parse_grid("3×4"), Ok((3, 4)));
-        assert!(parse_grid("0x5").is_err());
-        assert!(parse_grid("20").is_err());
-        assert_eq!(parse_point("1, 2,3.5"), Ok([1.0, 2.0, 3.5]));
-        assert!(parse_point("1,2").is_err());
-        assert!(parse_point("1,2,nan").is_err());
-        assert_eq!(parse_mark("A=1,2"), Ok(("A".into(), vec![1.0, 2.0])));
-        assert!(parse_mark("=1,2").is_err());
-        assert!(parse_mark("A=1").is_err());
-        // Issue 41: NaN blamed missing walls; 400 was echoed as 400°.
-        assert_eq!(parse_facing("400"), Ok(40.0));
-        assert_eq!(parse_facing("-90"), Ok(270.0));
-        let nan = parse_facing("NaN").unwrap_err();
-        assert!(nan.contains("degrees") && nan.contains("NaN"), "{nan}");
-        assert!(parse_facing("inf").is_err());
-    }
 }

@@ -5,7 +5,7 @@ use std::io::Write;
 
 use mrtmap_pipeline::StageOutcome;
 use mrtmap_pipeline::maps::Summary;
-use mrtmap_report::numbers::{fixed, uncertainty, xyz};
+use mrtmap_pipeline::report::numbers::{fixed, uncertainty, xyz};
 
 /// Like `println!`, but a closed pipe (`mrtmap rooms | head -1`) ends the program quietly.
 macro_rules! outln {
@@ -34,7 +34,7 @@ pub fn write_stdout(args: std::fmt::Arguments<'_>) {
         }
         eprintln!(
             "error: cannot write to standard output: {}",
-            mrtmap_io::io_words(&e)
+            mrtmap_pipeline::files::io_words(&e)
         );
         std::process::exit(1);
     }
@@ -121,10 +121,10 @@ pub fn print_map(s: &Summary) {
             }
             outln!(
                 "  its parts, the largest of each: {}",
-                mrtmap_report::parts_line(&f.max_std_error_parts, 3)
+                mrtmap_pipeline::report::parts_line(&f.max_std_error_parts, 3)
             );
             for u in f.unseen_patches.iter().take(3) {
-                outln!("  not seen: {}", mrtmap_report::unseen_line(u));
+                outln!("  not seen: {}", mrtmap_pipeline::report::unseen_line(u));
             }
         }
         None => outln!("no grid node could be computed"),
@@ -227,8 +227,8 @@ pub fn print_conversion(c: &mrtmap_pipeline::source::Conversion) {
 }
 
 /// Prints the streams a bag's scan would use, and what it lacks.
-pub fn print_plan(p: &mrtmap_sources::ros::Plan) {
-    use mrtmap_sources::ros::PoseSource;
+pub fn print_plan(p: &mrtmap_pipeline::source::Plan) {
+    use mrtmap_pipeline::source::PoseSource;
     let show = |o: &Option<String>| o.clone().unwrap_or_else(|| "—".into());
     outln!("for a scan:");
     outln!("  depth    {}", show(&p.depth));

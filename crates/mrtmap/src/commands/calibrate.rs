@@ -4,8 +4,8 @@
 use std::path::Path;
 
 use anyhow::bail;
-use mrtmap_calib::{Board, MonoResult, PairStatus, StereoOptions, StereoResult};
-use mrtmap_geometry::camera::PinholeCamera;
+use mrtmap_pipeline::calibration::PinholeCamera;
+use mrtmap_pipeline::calibration::{Board, MonoResult, PairStatus, StereoOptions, StereoResult};
 use mrtmap_pipeline::calibration::{
     ImageDetections, Seen, board, calibrate_images, calibrate_pairs, detect_images, detect_pairs,
     error_cell, found, status_text, write_mono_report, write_rig, write_stereo_report,
@@ -216,7 +216,7 @@ fn print_stereo<'a>(r: &StereoResult, names: impl Iterator<Item = &'a str>) {
     );
     print_extrinsic(r);
     outln!("model: {}", r.model_choice);
-    for w in mrtmap_calib::plausibility(r) {
+    for w in mrtmap_pipeline::calibration::plausibility(r) {
         outln!("warning: {w}");
     }
     let used = r

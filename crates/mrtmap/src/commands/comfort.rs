@@ -66,7 +66,8 @@ pub fn run(a: &ComfortArgs) -> anyhow::Result<()> {
 
 /// One line per row of a CSV with the columns ta,tr,v,rh,met,clo.
 fn batch(path: &std::path::Path) -> anyhow::Result<()> {
-    let text = std::fs::read_to_string(path).map_err(|e| mrtmap_io::FileError::io(path, e))?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| mrtmap_pipeline::files::FileError::io(path, e))?;
     let mut lines = text
         .lines()
         .enumerate()

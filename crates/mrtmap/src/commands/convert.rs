@@ -2,9 +2,9 @@
 //! recording folder → one of those.
 
 use mrtmap_pipeline::Error;
+use mrtmap_pipeline::source::Compression;
+use mrtmap_pipeline::source::Container;
 use mrtmap_pipeline::source::{ContainerOut, convert, write_container};
-use mrtmap_sources::ros::Container;
-use mrtmap_sources::ros::bag::Compression;
 
 use crate::cli::{CompressionArg, ConvertArgs};
 use crate::output::{print_conversion, print_plan};

@@ -65,7 +65,7 @@ pub fn run(a: &DemoArgs) -> anyhow::Result<()> {
             r.truth_c,
             r.globe_c,
             r.ours_c,
-            mrtmap_report::numbers::signed(r.diff_k, 2)
+            mrtmap_pipeline::report::numbers::signed(r.diff_k, 2)
         );
     }
     outln!(

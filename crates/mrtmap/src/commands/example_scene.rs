@@ -1,9 +1,9 @@
 //! `mrtmap example-scene`: the built-in example as scene.json.
 
-use mrtmap_radiation::EXAMPLE_OFFICE_JSON;
+use mrtmap_pipeline::points::EXAMPLE_OFFICE_JSON;
 
 use crate::cli::ExampleSceneArgs;
-use mrtmap_io::write_atomic;
+use mrtmap_pipeline::files::write_atomic;
 
 pub fn run(args: &ExampleSceneArgs) -> anyhow::Result<()> {
     match &args.out {

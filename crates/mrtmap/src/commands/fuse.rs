@@ -1,6 +1,6 @@
 //! `mrtmap fuse`: recording → thermal point cloud.
 
-use mrtmap_io::Recording;
+use mrtmap_pipeline::files::Recording;
 use mrtmap_pipeline::run::fuse_into;
 use mrtmap_pipeline::settings::FuseSection;
 use mrtmap_pipeline::source::prepare;

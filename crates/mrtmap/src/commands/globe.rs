@@ -1,6 +1,6 @@
 //! `mrtmap globe`: globe temperature ↔ MRT.
 
-use mrtmap_physics::{
+use mrtmap_pipeline::validation::{
     Globe, GlobeMethod, GlobeReading, Temperature, globe_temperature, mrt_from_globe,
 };
 use serde::Serialize;
@@ -16,7 +16,7 @@ struct GlobeOut {
     air_speed_m_s: f64,
     diameter_m: f64,
     emissivity: f64,
-    formula: mrtmap_physics::GlobeFormula,
+    formula: mrtmap_pipeline::validation::GlobeFormula,
     formula_description: &'static str,
     h_w_m2k: f64,
     /// "mrt_from_globe" or "globe_from_mrt".

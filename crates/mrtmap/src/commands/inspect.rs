@@ -1,8 +1,8 @@
 //! `mrtmap inspect`: what a scan source holds and what a scan still lacks.
 
+use mrtmap_pipeline::source::DbSummary;
+use mrtmap_pipeline::source::SourceKind;
 use mrtmap_pipeline::source::{FolderSummary, Inspection, RosSummary, inspect};
-use mrtmap_sources::SourceKind;
-use mrtmap_sources::rtabmap::DbSummary;
 use serde_json::json;
 
 use crate::cli::InspectArgs;
@@ -46,9 +46,9 @@ fn inspection_json(a: &InspectArgs, what: &Inspection) -> serde_json::Value {
         Inspection::Ros(r) => json!({
             "source": source,
             "kind": match r.container {
-                mrtmap_sources::ros::Container::Bag => SourceKind::Bag,
-                mrtmap_sources::ros::Container::Mcap => SourceKind::Mcap,
-                mrtmap_sources::ros::Container::Db3 => SourceKind::Db3,
+                mrtmap_pipeline::source::Container::Bag => SourceKind::Bag,
+                mrtmap_pipeline::source::Container::Mcap => SourceKind::Mcap,
+                mrtmap_pipeline::source::Container::Db3 => SourceKind::Db3,
             },
             "topics": r.survey.topics.values().collect::<Vec<_>>(),
             "static_transforms": r.survey.static_tf.iter().map(|t| format!("{} → {}", t.parent, t.child)).collect::<Vec<_>>(),

@@ -3,10 +3,10 @@
 
 use mrtmap_pipeline::Project;
 use mrtmap_pipeline::comfort::value_of;
+use mrtmap_pipeline::maps::GridSpec;
 use mrtmap_pipeline::maps::{Mark, MarkAt, load_scene, map_scene};
+use mrtmap_pipeline::report::numbers::{fixed, uncertainty};
 use mrtmap_pipeline::settings::Quantity;
-use mrtmap_radiation::GridSpec;
-use mrtmap_report::numbers::{fixed, uncertainty};
 
 use crate::cli::MapArgs;
 use crate::output::print_map;

@@ -1,8 +1,8 @@
 //! `mrtmap mrt`: MRT at points with view-factor tables.
 
-use mrtmap_physics::AsymmetryKind;
-use mrtmap_radiation::{AsymmetryVerdict, ENCLOSURE_TOLERANCE, Facing};
-use mrtmap_report::numbers::{fixed, uncertainty};
+use mrtmap_pipeline::points::AsymmetryKind;
+use mrtmap_pipeline::points::{AsymmetryVerdict, ENCLOSURE_TOLERANCE, Facing};
+use mrtmap_pipeline::report::numbers::{fixed, uncertainty};
 
 use mrtmap_pipeline::maps::load_scene;
 use mrtmap_pipeline::points::{PersonAnswer, PlaneAnswer, PointAnswers, PointQuery, mrt_at_points};
@@ -67,7 +67,10 @@ pub fn run(a: &MrtArgs) -> anyhow::Result<()> {
             uncertainty(p.std_error_k, 2),
             p.view_factor_sum
         );
-        outln!("  ± in parts: {}", mrtmap_report::parts_line(&p.parts(), 2));
+        outln!(
+            "  ± in parts: {}",
+            mrtmap_pipeline::report::parts_line(&p.parts(), 2)
+        );
         if (p.view_factor_sum - 1.0).abs() > ENCLOSURE_TOLERANCE {
             outln!(
                 "  warning: the scene covers only {:.1} % of the view here (asked for with --allow-open): the MRT leaves the rest out",

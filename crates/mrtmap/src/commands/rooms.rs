@@ -1,7 +1,7 @@
 //! `mrtmap rooms`: the preset rooms, or one as TOML.
 
 use anyhow::bail;
-use mrtmap_sim::{PRESETS, Room};
+use mrtmap_pipeline::simulation::{PRESETS, Room};
 
 use crate::cli::RoomsArgs;
 

@@ -1,11 +1,11 @@
 //! `mrtmap segment`: thermal cloud → radiant scene.
 
 use anyhow::bail;
-use mrtmap_io::Recording;
+use mrtmap_pipeline::files::Recording;
 use mrtmap_pipeline::level::{DEFAULT_CAMERA_ACCURACY_K, read_references};
 use mrtmap_pipeline::run::{LevelInputs, SegmentInputs, segment_into};
+use mrtmap_pipeline::run::{SegmentReport, Votes};
 use mrtmap_pipeline::settings::{RoomSection, SegmentSection};
-use mrtmap_scan::segment::{SegmentReport, Votes};
 
 use crate::cli::SegmentArgs;
 
@@ -94,7 +94,7 @@ fn print_report(r: &SegmentReport) {
             s.temperature_c
                 .map_or("not observed".to_string(), |t| format!(
                     "{t:6.2} °C ± {} K",
-                    mrtmap_report::numbers::uncertainty(s.temperature_std_k, 2)
+                    mrtmap_pipeline::report::numbers::uncertainty(s.temperature_std_k, 2)
                 )),
             s.observed_fraction * 100.0
         );

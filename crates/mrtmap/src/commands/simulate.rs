@@ -3,8 +3,8 @@
 use std::time::Instant;
 
 use mrtmap_pipeline::Progress;
+use mrtmap_pipeline::simulation::{Drift, SimConfig, ThermalNoise, simulate};
 use mrtmap_pipeline::simulation::{load_room, set_depth_size};
-use mrtmap_sim::{Drift, SimConfig, ThermalNoise, simulate};
 
 use crate::cli::{DriftArg, SimulateArgs};
 use crate::output::Bar;

@@ -1,6 +1,6 @@
 //! `mrtmap simulate-board`: synthetic checkerboard pairs with exact truth.
 
-use mrtmap_calib::synth::SynthOptions;
+use mrtmap_pipeline::calibration::SynthOptions;
 use mrtmap_pipeline::calibration::simulate_boards;
 
 use crate::cli::SimulateBoardArgs;

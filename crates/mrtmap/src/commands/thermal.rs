@@ -1,12 +1,12 @@
 //! `mrtmap thermal`: one thermal image → metadata, statistics, CSV / PNG.
 
 use anyhow::bail;
-use mrtmap_io::flir::FlirOverrides;
-use mrtmap_io::{FileError, ThermalOptions, encode_png16};
+use mrtmap_pipeline::files::FlirOverrides;
+use mrtmap_pipeline::files::{FileError, ThermalOptions, encode_png16};
 use serde::Serialize;
 
 use crate::cli::ThermalArgs;
-use mrtmap_io::write_atomic;
+use mrtmap_pipeline::files::write_atomic;
 
 use crate::output::json;
 
@@ -63,7 +63,7 @@ struct Out<'a> {
 
 pub fn run(a: &ThermalArgs) -> anyhow::Result<()> {
     let opts = options(a)?;
-    let img = mrtmap_io::read_thermal_file(&a.file, &opts)?;
+    let img = mrtmap_pipeline::files::read_thermal_file(&a.file, &opts)?;
     let Some((lo, hi, mean, median)) = img.stats() else {
         bail!(
             "{}: no pixel has a temperature (raw values outside the calibration)",

@@ -1,6 +1,6 @@
 //! `mrtmap track`: poses for a recording without a pose source.
 
-use mrtmap_io::Recording;
+use mrtmap_pipeline::files::Recording;
 use mrtmap_pipeline::run::track_into;
 use mrtmap_pipeline::settings::TrackSection;
 

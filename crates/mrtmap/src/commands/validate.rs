@@ -1,8 +1,8 @@
 //! `mrtmap validate`: a map against black-globe readings.
 
+use mrtmap_pipeline::report::numbers::{signed, uncertainty};
 use mrtmap_pipeline::validation::validate_map;
-use mrtmap_report::numbers::{signed, uncertainty};
-use mrtmap_report::{ISO_DESIRED_K, ISO_REQUIRED_K};
+use mrtmap_pipeline::validation::{ISO_DESIRED_K, ISO_REQUIRED_K};
 
 use crate::cli::ValidateArgs;
 

@@ -148,7 +148,7 @@ fn mrt_exact_and_montecarlo_agree_on_the_example() {
 }
 
 fn scene_with_desk(dir: &Path) -> String {
-    let mut v: Value = serde_json::from_str(mrtmap_radiation::EXAMPLE_OFFICE_JSON).unwrap();
+    let mut v: Value = serde_json::from_str(mrtmap_pipeline::points::EXAMPLE_OFFICE_JSON).unwrap();
     v["occluders"] = serde_json::json!([
         { "id": "desk-1", "label": "desk", "temperature_c": 21.0, "box": { "min": [1.0, 1.0, 0.0], "max": [2.2, 1.8, 0.75] } }
     ]);
@@ -205,7 +205,7 @@ fn occluders_need_montecarlo_and_auto_picks_it() {
 fn bad_scene_files_get_one_clear_sentence() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("bad.json");
-    let mut v: Value = serde_json::from_str(mrtmap_radiation::EXAMPLE_OFFICE_JSON).unwrap();
+    let mut v: Value = serde_json::from_str(mrtmap_pipeline::points::EXAMPLE_OFFICE_JSON).unwrap();
     v["surfaces"][2]["temperature_c"] = serde_json::json!(400.0);
     std::fs::write(&p, serde_json::to_string(&v).unwrap()).unwrap();
     let path = p.display().to_string();
@@ -338,7 +338,7 @@ fn example_scene_round_trips_through_map() {
 
 /// The example office as JSON, changed by `edit`, written to `dir/name`.
 fn edited_example(dir: &Path, name: &str, edit: impl FnOnce(&mut Value)) -> String {
-    let mut v: Value = serde_json::from_str(mrtmap_radiation::EXAMPLE_OFFICE_JSON).unwrap();
+    let mut v: Value = serde_json::from_str(mrtmap_pipeline::points::EXAMPLE_OFFICE_JSON).unwrap();
     edit(&mut v);
     let p = dir.join(name);
     std::fs::write(&p, serde_json::to_string_pretty(&v).unwrap()).unwrap();
@@ -803,7 +803,7 @@ fn validate_can_take_the_level_from_named_globe_readings() {
 fn first_contact_inputs_are_refused_or_answered_plainly() {
     let dir = tempfile::tempdir().unwrap();
     // A point inside a desk written as a mesh (as segmentation writes furniture) was answered.
-    let mut v: Value = serde_json::from_str(mrtmap_radiation::EXAMPLE_OFFICE_JSON).unwrap();
+    let mut v: Value = serde_json::from_str(mrtmap_pipeline::points::EXAMPLE_OFFICE_JSON).unwrap();
     let c = |x: f64, y: f64, z: f64| serde_json::json!([x, y, z]);
     let (lo, hi) = ([1.0, 1.0, 0.0], [2.2, 1.8, 0.75]);
     let vertices: Vec<Value> = (0..8)
