@@ -112,6 +112,42 @@ pub enum Inspection {
     },
 }
 
+impl Inspection {
+    /// What `mrtmap inspect --json` prints: the source, its kind, what it holds and whether it
+    /// is ready to be a scan.
+    pub fn to_json(&self, source: &Path) -> serde_json::Value {
+        let source = source.display().to_string();
+        match self {
+            Inspection::Folder(f) => serde_json::json!({
+                "source": source,
+                "kind": SourceKind::Folder,
+                "streams": f.streams,
+                "warnings": f.warnings,
+                "ready": f.warnings.is_empty(),
+            }),
+            Inspection::Ros(r) => serde_json::json!({
+                "source": source,
+                "kind": match r.container {
+                    Container::Bag => SourceKind::Bag,
+                    Container::Mcap => SourceKind::Mcap,
+                    Container::Db3 => SourceKind::Db3,
+                },
+                "topics": r.survey.topics.values().collect::<Vec<_>>(),
+                "static_transforms": r.survey.static_tf.iter().map(|t| format!("{} → {}", t.parent, t.child)).collect::<Vec<_>>(),
+                "plan": r.plan,
+                "ready": r.plan.missing.is_empty() && r.plan.rig.is_some(),
+            }),
+            Inspection::RtabMap { summary, missing } => serde_json::json!({
+                "source": source,
+                "kind": SourceKind::RtabMap,
+                "database": summary,
+                "missing": missing,
+                "ready": missing.is_empty(),
+            }),
+        }
+    }
+}
+
 /// Bytes in a source file, or in a split bag's storage files.
 fn source_bytes(file: &Path, c: Container) -> Result<u64> {
     let files = if file.is_dir() {

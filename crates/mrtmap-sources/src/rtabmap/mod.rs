@@ -420,19 +420,26 @@ pub fn summarize(path: &Path) -> Result<DbSummary, FileError> {
     })
 }
 
+/// A database blob that cannot be decoded, and why.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct BlobError(pub String);
+
 /// Decodes a depth blob: RVL (`DEPTHRVL`), 16-bit PNG, or a 4×u8 PNG holding f32 metres.
-pub fn depth_blob(b: &[u8]) -> Result<Image16, String> {
+pub fn depth_blob(b: &[u8]) -> Result<Image16, BlobError> {
     if let Some(rest) = b.strip_prefix(MAGIC_RVL) {
         if rest.len() < 8 {
-            return Err("RVL depth blob shorter than its size header".into());
+            return Err(BlobError(
+                "RVL depth blob shorter than its size header".into(),
+            ));
         }
         let w = u32::from_le_bytes([rest[0], rest[1], rest[2], rest[3]]);
         let h = u32::from_le_bytes([rest[4], rest[5], rest[6], rest[7]]);
         if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
-            return Err(format!("RVL depth blob says {w}×{h} pixels"));
+            return Err(BlobError(format!("RVL depth blob says {w}×{h} pixels")));
         }
-        let px =
-            rvl::decode(&rest[8..], (w * h) as usize, 16).map_err(|e| format!("RVL depth: {e}"))?;
+        let px = rvl::decode(&rest[8..], (w * h) as usize, 16)
+            .map_err(|e| BlobError(format!("RVL depth: {e}")))?;
         return Ok(Image16 {
             width: w,
             height: h,
@@ -440,7 +447,7 @@ pub fn depth_blob(b: &[u8]) -> Result<Image16, String> {
         });
     }
     let img = image::load_from_memory_with_format(b, image::ImageFormat::Png)
-        .map_err(|e| format!("depth blob is neither RVL nor a PNG: {e}"))?;
+        .map_err(|e| BlobError(format!("depth blob is neither RVL nor a PNG: {e}")))?;
     match img {
         image::DynamicImage::ImageLuma16(i) => {
             let (w, h) = i.dimensions();
@@ -470,10 +477,10 @@ pub fn depth_blob(b: &[u8]) -> Result<Image16, String> {
                 data,
             })
         }
-        other => Err(format!(
+        other => Err(BlobError(format!(
             "depth PNG is {:?}, not 16-bit or float-in-RGBA",
             other.color()
-        )),
+        ))),
     }
 }
 
@@ -627,7 +634,7 @@ pub fn for_each_node(
             let image: Option<Vec<u8>> = r.get(3).map_err(|e| format!("image: {e}"))?;
             let depth: Option<Vec<u8>> = r.get(4).map_err(|e| format!("depth: {e}"))?;
             let depth = match depth.filter(|d| !d.is_empty()) {
-                Some(d) => Some(depth_blob(&d)?),
+                Some(d) => Some(depth_blob(&d).map_err(|e| e.0)?),
                 None => None,
             };
             Ok(Node {

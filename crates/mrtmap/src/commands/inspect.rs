@@ -1,9 +1,7 @@
 //! `mrtmap inspect`: what a scan source holds and what a scan still lacks.
 
 use mrtmap_pipeline::source::DbSummary;
-use mrtmap_pipeline::source::SourceKind;
 use mrtmap_pipeline::source::{FolderSummary, Inspection, RosSummary, inspect};
-use serde_json::json;
 
 use crate::cli::InspectArgs;
 use crate::output::{json, print_missing, print_plan};
@@ -19,7 +17,7 @@ fn fmt_span(t0: f64, t1: f64) -> String {
 pub fn run(a: &InspectArgs) -> anyhow::Result<()> {
     let what = inspect(&a.source, &a.src.options())?;
     if a.json {
-        out!("{}", json(&inspection_json(a, &what))?);
+        out!("{}", json(&what.to_json(&a.source))?);
         return Ok(());
     }
     match &what {
@@ -31,38 +29,6 @@ pub fn run(a: &InspectArgs) -> anyhow::Result<()> {
         }
     }
     Ok(())
-}
-
-fn inspection_json(a: &InspectArgs, what: &Inspection) -> serde_json::Value {
-    let source = a.source.display().to_string();
-    match what {
-        Inspection::Folder(f) => json!({
-            "source": source,
-            "kind": SourceKind::Folder,
-            "streams": f.streams,
-            "warnings": f.warnings,
-            "ready": f.warnings.is_empty(),
-        }),
-        Inspection::Ros(r) => json!({
-            "source": source,
-            "kind": match r.container {
-                mrtmap_pipeline::source::Container::Bag => SourceKind::Bag,
-                mrtmap_pipeline::source::Container::Mcap => SourceKind::Mcap,
-                mrtmap_pipeline::source::Container::Db3 => SourceKind::Db3,
-            },
-            "topics": r.survey.topics.values().collect::<Vec<_>>(),
-            "static_transforms": r.survey.static_tf.iter().map(|t| format!("{} → {}", t.parent, t.child)).collect::<Vec<_>>(),
-            "plan": r.plan,
-            "ready": r.plan.missing.is_empty() && r.plan.rig.is_some(),
-        }),
-        Inspection::RtabMap { summary, missing } => json!({
-            "source": source,
-            "kind": SourceKind::RtabMap,
-            "database": summary,
-            "missing": missing,
-            "ready": missing.is_empty(),
-        }),
-    }
 }
 
 fn print_folder(a: &InspectArgs, f: &FolderSummary) {
