@@ -486,3 +486,153 @@ pub fn simulate_boards(out: &Path, o: &SynthOptions) -> Result<usize> {
     write_json(&out.join("truth.json"), &truth)?;
     Ok(pairs.len())
 }
+
+/// One camera's intrinsics in a line: size, focal lengths, principal point and distortion with
+/// their standard deviations (`std`, when known), and its own fit's error.
+fn describe(name: &str, c: &PinholeCamera, m: &MonoResult, std: Option<&[f64]>) -> String {
+    let d = c.distortion.to_array();
+    let pm = |k: usize| std.map_or(String::new(), |s| format!(" ± {:.2}", s[k]));
+    format!(
+        "{name:<8} {}×{}  fx {:.2}{}  fy {:.2}{}  cx {:.2}{}  cy {:.2}{}  k1 {:.4} k2 {:.4} p1 {:.5} p2 {:.5} k3 {:.4}  (alone: MRE {:.3} px over {} views)",
+        c.width,
+        c.height,
+        c.fx,
+        pm(0),
+        c.fy,
+        pm(1),
+        c.cx,
+        pm(2),
+        c.cy,
+        pm(3),
+        d[0],
+        d[1],
+        d[2],
+        d[3],
+        d[4],
+        m.error.mean_px,
+        m.view_errors.iter().flatten().count()
+    )
+}
+
+/// What a one-camera calibration found, in lines: the camera and the fit's error, with the
+/// images left out by name.
+pub fn mono_lines(d: &ImageDetections, r: &MonoResult) -> Vec<String> {
+    let mut lines = Vec::new();
+    lines.push(describe(
+        "camera",
+        &r.camera,
+        r,
+        r.std.as_ref().map(|s| &s[..]),
+    ));
+    let rejected = if r.rejected.is_empty() {
+        "none".to_string()
+    } else {
+        r.rejected
+            .iter()
+            .map(|k| {
+                d.paths[*k]
+                    .file_name()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_default()
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    lines.push(format!(
+        "mean reprojection error {:.3} px (RMS {:.3} px) over {} views, {} corners; rejected: {rejected}",
+        r.error.mean_px,
+        r.error.rms_px,
+        r.view_errors.iter().flatten().count(),
+        r.error.corners,
+    ));
+    lines
+}
+
+/// The thermal camera's pose in the colour frame, with its standard deviations.
+fn extrinsic_line(r: &StereoResult) -> String {
+    let std = r.std.as_deref();
+    let t = r.rgb_from_thermal.translation.vector * 1e3;
+    let (axis, angle) = r
+        .rgb_from_thermal
+        .rotation
+        .axis_angle()
+        .map_or(([0.0; 3], 0.0), |(ax, an)| ([ax.x, ax.y, ax.z], an));
+    let tstd = std.map_or(String::new(), |s| {
+        format!(
+            " ± ({:.2}, {:.2}, {:.2})",
+            s[21] * 1e3,
+            s[22] * 1e3,
+            s[23] * 1e3
+        )
+    });
+    let rstd = std.map_or(String::new(), |s| {
+        format!(
+            " ± {:.3}°",
+            (s[18] * s[18] + s[19] * s[19] + s[20] * s[20])
+                .sqrt()
+                .to_degrees()
+        )
+    });
+    format!(
+        "thermal camera in the colour frame: translation ({:.2}, {:.2}, {:.2}) mm{tstd}, rotation {:.3}°{rstd} about ({:.3}, {:.3}, {:.3})",
+        t.x,
+        t.y,
+        t.z,
+        angle.to_degrees(),
+        axis[0],
+        axis[1],
+        axis[2]
+    )
+}
+
+/// What a rig calibration found, in lines: both cameras, the extrinsic, how the model was
+/// chosen, plausibility warnings, the joint fit's errors and a table of the pairs.
+pub fn stereo_lines<'a>(r: &StereoResult, names: impl Iterator<Item = &'a str>) -> Vec<String> {
+    let mut lines = Vec::new();
+    let std = r.std.as_deref();
+    lines.push(describe(
+        "colour",
+        &r.rgb,
+        &r.rgb_alone,
+        std.map(|s| &s[0..9]),
+    ));
+    lines.push(describe(
+        "thermal",
+        &r.thermal,
+        &r.thermal_alone,
+        std.map(|s| &s[9..18]),
+    ));
+    lines.push(extrinsic_line(r));
+    lines.push(format!("model: {}", r.model_choice));
+    for w in plausibility(r) {
+        lines.push(format!("warning: {w}"));
+    }
+    let used = r
+        .pairs
+        .iter()
+        .filter(|p| p.status == PairStatus::Used)
+        .count();
+    lines.push(format!(
+        "joint fit over {used} of {} pairs: mean reprojection error colour {:.3} px (RMS {:.3}), thermal {:.3} px (RMS {:.3})",
+        r.pairs.len(),
+        r.rgb_error.mean_px,
+        r.rgb_error.rms_px,
+        r.thermal_error.mean_px,
+        r.thermal_error.rms_px
+    ));
+    lines.push(format!(
+        "{:<24} {:>7} {:>8} {:>10} {:>11}  status",
+        "pair", "colour", "thermal", "MRE col", "MRE therm"
+    ));
+    for (p, name) in r.pairs.iter().zip(names) {
+        lines.push(format!(
+            "{name:<24} {:>7} {:>8} {:>10} {:>11}  {}",
+            p.rgb_corners,
+            p.thermal_corners,
+            error_cell(p.rgb_error),
+            error_cell(p.thermal_error),
+            status_text(&p.status)
+        ));
+    }
+    lines
+}

@@ -9,23 +9,33 @@ use serde::Serialize;
 
 use crate::error::{Error, Result};
 
-/// How to read a bag, MCAP file or RTAB-Map database as a scan.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+/// How to read a bag, MCAP file or RTAB-Map database as a scan (also the flags of the commands
+/// that read one; the doc comments are their `--help`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, clap::Args)]
 pub struct SourceOptions {
-    /// A rig.toml: its thermal camera and extrinsic, and its depth/colour cameras where the
-    /// source has no CameraInfo.
+    /// A rig.toml (from mrtmap calibrate): its thermal camera and extrinsic are used, and its
+    /// depth/colour cameras where the source has no CameraInfo.
+    #[arg(long, value_name = "FILE")]
     pub rig: Option<PathBuf>,
-    /// Depth image topic.
+    /// Depth image topic (default: /camera/aligned_depth_to_color/image_raw, or any 16UC1 depth).
+    #[arg(long, value_name = "TOPIC")]
     pub depth_topic: Option<String>,
-    /// Thermal image topic.
+    /// Thermal image topic (default: any mono16 image topic).
+    #[arg(long, value_name = "TOPIC")]
     pub thermal_topic: Option<String>,
-    /// Colour image topic.
+    /// Colour image topic (default: /camera/color/image_raw).
+    #[arg(long, value_name = "TOPIC")]
     pub rgb_topic: Option<String>,
-    /// Pose topic (Odometry or PoseStamped).
+    /// Pose topic, nav_msgs/Odometry or geometry_msgs/PoseStamped (default: /camera/odom/sample,
+    /// else any; else /tf).
+    #[arg(long, value_name = "TOPIC")]
     pub pose_topic: Option<String>,
-    /// Raw depth units per metre of 16-bit depth.
+    /// Raw depth units per metre of 16-bit depth (default 1000, RealSense).
+    #[arg(long)]
     pub depth_scale: Option<f64>,
-    /// Thermal frames for a source without them (an RTAB-Map database).
+    /// Thermal frames for a source without them (an RTAB-Map database): a bag/MCAP/ROS 2 bag with
+    /// a mono16 topic, or a folder of 16-bit thermal images named by timestamp.
+    #[arg(long, value_name = "SRC")]
     pub thermal: Option<PathBuf>,
 }
 

@@ -95,6 +95,15 @@ pub fn parse_interval(s: &str) -> Result<[f64; 2], ParseError> {
     Ok([v[0], v[1]])
 }
 
+/// A switch: on or off.
+pub fn parse_on_off(s: &str) -> Result<bool, ParseError> {
+    match s.trim() {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        _ => Err(ParseError(format!("expected on or off, got '{s}'"))),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -117,5 +126,7 @@ mod tests {
         let nan = parse_facing("NaN").unwrap_err().0;
         assert!(nan.contains("degrees") && nan.contains("NaN"), "{nan}");
         assert!(parse_facing("inf").is_err());
+        assert_eq!(parse_on_off("off"), Ok(false));
+        assert!(parse_on_off("yes").is_err());
     }
 }

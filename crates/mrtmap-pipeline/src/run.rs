@@ -30,7 +30,9 @@ use crate::error::{Error, Result};
 use crate::level::{DEFAULT_CAMERA_ACCURACY_K, Level, Reference, find_level, read_references};
 use crate::maps::{Mark, MarkAt, Summary, make_map};
 use crate::progress::Progress;
-use crate::settings::{PointEntry, PointFrame, Project, Quantity, TrackMode};
+use crate::settings::{
+    PointEntry, PointFrame, Project, Quantity, RoomSection, SegmentSection, TrackMode,
+};
 
 /// Tracks `rec`'s colour and depth frames into `out`: trajectory.txt (world_from_depth, TUM) and
 /// track.json (what was done; with the recording's groundtruth.txt, the trajectory error).
@@ -149,6 +151,76 @@ fn mean_temperature_c(scene: &RadiantScene) -> f64 {
         t += area * s.temperature.celsius();
     }
     if a > 0.0 { t / a } else { 20.0 }
+}
+
+/// What `mrtmap segment` is given: a fusion's folder and where to write, with the recording to
+/// texture from, the masks to label by, the settings and the contact readings.
+#[derive(Clone, Debug)]
+pub struct SegmentJob<'a> {
+    /// The output folder of a fusion (cloud.ply, poses.txt).
+    pub fused: &'a Path,
+    /// A recording with instance masks (masks.txt) to label the features by.
+    pub masks: Option<&'a Path>,
+    /// The recording that was fused, whose thermal frames texture the room model (the masks'
+    /// recording when not given).
+    pub recording: Option<&'a Path>,
+    /// Feature threshold, smallest feature, raster texel (its `masks` and `texture` are set from
+    /// the recordings given).
+    pub section: SegmentSection,
+    /// The floor corner at the room frame's origin.
+    pub origin_corner: Option<usize>,
+    /// Contact readings (references.csv).
+    pub references: Option<&'a Path>,
+    /// Where scene.json, segments.ply and segment.json go.
+    pub out: &'a Path,
+}
+
+/// Segments a fusion's folder as [`SegmentJob`] says, after checking its inputs; one call for
+/// `mrtmap segment`.
+pub fn segment_folder(job: &SegmentJob<'_>) -> Result<SegmentReport> {
+    if !job.fused.join("cloud.ply").exists() {
+        return Err(Error::source(
+            job.fused,
+            "no cloud.ply here: give the output folder of `mrtmap fuse`",
+        ));
+    }
+    let masks = match job.masks {
+        Some(dir) => {
+            let r = Recording::open(dir)?;
+            if r.masks.is_empty() {
+                return Err(Error::source(dir, "no masks listed (masks.txt)"));
+            }
+            Some(r)
+        }
+        None => None,
+    };
+    let recording = match (job.recording, masks) {
+        (Some(dir), _) => Some(Recording::open(dir)?),
+        (None, m) => m,
+    };
+    let section = SegmentSection {
+        masks: job.masks.is_some(),
+        texture: recording.is_some(),
+        ..job.section.clone()
+    };
+    section.check()?;
+    let room = RoomSection {
+        origin_corner: job.origin_corner,
+    };
+    room.check()?;
+    let inputs = SegmentInputs {
+        recording: recording.as_ref(),
+        masks: section.masks,
+        texture: section.texture,
+    };
+    let level = LevelInputs {
+        references: match job.references {
+            Some(f) => read_references(f)?,
+            None => Vec::new(),
+        },
+        camera_accuracy_k: DEFAULT_CAMERA_ACCURACY_K,
+    };
+    segment_into(job.fused, &inputs, &section.params(&room), &level, job.out)
 }
 
 /// Segments the fusion in `fused` (cloud.ply, poses.txt) into `out`: scene.json, segments.ply,

@@ -411,23 +411,35 @@ impl TrackSection {
     }
 }
 
-/// `[fuse]`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// `[fuse]`, and the flags of `mrtmap fuse` (the doc comments are their `--help`, the defaults
+/// those of [`Default`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, clap::Args)]
 #[serde(default, deny_unknown_fields)]
 pub struct FuseSection {
     /// Voxel size (m).
+    #[arg(long = "voxel-m", default_value_t = 0.03)]
     pub voxel_m: f64,
-    /// Refine poses by ICP against the map.
+    /// Refine poses by point-to-plane ICP against the map built so far (on or off).
+    #[arg(long, default_value = "on", value_name = "on|off", action = clap::ArgAction::Set,
+          value_parser = crate::parse::parse_on_off)]
     pub icp: bool,
-    /// Largest time between a thermal frame and its depth frame (ms).
+    /// Largest time between a thermal frame and the depth frame it takes (ms); at least 0.55 of
+    /// the depth frames' interval is used, so every thermal frame finds one at any depth rate.
+    #[arg(long = "sync-tolerance-ms", default_value_t = 20.0)]
     pub sync_tolerance_ms: f64,
-    /// Every N-th depth pixel in each direction.
+    /// Use every N-th depth pixel in each direction; 0: about one depth point per thermal pixel
+    /// (the cameras' focal lengths' ratio, rounded: 3 for a 640×480 D435 beside a Lepton).
+    #[arg(long, default_value_t = 0)]
     pub depth_stride: u32,
-    /// Estimate and remove each frame's offset (flat-field corrections, drift) and the lens's
-    /// vignetting from the frames' overlaps.
+    /// Radiometric self-calibration (on or off): estimate and remove each frame's offset
+    /// (flat-field corrections, drift) and the vignetting from the frames' overlaps.
+    #[arg(long, default_value = "on", value_name = "on|off", action = clap::ArgAction::Set,
+          value_parser = crate::parse::parse_on_off)]
     pub self_calibrate: bool,
-    /// What to add to the thermal stamps: "auto" (rig.toml's `[thermal] time_offset_s`, else
-    /// estimated from the scan), "estimate", "off", or milliseconds ("-70").
+    /// What to add to the thermal stamps to put them on the depth camera's clock: auto (rig.toml's
+    /// `[thermal] time_offset_s`, else estimated from the scan), estimate, off, or milliseconds
+    /// (-70: frames stamped 70 ms after their exposure).
+    #[arg(long, default_value = "auto", allow_hyphen_values = true)]
     pub time_offset: String,
 }
 
@@ -502,21 +514,28 @@ impl FuseSection {
     }
 }
 
-/// `[segment]`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// `[segment]`, and the flags of `mrtmap segment` (the doc comments are their `--help`, the
+/// defaults those of [`Default`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, clap::Args)]
 #[serde(default, deny_unknown_fields)]
 pub struct SegmentSection {
     /// A texel belongs to a feature when it differs from its surface's background by more (K).
+    #[arg(long, default_value_t = 0.3)]
     pub feature_threshold_k: f64,
     /// Smallest feature (m²).
+    #[arg(long = "feature-min-area-m2", default_value_t = 0.04)]
     pub feature_min_area_m2: f64,
-    /// Texel of each surface's temperature raster (m); 0 for one temperature per surface.
+    /// Texel of each surface's temperature raster in scene.json (m), so that a stratified wall
+    /// radiates as it is; 0 for one temperature per surface.
+    #[arg(long = "raster-m", default_value_t = 0.15)]
     pub raster_m: f64,
     /// Label features by the recording's instance masks when it has them.
+    #[arg(skip = true)]
     pub masks: bool,
     /// Cast the fused thermal frames onto the room model found, so that what the depth camera
     /// did not see (glass, dark or shiny surfaces, dropouts) takes the thermal camera's
     /// temperatures.
+    #[arg(skip = true)]
     pub texture: bool,
 }
 
@@ -591,25 +610,37 @@ impl From<DirectionChoice> for DirectionSet {
     }
 }
 
-/// `[mrt]`, and the flags of `map` and `mrt`: the view-factor method.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+/// `[mrt]`, and the flags of `map` and `mrt`: the view-factor method. One definition for both:
+/// the doc comments are the flags' `--help`, the defaults those of [`Default`].
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, clap::Args)]
 #[serde(default, deny_unknown_fields)]
 pub struct MrtSection {
-    /// Exact, Monte Carlo, or exact where valid.
+    /// View-factor method: exact solid angles where valid and Monte Carlo with occluders or where
+    /// surfaces hide each other (auto), exact solid angles only (exact), or Monte Carlo ray
+    /// tracing (montecarlo).
+    #[arg(long, value_enum, default_value_t = MethodChoice::Auto)]
     pub method: MethodChoice,
-    /// Monte Carlo rays per point.
+    /// Monte Carlo: rays per point.
+    #[arg(long, default_value_t = MonteCarlo::default().rays)]
     pub rays: usize,
-    /// Monte Carlo seed.
+    /// Monte Carlo: random seed (results are reproducible from it).
+    #[arg(long, default_value_t = MonteCarlo::default().seed)]
     pub seed: u64,
-    /// Monte Carlo direction set.
+    /// Monte Carlo: direction set (randomly rotated spherical Fibonacci lattices converge faster
+    /// than independent random directions).
+    #[arg(long, value_enum, default_value_t = DirectionChoice::Fibonacci)]
     pub directions: DirectionChoice,
-    /// Independent Monte Carlo replicates the standard errors come from.
+    /// Monte Carlo: independent replicates the standard errors come from.
+    #[arg(long, default_value_t = MonteCarlo::default().replicates)]
     pub replicates: usize,
-    /// Answer at points the scene does not enclose (ΣF short of 1: a missing wall, floor or
-    /// ceiling) instead of refusing them; the result says how much of the view is missing.
+    /// Answer at points the scene does not enclose (a missing wall, floor or ceiling leaves part
+    /// of the view empty: ΣF short of 1) instead of refusing them; ΣF is printed with each point.
+    #[arg(long)]
     pub allow_open: bool,
-    /// Standard deviation (m) of a point's place relative to the room's surfaces: the MRT's
-    /// gradient times it joins the MRT's standard error (0 leaves it out).
+    /// How well a point is placed relative to the room's surfaces (m, one standard deviation): the
+    /// MRT's gradient times it joins the MRT's ± (near a cold window it dominates; not yet a
+    /// person's or a plane's); 0 leaves it out.
+    #[arg(long, default_value_t = 0.01)]
     pub placement_std_m: f64,
 }
 

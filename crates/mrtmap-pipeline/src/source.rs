@@ -148,6 +148,189 @@ impl Inspection {
     }
 }
 
+impl Inspection {
+    /// What `mrtmap inspect` prints about `source`, in lines.
+    pub fn lines(&self, source: &Path) -> Vec<String> {
+        match self {
+            Inspection::Folder(f) => folder_lines(source, f),
+            Inspection::Ros(r) => ros_lines(source, r),
+            Inspection::RtabMap { summary, missing } => {
+                let mut lines = database_lines(source, summary);
+                lines.extend(missing_lines(missing));
+                lines
+            }
+        }
+    }
+}
+
+/// A time span in words ("—" when empty).
+fn fmt_span(t0: f64, t1: f64) -> String {
+    if t1 >= t0 {
+        format!("{t0:.3} … {t1:.3} s ({:.2} s)", t1 - t0)
+    } else {
+        "—".into()
+    }
+}
+
+/// A recording folder's streams and rig, in lines.
+fn folder_lines(source: &Path, f: &FolderSummary) -> Vec<String> {
+    let mut lines = Vec::new();
+    lines.push(format!("{}: recording folder", source.display()));
+    for s in &f.streams {
+        lines.push(format!(
+            "  {:<10} {:>6} {:>8.2} Hz  {}",
+            s.name,
+            s.count,
+            s.rate_hz(),
+            fmt_span(s.t0, s.t1)
+        ));
+    }
+    lines.push(format!(
+        "  rig: depth {}×{}, thermal {}×{}{}",
+        f.rig.depth.width,
+        f.rig.depth.height,
+        f.rig.thermal.width,
+        f.rig.thermal.height,
+        if f.rig.rgb.is_some() { ", colour" } else { "" }
+    ));
+    for w in &f.warnings {
+        lines.push(format!("  warning: {w}"));
+    }
+    lines
+}
+
+/// A bag's topics and the plan for a scan, in lines.
+fn ros_lines(source: &Path, r: &RosSummary) -> Vec<String> {
+    let mut lines = Vec::new();
+    let s = &r.survey;
+    lines.push(format!(
+        "{}: {} ({} bytes){}",
+        source.display(),
+        r.describe(),
+        r.bytes,
+        if s.unfinished {
+            ", cut or never closed"
+        } else {
+            ""
+        }
+    ));
+    let w = s.topics.keys().map(|k| k.len()).max().unwrap_or(5).max(5);
+    lines.push(format!(
+        "{:<w$}  {:<28} {:>6} {:>8}  {:<14} span",
+        "topic", "type", "count", "rate Hz", "encoding"
+    ));
+    for t in s.topics.values() {
+        lines.push(format!(
+            "{:<w$}  {:<28} {:>6} {:>8.2}  {:<14} {}{}",
+            t.topic,
+            t.datatype,
+            t.count,
+            t.rate_hz(),
+            match t.size {
+                Some((w, h)) if !t.encoding.is_empty() => format!("{} {w}×{h}", t.encoding),
+                _ => t.encoding.clone(),
+            },
+            fmt_span(t.t0, t.t1),
+            if t.undecodable > 0 {
+                format!("  ({} do not decode)", t.undecodable)
+            } else {
+                String::new()
+            }
+        ));
+    }
+    for tf in &s.static_tf {
+        lines.push(format!("static transform {} → {}", tf.parent, tf.child));
+    }
+    lines.extend(plan_lines(&r.plan));
+    lines
+}
+
+/// An RTAB-Map database's summary, in lines.
+fn database_lines(path: &Path, s: &DbSummary) -> Vec<String> {
+    let mut lines = Vec::new();
+    lines.push(format!(
+        "{}: RTAB-Map database, schema {}",
+        path.display(),
+        s.version
+    ));
+    lines.push(format!(
+        "  nodes {}  colour {}  depth {} ({} RVL)  span {:.3} … {:.3} s ({:.2} s)",
+        s.nodes,
+        s.images,
+        s.depths,
+        s.rvl,
+        s.span.0,
+        s.span.1,
+        s.span.1 - s.span.0
+    ));
+    if s.nodes > 1 && s.span.1 > s.span.0 {
+        lines.push(format!(
+            "  node rate {:.2} Hz",
+            (s.nodes - 1) as f64 / (s.span.1 - s.span.0)
+        ));
+    }
+    lines.push(format!("  poses: {}", s.poses));
+    for (name, n) in &s.links {
+        lines.push(format!("  links: {n} {name}"));
+    }
+    match &s.calibration {
+        Some(c) => lines.push(format!(
+            "  camera {}×{} fx {:.2} fy {:.2} cx {:.2} cy {:.2} (written by RTAB-Map {}.{}.{})",
+            c.camera.width,
+            c.camera.height,
+            c.camera.fx,
+            c.camera.fy,
+            c.camera.cx,
+            c.camera.cy,
+            c.version[0],
+            c.version[1],
+            c.version[2]
+        )),
+        None => lines.push("  camera: no calibration".to_string()),
+    }
+    for n in &s.notes {
+        lines.push(format!("  note: {n}"));
+    }
+    lines
+}
+
+/// The streams chosen for a scan and what is missing, in lines.
+pub fn plan_lines(p: &Plan) -> Vec<String> {
+    let mut lines = Vec::new();
+    let show = |o: &Option<String>| o.clone().unwrap_or_else(|| "—".into());
+    lines.push("for a scan:".to_string());
+    lines.push(format!("  depth    {}", show(&p.depth)));
+    lines.push(format!("  thermal  {}", show(&p.thermal)));
+    lines.push(format!("  colour   {}", show(&p.rgb)));
+    lines.push(format!(
+        "  poses    {}",
+        match &p.poses {
+            Some(PoseSource::Topic(t)) => t.clone(),
+            Some(PoseSource::Tf(a, b)) => format!("/tf {a} → {b}"),
+            None => "—".into(),
+        }
+    ));
+    for n in &p.notes {
+        lines.push(format!("  note: {n}"));
+    }
+    lines.extend(missing_lines(&p.missing));
+    lines
+}
+
+/// Whether a source is ready for a scan, or what it lacks, in lines.
+pub fn missing_lines(missing: &[String]) -> Vec<String> {
+    let mut lines = Vec::new();
+    if missing.is_empty() {
+        lines.push("ready: mrtmap convert / fuse / run can use it".to_string());
+    } else {
+        lines.push("missing for a scan:".to_string());
+        for m in missing {
+            lines.push(format!("  - {m}"));
+        }
+    }
+    lines
+}
+
 /// Bytes in a source file, or in a split bag's storage files.
 fn source_bytes(file: &Path, c: Container) -> Result<u64> {
     let files = if file.is_dir() {

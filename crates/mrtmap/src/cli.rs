@@ -3,11 +3,15 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use mrtmap_pipeline::parse::{parse_facing, parse_grid, parse_image_size, parse_mark, parse_point};
+use mrtmap_pipeline::MrtSection;
+use mrtmap_pipeline::parse::{
+    parse_facing, parse_grid, parse_image_size, parse_mark, parse_on_off, parse_point,
+};
+use mrtmap_pipeline::settings::{FuseSection, SegmentSection};
 use mrtmap_pipeline::settings::{PointFrame, Quantity};
 use mrtmap_pipeline::simulation::CameraErrorArgs;
 use mrtmap_pipeline::simulation::NoiseLevel;
-use mrtmap_pipeline::{DirectionChoice, MethodChoice, MrtSection};
+use mrtmap_pipeline::source::SourceOptions;
 
 /// Map the mean radiant temperature (MRT) of a room.
 ///
@@ -71,50 +75,6 @@ pub enum Command {
     Convert(ConvertArgs),
 }
 
-/// How to read a bag, MCAP file or RTAB-Map database as a scan.
-#[derive(Debug, Args, Clone, Default)]
-pub struct SourceArgs {
-    /// A rig.toml (from mrtmap calibrate): its thermal camera and extrinsic are used, and its
-    /// depth/colour cameras where the source has no CameraInfo.
-    #[arg(long, value_name = "FILE")]
-    pub rig: Option<PathBuf>,
-    /// Depth image topic (default: /camera/aligned_depth_to_color/image_raw, or any 16UC1 depth).
-    #[arg(long, value_name = "TOPIC")]
-    pub depth_topic: Option<String>,
-    /// Thermal image topic (default: any mono16 image topic).
-    #[arg(long, value_name = "TOPIC")]
-    pub thermal_topic: Option<String>,
-    /// Colour image topic (default: /camera/color/image_raw).
-    #[arg(long, value_name = "TOPIC")]
-    pub rgb_topic: Option<String>,
-    /// Pose topic, nav_msgs/Odometry or geometry_msgs/PoseStamped (default: /camera/odom/sample,
-    /// else any; else /tf).
-    #[arg(long, value_name = "TOPIC")]
-    pub pose_topic: Option<String>,
-    /// Raw depth units per metre of 16-bit depth (default 1000, RealSense).
-    #[arg(long)]
-    pub depth_scale: Option<f64>,
-    /// Thermal frames for a source without them (an RTAB-Map database): a bag/MCAP/ROS 2 bag with
-    /// a mono16 topic, or a folder of 16-bit thermal images named by timestamp.
-    #[arg(long, value_name = "SRC")]
-    pub thermal: Option<PathBuf>,
-}
-
-impl SourceArgs {
-    /// The reading options these flags stand for.
-    pub fn options(&self) -> mrtmap_pipeline::source::SourceOptions {
-        mrtmap_pipeline::source::SourceOptions {
-            rig: self.rig.clone(),
-            depth_topic: self.depth_topic.clone(),
-            thermal_topic: self.thermal_topic.clone(),
-            rgb_topic: self.rgb_topic.clone(),
-            pose_topic: self.pose_topic.clone(),
-            depth_scale: self.depth_scale,
-            thermal: self.thermal.clone(),
-        }
-    }
-}
-
 /// `mrtmap inspect`.
 #[derive(Debug, Args)]
 #[command(after_long_help = "Examples:
@@ -130,7 +90,7 @@ pub struct InspectArgs {
     pub json: bool,
     /// Reading options.
     #[command(flatten)]
-    pub src: SourceArgs,
+    pub src: SourceOptions,
 }
 
 /// Container of `convert`'s output when it is a file.
@@ -174,7 +134,7 @@ pub struct ConvertArgs {
     pub schema: mrtmap_pipeline::source::Schema,
     /// Reading options.
     #[command(flatten)]
-    pub src: SourceArgs,
+    pub src: SourceOptions,
 }
 
 /// `mrtmap thermal`.
@@ -310,7 +270,7 @@ pub struct RunArgs {
     pub recording: PathBuf,
     /// How to read a bag, MCAP file or database.
     #[command(flatten)]
-    pub src: SourceArgs,
+    pub src: SourceOptions,
     /// Output folder: fuse/, segment/, map-H.HHm/ per height, report.html, run.json.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
@@ -349,11 +309,11 @@ pub struct RunArgs {
     #[arg(long = "voxel-m")]
     pub voxel_m: Option<f64>,
     /// ICP refinement ([fuse] icp).
-    #[arg(long, value_enum)]
-    pub icp: Option<OnOff>,
+    #[arg(long, value_name = "on|off", value_parser = parse_on_off)]
+    pub icp: Option<bool>,
     /// Radiometric self-calibration of the frames ([fuse] self_calibrate).
-    #[arg(long, value_enum)]
-    pub self_calibrate: Option<OnOff>,
+    #[arg(long, value_name = "on|off", value_parser = parse_on_off)]
+    pub self_calibrate: Option<bool>,
     /// Do not use the recording's instance masks ([segment] masks = false).
     #[arg(long)]
     pub no_masks: bool,
@@ -369,7 +329,7 @@ pub struct CoverageArgs {
     pub recording: PathBuf,
     /// How to read a bag, MCAP file or database.
     #[command(flatten)]
-    pub src: SourceArgs,
+    pub src: SourceOptions,
     /// Keep the coarse run here (fuse/, segment/, map-1.10m/); by default it goes to a temporary
     /// folder that is removed.
     #[arg(long, value_name = "DIR")]
@@ -472,16 +432,9 @@ pub struct SegmentArgs {
     /// Output folder for scene.json, segments.ply and segment.json.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-    /// A texel belongs to a feature when it differs from its surface's background by more (K).
-    #[arg(long, default_value_t = 0.3)]
-    pub feature_threshold_k: f64,
-    /// Smallest feature (m²).
-    #[arg(long = "feature-min-area-m2", default_value_t = 0.04)]
-    pub feature_min_area_m2: f64,
-    /// Texel of each surface's temperature raster in scene.json (m), so that a stratified wall
-    /// radiates as it is; 0 for one temperature per surface.
-    #[arg(long = "raster-m", default_value_t = 0.15)]
-    pub raster_m: f64,
+    /// Feature and raster settings.
+    #[command(flatten)]
+    pub section: SegmentSection,
     /// The floor corner at the room frame's origin, as numbered in segment.json's floor_corners;
     /// by default the start of the longest wall with the room at x, y ≥ 0.
     #[arg(long, value_name = "N")]
@@ -494,15 +447,6 @@ pub struct SegmentArgs {
     pub references: Option<PathBuf>,
 }
 
-/// On or off.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum OnOff {
-    /// On.
-    On,
-    /// Off.
-    Off,
-}
-
 /// `mrtmap fuse`.
 #[derive(Debug, Args)]
 pub struct FuseArgs {
@@ -512,33 +456,13 @@ pub struct FuseArgs {
     pub recording: PathBuf,
     /// How to read a bag, MCAP file or database.
     #[command(flatten)]
-    pub src: SourceArgs,
+    pub src: SourceOptions,
     /// Output folder for cloud.ply, fusion.json and the refined trajectory.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-    /// Voxel size (m).
-    #[arg(long = "voxel-m", default_value_t = 0.03)]
-    pub voxel_m: f64,
-    /// Refine poses by point-to-plane ICP against the map built so far.
-    #[arg(long, value_enum, default_value_t = OnOff::On)]
-    pub icp: OnOff,
-    /// Largest time between a thermal frame and the depth frame it takes (ms); at least 0.55 of
-    /// the depth frames' interval is used, so every thermal frame finds one at any depth rate.
-    #[arg(long = "sync-tolerance-ms", default_value_t = 20.0)]
-    pub sync_tolerance_ms: f64,
-    /// Use every N-th depth pixel in each direction; 0: about one depth point per thermal pixel
-    /// (the cameras' focal lengths' ratio, rounded: 3 for a 640×480 D435 beside a Lepton).
-    #[arg(long, default_value_t = 0)]
-    pub depth_stride: u32,
-    /// Radiometric self-calibration: estimate and remove each frame's offset (flat-field
-    /// corrections, drift) and the vignetting from the frames' overlaps.
-    #[arg(long, value_enum, default_value_t = OnOff::On)]
-    pub self_calibrate: OnOff,
-    /// What to add to the thermal stamps to put them on the depth camera's clock: auto (rig.toml's
-    /// `[thermal] time_offset_s`, else estimated from the scan), estimate, off, or milliseconds
-    /// (-70: frames stamped 70 ms after their exposure).
-    #[arg(long, default_value = "auto", allow_hyphen_values = true)]
-    pub time_offset: String,
+    /// The fusion's settings.
+    #[command(flatten)]
+    pub fuse: FuseSection,
 }
 
 /// A simulated effect: on, off, or the noise level's default.
@@ -672,53 +596,6 @@ pub struct SceneArgs {
     pub scene: Option<PathBuf>,
 }
 
-/// View-factor settings shared by `mrt` and `map` (`[mrt]` of project.toml).
-#[derive(Debug, Args, Clone)]
-pub struct MethodArgs {
-    /// View-factor method: exact solid angles where valid and Monte Carlo with occluders or where
-    /// surfaces hide each other (auto), exact solid angles only (exact), or Monte Carlo ray
-    /// tracing (montecarlo).
-    #[arg(long, value_enum, default_value_t = MethodChoice::Auto)]
-    pub method: MethodChoice,
-    /// Monte Carlo: rays per point.
-    #[arg(long, default_value_t = 20_000)]
-    pub rays: usize,
-    /// Monte Carlo: random seed (results are reproducible from it).
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
-    /// Monte Carlo: direction set (randomly rotated spherical Fibonacci lattices converge faster
-    /// than independent random directions).
-    #[arg(long, value_enum, default_value_t = DirectionChoice::Fibonacci)]
-    pub directions: DirectionChoice,
-    /// Monte Carlo: independent replicates the standard errors come from.
-    #[arg(long, default_value_t = 8)]
-    pub replicates: usize,
-    /// Answer at points the scene does not enclose (a missing wall, floor or ceiling leaves part
-    /// of the view empty: ΣF short of 1) instead of refusing them; ΣF is printed with each point.
-    #[arg(long)]
-    pub allow_open: bool,
-    /// How well a point is placed relative to the room's surfaces (m, one standard deviation): the
-    /// MRT's gradient times it joins the MRT's ± (near a cold window it dominates; not yet a
-    /// person's or a plane's); 0 leaves it out.
-    #[arg(long, default_value_t = 0.01)]
-    pub placement_std_m: f64,
-}
-
-impl MethodArgs {
-    /// The `[mrt]` settings these flags stand for.
-    pub fn section(&self) -> MrtSection {
-        MrtSection {
-            method: self.method,
-            rays: self.rays,
-            seed: self.seed,
-            directions: self.directions,
-            replicates: self.replicates,
-            allow_open: self.allow_open,
-            placement_std_m: self.placement_std_m,
-        }
-    }
-}
-
 /// `mrtmap map`.
 #[derive(Debug, Args)]
 pub struct MapArgs {
@@ -738,7 +615,7 @@ pub struct MapArgs {
     #[arg(long = "mark", value_name = "NAME=U,V", allow_hyphen_values = true, value_parser = parse_mark)]
     pub marks: Vec<(String, Vec<f64>)>,
     #[command(flatten)]
-    pub method: MethodArgs,
+    pub method: MrtSection,
     /// What else to map, repeatable: a person's MRT (mrt_seated, mrt_standing), radiant asymmetry,
     /// operative temperature, PMV, PPD; the person and the air come from --config's [comfort] and
     /// [air]. Written as QUANTITY.png/.svg/.csv and comfort.json beside the MRT map.
@@ -770,7 +647,7 @@ pub struct MrtArgs {
     #[arg(long, value_enum, default_value_t = PointFrame::Room)]
     pub frame: PointFrame,
     #[command(flatten)]
-    pub method: MethodArgs,
+    pub method: MrtSection,
     /// The MRT of a person instead of a small sphere: --at is the body centre (0.6 m above the
     /// floor seated, 1.0 m standing); angle factors from the projected-area factors of a seated or
     /// standing body.

@@ -227,39 +227,6 @@ pub fn print_conversion(c: &mrtmap_pipeline::source::Conversion) {
 }
 
 /// Prints the streams a bag's scan would use, and what it lacks.
-pub fn print_plan(p: &mrtmap_pipeline::source::Plan) {
-    use mrtmap_pipeline::source::PoseSource;
-    let show = |o: &Option<String>| o.clone().unwrap_or_else(|| "—".into());
-    outln!("for a scan:");
-    outln!("  depth    {}", show(&p.depth));
-    outln!("  thermal  {}", show(&p.thermal));
-    outln!("  colour   {}", show(&p.rgb));
-    outln!(
-        "  poses    {}",
-        match &p.poses {
-            Some(PoseSource::Topic(t)) => t.clone(),
-            Some(PoseSource::Tf(a, b)) => format!("/tf {a} → {b}"),
-            None => "—".into(),
-        }
-    );
-    for n in &p.notes {
-        outln!("  note: {n}");
-    }
-    print_missing(&p.missing);
-}
-
-/// Prints whether a source is ready for a scan, or what it lacks.
-pub fn print_missing(missing: &[String]) {
-    if missing.is_empty() {
-        outln!("ready: mrtmap convert / fuse / run can use it");
-    } else {
-        outln!("missing for a scan:");
-        for m in missing {
-            outln!("  - {m}");
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

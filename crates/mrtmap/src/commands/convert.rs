@@ -7,7 +7,8 @@ use mrtmap_pipeline::source::Container;
 use mrtmap_pipeline::source::{ContainerOut, convert, write_container};
 
 use crate::cli::{CompressionArg, ConvertArgs};
-use crate::output::{print_conversion, print_plan};
+use crate::output::print_conversion;
+use mrtmap_pipeline::source::plan_lines;
 
 /// The container an output file name asks for, if any.
 fn container_out(a: &ConvertArgs) -> Option<ContainerOut> {
@@ -47,7 +48,7 @@ pub fn run(a: &ConvertArgs) -> anyhow::Result<()> {
         }
         return Ok(());
     }
-    match convert(&a.source, &a.out, &a.src.options()) {
+    match convert(&a.source, &a.out, &a.src) {
         Ok(c) => {
             print_conversion(&c);
             Ok(())
@@ -57,7 +58,9 @@ pub fn run(a: &ConvertArgs) -> anyhow::Result<()> {
                 plan: Some(plan), ..
             } = &e
             {
-                print_plan(plan);
+                for line in plan_lines(plan) {
+                    outln!("{line}");
+                }
             }
             Err(e.into())
         }

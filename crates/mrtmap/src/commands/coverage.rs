@@ -33,7 +33,7 @@ pub fn run(a: &CoverageArgs) -> anyhow::Result<()> {
     };
     mrtmap_pipeline::run::check_out_dir(&out)?;
     let t0 = Instant::now();
-    let prepared = prepare(&a.recording, &out, &a.src.options())?;
+    let prepared = prepare(&a.recording, &out, &a.src)?;
     let bar = Bar::new("");
     let c = coverage(&prepared.dir, &out, &p, a.target_k, &bar)?;
     bar.finish();

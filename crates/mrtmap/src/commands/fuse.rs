@@ -2,24 +2,15 @@
 
 use mrtmap_pipeline::files::Recording;
 use mrtmap_pipeline::run::fuse_into;
-use mrtmap_pipeline::settings::FuseSection;
 use mrtmap_pipeline::source::prepare;
 
-use crate::cli::{FuseArgs, OnOff};
+use crate::cli::FuseArgs;
 use crate::output::{Bar, print_conversion};
 
 pub fn run(a: &FuseArgs) -> anyhow::Result<()> {
-    let settings = FuseSection {
-        voxel_m: a.voxel_m,
-        icp: a.icp == OnOff::On,
-        sync_tolerance_ms: a.sync_tolerance_ms,
-        depth_stride: a.depth_stride,
-        self_calibrate: a.self_calibrate == OnOff::On,
-        time_offset: a.time_offset.clone(),
-    };
-    let params = settings.params()?;
+    let params = a.fuse.params()?;
     mrtmap_pipeline::run::check_out_apart(&a.recording, &a.out)?;
-    let prepared = prepare(&a.recording, &a.out, &a.src.options())?;
+    let prepared = prepare(&a.recording, &a.out, &a.src)?;
     if let Some(c) = &prepared.conversion {
         print_conversion(c);
     } else if prepared.reused {
@@ -41,7 +32,7 @@ pub fn run(a: &FuseArgs) -> anyhow::Result<()> {
         r.used_frames,
         r.thermal_frames,
         r.voxels,
-        a.voxel_m,
+        a.fuse.voxel_m,
         r.timing_s.total,
         r.frames_per_second
     );

@@ -23,7 +23,7 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
         project.air.temperature_c = a.air_c;
     }
     let (scene, source) = load_scene(a.scene.scene.as_deref())?;
-    project.mrt = a.method.section();
+    project.mrt = a.method;
     let spec = GridSpec {
         nx: a.grid.0,
         ny: a.grid.1,

@@ -27,7 +27,7 @@ fn verdict_text(v: &AsymmetryVerdict) -> String {
 
 pub fn run(a: &MrtArgs) -> anyhow::Result<()> {
     let (scene, source) = load_scene(a.scene.scene.as_deref())?;
-    let section = a.method.section();
+    let section = a.method;
     let query = PointQuery {
         at: a.at.clone(),
         frame: a.frame,

@@ -8,7 +8,7 @@ use mrtmap_pipeline::report::{report_data, write_run_outputs};
 use mrtmap_pipeline::settings::PointEntry;
 use mrtmap_pipeline::source::prepare;
 
-use crate::cli::{OnOff, RunArgs};
+use crate::cli::RunArgs;
 use crate::output::{Bar, print_conversion, print_run};
 
 /// The project from the file and the flags.
@@ -46,10 +46,10 @@ fn settings(a: &RunArgs) -> anyhow::Result<Project> {
         p.fuse.voxel_m = v;
     }
     if let Some(i) = a.icp {
-        p.fuse.icp = i == OnOff::On;
+        p.fuse.icp = i;
     }
     if let Some(s) = a.self_calibrate {
-        p.fuse.self_calibrate = s == OnOff::On;
+        p.fuse.self_calibrate = s;
     }
     if a.no_masks {
         p.segment.masks = false;
@@ -68,7 +68,7 @@ pub fn run(a: &RunArgs) -> anyhow::Result<()> {
     let p = settings(a)?;
     mrtmap_pipeline::run::check_out_dir(&a.out)?;
     let t0 = Instant::now();
-    let prepared = prepare(&a.recording, &a.out, &a.src.options())?;
+    let prepared = prepare(&a.recording, &a.out, &a.src)?;
     if let Some(c) = &prepared.conversion {
         print_conversion(c);
     } else if prepared.reused {

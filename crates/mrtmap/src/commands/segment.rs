@@ -1,60 +1,19 @@
 //! `mrtmap segment`: thermal cloud → radiant scene.
 
-use anyhow::bail;
-use mrtmap_pipeline::files::Recording;
-use mrtmap_pipeline::level::{DEFAULT_CAMERA_ACCURACY_K, read_references};
-use mrtmap_pipeline::run::{LevelInputs, SegmentInputs, segment_into};
-use mrtmap_pipeline::run::{SegmentReport, Votes};
-use mrtmap_pipeline::settings::{RoomSection, SegmentSection};
+use mrtmap_pipeline::run::{SegmentJob, SegmentReport, Votes, segment_folder};
 
 use crate::cli::SegmentArgs;
 
 pub fn run(a: &SegmentArgs) -> anyhow::Result<()> {
-    if !a.fused.join("cloud.ply").exists() {
-        bail!(
-            "{} has no cloud.ply: give the output folder of `mrtmap fuse`",
-            a.fused.display()
-        );
-    }
-    let masks = match &a.masks {
-        Some(dir) => {
-            let r = Recording::open(dir)?;
-            if r.masks.is_empty() {
-                bail!("{} lists no masks (masks.txt)", dir.display());
-            }
-            Some(r)
-        }
-        None => None,
-    };
-    let recording = match (&a.recording, masks) {
-        (Some(dir), _) => Some(Recording::open(dir)?),
-        (None, m) => m,
-    };
-    let section = SegmentSection {
-        feature_threshold_k: a.feature_threshold_k,
-        feature_min_area_m2: a.feature_min_area_m2,
-        raster_m: a.raster_m,
-        masks: a.masks.is_some(),
-        texture: recording.is_some(),
-    };
-    section.check()?;
-    let inputs = SegmentInputs {
-        recording: recording.as_ref(),
-        masks: section.masks,
-        texture: section.texture,
-    };
-    let room = RoomSection {
+    let report = segment_folder(&SegmentJob {
+        fused: &a.fused,
+        masks: a.masks.as_deref(),
+        recording: a.recording.as_deref(),
+        section: a.section.clone(),
         origin_corner: a.origin_corner,
-    };
-    room.check()?;
-    let level = LevelInputs {
-        references: match &a.references {
-            Some(f) => read_references(f)?,
-            None => Vec::new(),
-        },
-        camera_accuracy_k: DEFAULT_CAMERA_ACCURACY_K,
-    };
-    let report = segment_into(&a.fused, &inputs, &section.params(&room), &level, &a.out)?;
+        references: a.references.as_deref(),
+        out: &a.out,
+    })?;
     print_report(&report);
     for w in &report.warnings {
         outln!("  warning: {w}");
