@@ -189,6 +189,24 @@ pub fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
     })
 }
 
+/// One line per stage: its time, and whether it was reused.
+pub fn stage_lines(stages: &[StageOutcome]) -> Vec<String> {
+    let mut lines = Vec::new();
+    for st in stages {
+        lines.push(format!(
+            "  {:<14} {:>7.1} s{}",
+            st.stage,
+            st.secs,
+            if st.skipped {
+                "  (inputs unchanged: reused)"
+            } else {
+                ""
+            }
+        ));
+    }
+    lines
+}
+
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used)]

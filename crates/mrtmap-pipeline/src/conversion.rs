@@ -89,3 +89,38 @@ pub struct Conversion {
     /// How things were decided.
     pub notes: Vec<String>,
 }
+
+impl Conversion {
+    /// What a conversion wrote, in lines.
+    pub fn lines(&self) -> Vec<String> {
+        let mut lines = Vec::new();
+        let from = |s: &Option<String>| s.as_ref().map(|s| format!(" ({s})")).unwrap_or_default();
+        lines.push(format!(
+            "wrote {}: {} depth, {} thermal{}, {} colour frames, {} poses{}{}{}",
+            self.out.display(),
+            self.depth,
+            self.thermal,
+            from(&self.thermal_from),
+            self.rgb,
+            self.poses,
+            from(&self.poses_from),
+            if self.imu > 0 {
+                format!(", {} inertial samples", self.imu)
+            } else {
+                String::new()
+            },
+            if self.skipped > 0 {
+                format!("; skipped {} {}", self.skipped, self.skipped_unit)
+            } else {
+                String::new()
+            }
+        ));
+        for r in &self.skipped_reasons {
+            lines.push(format!("  skipped: {r}"));
+        }
+        for n in &self.notes {
+            lines.push(format!("  note: {n}"));
+        }
+        lines
+    }
+}

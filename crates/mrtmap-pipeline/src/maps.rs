@@ -11,6 +11,7 @@ pub use mrtmap_radiation::GridSpec;
 use mrtmap_radiation::{
     MapFrame, Method, MrtEngine, MrtError, MrtField, PointRecord, RadiantScene,
 };
+use mrtmap_report::numbers::{fixed, uncertainty, xyz};
 use mrtmap_report::{MapAxes, MapInput, MapMark, MapSummary, grid_csv, render_png, render_svg};
 use serde::{Deserialize, Serialize};
 
@@ -268,6 +269,55 @@ pub fn to_scene_frame(
                 "has no world_from_room (it was not written by segmentation), so points in the scan's frame cannot be placed in it: give them in its own frame",
             )),
         },
+    }
+}
+
+impl Summary {
+    /// A map's extremes, the parts of its largest ±, the unseen patches that matter most and its
+    /// marks, in lines (what `map` and `run` print).
+    pub fn lines(&self) -> Vec<String> {
+        let mut lines = Vec::new();
+        match &self.map.field {
+            Some(f) => {
+                lines.push(format!(
+                    "MRT at {:.2} m over {} nodes: min {:.2} °C at ({}, {}), max {:.2} °C at ({}, {}), mean {:.2} °C; largest standard error {} K",
+                    self.map.height_m,
+                    f.nodes,
+                    f.min.mrt_c,
+                    fixed(f.min.uv[0], 2),
+                    fixed(f.min.uv[1], 2),
+                    f.max.mrt_c,
+                    fixed(f.max.uv[0], 2),
+                    fixed(f.max.uv[1], 2),
+                    f.mean_c,
+                    uncertainty(f.max_std_error_k, 3)
+                ));
+                if f.skipped > 0 {
+                    lines.push(format!(
+                        "{} nodes skipped (inside furniture, or refused): see the note column of mrt_grid.csv",
+                        f.skipped
+                    ));
+                }
+                lines.push(format!(
+                    "  its parts, the largest of each: {}",
+                    crate::report::parts_line(&f.max_std_error_parts, 3)
+                ));
+                for u in f.unseen_patches.iter().take(3) {
+                    lines.push(format!("  not seen: {}", crate::report::unseen_line(u)));
+                }
+            }
+            None => lines.push("no grid node could be computed".to_string()),
+        }
+        for m in &self.marks {
+            lines.push(format!(
+                "  {}: MRT {:.2} °C ± {} K at {}",
+                m.name.as_deref().unwrap_or("?"),
+                m.mrt_c,
+                uncertainty(m.std_error_k, 2),
+                xyz(&m.xyz)
+            ));
+        }
+        lines
     }
 }
 

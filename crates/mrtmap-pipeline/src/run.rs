@@ -796,3 +796,47 @@ pub fn run(
         warnings,
     })
 }
+
+impl RunOutcome {
+    /// What `run` and `demo` print: the tracker's figures, each stage, the frames fused and the
+    /// clock, each map, the warnings and where the report is (`out`, after `secs`), in lines.
+    pub fn lines(&self, out: &Path, secs: f64) -> Vec<String> {
+        let mut lines = Vec::new();
+        if let Some(t) = &self.track {
+            lines.push(format!(
+                "poses from the built-in tracker (track/trajectory.txt): {} of {} colour frames, {} keyframes, {} loop closures{}",
+                t.tracked,
+                t.frames,
+                t.keyframes,
+                t.loops_accepted,
+                t.accuracy
+                    .map(|e| format!(
+                        "; against groundtruth.txt ATE {:.1} mm, drift over {:.1} s {:.1} mm, {:.2}°",
+                        e.ate_rmse_m * 1000.0,
+                        e.drift_span_s,
+                        e.drift_translation_rmse_m * 1000.0,
+                        e.drift_rotation_rmse_deg
+                    ))
+                    .unwrap_or_default()
+            ));
+        }
+        lines.extend(crate::cache::stage_lines(&self.stages));
+        lines.push(format!(
+            "{} of {} thermal frames fused; {}",
+            self.fusion.used_frames,
+            self.fusion.thermal_frames,
+            self.fusion.clock.describe()
+        ));
+        for m in &self.maps {
+            lines.extend(m.summary.lines());
+        }
+        for w in &self.warnings {
+            lines.push(format!("warning: {w}"));
+        }
+        lines.push(format!(
+            "done in {secs:.1} s; report: {}",
+            out.join("report.html").display()
+        ));
+        lines
+    }
+}

@@ -3,10 +3,6 @@
 
 use std::io::Write;
 
-use mrtmap_pipeline::StageOutcome;
-use mrtmap_pipeline::maps::Summary;
-use mrtmap_pipeline::report::numbers::{fixed, uncertainty, xyz};
-
 /// Like `println!`, but a closed pipe (`mrtmap rooms | head -1`) ends the program quietly.
 macro_rules! outln {
     () => {
@@ -96,137 +92,13 @@ impl mrtmap_pipeline::Progress for Bar {
     }
 }
 
-/// Prints a map's extremes and marks.
-pub fn print_map(s: &Summary) {
-    match &s.map.field {
-        Some(f) => {
-            outln!(
-                "MRT at {:.2} m over {} nodes: min {:.2} °C at ({}, {}), max {:.2} °C at ({}, {}), mean {:.2} °C; largest standard error {} K",
-                s.map.height_m,
-                f.nodes,
-                f.min.mrt_c,
-                fixed(f.min.uv[0], 2),
-                fixed(f.min.uv[1], 2),
-                f.max.mrt_c,
-                fixed(f.max.uv[0], 2),
-                fixed(f.max.uv[1], 2),
-                f.mean_c,
-                uncertainty(f.max_std_error_k, 3)
-            );
-            if f.skipped > 0 {
-                outln!(
-                    "{} nodes skipped (inside furniture, or refused): see the note column of mrt_grid.csv",
-                    f.skipped
-                );
-            }
-            outln!(
-                "  its parts, the largest of each: {}",
-                mrtmap_pipeline::report::parts_line(&f.max_std_error_parts, 3)
-            );
-            for u in f.unseen_patches.iter().take(3) {
-                outln!("  not seen: {}", mrtmap_pipeline::report::unseen_line(u));
-            }
-        }
-        None => outln!("no grid node could be computed"),
-    }
-    for m in &s.marks {
-        outln!(
-            "  {}: MRT {:.2} °C ± {} K at {}",
-            m.name.as_deref().unwrap_or("?"),
-            m.mrt_c,
-            uncertainty(m.std_error_k, 2),
-            xyz(&m.xyz)
-        );
+/// Prints each line.
+pub fn print_lines(lines: impl IntoIterator<Item = String>) {
+    for line in lines {
+        outln!("{line}");
     }
 }
 
-/// Prints one line per stage: its time, and whether it was reused.
-pub fn print_stages(stages: &[StageOutcome]) {
-    for st in stages {
-        outln!(
-            "  {:<14} {:>7.1} s{}",
-            st.stage,
-            st.secs,
-            if st.skipped {
-                "  (inputs unchanged: reused)"
-            } else {
-                ""
-            }
-        );
-    }
-}
-
-/// Prints a run's stages, maps and warnings, and where the report is.
-pub fn print_run(o: &mrtmap_pipeline::run::RunOutcome, out: &std::path::Path, secs: f64) {
-    if let Some(t) = &o.track {
-        outln!(
-            "poses from the built-in tracker (track/trajectory.txt): {} of {} colour frames, {} keyframes, {} loop closures{}",
-            t.tracked,
-            t.frames,
-            t.keyframes,
-            t.loops_accepted,
-            t.accuracy
-                .map(|e| format!(
-                    "; against groundtruth.txt ATE {:.1} mm, drift over {:.1} s {:.1} mm, {:.2}°",
-                    e.ate_rmse_m * 1000.0,
-                    e.drift_span_s,
-                    e.drift_translation_rmse_m * 1000.0,
-                    e.drift_rotation_rmse_deg
-                ))
-                .unwrap_or_default()
-        );
-    }
-    print_stages(&o.stages);
-    outln!(
-        "{} of {} thermal frames fused; {}",
-        o.fusion.used_frames,
-        o.fusion.thermal_frames,
-        o.fusion.clock.describe()
-    );
-    for m in &o.maps {
-        print_map(&m.summary);
-    }
-    for w in &o.warnings {
-        outln!("warning: {w}");
-    }
-    outln!(
-        "done in {secs:.1} s; report: {}",
-        out.join("report.html").display()
-    );
-}
-
-/// Prints what a conversion wrote.
-pub fn print_conversion(c: &mrtmap_pipeline::source::Conversion) {
-    let from = |s: &Option<String>| s.as_ref().map(|s| format!(" ({s})")).unwrap_or_default();
-    outln!(
-        "wrote {}: {} depth, {} thermal{}, {} colour frames, {} poses{}{}{}",
-        c.out.display(),
-        c.depth,
-        c.thermal,
-        from(&c.thermal_from),
-        c.rgb,
-        c.poses,
-        from(&c.poses_from),
-        if c.imu > 0 {
-            format!(", {} inertial samples", c.imu)
-        } else {
-            String::new()
-        },
-        if c.skipped > 0 {
-            format!("; skipped {} {}", c.skipped, c.skipped_unit)
-        } else {
-            String::new()
-        }
-    );
-    for r in &c.skipped_reasons {
-        outln!("  skipped: {r}");
-    }
-    for n in &c.notes {
-        outln!("  note: {n}");
-    }
-}
-
-/// Prints the streams a bag's scan would use, and what it lacks.
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -11,6 +11,7 @@ use mrtmap_pipeline::calibration::{
 };
 
 use crate::cli::CalibrateArgs;
+use crate::output::print_lines;
 
 fn print_problems<'a>(seen: impl Iterator<Item = &'a Seen>) {
     for s in seen {
@@ -50,9 +51,7 @@ fn mono(a: &CalibrateArgs, board: &Board, dir: &Path) -> anyhow::Result<()> {
         d.size.1
     );
     let r = calibrate_images(&d, board, a.distortion)?;
-    for line in mono_lines(&d, &r) {
-        outln!("{line}");
-    }
+    print_lines(mono_lines(&d, &r));
     if let Some(rep) = &a.report {
         write_mono_report(rep, board, &d, &r)?;
         outln!("report: {}", rep.display());
@@ -89,9 +88,7 @@ fn stereo(a: &CalibrateArgs, board: &Board, dir: &Path) -> anyhow::Result<()> {
         common_corners: a.common_corners,
     };
     let r = calibrate_pairs(&d, board, &opts)?;
-    for line in stereo_lines(&r, d.pairs.iter().map(|p| p.name.as_str())) {
-        outln!("{line}");
-    }
+    print_lines(stereo_lines(&r, d.pairs.iter().map(|p| p.name.as_str())));
     if let Some(out) = &a.out {
         let updated = write_rig(out, board, &d, &r)?;
         outln!(

@@ -7,7 +7,7 @@ use mrtmap_pipeline::source::Container;
 use mrtmap_pipeline::source::{ContainerOut, convert, write_container};
 
 use crate::cli::{CompressionArg, ConvertArgs};
-use crate::output::print_conversion;
+use crate::output::print_lines;
 use mrtmap_pipeline::source::plan_lines;
 
 /// The container an output file name asks for, if any.
@@ -50,7 +50,7 @@ pub fn run(a: &ConvertArgs) -> anyhow::Result<()> {
     }
     match convert(&a.source, &a.out, &a.src) {
         Ok(c) => {
-            print_conversion(&c);
+            print_lines(c.lines());
             Ok(())
         }
         Err(e) => {
@@ -58,9 +58,7 @@ pub fn run(a: &ConvertArgs) -> anyhow::Result<()> {
                 plan: Some(plan), ..
             } = &e
             {
-                for line in plan_lines(plan) {
-                    outln!("{line}");
-                }
+                print_lines(plan_lines(plan));
             }
             Err(e.into())
         }

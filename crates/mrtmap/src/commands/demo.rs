@@ -3,7 +3,7 @@
 use mrtmap_pipeline::demo::{DemoSettings, demo};
 
 use crate::cli::DemoArgs;
-use crate::output::{Bar, print_run};
+use crate::output::{Bar, print_lines};
 
 pub fn run(a: &DemoArgs) -> anyhow::Result<()> {
     let t0 = std::time::Instant::now();
@@ -47,7 +47,7 @@ pub fn run(a: &DemoArgs) -> anyhow::Result<()> {
         d.simulate.secs,
         if d.simulate.skipped { "  (reused)" } else { "" }
     );
-    print_run(&d.run, &d.run_dir, t0.elapsed().as_secs_f64());
+    print_lines(d.run.lines(&d.run_dir, t0.elapsed().as_secs_f64()));
     outln!();
     outln!("MRT at the validation points (°C), as in the seed paper's table:");
     outln!(

@@ -5,14 +5,14 @@ use mrtmap_pipeline::run::fuse_into;
 use mrtmap_pipeline::source::prepare;
 
 use crate::cli::FuseArgs;
-use crate::output::{Bar, print_conversion};
+use crate::output::{Bar, print_lines};
 
 pub fn run(a: &FuseArgs) -> anyhow::Result<()> {
     let params = a.fuse.params()?;
     mrtmap_pipeline::run::check_out_apart(&a.recording, &a.out)?;
     let prepared = prepare(&a.recording, &a.out, &a.src)?;
     if let Some(c) = &prepared.conversion {
-        print_conversion(c);
+        print_lines(c.lines());
     } else if prepared.reused {
         outln!(
             "using {} (converted earlier from {})",

@@ -3,7 +3,7 @@
 use mrtmap_pipeline::source::inspect;
 
 use crate::cli::InspectArgs;
-use crate::output::json;
+use crate::output::{json, print_lines};
 
 pub fn run(a: &InspectArgs) -> anyhow::Result<()> {
     let what = inspect(&a.source, &a.src)?;
@@ -11,8 +11,6 @@ pub fn run(a: &InspectArgs) -> anyhow::Result<()> {
         out!("{}", json(&what.to_json(&a.source))?);
         return Ok(());
     }
-    for line in what.lines(&a.source) {
-        outln!("{line}");
-    }
+    print_lines(what.lines(&a.source));
     Ok(())
 }

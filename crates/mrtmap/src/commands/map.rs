@@ -9,7 +9,7 @@ use mrtmap_pipeline::report::numbers::{fixed, uncertainty};
 use mrtmap_pipeline::settings::Quantity;
 
 use crate::cli::MapArgs;
-use crate::output::print_map;
+use crate::output::print_lines;
 
 pub fn run(a: &MapArgs) -> anyhow::Result<()> {
     let mut project = match &a.config {
@@ -45,7 +45,7 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
     let m = &maps.map;
     outln!("scene: {source}");
     outln!("method: {}", m.method);
-    print_map(&m.summary);
+    print_lines(m.summary.lines());
     outln!(
         "computed in {:.3} s; wrote mrt_grid.csv, mrt_map.png, mrt_map.svg, summary.json in {}",
         m.summary.map.compute_secs,

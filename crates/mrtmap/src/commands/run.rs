@@ -9,7 +9,7 @@ use mrtmap_pipeline::settings::PointEntry;
 use mrtmap_pipeline::source::prepare;
 
 use crate::cli::RunArgs;
-use crate::output::{Bar, print_conversion, print_run};
+use crate::output::{Bar, print_lines};
 
 /// The project from the file and the flags.
 fn settings(a: &RunArgs) -> anyhow::Result<Project> {
@@ -70,7 +70,7 @@ pub fn run(a: &RunArgs) -> anyhow::Result<()> {
     let t0 = Instant::now();
     let prepared = prepare(&a.recording, &a.out, &a.src)?;
     if let Some(c) = &prepared.conversion {
-        print_conversion(c);
+        print_lines(c.lines());
     } else if prepared.reused {
         outln!(
             "using {} (converted earlier from {})",
@@ -90,6 +90,6 @@ pub fn run(a: &RunArgs) -> anyhow::Result<()> {
     let secs = t0.elapsed().as_secs_f64();
     write_run_outputs(&a.out, &data, &outcome, &a.recording, &p, secs)?;
     outln!("ran {} into {}", a.recording.display(), a.out.display());
-    print_run(&outcome, &a.out, secs);
+    print_lines(outcome.lines(&a.out, secs));
     Ok(())
 }
