@@ -203,3 +203,106 @@ pub fn judge(o: &RunOutcome, target_k: f64) -> Coverage {
         frames: [fused, recorded],
     }
 }
+
+impl Coverage {
+    /// The verdict in lines, as `mrtmap coverage` prints it (`secs`: how long the check took).
+    pub fn lines(&self, secs: f64) -> Vec<String> {
+        let mut lines = Vec::new();
+        if self.surfaces.is_empty() {
+            lines.push(format!(
+                "not good enough for a ±{} K map (checked in {secs:.1} s):",
+                self.target_k
+            ));
+            for r in &self.reasons {
+                lines.push(format!("  - {r}"));
+            }
+            return lines;
+        }
+        lines.push(format!(
+            "{:<10} {:>8} {:>16} {:>14} {:>8}",
+            "surface", "area m²", "seen with depth", "textured only", "unseen"
+        ));
+        for s in &self.surfaces {
+            lines.push(format!(
+                "{:<10} {:>8.1} {:>15.0} % {:>12.0} % {:>6.0} %{}",
+                s.id,
+                s.area_m2,
+                100.0 * s.seen_with_depth,
+                100.0 * s.textured_only,
+                100.0 * s.unseen,
+                if s.inferred { "  (never seen)" } else { "" }
+            ));
+        }
+        lines.push(format!(
+            "{} of {} thermal frames fused; the temperatures' level rests on {} (±{:.2} K)",
+            self.frames[0], self.frames[1], self.level_basis, self.level_std_k
+        ));
+        lines.push(format!(
+            "what the scan did not see: up to ±{:.2} K (2σ) on the map at 1.1 m",
+            2.0 * self.max_unseen_k
+        ));
+        if self.good_enough {
+            lines.push(format!(
+                "good enough for a ±{} K map (checked in {secs:.1} s)",
+                self.target_k
+            ));
+        } else {
+            lines.push(format!(
+                "not good enough for a ±{} K map (checked in {secs:.1} s):",
+                self.target_k
+            ));
+            for r in &self.reasons {
+                lines.push(format!("  - {r}"));
+            }
+        }
+        for n in &self.notes {
+            lines.push(format!("note: {n}"));
+        }
+        if !self.look_at.is_empty() {
+            lines.push("where to point the camera, most important first:".to_string());
+            for l in &self.look_at {
+                lines.push(format!("  - {l}"));
+            }
+        }
+        lines
+    }
+}
+
+/// `mrtmap coverage` in one call: checks the target (K, 2σ), reads the project file when given,
+/// prepares the recording (any source `run` takes) and runs the coarse check into `out`, or into
+/// a temporary folder that is removed.
+pub fn coverage_of(
+    recording: &Path,
+    out: Option<&Path>,
+    config: Option<&Path>,
+    source: &crate::source::SourceOptions,
+    target_k: f64,
+    progress: &dyn Progress,
+) -> Result<Coverage> {
+    if !(target_k.is_finite() && target_k > 0.0 && target_k <= 10.0) {
+        return Err(Error::setting(
+            format!("--target-k {target_k}"),
+            "give the map's target as a positive number of kelvin (2σ), at most 10",
+        ));
+    }
+    let p = match config {
+        Some(f) => Project::load(f)?,
+        None => Project::default(),
+    };
+    p.check()?;
+    let temp = match out {
+        Some(_) => None,
+        None => Some(
+            tempfile::tempdir()
+                .map_err(|e| mrtmap_io::FileError::io(Path::new("a temporary folder"), e))?,
+        ),
+    };
+    let out = match (out, &temp) {
+        (Some(o), _) => o.to_path_buf(),
+        (None, Some(t)) => t.path().join("coverage"),
+        (None, None) => unreachable!("one of the two is set"),
+    };
+    crate::run::check_out_dir(&out)?;
+    let prepared = crate::source::prepare(recording, &out, source)?;
+    coverage(&prepared.dir, &out, &p, target_k, progress)
+}

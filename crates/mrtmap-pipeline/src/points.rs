@@ -8,6 +8,7 @@ pub use mrtmap_physics::{AsymmetryKind, Posture};
 /// example scene (mrtmap-radiation's).
 pub use mrtmap_radiation::{AsymmetryVerdict, ENCLOSURE_TOLERANCE, EXAMPLE_OFFICE_JSON, Facing};
 use mrtmap_radiation::{PersonMrt, PointRecord, RadiantAsymmetry, RadiantScene};
+use mrtmap_report::numbers::{fixed, uncertainty};
 use serde::Serialize;
 
 use crate::error::Result;
@@ -165,6 +166,133 @@ pub fn mrt_at_points(
         }
     }
     Ok(answers)
+}
+
+/// An asymmetry's verdict in words.
+fn verdict_text(v: &AsymmetryVerdict) -> String {
+    let kind = match v.kind {
+        AsymmetryKind::WarmCeiling => "warm ceiling",
+        AsymmetryKind::CoolCeiling => "cool ceiling",
+        AsymmetryKind::WarmWall => "warm wall",
+        AsymmetryKind::CoolWall => "cool wall",
+    };
+    format!(
+        "{:.2} K ({kind}): {:.1} % dissatisfied, ISO 7730 category {}",
+        v.delta_k,
+        v.pd_pct,
+        v.category.as_str()
+    )
+}
+
+impl PointAnswers {
+    /// What `mrtmap mrt` prints, in lines: each person's MRT with its angle factors, each plane's
+    /// radiant temperatures and asymmetries, and each point's MRT, its ± in parts and its
+    /// view-factor table.
+    pub fn lines(&self) -> Vec<String> {
+        let mut lines = Vec::new();
+        if !self.persons.is_empty() || !self.planes.is_empty() {
+            lines.push(format!("scene: {}", self.scene));
+            lines.extend(person_and_plane_lines(&self.persons, &self.planes));
+            if self.points.is_empty() {
+                return lines;
+            }
+        }
+        lines.push(format!("scene: {}", self.scene));
+        lines.push(format!("method: {}", self.method_description));
+        for p in &self.points {
+            lines.push(String::new());
+            lines.push(format!(
+                "point ({}, {}, {}): MRT {:.2} °C ± {} K   (ΣF = {:.4})",
+                fixed(p.xyz[0], 3),
+                fixed(p.xyz[1], 3),
+                fixed(p.xyz[2], 3),
+                p.mrt_c,
+                uncertainty(p.std_error_k, 2),
+                p.view_factor_sum
+            ));
+            lines.push(format!(
+                "  ± in parts: {}",
+                crate::report::parts_line(&p.parts(), 2)
+            ));
+            if (p.view_factor_sum - 1.0).abs() > ENCLOSURE_TOLERANCE {
+                lines.push(format!(
+                    "  warning: the scene covers only {:.1} % of the view here (asked for with --allow-open): the MRT leaves the rest out",
+                    p.view_factor_sum * 100.0
+                ));
+            }
+            lines.push(format!(
+                "  {:<28} {:<18} {:>9} {:>9} {:>8}",
+                "id", "label", "F", "±", "T (°C)"
+            ));
+            for v in &p.view_factors {
+                let label = if v.label.is_empty() {
+                    "-"
+                } else {
+                    v.label.as_str()
+                };
+                let id = match &v.host {
+                    Some(h) => format!("{} (on {h})", v.id),
+                    None => v.id.clone(),
+                };
+                lines.push(format!(
+                    "  {:<28} {:<18} {:>9.5} {:>9.5} {:>8.2}",
+                    id, label, v.view_factor, v.view_factor_std_error, v.temperature_c
+                ));
+            }
+        }
+        lines
+    }
+}
+
+/// Each person's MRT and angle factors, each plane's radiant temperatures, in lines.
+fn person_and_plane_lines(persons: &[PersonAnswer], planes: &[PlaneAnswer]) -> Vec<String> {
+    let mut lines = Vec::new();
+    for p in persons {
+        lines.push(String::new());
+        lines.push(format!(
+            "{} person, body centre ({}, {}, {}), {}: MRT {:.2} °C ± {} K",
+            p.posture.as_str(),
+            fixed(p.centre[0], 3),
+            fixed(p.centre[1], 3),
+            fixed(p.centre[2], 3),
+            p.facing.describe(),
+            p.mrt_c,
+            uncertainty(p.std_error_k, 2)
+        ));
+        lines.push(format!(
+            "  angle factors (sum {:.4}; fp's closure is about 0.99, the MRT is normalised by it):",
+            p.angle_factor_sum
+        ));
+        for (id, f) in p.angle_factors.iter().filter(|(_, f)| *f > 0.0) {
+            lines.push(format!("  {id:<28} {f:>9.5}"));
+        }
+    }
+    for pl in planes {
+        lines.push(String::new());
+        lines.push(format!(
+            "plane radiant temperatures at ({}, {}, {}) ({}):",
+            fixed(pl.point[0], 3),
+            fixed(pl.point[1], 3),
+            fixed(pl.point[2], 3),
+            if pl.exact { "exact" } else { "rays" }
+        ));
+        for (face, t, e) in &pl.faces {
+            lines.push(format!(
+                "  {face:<5} {t:>7.2} °C ± {} K",
+                uncertainty(*e, 2)
+            ));
+        }
+        lines.push(format!(
+            "  vertical asymmetry   {}",
+            verdict_text(&pl.vertical)
+        ));
+        lines.push(format!(
+            "  horizontal asymmetry {} (warmer side towards {:.0}°)",
+            verdict_text(&pl.horizontal),
+            pl.horizontal_warm_azimuth_deg
+        ));
+    }
+    lines
 }
 
 #[cfg(test)]
