@@ -55,16 +55,13 @@ pub mod run;
 pub mod settings;
 pub mod simulation;
 pub mod source;
+pub mod thermal_image;
 pub mod validation;
 
-/// The file formats a front end reads or writes itself (mrtmap-io's): a recording, thermal image
-/// files, atomic writes, and I/O errors in words.
+/// The file formats a front end reads or writes itself (mrtmap-io's): a recording, its rig,
+/// atomic writes, and I/O errors in words.
 pub mod files {
-    pub use mrtmap_io::flir::FlirOverrides;
-    pub use mrtmap_io::{
-        FileError, InterpolationLimits, Recording, Rig, ThermalOptions, encode_png16, io_words,
-        read_thermal_file, write_atomic,
-    };
+    pub use mrtmap_io::{FileError, InterpolationLimits, Recording, Rig, io_words, write_atomic};
 }
 
 pub use cache::{Fingerprint, Stage, StageOutcome, run_or_reuse};

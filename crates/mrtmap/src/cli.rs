@@ -4,14 +4,13 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use mrtmap_pipeline::MrtSection;
-use mrtmap_pipeline::parse::{
-    parse_facing, parse_grid, parse_image_size, parse_mark, parse_on_off, parse_point,
-};
+use mrtmap_pipeline::parse::{parse_facing, parse_grid, parse_mark, parse_on_off, parse_point};
 use mrtmap_pipeline::settings::{FuseSection, SegmentSection};
 use mrtmap_pipeline::settings::{PointFrame, Quantity};
 use mrtmap_pipeline::simulation::CameraErrorArgs;
 use mrtmap_pipeline::simulation::NoiseLevel;
 use mrtmap_pipeline::source::SourceOptions;
+use mrtmap_pipeline::thermal_image::ThermalReading;
 
 /// Map the mean radiant temperature (MRT) of a room.
 ///
@@ -164,30 +163,9 @@ pub struct ThermalArgs {
     /// Print the metadata and statistics as JSON.
     #[arg(long)]
     pub json: bool,
-    /// Size of a raw .y16/.bin file, WxH (default: 160x120 or 80x60 from the file length).
-    #[arg(long, value_name = "WxH", value_parser = parse_image_size)]
-    pub size: Option<(u32, u32)>,
-    /// Kelvin per count of 16-bit PNG/TIFF/raw values.
-    #[arg(long)]
-    pub scale: Option<f64>,
-    /// Kelvin added after scaling 16-bit values.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub offset_k: f64,
-    /// FLIR: object emissivity (replaces the file's).
-    #[arg(long)]
-    pub emissivity: Option<f64>,
-    /// FLIR: object distance, m.
-    #[arg(long)]
-    pub distance: Option<f64>,
-    /// FLIR: reflected apparent temperature, °C.
-    #[arg(long, allow_negative_numbers = true)]
-    pub reflected: Option<f64>,
-    /// FLIR: atmospheric temperature, °C.
-    #[arg(long, allow_negative_numbers = true)]
-    pub atmospheric: Option<f64>,
-    /// FLIR: relative humidity, percent.
-    #[arg(long)]
-    pub humidity: Option<f64>,
+    /// How to read the file.
+    #[command(flatten)]
+    pub reading: ThermalReading,
 }
 
 /// `mrtmap calibrate`.
