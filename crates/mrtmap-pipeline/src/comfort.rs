@@ -12,6 +12,7 @@
 use std::path::Path;
 
 use mrtmap_geometry::nalgebra::Point2;
+use mrtmap_io::FileError;
 use mrtmap_physics::{
     Category, OperativeMethod, PmvInputs, Posture, Temperature, operative_temperature, pmv_ppd,
 };
@@ -542,4 +543,126 @@ fn summarise(
         marks,
         compute_secs,
     }
+}
+
+/// A person's comfort at one air state and MRT (what `mrtmap comfort` prints).
+#[derive(Clone, Debug, Serialize)]
+pub struct ComfortAnswer {
+    /// The air, activity and clothing.
+    pub air: Air,
+    /// The mean radiant temperature (°C).
+    pub mrt_c: f64,
+    /// The PMV model, in words.
+    pub model: &'static str,
+    /// Operative temperature (°C, ISO 7726).
+    pub operative_c: f64,
+    /// Predicted mean vote.
+    pub pmv: f64,
+    /// Predicted percentage dissatisfied (%).
+    pub ppd_pct: f64,
+    /// Whether the inputs lie within ISO 7730's ranges.
+    pub within_iso_ranges: bool,
+    /// ISO 7730 category.
+    pub category: &'static str,
+}
+
+/// Operative temperature, PMV and PPD for `air` at the mean radiant temperature `mrt_c`.
+pub fn comfort_of(air: Air, mrt_c: f64) -> Result<ComfortAnswer> {
+    let t = thermal(&air, mrt_c, 0.0)?;
+    Ok(ComfortAnswer {
+        air,
+        mrt_c,
+        model: PMV_MODEL,
+        operative_c: t.operative_c,
+        pmv: t.pmv,
+        ppd_pct: t.ppd_pct,
+        within_iso_ranges: t.within_iso_ranges,
+        category: t.category.as_str(),
+    })
+}
+
+impl ComfortAnswer {
+    /// The answer in lines.
+    pub fn lines(&self) -> Vec<String> {
+        vec![
+            format!("model: {}", self.model),
+            format!(
+                "operative temperature {:.2} °C (ISO 7726)",
+                self.operative_c
+            ),
+            format!(
+                "PMV {:.3}, PPD {:.1} %: ISO 7730 category {}{}",
+                self.pmv,
+                self.ppd_pct,
+                self.category,
+                if self.within_iso_ranges {
+                    ""
+                } else {
+                    " (inputs outside ISO 7730's ranges: indicative only)"
+                }
+            ),
+        ]
+    }
+}
+
+/// Many cases at once: a CSV with the columns ta,tr,v,rh,met,clo (header first, in any order,
+/// other columns kept) becomes the same CSV with operative_c, pmv and ppd added; a case the
+/// model refuses gets empty cells and the reason. A cell that is not a number is refused, naming
+/// the line.
+pub fn comfort_csv(path: &Path) -> Result<Vec<String>> {
+    let text = std::fs::read_to_string(path).map_err(|e| FileError::io(path, e))?;
+    let mut rows = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty());
+    let Some((_, header)) = rows.next() else {
+        return Err(FileError::syntax(
+            path,
+            1,
+            "empty: give a header ta,tr,v,rh,met,clo and one row per case",
+        )
+        .into());
+    };
+    let names: Vec<&str> = header.split(',').map(str::trim).collect();
+    let col = |n: &str| {
+        names.iter().position(|h| *h == n).ok_or_else(|| {
+            FileError::syntax(
+                path,
+                1,
+                format!("the header has no column '{n}' (needs ta,tr,v,rh,met,clo)"),
+            )
+        })
+    };
+    let idx = [
+        col("ta")?,
+        col("tr")?,
+        col("v")?,
+        col("rh")?,
+        col("met")?,
+        col("clo")?,
+    ];
+    let mut lines = vec![format!("{header},operative_c,pmv,ppd")];
+    for (k, line) in rows {
+        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+        let num = |i: usize| {
+            cells
+                .get(i)
+                .and_then(|c| c.parse::<f64>().ok())
+                .ok_or_else(|| {
+                    FileError::syntax(path, k + 1, format!("column {} is not a number", names[i]))
+                })
+        };
+        let air = Air {
+            temperature_c: num(idx[0])?,
+            speed_m_s: num(idx[2])?,
+            relative_humidity_pct: num(idx[3])?,
+            met: num(idx[4])?,
+            clo: num(idx[5])?,
+        };
+        lines.push(match thermal(&air, num(idx[1])?, 0.0) {
+            Ok(t) => format!("{line},{:.6},{:.6},{:.6}", t.operative_c, t.pmv, t.ppd_pct),
+            Err(e) => format!("{line},,,\"{e}\""),
+        });
+    }
+    Ok(lines)
 }

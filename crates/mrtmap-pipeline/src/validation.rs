@@ -13,6 +13,8 @@ use mrtmap_report::{GlobeRow, ValidationRow, parse_globe_csv, validate, validati
 /// The ISO 7726 accuracy bounds a validation judges by (mrtmap-report's).
 pub use mrtmap_report::{ISO_DESIRED_K, ISO_REQUIRED_K};
 
+use serde::Serialize;
+
 use crate::cache::write_json;
 use crate::error::{Error, Result};
 use crate::maps::to_scene_frame;
@@ -183,4 +185,136 @@ pub fn validate_map(
         rows,
         level_shift_k,
     })
+}
+
+/// The globe formula to convert with: one choice for `mrtmap globe --method`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum GlobeFormulaChoice {
+    /// ISO 7726 general formula (any diameter and emissivity).
+    Iso,
+    /// ISO 7726 closed forms for the standard globe (0.15 m, ε 0.95), as printed in the seed paper.
+    IsoClosedForm,
+    /// Mixed-convection correction (Teitelbaum et al. 2022), 0.04–0.15 m globes.
+    Mixed,
+}
+
+impl GlobeFormulaChoice {
+    /// The method, with the convection regime for the ISO formulas.
+    pub fn method(self, convection: Convection) -> GlobeMethod {
+        match self {
+            Self::Iso => GlobeMethod::Iso { convection },
+            Self::IsoClosedForm => GlobeMethod::IsoClosedForm { convection },
+            Self::Mixed => GlobeMethod::MixedConvection,
+        }
+    }
+}
+
+/// A globe reading converted to MRT, or an MRT to the reading a globe would give.
+#[derive(Clone, Debug, Serialize)]
+pub struct GlobeConversion {
+    /// Mean radiant temperature (°C).
+    pub mrt_c: f64,
+    /// Globe temperature (°C).
+    pub globe_c: f64,
+    /// Air temperature (°C).
+    pub air_c: f64,
+    /// Air speed (m/s).
+    pub air_speed_m_s: f64,
+    /// Globe diameter (m).
+    pub diameter_m: f64,
+    /// Globe emissivity.
+    pub emissivity: f64,
+    /// The formula used.
+    pub formula: GlobeFormula,
+    /// The formula in words.
+    pub formula_description: &'static str,
+    /// Convective heat transfer coefficient (W/m²K).
+    pub h_w_m2k: f64,
+    /// "mrt_from_globe" or "globe_from_mrt".
+    pub direction: &'static str,
+}
+
+/// What a globe reads: its temperature `globe_c` (°C) to convert to MRT, or an MRT `mrt_c` to
+/// give the globe temperature for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GlobeInput {
+    /// A globe temperature (°C).
+    Globe(f64),
+    /// A mean radiant temperature (°C).
+    Mrt(f64),
+}
+
+/// Converts a globe reading to MRT, or an MRT to the globe's reading, with `globe` in air at
+/// `air_c` (°C) moving at `air_speed_m_s`.
+pub fn convert_globe(
+    input: GlobeInput,
+    globe: &Globe,
+    air_c: f64,
+    air_speed_m_s: f64,
+    method: GlobeMethod,
+) -> Result<GlobeConversion> {
+    let air = Temperature::from_celsius(air_c);
+    let (tg, direction) = match input {
+        GlobeInput::Globe(tg) => (Temperature::from_celsius(tg), "mrt_from_globe"),
+        GlobeInput::Mrt(tr) => (
+            globe_temperature(
+                globe,
+                Temperature::from_celsius(tr),
+                air,
+                air_speed_m_s,
+                method,
+            )?,
+            "globe_from_mrt",
+        ),
+    };
+    let r = mrt_from_globe(
+        globe,
+        &GlobeReading {
+            globe: tg,
+            air,
+            air_speed_m_s,
+        },
+        method,
+    )?;
+    Ok(GlobeConversion {
+        mrt_c: r.mrt.celsius(),
+        globe_c: tg.celsius(),
+        air_c,
+        air_speed_m_s,
+        diameter_m: globe.diameter_m,
+        emissivity: globe.emissivity,
+        formula: r.formula,
+        formula_description: r.formula.describe(),
+        h_w_m2k: r.h_w_m2k,
+        direction,
+    })
+}
+
+impl GlobeConversion {
+    /// The conversion in lines, as `mrtmap globe` prints it.
+    pub fn lines(&self) -> Vec<String> {
+        let conditions = format!(
+            "air {:.2} °C, air speed {} m/s, globe {} m, ε {}",
+            self.air_c, self.air_speed_m_s, self.diameter_m, self.emissivity
+        );
+        if self.direction == "mrt_from_globe" {
+            vec![
+                format!("MRT {:.2} °C", self.mrt_c),
+                format!("  from globe {:.2} °C, {conditions}", self.globe_c),
+                format!(
+                    "  formula: {} (h = {:.2} W/m²K)",
+                    self.formula_description, self.h_w_m2k
+                ),
+            ]
+        } else {
+            vec![
+                format!("globe temperature {:.2} °C", self.globe_c),
+                format!("  at MRT {:.2} °C, {conditions}", self.mrt_c),
+                format!(
+                    "  formula: {} (h = {:.2} W/m²K), solved numerically",
+                    self.formula_description, self.h_w_m2k
+                ),
+            ]
+        }
+    }
 }

@@ -11,6 +11,7 @@ use mrtmap_pipeline::simulation::CameraErrorArgs;
 use mrtmap_pipeline::simulation::NoiseLevel;
 use mrtmap_pipeline::source::SourceOptions;
 use mrtmap_pipeline::thermal_image::ThermalReading;
+use mrtmap_pipeline::validation::GlobeFormulaChoice;
 
 /// Map the mean radiant temperature (MRT) of a room.
 ///
@@ -674,17 +675,6 @@ pub struct ComfortArgs {
     pub json: bool,
 }
 
-/// Globe conversion formula.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum GlobeMethodArg {
-    /// ISO 7726 general formula (any diameter and emissivity).
-    Iso,
-    /// ISO 7726 closed forms for the standard globe (0.15 m, ε 0.95), as printed in the seed paper.
-    IsoClosedForm,
-    /// Mixed-convection correction (Teitelbaum et al. 2022), 0.04–0.15 m globes.
-    Mixed,
-}
-
 /// `mrtmap globe`.
 #[derive(Debug, Args)]
 #[command(group(clap::ArgGroup::new("reading").required(true).args(["tg", "tr"])))]
@@ -708,8 +698,8 @@ pub struct GlobeArgs {
     #[arg(long, default_value_t = 0.95)]
     pub emissivity: f64,
     /// Formula.
-    #[arg(long, value_enum, default_value_t = GlobeMethodArg::Iso)]
-    pub method: GlobeMethodArg,
+    #[arg(long, value_enum, default_value_t = GlobeFormulaChoice::Iso)]
+    pub method: GlobeFormulaChoice,
     /// Convection regime for the ISO formulas.
     #[arg(long, value_enum, default_value_t = mrtmap_pipeline::validation::Convection::Larger)]
     pub convection: mrtmap_pipeline::validation::Convection,
