@@ -840,3 +840,67 @@ impl RunOutcome {
         lines
     }
 }
+
+/// A label's vote share, in words.
+fn votes_text(v: Option<&Votes>) -> String {
+    v.map(|v| {
+        format!(
+            ", {:.0} % of {} votes",
+            v.share * 100.0,
+            v.votes.values().sum::<usize>()
+        )
+    })
+    .unwrap_or_default()
+}
+
+/// What segmentation found, in lines (what `mrtmap segment` prints): the room, its surfaces with
+/// their temperatures and coverage, the features with their labels and votes, the furniture, and
+/// the warnings.
+pub fn segment_lines(r: &SegmentReport) -> Vec<String> {
+    let mut lines = Vec::new();
+    lines.push(format!(
+        "room: {} walls, {:.2} m high; {:.0} % of the cloud on no surface (furniture, clutter)",
+        r.surfaces.len() - 2,
+        r.height_m,
+        r.unassigned_fraction * 100.0
+    ));
+    for s in &r.surfaces {
+        lines.push(format!(
+            "  {:<8} {:>6.2} m²  {}  ({:.0} % observed)",
+            s.id,
+            s.area_m2,
+            s.temperature_c
+                .map_or("not observed".to_string(), |t| format!(
+                    "{t:6.2} °C ± {} K",
+                    mrtmap_report::numbers::uncertainty(s.temperature_std_k, 2)
+                )),
+            s.observed_fraction * 100.0
+        ));
+    }
+    for f in &r.features {
+        lines.push(format!(
+            "  {:<18} on {:<8} {:6.2} °C ({:+.1} K), {:.2} m², label by {}{}",
+            f.id,
+            f.host,
+            f.temperature_c,
+            f.contrast_k,
+            f.area_m2,
+            f.label_source,
+            votes_text(f.votes.as_ref())
+        ));
+    }
+    for f in &r.furniture {
+        lines.push(format!(
+            "  {:<18} furniture {:.2} × {:.2} × {:.2} m, {:6.2} °C, label by {}{}",
+            f.id,
+            f.size_m[0],
+            f.size_m[1],
+            f.size_m[2],
+            f.temperature_c,
+            f.label_source,
+            votes_text(f.votes.as_ref())
+        ));
+    }
+    lines.extend(r.warnings.iter().map(|w| format!("  warning: {w}")));
+    lines
+}
