@@ -16,12 +16,10 @@ use mrtmap_geometry::nalgebra::{Isometry3, Point3};
 use mrtmap_io::{Recording, Trajectory, read_cloud_ply, write_atomic, write_cloud_ply};
 use mrtmap_radiation::{GridSpec, RadiantScene};
 use mrtmap_scan::FusedFrame;
-use mrtmap_scan::segment::{
-    MaskInput, SegmentParams, TextureInput, refined_poses, segment_textured,
-};
+use mrtmap_scan::segment::{MaskInput, SegmentParams, TextureInput, segment_textured};
 /// What segmentation reports, and the label votes (mrtmap-scan's).
 pub use mrtmap_scan::segment::{SegmentReport, Votes};
-use mrtmap_scan::{FuseParams, FusionReport, fuse};
+use mrtmap_scan::{FuseParams, FusionReport, fuse, refined_poses};
 use mrtmap_track::{TrackParams, TrackReport, track};
 
 use crate::cache::{Fingerprint, Stage, StageOutcome, read_json, run_or_reuse, write_json};

@@ -23,4 +23,4 @@ pub use fuse::{
     FuseParams, Fused, FusedFrame, FusionReport, IcpReport, IcpSettings, Timing, from_pose7, fuse,
     pose7,
 };
-pub use sync::{Pairing, SkipReason, pair_frames};
+pub use sync::{Pairing, SkipReason, pair_frames, refined_poses};

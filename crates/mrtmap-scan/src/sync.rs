@@ -1,6 +1,7 @@
 //! Matching streams by timestamp: each thermal frame takes the nearest depth frame within a
 //! tolerance; poses are interpolated at each frame's own time.
 
+use mrtmap_geometry::nalgebra::Isometry3;
 use mrtmap_io::{InterpolationLimits, Recording};
 use serde::{Deserialize, Serialize};
 
@@ -79,4 +80,40 @@ pub(crate) fn nearest(times: &[f64], t: f64) -> Option<usize> {
         .into_iter()
         .flatten()
         .min_by(|&a, &b| (times[a] - t).abs().total_cmp(&(times[b] - t).abs()))
+}
+
+/// The refined pose at any time: the recording's trajectory corrected by fusion's ICP correction
+/// (`fused` = the refined world_from_depth of the fused frames), interpolated between the fused
+/// frames. For placing mask frames, which run on their own clock.
+pub fn refined_poses(
+    rec: &Recording,
+    fused: &mrtmap_io::Trajectory,
+) -> impl Fn(f64) -> Option<Isometry3<f64>> + Sync + use<> {
+    let wide = InterpolationLimits {
+        max_gap_secs: 5.0,
+        max_extrapolation_secs: 5.0,
+    };
+    let corrections = mrtmap_io::Trajectory {
+        stamps: fused.stamps.clone(),
+        poses: fused
+            .stamps
+            .iter()
+            .zip(&fused.poses)
+            .map(|(t, p)| {
+                rec.trajectory
+                    .interpolate(*t, &InterpolationLimits::default())
+                    .map_or(Isometry3::identity(), |s| p * s.inverse())
+            })
+            .collect(),
+    };
+    let traj = rec.trajectory.clone();
+    move |t| {
+        let s = traj.interpolate(t, &InterpolationLimits::default())?;
+        Some(
+            corrections
+                .interpolate(t, &wide)
+                .unwrap_or(Isometry3::identity())
+                * s,
+        )
+    }
 }

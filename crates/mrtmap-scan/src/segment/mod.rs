@@ -1193,43 +1193,6 @@ pub fn unit(v: [f64; 3]) -> Option<Unit<Vector3<f64>>> {
     Unit::try_new(Vector3::from(v), 1e-9)
 }
 
-/// The refined pose at any time: the recording's trajectory corrected by fusion's ICP correction
-/// (`fused` = the refined world_from_depth of the fused frames), interpolated between the fused
-/// frames. For placing mask frames, which run on their own clock.
-pub fn refined_poses(
-    rec: &Recording,
-    fused: &mrtmap_io::Trajectory,
-) -> impl Fn(f64) -> Option<Isometry3<f64>> + Sync + use<> {
-    use mrtmap_io::InterpolationLimits;
-    let wide = InterpolationLimits {
-        max_gap_secs: 5.0,
-        max_extrapolation_secs: 5.0,
-    };
-    let corrections = mrtmap_io::Trajectory {
-        stamps: fused.stamps.clone(),
-        poses: fused
-            .stamps
-            .iter()
-            .zip(&fused.poses)
-            .map(|(t, p)| {
-                rec.trajectory
-                    .interpolate(*t, &InterpolationLimits::default())
-                    .map_or(Isometry3::identity(), |s| p * s.inverse())
-            })
-            .collect(),
-    };
-    let traj = rec.trajectory.clone();
-    move |t| {
-        let s = traj.interpolate(t, &InterpolationLimits::default())?;
-        Some(
-            corrections
-                .interpolate(t, &wide)
-                .unwrap_or(Isometry3::identity())
-                * s,
-        )
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

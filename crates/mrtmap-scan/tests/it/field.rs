@@ -7,9 +7,8 @@ use std::path::Path;
 use mrtmap_geometry::nalgebra::{Isometry3, Translation3, UnitQuaternion};
 use mrtmap_io::{Recording, Trajectory};
 use mrtmap_scan::clock::{ClockOffset, OffsetSource};
-use mrtmap_scan::segment::{
-    MaskInput, SegmentParams, TextureInput, refined_poses, segment, segment_textured,
-};
+use mrtmap_scan::refined_poses;
+use mrtmap_scan::segment::{MaskInput, SegmentParams, TextureInput, segment, segment_textured};
 use mrtmap_scan::{SkipReason, fuse, pair_frames};
 use mrtmap_sim::{NoiseLevel, SimConfig, Truth, preset, simulate};
 

@@ -1,8 +1,7 @@
 use mrtmap_geometry::nalgebra::Isometry3;
 use mrtmap_io::Recording;
-use mrtmap_scan::segment::{
-    MaskInput, SegmentParams, TextureInput, refined_poses, segment_textured,
-};
+use mrtmap_scan::refined_poses;
+use mrtmap_scan::segment::{MaskInput, SegmentParams, TextureInput, segment_textured};
 use mrtmap_sim::{Drift, NoiseLevel, SceneScore, Truth, score_scene};
 
 use crate::common::*;
