@@ -29,6 +29,7 @@
 
 mod atomic;
 pub mod bytes;
+pub mod depth;
 mod error;
 mod image16;
 pub mod layout;

@@ -131,3 +131,19 @@ impl Error {
 
 /// The pipeline's result.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+impl From<mrtmap_sources::convert::ConvertError> for Error {
+    fn from(e: mrtmap_sources::convert::ConvertError) -> Self {
+        use mrtmap_sources::convert::ConvertError as C;
+        match e {
+            C::File(f) => Self::File(f),
+            C::Source { path, problem } => Self::Source { path, problem },
+            C::NotAScan { path, missing } => Self::NotAScan {
+                path,
+                missing,
+                plan: None,
+            },
+            C::Setting { setting, problem } => Self::Setting { setting, problem },
+        }
+    }
+}

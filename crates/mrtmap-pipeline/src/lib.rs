@@ -50,7 +50,6 @@ pub mod parse;
 pub mod points;
 pub mod progress;
 pub mod report;
-mod rtabmap;
 pub mod run;
 pub mod settings;
 pub mod simulation;

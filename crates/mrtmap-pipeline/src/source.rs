@@ -370,7 +370,7 @@ pub fn inspect(source: &Path, o: &SourceOptions) -> Result<Inspection> {
         }
         SourceKind::RtabMap => {
             let summary = rtabmap::summarize(source)?;
-            let missing = crate::rtabmap::missing(&summary, o);
+            let missing = rtabmap::convert::missing(&summary, o);
             Ok(Inspection::RtabMap { summary, missing })
         }
         SourceKind::Bag | SourceKind::Mcap | SourceKind::Db3 => {
@@ -403,7 +403,7 @@ pub fn convert(source: &Path, out: &Path, o: &SourceOptions) -> Result<Conversio
             source,
             "is already a recording folder (convert to a .bag, .mcap, .db3 or .db file by naming one as --out)",
         )),
-        SourceKind::RtabMap => crate::rtabmap::convert(source, out, o),
+        SourceKind::RtabMap => Ok(rtabmap::convert::convert(source, out, o)?),
         SourceKind::Bag | SourceKind::Mcap | SourceKind::Db3 => {
             let c = container_of(kind);
             let s = ros::survey(c, source).map_err(|e| e.in_file(source))?;

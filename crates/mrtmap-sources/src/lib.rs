@@ -17,6 +17,7 @@
 //! Binary parsers read through [`mrtmap_io::bytes`], so every error carries its byte offset (and
 //! inside a compressed chunk, the chunk's).
 
+pub mod convert;
 pub mod ros;
 pub mod rtabmap;
 

@@ -1,6 +1,6 @@
 //! The Rust side of `bench/run posegraph`: reads a g2o pose graph (`VERTEX_SE3:QUAT`,
 //! `EDGE_SE3:QUAT` with its 6×6 upper-triangular information over x y z qx qy qz), optimises it
-//! with `mrtmap_scan::pose_graph` (as `convert` does for an RTAB-Map database), writes the poses
+//! with `mrtmap_track::pose_graph` (as `convert` does for an RTAB-Map database), writes the poses
 //! as g2o vertices and prints JSON with the median time of 3 runs.
 //!
 //! `cargo run --release -p mrtmap-scan --example pose_graph_peer -- IN.g2o OUT.g2o`

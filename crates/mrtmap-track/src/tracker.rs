@@ -37,7 +37,7 @@ use serde::{Deserialize, Serialize};
 use mrtmap_geometry::icp::{IcpParams, IcpTarget, icp_point_to_plane};
 
 use crate::pose_graph::{Edge, optimise};
-use mrtmap_scan::frame::{DepthPoints, DepthSampling, RayTable, depth_points};
+use mrtmap_io::depth::{DepthPoints, DepthSampling, RayTable, depth_points};
 
 /// Tracking settings.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

@@ -7,6 +7,7 @@
 //! optimised poses). The version in `Admin.version` is checked first; columns are looked up with
 //! `PRAGMA table_info`. Every blob's size is checked before it is used.
 
+pub mod convert;
 pub mod rvl;
 
 use std::io::Read;

@@ -8,14 +8,18 @@ use std::path::Path;
 
 use mrtmap_geometry::nalgebra::{Isometry3, Matrix6};
 use mrtmap_io::{Image16, LayoutWriter, Recording, RgbCamera, Rig, read_image16};
-use mrtmap_sources::ros::{self, Container};
-use mrtmap_sources::rtabmap::{self, Calibration, DbSummary};
-use mrtmap_sources::{SourceKind, resolve_source};
 use mrtmap_track::pose_graph::{Edge, optimise};
 
-use crate::cache::json_text;
-use crate::conversion::{Conversion, SourceOptions};
-use crate::error::{Error, Result};
+use crate::convert::{Conversion, ConvertError as Error, Result, SourceOptions};
+use crate::ros::{self, Container};
+use crate::rtabmap::{self, Calibration, DbSummary};
+use crate::{SourceKind, resolve_source};
+
+/// Pretty JSON with a trailing newline.
+fn json_text<T: serde::Serialize>(value: &T) -> String {
+    // Serialising plain data (maps with string keys, numbers, strings) cannot fail.
+    serde_json::to_string_pretty(value).unwrap_or_default() + "\n"
+}
 
 /// What a scan needs besides the database.
 pub fn missing(s: &DbSummary, o: &SourceOptions) -> Vec<String> {
@@ -283,7 +287,6 @@ pub fn convert(source: &Path, out: &Path, o: &SourceOptions) -> Result<Conversio
         return Err(Error::NotAScan {
             path: source.to_path_buf(),
             missing: m,
-            plan: None,
         });
     };
     let given = Rig::read(rig_path)?;
