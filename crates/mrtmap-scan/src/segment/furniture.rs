@@ -25,7 +25,9 @@ use mrtmap_geometry::nalgebra::{Point2, Point3, Unit, Vector3};
 use mrtmap_geometry::polygon::{Containment, point_in_polygon};
 use mrtmap_physics::{RadiantAverage, Temperature};
 
+use super::Envelope;
 use super::SegmentParams;
+use super::membership::Points;
 
 /// A piece of furniture: a box in the room's axes.
 #[derive(Clone, Debug)]
@@ -451,6 +453,59 @@ pub fn find_furniture(
             furniture_box(comp, (pos, nrm, temp_k, observations), room, wall_reach_m)
         })
         .collect()
+}
+
+/// Furniture: what stands off the envelope, kept clear of the walls by their band and 5 cm.
+pub(super) fn furniture_of(
+    env: &Envelope,
+    longest: &Vector3<f64>,
+    bands: &[f64],
+    pts: &Points,
+    surface_id: &[i32],
+    height_m: f64,
+    p: &SegmentParams,
+) -> Vec<FoundFurniture> {
+    let up = env.up;
+    let floor_height = up.dot(&env.floor_corners[0].coords);
+    let u = (longest - up.as_ref() * longest.dot(&up)).normalize();
+    let v = up.cross(&u);
+    let floor_2d: Vec<Point2<f64>> = env
+        .floor_corners
+        .iter()
+        .map(|q| Point2::new(u.dot(&q.coords), v.dot(&q.coords)))
+        .collect();
+    let wall_planes: Vec<(mrtmap_geometry::Plane, f64)> = env
+        .walls
+        .iter()
+        .enumerate()
+        .map(|(w, &k)| (env.planes[k].plane, bands[w + 2] + 0.05))
+        .collect();
+    // Where the floor (surface 0) was seen, in 5 cm cells of the room's axes.
+    let c = FLOOR_CELL_M;
+    let floor_seen: std::collections::HashSet<(i32, i32)> = pts
+        .pos
+        .iter()
+        .zip(surface_id)
+        .filter(|(_, s)| **s == 0)
+        .map(|(q, _)| {
+            (
+                (u.dot(&q.coords) / c).floor() as i32,
+                (v.dot(&q.coords) / c).floor() as i32,
+            )
+        })
+        .collect();
+    let room = Room {
+        up,
+        along: *longest,
+        floor_height,
+        room_height: height_m,
+        floor_2d: &floor_2d,
+        wall_planes: &wall_planes,
+        floor_seen: &floor_seen,
+    };
+    find_furniture(
+        &pts.pos, &pts.nrm, &pts.temp, &pts.obs, surface_id, &room, p,
+    )
 }
 
 #[cfg(test)]

@@ -19,6 +19,7 @@
 
 use std::collections::BTreeMap;
 
+use super::MaskInput;
 use mrtmap_geometry::camera::PinholeCamera;
 use mrtmap_geometry::nalgebra::{Isometry3, Point2, Point3};
 use mrtmap_io::masks::{labels_path, read_mask_labels};
@@ -230,6 +231,38 @@ pub fn vote(
         }
     }
     (tallies.iter().map(Votes::from_counts).collect(), summary)
+}
+
+/// A label's vote, if masks gave one.
+pub(super) type Vote = Option<(String, Votes)>;
+
+/// Labels: one pass over the masks for features and furniture; returns their votes (none without
+/// masks) and the masks' summary.
+pub(super) fn vote_labels(
+    masks: Option<&MaskInput<'_>>,
+    features: &[(usize, &crate::segment::features::FoundFeature)],
+    furniture: &[crate::segment::furniture::FoundFurniture],
+    pos: &[Point3<f64>],
+) -> (Vec<Vote>, Vec<Vote>, Option<MaskSummary>) {
+    let Some(m) = masks else {
+        return (
+            vec![None; features.len()],
+            vec![None; furniture.len()],
+            None,
+        );
+    };
+    let pts: Vec<Vec<Point3<f64>>> = features
+        .iter()
+        .map(|(_, f)| f.points.iter().map(|&i| pos[i]).collect())
+        .chain(
+            furniture
+                .iter()
+                .map(|f| f.points.iter().map(|&i| pos[i]).collect()),
+        )
+        .collect();
+    let (mut voted, summary) = vote(m.recording, m.world_from_depth, &pts);
+    let furniture_votes = voted.split_off(features.len());
+    (voted, furniture_votes, Some(summary))
 }
 
 #[cfg(test)]

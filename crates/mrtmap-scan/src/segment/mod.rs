@@ -15,8 +15,11 @@ mod outputs;
 pub mod room;
 mod texture;
 
+use furniture::furniture_of;
+use labels::{Vote, vote_labels};
 use membership::*;
 use outputs::*;
+use texture::fill_from_texture;
 
 use std::collections::BTreeMap;
 
@@ -298,93 +301,8 @@ fn arr(p: &Point3<f64>) -> [f64; 3] {
     [p.x, p.y, p.z]
 }
 
-/// Furniture: what stands off the envelope, kept clear of the walls by their band and 5 cm.
-fn furniture_of(
-    env: &Envelope,
-    longest: &Vector3<f64>,
-    bands: &[f64],
-    pts: &Points,
-    surface_id: &[i32],
-    height_m: f64,
-    p: &SegmentParams,
-) -> Vec<furniture::FoundFurniture> {
-    let up = env.up;
-    let floor_height = up.dot(&env.floor_corners[0].coords);
-    let u = (longest - up.as_ref() * longest.dot(&up)).normalize();
-    let v = up.cross(&u);
-    let floor_2d: Vec<Point2<f64>> = env
-        .floor_corners
-        .iter()
-        .map(|q| Point2::new(u.dot(&q.coords), v.dot(&q.coords)))
-        .collect();
-    let wall_planes: Vec<(mrtmap_geometry::Plane, f64)> = env
-        .walls
-        .iter()
-        .enumerate()
-        .map(|(w, &k)| (env.planes[k].plane, bands[w + 2] + 0.05))
-        .collect();
-    // Where the floor (surface 0) was seen, in 5 cm cells of the room's axes.
-    let c = furniture::FLOOR_CELL_M;
-    let floor_seen: std::collections::HashSet<(i32, i32)> = pts
-        .pos
-        .iter()
-        .zip(surface_id)
-        .filter(|(_, s)| **s == 0)
-        .map(|(q, _)| {
-            (
-                (u.dot(&q.coords) / c).floor() as i32,
-                (v.dot(&q.coords) / c).floor() as i32,
-            )
-        })
-        .collect();
-    let room = furniture::Room {
-        up,
-        along: *longest,
-        floor_height,
-        room_height: height_m,
-        floor_2d: &floor_2d,
-        wall_planes: &wall_planes,
-        floor_seen: &floor_seen,
-    };
-    furniture::find_furniture(
-        &pts.pos, &pts.nrm, &pts.temp, &pts.obs, surface_id, &room, p,
-    )
-}
-
 /// The margin of a furniture footprint whose floor points are released (m).
 const UNDER_FURNITURE_M: f64 = 0.03;
-
-/// A label's vote, if masks gave one.
-type Vote = Option<(String, Votes)>;
-
-/// Labels: one pass over the masks for features and furniture; returns their votes (none without
-/// masks) and the masks' summary.
-fn vote_labels(
-    masks: Option<&MaskInput<'_>>,
-    features: &[(usize, &features::FoundFeature)],
-    furniture: &[furniture::FoundFurniture],
-    pos: &[Point3<f64>],
-) -> (Vec<Vote>, Vec<Vote>, Option<MaskSummary>) {
-    let Some(m) = masks else {
-        return (
-            vec![None; features.len()],
-            vec![None; furniture.len()],
-            None,
-        );
-    };
-    let pts: Vec<Vec<Point3<f64>>> = features
-        .iter()
-        .map(|(_, f)| f.points.iter().map(|&i| pos[i]).collect())
-        .chain(
-            furniture
-                .iter()
-                .map(|f| f.points.iter().map(|&i| pos[i]).collect()),
-        )
-        .collect();
-    let (mut voted, summary) = labels::vote(m.recording, m.world_from_depth, &pts);
-    let furniture_votes = voted.split_off(features.len());
-    (voted, furniture_votes, Some(summary))
-}
 
 /// The room frame (see [`room`]): the walls described by their length, the features found on
 /// them and their temperature.
@@ -435,75 +353,6 @@ pub fn segment(
     p: &SegmentParams,
 ) -> Result<Segmentation, SegmentError> {
     segment_textured(cloud, camera_poses, masks, None, p)
-}
-
-/// Texels the cloud's points of a surface cover, in the texel grid of its outline's lower corner.
-fn covered_texels(
-    g: &SurfaceGeom,
-    lo: &Point2<f64>,
-    members: &[usize],
-    pts: &Points,
-    texel_m: f64,
-) -> std::collections::HashSet<(i64, i64)> {
-    members
-        .iter()
-        .map(|&i| {
-            let q = g.frame.to_2d(&pts.pos[i]);
-            (
-                ((q.x - lo.x) / texel_m).floor() as i64,
-                ((q.y - lo.y) / texel_m).floor() as i64,
-            )
-        })
-        .collect()
-}
-
-/// Thermal texturing of the texels the cloud left empty: samples appended to the points (and
-/// their weights and the surfaces' members).
-#[allow(clippy::too_many_arguments)]
-fn fill_from_texture(
-    input: &TextureInput<'_>,
-    geoms: &[SurfaceGeom],
-    polys2: &[Vec<Point2<f64>>],
-    furniture: &[furniture::FoundFurniture],
-    pts: &mut Points,
-    weights: &mut Vec<f64>,
-    members: &mut [Vec<usize>],
-    p: &SegmentParams,
-) -> TextureReport {
-    let surfaces: Vec<texture::ModelSurface<'_>> = geoms
-        .iter()
-        .enumerate()
-        .map(|(s, g)| {
-            let lo = polys2[s]
-                .iter()
-                .fold(Point2::new(f64::INFINITY, f64::INFINITY), |a, q| {
-                    Point2::new(a.x.min(q.x), a.y.min(q.y))
-                });
-            texture::ModelSurface {
-                frame: &g.frame,
-                polygon: &polys2[s],
-                texel_origin: lo,
-                covered: covered_texels(g, &lo, &members[s], pts, p.texel_m),
-            }
-        })
-        .collect();
-    let boxes: Vec<[Point3<f64>; 8]> = furniture.iter().map(|f| f.corners).collect();
-    let (tx, report) = texture::texture(
-        input,
-        &surfaces,
-        &boxes,
-        p.texel_m,
-        &TextureParams::default(),
-    );
-    for k in 0..tx.surface.len() {
-        members[tx.surface[k]].push(pts.pos.len());
-        pts.pos.push(tx.pos[k]);
-        pts.nrm.push(tx.nrm[k]);
-        pts.temp.push(tx.temp_k[k]);
-        pts.obs.push(tx.pixels[k]);
-        weights.push(f64::from(tx.pixels[k]));
-    }
-    report
 }
 
 /// Segments the cloud into a radiant scene; with `texture`, the thermal frames are also cast onto

@@ -24,6 +24,8 @@ use mrtmap_io::Recording;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::SegmentParams;
+use super::membership::{Points, SurfaceGeom};
 use crate::frame::ThermalImage;
 use crate::fuse::{FusedFrame, from_pose7};
 
@@ -409,6 +411,75 @@ fn grown_box(corners: &[Point3<f64>; 8], margin: f64) -> [Point3<f64>; 8] {
         }
         q
     })
+}
+
+/// Texels the cloud's points of a surface cover, in the texel grid of its outline's lower corner.
+pub(super) fn covered_texels(
+    g: &SurfaceGeom,
+    lo: &Point2<f64>,
+    members: &[usize],
+    pts: &Points,
+    texel_m: f64,
+) -> HashSet<(i64, i64)> {
+    members
+        .iter()
+        .map(|&i| {
+            let q = g.frame.to_2d(&pts.pos[i]);
+            (
+                ((q.x - lo.x) / texel_m).floor() as i64,
+                ((q.y - lo.y) / texel_m).floor() as i64,
+            )
+        })
+        .collect()
+}
+
+/// Thermal texturing of the texels the cloud left empty: samples appended to the points (and
+/// their weights and the surfaces' members).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn fill_from_texture(
+    input: &TextureInput<'_>,
+    geoms: &[SurfaceGeom],
+    polys2: &[Vec<Point2<f64>>],
+    furniture: &[crate::segment::furniture::FoundFurniture],
+    pts: &mut Points,
+    weights: &mut Vec<f64>,
+    members: &mut [Vec<usize>],
+    p: &SegmentParams,
+) -> TextureReport {
+    let surfaces: Vec<ModelSurface<'_>> = geoms
+        .iter()
+        .enumerate()
+        .map(|(s, g)| {
+            let lo = polys2[s]
+                .iter()
+                .fold(Point2::new(f64::INFINITY, f64::INFINITY), |a, q| {
+                    Point2::new(a.x.min(q.x), a.y.min(q.y))
+                });
+            ModelSurface {
+                frame: &g.frame,
+                polygon: &polys2[s],
+                texel_origin: lo,
+                covered: covered_texels(g, &lo, &members[s], pts, p.texel_m),
+            }
+        })
+        .collect();
+    let boxes: Vec<[Point3<f64>; 8]> = furniture.iter().map(|f| f.corners).collect();
+    let (tx, report) = texture(
+        input,
+        &surfaces,
+        &boxes,
+        p.texel_m,
+        &TextureParams::default(),
+    );
+    for k in 0..tx.surface.len() {
+        members[tx.surface[k]].push(pts.pos.len());
+        pts.pos.push(tx.pos[k]);
+        pts.nrm.push(tx.nrm[k]);
+        pts.temp.push(tx.temp_k[k]);
+        pts.obs.push(tx.pixels[k]);
+        weights.push(f64::from(tx.pixels[k]));
+    }
+    report
 }
 
 #[cfg(test)]
