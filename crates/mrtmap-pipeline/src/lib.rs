@@ -19,8 +19,12 @@
 //! - [`source`], [`run`], [`maps`], [`report`], [`demo`], [`calibration`]: one job each.
 //! - [`points`]: MRT at points of a scene (a sphere's, a person's, the plane radiant
 //!   temperatures) from one call, [`points::mrt_at_points`].
+//! - [`coverage`], [`comfort`], [`validation`] (also globe ↔ MRT), [`thermal_image`] (one thermal
+//!   file), [`simulation`]: one job each; [`parse`]: the text forms flags share (`20x20`,
+//!   `X,Y,Z`, `on|off`); [`files`]: mrtmap-io's types a front end handles itself.
 //!
-//! Everything here returns data and writes files; nothing prints.
+//! Everything here returns data, text lines and files; nothing prints. A result a person reads
+//! has a `lines()` (or `*_lines`) giving what the CLI prints, so a binding can show the same.
 //!
 //! ```no_run
 //! use mrtmap_pipeline::{Project, Silent, run::run};
