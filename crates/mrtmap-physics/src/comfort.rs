@@ -78,7 +78,7 @@ pub struct Pmv {
     /// Predicted percentage dissatisfied (%).
     pub ppd_pct: f64,
     /// Whether every input and the PMV lie within ISO 7730's ranges (10 ≤ ta ≤ 30, 10 ≤ tr ≤ 40,
-    /// 0 ≤ vr ≤ 1, 0.8 ≤ met ≤ 4, 0 ≤ clo ≤ 2, −2 ≤ PMV ≤ 2).
+    /// 0 ≤ vr ≤ 1, 0.8 ≤ met ≤ 4, 0 ≤ clo ≤ 2, water vapour pressure 0–2700 Pa, −2 ≤ PMV ≤ 2).
     pub within_iso_ranges: bool,
 }
 
@@ -87,8 +87,27 @@ pub fn ppd_from_pmv(pmv: f64) -> f64 {
     100.0 - 95.0 * (-0.03353 * pmv.powi(4) - 0.2179 * pmv.powi(2)).exp()
 }
 
-/// Fanger's PMV/PPD as printed in ISO 7730 (annex D; 273 as the Kelvin offset, like the standard).
+/// The edition of ISO 7730 whose annex D code computes the PMV. The two differ only in the first
+/// guess of the clothing surface temperature; the iteration stops within 0.015 K of its fixed
+/// point, so the guess moves the PMV by up to 0.002.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Iso7730Edition {
+    /// ISO 7730:2005's code: t_cl,0 = t_a + (35.5 − t_a)/(3.5·I_cl + 0.1), I_cl in m²K/W.
+    Y2005,
+    /// ISO 7730:2025's code: t_cl,0 = t_a + (35.5 − t_a)/(3.5·(6.45·I_cl + 0.1)). pythermalcomfort
+    /// 4's `pmv_ppd_iso` uses it (for both of its `model`s), so the PMV equals its to 1e-9.
+    #[default]
+    Y2025,
+}
+
+/// Fanger's PMV/PPD as printed in ISO 7730:2025 (annex D; 273 as the Kelvin offset, like the
+/// standard). See [`pmv_ppd_edition`] for ISO 7730:2005's.
 pub fn pmv_ppd(inp: &PmvInputs) -> Result<Pmv, PhysicsError> {
+    pmv_ppd_edition(inp, Iso7730Edition::Y2025)
+}
+
+/// Fanger's PMV/PPD as printed in annex D of the given edition of ISO 7730.
+pub fn pmv_ppd_edition(inp: &PmvInputs, edition: Iso7730Edition) -> Result<Pmv, PhysicsError> {
     let ta = in_range("air temperature (°C)", inp.air.celsius(), -50.0, 100.0)?;
     let tr = in_range(
         "mean radiant temperature (°C)",
@@ -127,7 +146,10 @@ pub fn pmv_ppd(inp: &PmvInputs) -> Result<Pmv, PhysicsError> {
     let hcf = 12.1 * vr.sqrt();
     let taa = ta + 273.0;
     let tra = tr + 273.0;
-    let tcla = taa + (35.5 - ta) / (3.5 * icl + 0.1);
+    let tcla = match edition {
+        Iso7730Edition::Y2005 => taa + (35.5 - ta) / (3.5 * icl + 0.1),
+        Iso7730Edition::Y2025 => taa + (35.5 - ta) / (3.5 * (6.45 * icl + 0.1)),
+    };
     let p1 = icl * fcl;
     let p2 = p1 * 3.96;
     let p3 = p1 * 100.0;
@@ -166,6 +188,7 @@ pub fn pmv_ppd(inp: &PmvInputs) -> Result<Pmv, PhysicsError> {
         && (0.0..=1.0).contains(&vr)
         && (0.8..=4.0).contains(&met)
         && (0.0..=2.0).contains(&clo)
+        && (0.0..=2700.0).contains(&pa)
         && (-2.0..=2.0).contains(&pmv);
     Ok(Pmv {
         pmv,

@@ -38,8 +38,8 @@ mod person;
 mod units;
 
 pub use comfort::{
-    AsymmetryKind, OperativeMethod, Pmv, PmvInputs, operative_temperature, pmv_ppd, ppd_from_pmv,
-    radiant_asymmetry_ppd,
+    AsymmetryKind, Iso7730Edition, OperativeMethod, Pmv, PmvInputs, operative_temperature, pmv_ppd,
+    pmv_ppd_edition, ppd_from_pmv, radiant_asymmetry_ppd,
 };
 pub use error::PhysicsError;
 pub use globe::{

@@ -3,7 +3,7 @@
 //! `comfort.json` (the share of the floor in each ISO 7730 category, the worst asymmetry and
 //! where, the values at the marked points).
 //!
-//! PMV/PPD: ISO 7730:2005 (Fanger; the variant of pythermalcomfort's `pmv_ppd_iso`), with the
+//! PMV/PPD: ISO 7730:2025's annex D code (Fanger; pythermalcomfort 4's `pmv_ppd_iso`), with the
 //! relative air speed vr = v + 0.3 (met − 1) for met > 1 (ISO 7730 / pythermalcomfort
 //! `v_relative`) and the clothing insulation as given (no dynamic correction). Operative
 //! temperature: ISO 7726, (ta √(10 v) + tr) / (1 + √(10 v)), with the person's tr. Standard errors
@@ -315,7 +315,7 @@ pub struct ComfortSummary {
 }
 
 /// The PMV/PPD variant, in words.
-pub const PMV_MODEL: &str = "ISO 7730:2005 (Fanger), as pythermalcomfort pmv_ppd_iso; vr = v + 0.3 (met − 1) above 1 met; clo as given";
+pub const PMV_MODEL: &str = "ISO 7730:2025 annex D (Fanger), as pythermalcomfort 4 pmv_ppd_iso; vr = v + 0.3 (met − 1) above 1 met; clo as given";
 
 /// A comfort map set computed and written.
 pub struct ComfortOutput {

@@ -1,6 +1,6 @@
 use mrtmap_physics::{
-    AsymmetryKind, OperativeMethod, PmvInputs, Temperature, operative_temperature, pmv_ppd,
-    ppd_from_pmv, radiant_asymmetry_ppd,
+    AsymmetryKind, Iso7730Edition, OperativeMethod, PmvInputs, Temperature, operative_temperature,
+    pmv_ppd, pmv_ppd_edition, ppd_from_pmv, radiant_asymmetry_ppd,
 };
 
 fn c(x: f64) -> Temperature {
@@ -68,11 +68,25 @@ fn pmv_ppd_table_vectors() {
     }
 }
 
-/// Unrounded: ta = tr = 25, vr 0.1, rh 50, met 1.1, clo 0.5 → −0.13201636.
+/// Unrounded: ta = tr = 25, vr 0.1, rh 50, met 1.1, clo 0.5 → −0.13201636 (ISO 7730:2005's
+/// code); ISO 7730:2025's first guess gives −0.13214292, pythermalcomfort 4.8.1's
+/// `pmv_ppd_iso(25, 25, 0.1, 50, 1.1, 0.5, round_output=False)`.
 #[test]
 fn pmv_unrounded_vector() {
-    let r = pmv(25.0, 25.0, 50.0, 0.1, 1.1, 0.5);
-    assert!((r.pmv - -0.13201636).abs() < 1e-6, "{}", r.pmv);
+    let inputs = |t: f64| PmvInputs {
+        air: Temperature::from_celsius(t),
+        mrt: Temperature::from_celsius(t),
+        relative_air_speed_m_s: 0.1,
+        relative_humidity_pct: 50.0,
+        met: 1.1,
+        clo: 0.5,
+        external_work_met: 0.0,
+    };
+    let y2005 = pmv_ppd_edition(&inputs(25.0), Iso7730Edition::Y2005).unwrap();
+    assert!((y2005.pmv - -0.13201636).abs() < 1e-6, "{}", y2005.pmv);
+    let y2025 = pmv_ppd_edition(&inputs(25.0), Iso7730Edition::Y2025).unwrap();
+    assert!((y2025.pmv - -0.13214292).abs() < 1e-6, "{}", y2025.pmv);
+    assert_eq!(pmv_ppd(&inputs(25.0)).unwrap(), y2025);
 }
 
 #[test]

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """`mrtmap coverage` against the full run, on the walks a robustness study kept.
 
-    coverage.py MRTMAP STUDY_DIR [STUDY_DIR ...] [--repeat 3] [--target-k 0.2]
+    coverage_study.py MRTMAP STUDY_DIR [STUDY_DIR ...] [--repeat 3] [--target-k 0.2]
 
 For every walk of each study (a folder written by robustness.py --keep, with its robustness.json)
 this runs `mrtmap coverage` on the recording (`--repeat` times; the median time is reported) and
