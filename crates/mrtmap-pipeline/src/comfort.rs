@@ -13,8 +13,11 @@ use std::path::Path;
 
 use mrtmap_geometry::nalgebra::Point2;
 use mrtmap_io::FileError;
-use mrtmap_physics::{
-    Category, OperativeMethod, PmvInputs, Posture, Temperature, operative_temperature, pmv_ppd,
+use mrtmap_physics::{Category, Posture, Temperature, pmv_ppd};
+/// The comfort formulas themselves, for callers with their own inputs (a binding's arrays):
+/// PMV/PPD by edition of ISO 7730 and the operative temperature (mrtmap-physics').
+pub use mrtmap_physics::{
+    Iso7730Edition, OperativeMethod, Pmv, PmvInputs, operative_temperature, pmv_ppd_edition,
 };
 use mrtmap_radiation::{
     AsymmetryVerdict, GridSpec, MapFrame, MrtEngine, MrtError, MrtField, RadiantAsymmetry,

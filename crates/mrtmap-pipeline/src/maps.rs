@@ -6,13 +6,16 @@ use std::time::Instant;
 
 use mrtmap_geometry::nalgebra::{Point2, Point3};
 use mrtmap_io::write_atomic;
-/// A map's grid (mrtmap-radiation's).
-pub use mrtmap_radiation::GridSpec;
+/// A map's grid, the summary of its values and the radiant scene it is computed on
+/// (mrtmap-radiation's).
+pub use mrtmap_radiation::{FieldSummary, GridSpec, RadiantScene};
+/// Where a map lies in the scene (mrtmap-report's).
+pub use mrtmap_report::MapAxes;
 use mrtmap_radiation::{
-    MapFrame, Method, MrtEngine, MrtError, MrtField, PointRecord, RadiantScene,
+    MapFrame, Method, MrtEngine, MrtError, MrtField, PointRecord,
 };
 use mrtmap_report::numbers::{fixed, uncertainty, xyz};
-use mrtmap_report::{MapAxes, MapInput, MapMark, MapSummary, grid_csv, render_png, render_svg};
+use mrtmap_report::{MapInput, MapMark, MapSummary, grid_csv, render_png, render_svg};
 use serde::{Deserialize, Serialize};
 
 use crate::cache::write_json;
@@ -169,6 +172,112 @@ pub fn map_scene(
     })
 }
 
+/// The map frame of `scene` (from `source`) with `spec`'s height checked against the room.
+fn map_frame(
+    engine: &MrtEngine<'_>,
+    scene: &RadiantScene,
+    source: &str,
+    spec: GridSpec,
+) -> Result<MapFrame> {
+    let frame = MapFrame::of_scene(scene).map_err(|source_err| Error::Map {
+        scene: source.to_string(),
+        source: source_err,
+    })?;
+    if let Some(b) = engine.bounds() {
+        b.check_height(spec.height_m)?;
+    }
+    Ok(frame)
+}
+
+/// The MRT over `spec`'s grid and the seconds it took; an open scene is refused as a whole, not
+/// drawn as a map with holes.
+fn compute_field(
+    engine: &MrtEngine<'_>,
+    frame: MapFrame,
+    spec: GridSpec,
+) -> Result<(MrtField, f64)> {
+    let t0 = Instant::now();
+    let field = MrtField::compute(engine, frame, spec)?;
+    let secs = t0.elapsed().as_secs_f64();
+    if let Some(e) = field.nodes.iter().find_map(|n| match &n.result {
+        Err(e @ MrtError::NotEnclosed { .. }) => Some(e.clone()),
+        _ => None,
+    }) {
+        return Err(e.into());
+    }
+    Ok((field, secs))
+}
+
+/// An MRT map as arrays, nothing written: what a binding hands to numpy. Grids are row-major,
+/// `ny` rows (along v) of `nx` columns (along u); NaN where the grid has no node (outside the
+/// floor outline, inside furniture, refused), with the reason in `refused`.
+#[derive(Clone, Debug, Serialize)]
+pub struct MapArrays {
+    /// Height above the floor (m).
+    pub height_m: f64,
+    /// Node coordinates along u (m, map frame).
+    pub u: Vec<f64>,
+    /// Node coordinates along v (m, map frame).
+    pub v: Vec<f64>,
+    /// The map frame in the scene's frame: origin on the floor, u, v and up.
+    pub axes: MapAxes,
+    /// MRT (°C), `ny × nx`.
+    pub mrt_c: Vec<f64>,
+    /// Its standard error (K), `ny × nx`.
+    pub std_error_k: Vec<f64>,
+    /// Each node's point in the scene's frame (m), `ny × nx × 3`.
+    pub xyz: Vec<f64>,
+    /// Nodes without a value: (row j, column i, why).
+    pub refused: Vec<(usize, usize, String)>,
+    /// Extremes, mean, largest ± and its parts, unseen patches (None without a node).
+    pub summary: Option<FieldSummary>,
+    /// How view factors were computed.
+    pub method: String,
+    /// Seconds computing.
+    pub compute_secs: f64,
+}
+
+/// The MRT of `scene` (from `source`, named in errors) over `spec`'s grid with the view-factor
+/// settings `mrt`, as arrays; nothing is written. The same nodes and values as [`make_map`]'s
+/// mrt_grid.csv.
+pub fn map_arrays(
+    scene: &RadiantScene,
+    source: &str,
+    mrt: &MrtSection,
+    spec: GridSpec,
+) -> Result<MapArrays> {
+    let method = mrt.method(scene)?;
+    let engine = mrt.engine(scene)?;
+    let frame = map_frame(&engine, scene, source, spec)?;
+    let (field, secs) = compute_field(&engine, frame, spec)?;
+    let (nx, ny) = (spec.nx, spec.ny);
+    let mut out = MapArrays {
+        height_m: spec.height_m,
+        u: field.u.clone(),
+        v: field.v.clone(),
+        axes: MapAxes::of(&field),
+        mrt_c: vec![f64::NAN; nx * ny],
+        std_error_k: vec![f64::NAN; nx * ny],
+        xyz: vec![f64::NAN; nx * ny * 3],
+        refused: Vec::new(),
+        summary: field.summary(),
+        method: method.describe(engine.ray_engine()),
+        compute_secs: secs,
+    };
+    for n in &field.nodes {
+        let k = n.j * nx + n.i;
+        out.xyz[3 * k..3 * k + 3].copy_from_slice(&[n.point.x, n.point.y, n.point.z]);
+        match &n.result {
+            Ok(r) => {
+                out.mrt_c[k] = r.mrt.celsius();
+                out.std_error_k[k] = r.std_error_k;
+            }
+            Err(e) => out.refused.push((n.j, n.i, e.to_string())),
+        }
+    }
+    Ok(out)
+}
+
 /// Computes the MRT map of `scene` (from `source`, for people) on `spec` with `marks`, and writes
 /// mrt_grid.csv, mrt_map.png, mrt_map.svg and summary.json into `out`. The height and the marks
 /// are checked against the room before anything is computed.
@@ -182,24 +291,9 @@ pub fn make_map(
 ) -> Result<MapOutput> {
     let method = mrt.method(scene)?;
     let engine = mrt.engine(scene)?;
-    let frame = MapFrame::of_scene(scene).map_err(|source_err| Error::Map {
-        scene: source.to_string(),
-        source: source_err,
-    })?;
-    if let Some(b) = engine.bounds() {
-        b.check_height(spec.height_m)?;
-    }
+    let frame = map_frame(&engine, scene, source, spec)?;
     let points = mark_points(&engine, &frame, &spec, marks)?;
-    let t0 = Instant::now();
-    let field = MrtField::compute(&engine, frame, spec)?;
-    let secs = t0.elapsed().as_secs_f64();
-    // An open scene is refused as a whole, not drawn as a map with holes.
-    if let Some(e) = field.nodes.iter().find_map(|n| match &n.result {
-        Err(e @ MrtError::NotEnclosed { .. }) => Some(e.clone()),
-        _ => None,
-    }) {
-        return Err(e.into());
-    }
+    let (field, secs) = compute_field(&engine, frame, spec)?;
     let (records, map_marks) = mark_records(&engine, &field, &spec, marks, &points)?;
     let how = method.describe(engine.ray_engine());
     let input = MapInput {

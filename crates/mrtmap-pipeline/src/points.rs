@@ -7,8 +7,11 @@ pub use mrtmap_physics::{AsymmetryKind, Posture};
 /// Which way a person faces, an asymmetry's verdict, the enclosure tolerance and the built-in
 /// example scene (mrtmap-radiation's).
 pub use mrtmap_radiation::{AsymmetryVerdict, ENCLOSURE_TOLERANCE, EXAMPLE_OFFICE_JSON, Facing};
-use mrtmap_radiation::{PersonMrt, PointRecord, RadiantAsymmetry, RadiantScene};
+/// A sphere's MRT at a point with its view-factor table (mrtmap-radiation's).
+pub use mrtmap_radiation::PointRecord;
+use mrtmap_radiation::{PersonMrt, RadiantAsymmetry, RadiantScene};
 use mrtmap_report::numbers::{fixed, uncertainty};
+use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::error::Result;
@@ -132,6 +135,7 @@ fn plane_answer(a: &RadiantAsymmetry) -> PlaneAnswer {
 /// Answers `q` on `scene` (read from `source`, which errors name) with the view-factor settings
 /// `mrt`. A point outside the room or inside its furniture is refused with an error naming it;
 /// the k-th point draws its rays from stream k, so answers do not depend on the other points.
+/// Points are answered in parallel.
 pub fn mrt_at_points(
     scene: &RadiantScene,
     source: &str,
@@ -148,22 +152,34 @@ pub fn mrt_at_points(
         persons: Vec::new(),
         planes: Vec::new(),
     };
-    for (k, p) in q.at.iter().enumerate() {
-        let at = to_scene_frame(*p, q.frame, scene, source)?;
-        if let Some((posture, facing)) = q.person {
-            let r = engine.person_at(&at, posture, facing, k as u64)?;
-            answers.persons.push(person_answer(&r, engine.patches()));
-        } else {
-            let r = engine.at(&at, k as u64)?;
-            answers
-                .points
-                .push(PointRecord::new(None, &r, engine.patches()));
-        }
-        if q.planes {
-            answers
-                .planes
-                .push(plane_answer(&engine.asymmetry_at(&at, k as u64)?));
-        }
+    // In parallel: the k-th point draws from stream k, so the answers are those of a loop; the
+    // first point refused (in order) is the one named.
+    type One = (Option<PointRecord>, Option<PersonAnswer>, Option<PlaneAnswer>);
+    let each: Vec<Result<One>> = q
+        .at
+        .par_iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let at = to_scene_frame(*p, q.frame, scene, source)?;
+            let mut one: One = (None, None, None);
+            if let Some((posture, facing)) = q.person {
+                let r = engine.person_at(&at, posture, facing, k as u64)?;
+                one.1 = Some(person_answer(&r, engine.patches()));
+            } else {
+                let r = engine.at(&at, k as u64)?;
+                one.0 = Some(PointRecord::new(None, &r, engine.patches()));
+            }
+            if q.planes {
+                one.2 = Some(plane_answer(&engine.asymmetry_at(&at, k as u64)?));
+            }
+            Ok(one)
+        })
+        .collect();
+    for one in each {
+        let (point, person, plane) = one?;
+        answers.points.extend(point);
+        answers.persons.extend(person);
+        answers.planes.extend(plane);
     }
     Ok(answers)
 }

@@ -611,3 +611,65 @@ mod tests {
         assert!(p.contains(" UTC by mrtmap "), "{p}");
     }
 }
+
+/// What [`run_recording`] did: the recording used (converted or not), the run's outcome and its
+/// seconds.
+#[derive(Clone, Debug)]
+pub struct RunDone {
+    /// The recording folder and what converting the source into it did.
+    pub prepared: crate::source::Prepared,
+    /// The run.
+    pub outcome: RunOutcome,
+    /// Seconds, conversion included.
+    pub secs: f64,
+}
+
+impl RunDone {
+    /// What `mrtmap run` prints: the conversion, where the run went, each stage, each map.
+    pub fn lines(&self, recording: &Path, out: &Path) -> Vec<String> {
+        let mut lines = Vec::new();
+        if let Some(c) = &self.prepared.conversion {
+            lines.extend(c.lines());
+        } else if self.prepared.reused {
+            lines.push(format!(
+                "using {} (converted earlier from {})",
+                self.prepared.dir.display(),
+                recording.display()
+            ));
+        }
+        lines.push(format!("ran {} into {}", recording.display(), out.display()));
+        lines.extend(self.outcome.lines(out, self.secs));
+        lines
+    }
+}
+
+/// `mrtmap run` in one call: `recording` (a folder, or a bag, MCAP file or RTAB-Map database
+/// converted with `source` into `out/recording`) through every stage with `project` into `out`,
+/// then report.html and run.json. `force` reruns stages whose inputs have not changed.
+pub fn run_recording(
+    recording: &Path,
+    out: &Path,
+    project: &Project,
+    force: bool,
+    source: &crate::source::SourceOptions,
+    progress: &dyn crate::Progress,
+) -> Result<RunDone> {
+    project.check()?;
+    crate::run::check_out_dir(out)?;
+    let t0 = std::time::Instant::now();
+    let prepared = crate::source::prepare(recording, out, source)?;
+    let outcome = crate::run::run(&prepared.dir, out, project, force, progress)?;
+    let data = report_data(
+        &outcome,
+        "Mean radiant temperature of a scanned room",
+        &recording.display().to_string(),
+        project,
+    );
+    let secs = t0.elapsed().as_secs_f64();
+    write_run_outputs(out, &data, &outcome, recording, project, secs)?;
+    Ok(RunDone {
+        prepared,
+        outcome,
+        secs,
+    })
+}

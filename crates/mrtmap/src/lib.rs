@@ -21,6 +21,27 @@ pub fn run() -> anyhow::Result<()> {
     commands::dispatch(cli)
 }
 
+/// Runs the command line `args` (the program's name first), as the `mrtmap` binary does, and
+/// gives the exit code: what the Python wheel's `mrtmap` command calls.
+pub fn main_with(args: Vec<std::ffi::OsString>) -> ExitCode {
+    on_interrupt_say_what_is_left();
+    let cli = match Cli::try_parse_from(args) {
+        Ok(c) => c,
+        Err(e) => {
+            let _ = e.print();
+            return if e.use_stderr() {
+                ExitCode::from(2)
+            } else {
+                ExitCode::SUCCESS
+            };
+        }
+    };
+    match commands::dispatch(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => report_error(&e),
+    }
+}
+
 /// Prints an error as one line (with its causes) and gives the exit code.
 pub fn report_error(e: &anyhow::Error) -> ExitCode {
     eprintln!("error: {e:#}");

@@ -1,12 +1,9 @@
 //! `mrtmap run`: the whole pipeline on a recording.
 
-use std::time::Instant;
-
 use anyhow::bail;
 use mrtmap_pipeline::Project;
-use mrtmap_pipeline::report::{report_data, write_run_outputs};
+use mrtmap_pipeline::report::run_recording;
 use mrtmap_pipeline::settings::PointEntry;
-use mrtmap_pipeline::source::prepare;
 
 use crate::cli::RunArgs;
 use crate::output::{Bar, print_lines};
@@ -66,30 +63,9 @@ fn settings(a: &RunArgs) -> anyhow::Result<Project> {
 
 pub fn run(a: &RunArgs) -> anyhow::Result<()> {
     let p = settings(a)?;
-    mrtmap_pipeline::run::check_out_dir(&a.out)?;
-    let t0 = Instant::now();
-    let prepared = prepare(&a.recording, &a.out, &a.src)?;
-    if let Some(c) = &prepared.conversion {
-        print_lines(c.lines());
-    } else if prepared.reused {
-        outln!(
-            "using {} (converted earlier from {})",
-            prepared.dir.display(),
-            a.recording.display()
-        );
-    }
     let bar = Bar::new("");
-    let outcome = mrtmap_pipeline::run::run(&prepared.dir, &a.out, &p, a.force, &bar)?;
+    let done = run_recording(&a.recording, &a.out, &p, a.force, &a.src, &bar)?;
     bar.finish();
-    let data = report_data(
-        &outcome,
-        "Mean radiant temperature of a scanned room",
-        &a.recording.display().to_string(),
-        &p,
-    );
-    let secs = t0.elapsed().as_secs_f64();
-    write_run_outputs(&a.out, &data, &outcome, &a.recording, &p, secs)?;
-    outln!("ran {} into {}", a.recording.display(), a.out.display());
-    print_lines(outcome.lines(&a.out, secs));
+    print_lines(done.lines(&a.recording, &a.out));
     Ok(())
 }
