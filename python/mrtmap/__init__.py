@@ -331,7 +331,7 @@ def run(
     maps = []
     for m in f["maps"]:
         s = m["summary"]
-        fs = s.get("field") or {}
+        fs = s.get("field") or s  # summary.json flattens the field's figures
         maps.append({
             "height_m": s["height_m"],
             "grid": s["grid"],
@@ -355,11 +355,18 @@ def run(
     )
 
 
-def survey(recordings, out, client=None, config=None, **kwargs):
-    """Maps many recordings as independent tasks on a Dask cluster; see :mod:`mrtmap.survey`."""
-    from .survey import survey as _survey
+def survey(recordings, out, client=None, config=None, n_workers=None):
+    """Maps each of ``recordings`` into ``out/<room>`` as an independent task on a Dask cluster
+    and returns one table (a pandas DataFrame, also written to ``out/survey.csv``).
 
-    return _survey(recordings, out, client=client, config=config, **kwargs)
+    Without ``client`` a ``dask.distributed.LocalCluster`` is started (``n_workers`` processes)
+    and closed; pass ``Client("tcp://scheduler:8786")`` to use a running cluster. A room that
+    fails is a row with status "failed" and its error; the others go on. Needs
+    ``pip install mrtmap[dask]``. See ``mrtmap._survey.survey`` for the columns.
+    """
+    from ._survey import survey as _survey
+
+    return _survey(recordings, out, client=client, config=config, n_workers=n_workers)
 
 
 # ---- comfort formulas, vectorised, named and unitised as pythermalcomfort's ----

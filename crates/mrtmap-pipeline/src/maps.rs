@@ -9,11 +9,9 @@ use mrtmap_io::write_atomic;
 /// A map's grid, the summary of its values and the radiant scene it is computed on
 /// (mrtmap-radiation's).
 pub use mrtmap_radiation::{FieldSummary, GridSpec, RadiantScene};
+use mrtmap_radiation::{MapFrame, Method, MrtEngine, MrtError, MrtField, PointRecord};
 /// Where a map lies in the scene (mrtmap-report's).
 pub use mrtmap_report::MapAxes;
-use mrtmap_radiation::{
-    MapFrame, Method, MrtEngine, MrtError, MrtField, PointRecord,
-};
 use mrtmap_report::numbers::{fixed, uncertainty, xyz};
 use mrtmap_report::{MapInput, MapMark, MapSummary, grid_csv, render_png, render_svg};
 use serde::{Deserialize, Serialize};

@@ -4,11 +4,11 @@
 
 /// A person's posture and the asymmetry kinds (mrtmap-physics' types).
 pub use mrtmap_physics::{AsymmetryKind, Posture};
+/// A sphere's MRT at a point with its view-factor table (mrtmap-radiation's).
+pub use mrtmap_radiation::PointRecord;
 /// Which way a person faces, an asymmetry's verdict, the enclosure tolerance and the built-in
 /// example scene (mrtmap-radiation's).
 pub use mrtmap_radiation::{AsymmetryVerdict, ENCLOSURE_TOLERANCE, EXAMPLE_OFFICE_JSON, Facing};
-/// A sphere's MRT at a point with its view-factor table (mrtmap-radiation's).
-pub use mrtmap_radiation::PointRecord;
 use mrtmap_radiation::{PersonMrt, RadiantAsymmetry, RadiantScene};
 use mrtmap_report::numbers::{fixed, uncertainty};
 use rayon::prelude::*;
@@ -154,27 +154,30 @@ pub fn mrt_at_points(
     };
     // In parallel: the k-th point draws from stream k, so the answers are those of a loop; the
     // first point refused (in order) is the one named.
-    type One = (Option<PointRecord>, Option<PersonAnswer>, Option<PlaneAnswer>);
-    let each: Vec<Result<One>> = q
-        .at
-        .par_iter()
-        .enumerate()
-        .map(|(k, p)| {
-            let at = to_scene_frame(*p, q.frame, scene, source)?;
-            let mut one: One = (None, None, None);
-            if let Some((posture, facing)) = q.person {
-                let r = engine.person_at(&at, posture, facing, k as u64)?;
-                one.1 = Some(person_answer(&r, engine.patches()));
-            } else {
-                let r = engine.at(&at, k as u64)?;
-                one.0 = Some(PointRecord::new(None, &r, engine.patches()));
-            }
-            if q.planes {
-                one.2 = Some(plane_answer(&engine.asymmetry_at(&at, k as u64)?));
-            }
-            Ok(one)
-        })
-        .collect();
+    type One = (
+        Option<PointRecord>,
+        Option<PersonAnswer>,
+        Option<PlaneAnswer>,
+    );
+    let each: Vec<Result<One>> =
+        q.at.par_iter()
+            .enumerate()
+            .map(|(k, p)| {
+                let at = to_scene_frame(*p, q.frame, scene, source)?;
+                let mut one: One = (None, None, None);
+                if let Some((posture, facing)) = q.person {
+                    let r = engine.person_at(&at, posture, facing, k as u64)?;
+                    one.1 = Some(person_answer(&r, engine.patches()));
+                } else {
+                    let r = engine.at(&at, k as u64)?;
+                    one.0 = Some(PointRecord::new(None, &r, engine.patches()));
+                }
+                if q.planes {
+                    one.2 = Some(plane_answer(&engine.asymmetry_at(&at, k as u64)?));
+                }
+                Ok(one)
+            })
+            .collect();
     for one in each {
         let (point, person, plane) = one?;
         answers.points.extend(point);

@@ -637,7 +637,11 @@ impl RunDone {
                 recording.display()
             ));
         }
-        lines.push(format!("ran {} into {}", recording.display(), out.display()));
+        lines.push(format!(
+            "ran {} into {}",
+            recording.display(),
+            out.display()
+        ));
         lines.extend(self.outcome.lines(out, self.secs));
         lines
     }

@@ -60,8 +60,10 @@ fn py_err(e: impl std::error::Error) -> PyErr {
 
 /// The view-factor settings from a JSON object of `[mrt]`'s keys (the Python layer's keywords).
 fn mrt_settings(json: &str) -> PyResult<MrtSection> {
-    let s: MrtSection = serde_json::from_str(json)
-        .map_err(|e| MrtmapError::new_err(format!("view-factor settings: {e}")))?;
+    let de = &mut serde_json::Deserializer::from_str(json);
+    let s: MrtSection = serde_path_to_error::deserialize(de).map_err(|e| {
+        MrtmapError::new_err(format!("view-factor setting {}: {}", e.path(), e.inner()))
+    })?;
     s.check().map_err(py_err)?;
     Ok(s)
 }
@@ -235,7 +237,11 @@ impl PyScene {
             .map_err(py_err)?;
         let n = a.planes.len();
         let grid = |f: &dyn Fn(&(String, f64, f64)) -> f64| -> PyResult<Bound<'py, PyArray2<f64>>> {
-            let v: Vec<f64> = a.planes.iter().flat_map(|p| p.faces.iter().map(f)).collect();
+            let v: Vec<f64> = a
+                .planes
+                .iter()
+                .flat_map(|p| p.faces.iter().map(f))
+                .collect();
             Ok(PyArray1::from_vec(py, v).reshape([n, 6])?)
         };
         let json = serde_json::to_string(&a.planes).map_err(py_err)?;
@@ -267,8 +273,7 @@ impl PyScene {
                 "grid ({nx}, {ny}) must have 2 to 2000 nodes each way"
             )));
         }
-        if !(height_m.is_finite() && height_m > 0.0) || !(margin_m.is_finite() && margin_m >= 0.0)
-        {
+        if !(height_m.is_finite() && height_m > 0.0) || !(margin_m.is_finite() && margin_m >= 0.0) {
             return Err(MrtmapError::new_err(format!(
                 "height {height_m} m must be positive and margin {margin_m} m not negative"
             )));
@@ -327,11 +332,14 @@ fn project_of(config: Option<&Bound<'_, PyAny>>) -> PyResult<Project> {
     };
     if let Ok(json) = c.getattr("__mrtmap_json__").and_then(|f| f.call0()) {
         let text: String = json.extract()?;
-        return serde_json::from_str(&text)
-            .map_err(|e| MrtmapError::new_err(format!("config: {e}")));
+        let de = &mut serde_json::Deserializer::from_str(&text);
+        return serde_path_to_error::deserialize(de)
+            .map_err(|e| MrtmapError::new_err(format!("config [{}]: {}", e.path(), e.inner())));
     }
     let path: PathBuf = c.extract().map_err(|_| {
-        MrtmapError::new_err("config must be None, a path to project.toml, or a dict of its sections")
+        MrtmapError::new_err(
+            "config must be None, a path to project.toml, or a dict of its sections",
+        )
     })?;
     Project::load(&path).map_err(py_err)
 }
@@ -428,7 +436,11 @@ fn pmv_ppd<'py>(
     let cols = [&tdb, &tr, &vr, &rh, &met, &clo, &wme].map(|a| a.as_array().to_vec());
     let n = cols[0].len();
     let names = ["tdb", "tr", "vr", "rh", "met", "clo", "wme"];
-    let lens: Vec<(&str, usize)> = names.iter().zip(&cols).map(|(a, c)| (*a, c.len())).collect();
+    let lens: Vec<(&str, usize)> = names
+        .iter()
+        .zip(&cols)
+        .map(|(a, c)| (*a, c.len()))
+        .collect();
     same_len(n, &lens)?;
     let out: Result<Vec<(f64, f64, bool)>, String> = py.detach(|| {
         (0..n)
@@ -508,7 +520,11 @@ fn mrt_from_globe<'py>(
     let cols = [&tg, &tdb, &v, &d, &emissivity].map(|a| a.as_array().to_vec());
     let n = cols[0].len();
     let names = ["tg", "tdb", "v", "d", "emissivity"];
-    let lens: Vec<(&str, usize)> = names.iter().zip(&cols).map(|(a, c)| (*a, c.len())).collect();
+    let lens: Vec<(&str, usize)> = names
+        .iter()
+        .zip(&cols)
+        .map(|(a, c)| (*a, c.len()))
+        .collect();
     same_len(n, &lens)?;
     let method = if mixed {
         GlobeFormulaChoice::Mixed

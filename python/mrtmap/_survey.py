@@ -1,4 +1,5 @@
-"""Surveys of many rooms: each recording mapped as an independent task on a Dask cluster.
+"""Surveys of many rooms (`mrtmap.survey`): each recording mapped as an independent task on a
+Dask cluster.
 
     import mrtmap
     table = mrtmap.survey(["scans/room-101", "scans/room-102", "scans/room-103"], "survey-out")

@@ -1,0 +1,92 @@
+"""The API gives what the command line gives: on the example scene and on a short simulated scan."""
+
+import csv
+import json
+
+import numpy as np
+import pytest
+
+import mrtmap
+from conftest import mrtmap_cli
+
+
+def cli_points(*args):
+    return json.loads(mrtmap_cli("mrt", *args, "--json").stdout)
+
+
+def test_example_mrt_equals_the_cli():
+    pts = [[2.0, 1.5, 1.1], [0.5, 0.5, 0.6], [3.9, 3.3, 1.7]]
+    r = mrtmap.Scene.example().mrt(pts)
+    args = [a for p in pts for a in ("--at", ",".join(map(str, p)))]
+    ref = cli_points(*args)["points"]
+    assert r.mrt.shape == (3,) and r.std_error.shape == (3,)
+    np.testing.assert_allclose(r.mrt, [p["mrt_c"] for p in ref], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(r.std_error, [p["std_error_k"] for p in ref], rtol=0, atol=1e-9)
+    # The CLI prints 20.68 °C at (2, 1.5, 1.1); so does str().
+    assert "MRT 20.68 °C" in str(r).splitlines()[0]
+    mrt, se = r  # unpacks
+    assert mrt[0] == r.mrt[0]
+
+
+def test_montecarlo_settings_reach_the_engine():
+    s = mrtmap.Scene.example()
+    a = s.mrt([[2.0, 1.5, 1.1]], method="montecarlo", rays=4000, seed=3)
+    ref = cli_points("--at", "2,1.5,1.1", "--method", "montecarlo", "--rays", 4000, "--seed", 3)
+    assert a.mrt[0] == pytest.approx(ref["points"][0]["mrt_c"], abs=1e-9)
+    b = s.mrt([[2.0, 1.5, 1.1]], method="montecarlo", rays=4000, seed=4)
+    assert a.mrt[0] != b.mrt[0]  # another seed, another draw
+
+
+def test_person_and_planes_equal_the_cli():
+    s = mrtmap.Scene.example()
+    p = s.person([[2.0, 1.5, 0.6]], posture="seated", facing_deg=90)
+    ref = cli_points("--at", "2,1.5,0.6", "--person", "seated", "--facing", 90)["persons"][0]
+    assert p.mrt[0] == pytest.approx(ref["mrt_c"], abs=1e-9)
+    pl = s.plane_radiant([[2.0, 1.5, 1.1]])
+    ref = cli_points("--at", "2,1.5,1.1", "--plane")["planes"][0]
+    np.testing.assert_allclose(pl.t_pr[0], [f[1] for f in ref["faces"]], atol=1e-9)
+    assert pl.vertical_asymmetry[0] == pytest.approx(ref["vertical_k"], abs=1e-9)
+
+
+def read_grid(path):
+    rows = list(csv.DictReader(open(path)))
+    return {(int(r["i"]), int(r["j"])): r for r in rows}
+
+
+def test_example_map_equals_the_cli_grid(tmp_path):
+    m = mrtmap.Scene.example().map(height=1.1, grid=(12, 9), margin=0.2)
+    mrtmap_cli("map", "--grid", "12x9", "--margin-m", 0.2, "--out", tmp_path)
+    grid = read_grid(tmp_path / "mrt_grid.csv")
+    assert m.mrt.shape == (9, 12) and m.x.shape == (12,) and m.y.shape == (9,)
+    assert np.isfinite(m.mrt).sum() == sum(1 for r in grid.values() if r["mrt_c"])
+    for (i, j), r in grid.items():
+        assert m.mrt[j, i] == pytest.approx(float(r["mrt_c"]), abs=5.1e-5)  # the CSV's 4 decimals
+        assert m.xyz[j, i, 0] == pytest.approx(float(r["x"]), abs=5.1e-5)
+    d = m.to_xarray_dict()
+    assert d["data_vars"]["mrt"]["dims"] == ("y", "x") and d["data_vars"]["mrt"]["data"] is m.mrt
+    df = m.to_dataframe()
+    assert len(df) == np.isfinite(m.mrt).sum()
+    assert m.summary["mean_c"] == pytest.approx(float(np.nanmean(m.mrt)), abs=1e-9)
+
+
+def test_run_equals_the_cli_on_a_short_scan(scans, tmp_path):
+    rec = scans[0]
+    seen = []
+    r = mrtmap.run(rec, tmp_path / "py", {"map": {"grid": [10, 10]}},
+                   progress=lambda stage, done, total: seen.append(stage))
+    mrtmap_cli("run", rec, "--out", tmp_path / "cli", "--grid", "10x10")
+    py_grid = (tmp_path / "py" / "map-1.10m" / "mrt_grid.csv").read_text()
+    cli_grid = (tmp_path / "cli" / "map-1.10m" / "mrt_grid.csv").read_text()
+    assert py_grid == cli_grid
+    assert (tmp_path / "py" / "report.html").exists()
+    assert r.maps[0]["nodes"] == 100 and r.maps[0]["min_c"] <= r.maps[0]["mean_c"] <= r.maps[0]["max_c"]
+    assert {"fuse", "segment"} <= {s["stage"].split()[0] for s in r.stages}
+    assert all(t >= 0 for t in r.timings.values())
+    assert r.surfaces >= 6
+    assert any("fusing" in s for s in seen), seen
+    assert "ran " in str(r)
+    # The scene it wrote answers as the CLI does at a point of the room.
+    scene = mrtmap.Scene.load(r.paths["scene"])
+    a = scene.mrt([[1.5, 1.5, 1.1]])
+    ref = cli_points("--scene", r.paths["scene"], "--at", "1.5,1.5,1.1")["points"][0]
+    assert a.mrt[0] == pytest.approx(ref["mrt_c"], abs=1e-9)
