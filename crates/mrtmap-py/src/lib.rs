@@ -11,6 +11,9 @@
 // Python hands owned values (strings, lists) to the functions PyO3 wraps.
 #![allow(clippy::needless_pass_by_value)]
 
+/// Two float arrays (values and their standard errors).
+type Pair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
+
 use std::path::PathBuf;
 use std::sync::Mutex;
 
@@ -62,10 +65,24 @@ fn py_err(e: impl std::error::Error) -> PyErr {
 fn mrt_settings(json: &str) -> PyResult<MrtSection> {
     let de = &mut serde_json::Deserializer::from_str(json);
     let s: MrtSection = serde_path_to_error::deserialize(de).map_err(|e| {
-        MrtmapError::new_err(format!("view-factor setting {}: {}", e.path(), e.inner()))
+        MrtmapError::new_err(format!(
+            "view-factor setting {}: {}",
+            e.path(),
+            json_words(e.inner())
+        ))
     })?;
     s.check().map_err(py_err)?;
     Ok(s)
+}
+
+/// A serde_json error without its position in the JSON the Python layer wrote (the path names
+/// the setting).
+fn json_words(e: &serde_json::Error) -> String {
+    let s = e.to_string();
+    match s.find(" at line ") {
+        Some(k) => s[..k].to_string(),
+        None => s,
+    }
 }
 
 /// Points from an (N, 3) array: every coordinate finite.
@@ -183,7 +200,7 @@ impl PyScene {
         facing_deg: Option<f64>,
         frame: &str,
         mrt_json: &str,
-    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+    ) -> PyResult<Pair<'py>> {
         let facing = match facing_deg {
             Some(d) if d.is_finite() => Facing::Azimuth(d),
             Some(d) => {
@@ -242,7 +259,7 @@ impl PyScene {
                 .iter()
                 .flat_map(|p| p.faces.iter().map(f))
                 .collect();
-            Ok(PyArray1::from_vec(py, v).reshape([n, 6])?)
+            PyArray1::from_vec(py, v).reshape([n, 6])
         };
         let json = serde_json::to_string(&a.planes).map_err(py_err)?;
         Ok((grid(&|f| f.1)?, grid(&|f| f.2)?, json))
@@ -273,7 +290,7 @@ impl PyScene {
                 "grid ({nx}, {ny}) must have 2 to 2000 nodes each way"
             )));
         }
-        if !(height_m.is_finite() && height_m > 0.0) || !(margin_m.is_finite() && margin_m >= 0.0) {
+        if !(height_m.is_finite() && height_m > 0.0 && margin_m.is_finite() && margin_m >= 0.0) {
             return Err(MrtmapError::new_err(format!(
                 "height {height_m} m must be positive and margin {margin_m} m not negative"
             )));
@@ -333,8 +350,9 @@ fn project_of(config: Option<&Bound<'_, PyAny>>) -> PyResult<Project> {
     if let Ok(json) = c.getattr("__mrtmap_json__").and_then(|f| f.call0()) {
         let text: String = json.extract()?;
         let de = &mut serde_json::Deserializer::from_str(&text);
-        return serde_path_to_error::deserialize(de)
-            .map_err(|e| MrtmapError::new_err(format!("config [{}]: {}", e.path(), e.inner())));
+        return serde_path_to_error::deserialize(de).map_err(|e| {
+            MrtmapError::new_err(format!("config [{}]: {}", e.path(), json_words(e.inner())))
+        });
     }
     let path: PathBuf = c.extract().map_err(|_| {
         MrtmapError::new_err(
