@@ -90,3 +90,13 @@ def test_run_equals_the_cli_on_a_short_scan(scans, tmp_path):
     a = scene.mrt([[1.5, 1.5, 1.1]])
     ref = cli_points("--scene", r.paths["scene"], "--at", "1.5,1.5,1.1")["points"][0]
     assert a.mrt[0] == pytest.approx(ref["mrt_c"], abs=1e-9)
+
+
+def test_map_goes_into_xarray():
+    xr = pytest.importorskip("xarray")
+    m = mrtmap.Scene.example().map(grid=(6, 5))
+    ds = xr.Dataset.from_dict(m.to_xarray_dict())
+    assert ds["mrt"].dims == ("y", "x") and ds["mrt"].shape == (5, 6)
+    assert ds["mrt"].attrs["units"] == "degC"
+    np.testing.assert_array_equal(ds["mrt"].values, m.mrt)
+    assert float(ds["mrt"].sel(x=m.x[2], y=m.y[3])) == m.mrt[3, 2]

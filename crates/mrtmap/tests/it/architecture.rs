@@ -23,7 +23,7 @@ fn named(cell: &str) -> BTreeSet<String> {
         .collect()
 }
 
-/// The mrtmap crates a crate's Cargo.toml lists under [dependencies].
+/// The mrtmap crates a crate's Cargo.toml lists under [dependencies] (`mrtmap` is the CLI).
 fn dependencies(manifest: &Path) -> BTreeSet<String> {
     let text = std::fs::read_to_string(manifest).unwrap();
     let mut in_deps = false;
@@ -34,7 +34,9 @@ fn dependencies(manifest: &Path) -> BTreeSet<String> {
             in_deps = line == "[dependencies]";
             continue;
         }
-        if in_deps && let Some(rest) = line.strip_prefix("mrtmap-") {
+        if in_deps && (line.starts_with("mrtmap ") || line.starts_with("mrtmap.")) {
+            out.insert("mrtmap".to_string());
+        } else if in_deps && let Some(rest) = line.strip_prefix("mrtmap-") {
             let name: String = rest
                 .chars()
                 .take_while(|c| c.is_ascii_alphanumeric() || *c == '-')

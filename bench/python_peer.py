@@ -1,0 +1,97 @@
+#!/usr/bin/env python3
+"""The Python package beside pythermalcomfort and beside the command line (issue 39).
+
+    python_peer.py MRTMAP_BIN
+
+1. PMV/PPD on a 777×444 grid (pythermalcomfort #227's size) of random valid inputs:
+   mrtmap.pmv_ppd_iso beside pythermalcomfort.models.pmv_ppd_iso, same arrays, round_output=False;
+   medians of 5 runs after one warm-up (numba compiles on its first call); the largest difference.
+2. MRT on a 100×100 grid at 1.1 m of the example office: `scene.map(grid=(100, 100))` from Python
+   beside `mrtmap map --grid 100x100` (wall time of the process, which also draws the PNG and SVG)
+   and beside the map's own compute time the CLI reports; and `scene.mrt` at the same 10,000
+   points. Medians of 5.
+Prints one JSON object.
+"""
+import json
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+import warnings
+
+import numpy as np
+
+warnings.filterwarnings("ignore")
+
+
+def median_time(f, runs=5):
+    times = []
+    out = None
+    for _ in range(runs):
+        t0 = time.perf_counter()
+        out = f()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times), out
+
+
+def comfort():
+    import mrtmap
+    from pythermalcomfort.models import pmv_ppd_iso
+
+    rng = np.random.default_rng(1)
+    shape = (777, 444)
+    args = dict(tdb=rng.uniform(10, 30, shape), tr=rng.uniform(10, 40, shape),
+                vr=rng.uniform(0, 1, shape), rh=rng.uniform(5, 95, shape),
+                met=rng.uniform(0.8, 4, shape), clo=rng.uniform(0, 2, shape))
+    pmv_ppd_iso(**args, round_output=False)  # numba's compilation
+    mrtmap.pmv_ppd_iso(**args, round_output=False)
+    t_peer, peer = median_time(lambda: pmv_ppd_iso(**args, round_output=False))
+    t_ours, ours = median_time(lambda: mrtmap.pmv_ppd_iso(**args, round_output=False))
+    same_nan = bool((np.isnan(ours.pmv) == np.isnan(peer.pmv)).all())
+    d = np.nanmax(np.abs(ours.pmv - peer.pmv))
+    dp = np.nanmax(np.abs(ours.ppd - peer.ppd))
+    return {
+        "cells": int(np.prod(shape)),
+        "pythermalcomfort_s": round(t_peer, 4),
+        "mrtmap_s": round(t_ours, 4),
+        "speedup": round(t_peer / t_ours, 1),
+        "max_abs_diff_pmv": float(d),
+        "max_abs_diff_ppd": float(dp),
+        "nan_alike": same_nan,
+        "within_1e-6": bool(d <= 1e-6 and dp <= 1e-6 and same_nan),
+    }
+
+
+def grid(bin_path):
+    import mrtmap
+
+    scene = mrtmap.Scene.example()
+    t_py, m = median_time(lambda: scene.map(height=1.1, grid=(100, 100)))
+    ok = np.isfinite(m.mrt)
+    pts = m.xyz[ok]
+    t_pts, r = median_time(lambda: scene.mrt(pts))
+    with tempfile.TemporaryDirectory() as d:
+        def cli():
+            subprocess.run([bin_path, "map", "--grid", "100x100", "--out", d], check=True,
+                           capture_output=True)
+            return json.load(open(f"{d}/summary.json"))
+
+        t_cli, summary = median_time(cli)
+    cli_compute = summary["compute_secs"]
+    return {
+        "nodes": int(ok.sum()),
+        "python_map_s": round(t_py, 4),
+        "python_map_compute_s": round(m.compute_secs, 4),
+        "python_points_s": round(t_pts, 4),
+        "cli_map_wall_s": round(t_cli, 4),
+        "cli_map_compute_s": round(cli_compute, 4),
+        "python_map_over_cli_wall": round(t_py / t_cli, 3),
+        "python_map_over_cli_compute": round(t_py / cli_compute, 3),
+        "same_mean_c": abs(float(np.nanmean(m.mrt)) - summary["mean_c"]) < 1e-9,
+        "points_equal_map": bool(np.allclose(r.mrt, m.mrt[ok], atol=1e-9, rtol=0)),
+    }
+
+
+if __name__ == "__main__":
+    print(json.dumps({"pmv_ppd_777x444": comfort(), "mrt_100x100": grid(sys.argv[1])}, indent=1))
