@@ -280,15 +280,15 @@ fn title_of(q: Quantity, c: &ComfortSection) -> (String, &'static str) {
     }
 }
 
-/// A node of the comfort grid.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ComfortNode {
+/// A node of the comfort grid (the maps' working set; the files hold what it gives).
+#[derive(Clone, Debug, PartialEq)]
+struct ComfortNode {
     /// Grid indices.
-    pub i: usize,
+    i: usize,
     /// Grid indices.
-    pub j: usize,
-    /// The values, or why not.
-    pub point: std::result::Result<ComfortPoint, String>,
+    j: usize,
+    /// The values, or why not (the CSV's note).
+    point: std::result::Result<ComfortPoint, String>,
 }
 
 /// `comfort.json`: what the comfort maps say as a whole.

@@ -3,10 +3,10 @@
 use std::path::{Path, PathBuf};
 
 use mrtmap_geometry::nalgebra::Point3;
-/// Globe ↔ MRT conversions (mrtmap-physics').
+/// Globe ↔ MRT conversions and why one fails (mrtmap-physics').
 pub use mrtmap_physics::{
-    Convection, Globe, GlobeFormula, GlobeMethod, GlobeReading, Temperature, globe_temperature,
-    mrt_from_globe,
+    Convection, Globe, GlobeFormula, GlobeMethod, GlobeReading, PhysicsError, Temperature,
+    globe_temperature, mrt_from_globe,
 };
 use mrtmap_radiation::{Method, MonteCarlo, MrtEngine, RadiantScene};
 use mrtmap_report::{GlobeRow, ValidationRow, parse_globe_csv, validate, validation_csv};
@@ -102,7 +102,6 @@ fn calibrate_level(
                 engine
                     .at(&Point3::from(*x), 0)
                     .map(|r| (r.mrt.celsius(), r.std_error_k))
-                    .map_err(|e| e.to_string())
             },
         );
         let d: Vec<f64> = rows.iter().filter_map(|r| r.diff_iso_k).collect();
@@ -165,7 +164,6 @@ pub fn validate_map(
         engine
             .at(&Point3::from(*x), 0)
             .map(|r| (r.mrt.celsius(), r.std_error_k))
-            .map_err(|e| e.to_string())
     };
     let mut rows = validate(&readings, &ours);
     for r in &mut rows {

@@ -198,10 +198,10 @@ fn comparison_section(o: &mut String, d: &ReportData) {
 }
 
 fn validation_row(r: &ValidationRow) -> Vec<String> {
-    let f = |r: &Result<f64, String>| {
+    let f = |r: &Result<f64, mrtmap_physics::PhysicsError>| {
         r.as_ref()
             .map(|v| format!("{v:.2}"))
-            .unwrap_or_else(|e| format!("— ({})", esc(e)))
+            .unwrap_or_else(|e| format!("— ({})", esc(&e.to_string())))
     };
     let yes = |b: Option<bool>| match b {
         Some(true) => "<span class=\"ok\">yes</span>".to_string(),
@@ -219,7 +219,7 @@ fn validation_row(r: &ValidationRow) -> Vec<String> {
         r.ours_c
             .as_ref()
             .map(|(o, s)| format!("{o:.2} ± {}", uncertainty(*s, 2)))
-            .unwrap_or_else(|e| esc(e)),
+            .unwrap_or_else(|e| esc(&e.to_string())),
         r.diff_iso_k.map_or("—".into(), |v| signed(v, 2)),
         r.diff_mixed_k.map_or("—".into(), |v| signed(v, 2)),
         yes(r.meets_required),

@@ -6,7 +6,8 @@
 //! x, y, z are in the frame of scene.json (the room's own frame for a scanned room); blank lines and lines starting with
 //! `#` are skipped.
 
-use mrtmap_physics::{Globe, GlobeMethod, GlobeReading, Temperature, mrt_from_globe};
+use mrtmap_physics::{Globe, GlobeMethod, GlobeReading, PhysicsError, Temperature, mrt_from_globe};
+use mrtmap_radiation::MrtError;
 use serde::{Deserialize, Serialize};
 
 use crate::ReportError;
@@ -175,7 +176,7 @@ fn globe_row(
 }
 
 /// The map's MRT (°C) and its standard error (K) at a scan-frame point, or why not.
-pub type MrtAt<'a> = dyn Fn(&[f64; 3]) -> Result<(f64, f64), String> + 'a;
+pub type MrtAt<'a> = dyn Fn(&[f64; 3]) -> Result<(f64, f64), MrtError> + 'a;
 
 /// A validation row. In JSON every value is a number or null, a missing one with a `…_note`
 /// saying why (`mrt_mixed_note`: "globe diameter … outside …").
@@ -184,13 +185,13 @@ pub struct ValidationRow {
     /// The reading.
     pub globe: GlobeRow,
     /// MRT from the globe by the ISO 7726 general formula (°C), or why not.
-    pub mrt_iso_c: Result<f64, String>,
+    pub mrt_iso_c: Result<f64, PhysicsError>,
     /// The ISO branch used (natural or forced convection).
     pub iso_formula: String,
     /// MRT from the globe with the mixed-convection correction (°C), or why not (0.04–0.15 m globes).
-    pub mrt_mixed_c: Result<f64, String>,
+    pub mrt_mixed_c: Result<f64, PhysicsError>,
     /// The map's MRT at the point (°C) and its standard error (K), or why not.
-    pub ours_c: Result<(f64, f64), String>,
+    pub ours_c: Result<(f64, f64), MrtError>,
     /// Ours − ISO (K).
     pub diff_iso_k: Option<f64>,
     /// Ours − mixed convection (K).
@@ -209,15 +210,15 @@ struct ValidationJson<'a> {
     globe: &'a GlobeRow,
     mrt_iso_c: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
-    mrt_iso_note: Option<&'a str>,
+    mrt_iso_note: Option<String>,
     iso_formula: &'a str,
     mrt_mixed_c: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
-    mrt_mixed_note: Option<&'a str>,
+    mrt_mixed_note: Option<String>,
     ours_c: Option<f64>,
     ours_std_error_k: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
-    ours_note: Option<&'a str>,
+    ours_note: Option<String>,
     diff_iso_k: Option<f64>,
     diff_mixed_k: Option<f64>,
     meets_required: Option<bool>,
@@ -230,13 +231,13 @@ impl Serialize for ValidationRow {
         ValidationJson {
             globe: &self.globe,
             mrt_iso_c: self.mrt_iso_c.as_ref().ok().copied(),
-            mrt_iso_note: self.mrt_iso_c.as_ref().err().map(String::as_str),
+            mrt_iso_note: self.mrt_iso_c.as_ref().err().map(ToString::to_string),
             iso_formula: &self.iso_formula,
             mrt_mixed_c: self.mrt_mixed_c.as_ref().ok().copied(),
-            mrt_mixed_note: self.mrt_mixed_c.as_ref().err().map(String::as_str),
+            mrt_mixed_note: self.mrt_mixed_c.as_ref().err().map(ToString::to_string),
             ours_c: self.ours_c.as_ref().ok().map(|x| x.0),
             ours_std_error_k: self.ours_c.as_ref().ok().map(|x| x.1),
-            ours_note: self.ours_c.as_ref().err().map(String::as_str),
+            ours_note: self.ours_c.as_ref().err().map(ToString::to_string),
             diff_iso_k: self.diff_iso_k,
             diff_mixed_k: self.diff_mixed_k,
             meets_required: self.meets_required,
@@ -263,15 +264,12 @@ pub fn validate(rows: &[GlobeRow], ours: &MrtAt<'_>) -> Vec<ValidationRow> {
             let iso = mrt_from_globe(&globe, &reading, GlobeMethod::ISO);
             let mixed = mrt_from_globe(&globe, &reading, GlobeMethod::MixedConvection);
             let ours = ours(&g.xyz);
-            let iso_c = iso
-                .as_ref()
-                .map(|r| r.mrt.celsius())
-                .map_err(|e| e.to_string());
+            let iso_c = iso.as_ref().map(|r| r.mrt.celsius()).map_err(Clone::clone);
             let mixed_c = mixed
                 .as_ref()
                 .map(|r| r.mrt.celsius())
-                .map_err(|e| e.to_string());
-            let diff = |r: &Result<f64, String>| match (&ours, r) {
+                .map_err(Clone::clone);
+            let diff = |r: &Result<f64, PhysicsError>| match (&ours, r) {
                 (Ok((o, _)), Ok(x)) => Some(o - x),
                 _ => None,
             };

@@ -116,7 +116,7 @@ fn rows_convert_the_globe_and_classify_the_difference() {
     assert!(
         v[3].mrt_mixed_c
             .as_ref()
-            .is_err_and(|e| e.contains("0.038") && e.contains("0.04")),
+            .is_err_and(|e| e.to_string().contains("0.038") && e.to_string().contains("0.04")),
         "{:?}",
         v[3].mrt_mixed_c
     );
@@ -143,7 +143,11 @@ fn rows_convert_the_globe_and_classify_the_difference() {
     assert_eq!(v[3].diff_mixed_k, None);
     // No map value: no differences, no class.
     let v = validate(&rows[..1], &|_: &[f64; 3]| {
-        Err("outside the room".to_string())
+        Err(mrtmap_radiation::MrtError::OutsideRoom {
+            point: [0.0, 0.0, 1.1],
+            where_: "outside the walls".into(),
+            room: "a test room".into(),
+        })
     });
     assert_eq!(
         (v[0].diff_iso_k, v[0].meets_required, v[0].meets_desired),

@@ -127,7 +127,7 @@ fn columns(c: &Connection, table: &str) -> Vec<String> {
 }
 
 /// 12 f32, row-major 3×4 [R|t] → isometry (rotation re-orthonormalised).
-pub fn pose_blob(b: &[u8], what: &str) -> Result<Isometry3<f64>, String> {
+pub(crate) fn pose_blob(b: &[u8], what: &str) -> Result<Isometry3<f64>, String> {
     if b.len() != 48 {
         return Err(format!(
             "{what} is {} bytes, expected 48 (12 floats)",

@@ -26,15 +26,19 @@ pub fn run(a: &ValidateArgs) -> anyhow::Result<()> {
     let mut notes = Vec::new();
     for r in result {
         let label = &r.globe.label;
-        let mut f = |what: &str, x: &Result<f64, String>| match x {
+        let mut f = |what: &str, x: Result<f64, String>| match x {
             Ok(v) => format!("{v:.2}"),
             Err(e) => {
                 notes.push(format!("{label}: no {what}: {e}"));
                 format!("— ({})", notes.len())
             }
         };
-        let iso = f("ISO 7726 MRT", &r.mrt_iso_c);
-        let mixed = f("mixed-convection MRT", &r.mrt_mixed_c);
+        let words = |x: &Result<f64, _>| {
+            x.clone()
+                .map_err(|e: mrtmap_pipeline::validation::PhysicsError| e.to_string())
+        };
+        let iso = f("ISO 7726 MRT", words(&r.mrt_iso_c));
+        let mixed = f("mixed-convection MRT", words(&r.mrt_mixed_c));
         let ours = match &r.ours_c {
             Ok((o, s)) => format!("{o:.2} ± {}", uncertainty(*s, 2)),
             Err(e) => {
