@@ -14,16 +14,24 @@
 //! become (T − α)/β, and the level's standard uncertainty at the scene's mean temperature is
 //! written as the scene's `temperature_level_std_k`; with the offset alone it holds the gain
 //! error left ([`GAIN_STD`] × the distance from the readings).
+//!
+//! Everything about the absolute level is here: the readings ([`read_references`]), what a run
+//! gathers ([`LevelInputs`]), the fit ([`find_level`]) and segmentation's scene and tables carried
+//! to it ([`level_segmentation`]). The relative level (each frame's offset after a flat-field
+//! correction, the vignetting) is removed during fusion, frame by frame, by
+//! `mrtmap-scan/src/radiometric.rs`.
 
 use std::path::Path;
 
 use mrtmap_geometry::nalgebra::{Isometry3, Point3};
-use mrtmap_io::ThermalCloud;
-use mrtmap_physics::ZERO_CELSIUS_K;
+use mrtmap_io::{Recording, ThermalCloud};
+use mrtmap_physics::{Temperature, ZERO_CELSIUS_K};
+use mrtmap_radiation::RadiantScene;
+use mrtmap_scan::segment::Segmentation;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::settings::PointFrame;
+use crate::settings::{PointFrame, Project};
 
 /// A thermal camera's absolute accuracy when the rig does not state one (K): the Lepton 3.5's
 /// datasheet (high gain).
@@ -400,6 +408,127 @@ impl Level {
     pub fn correct(&self, camera_c: f64) -> f64 {
         (camera_c - self.alpha_c) / self.beta
     }
+}
+
+/// What fixes the temperatures' absolute level: reference readings and the camera's accuracy.
+#[derive(Clone, Debug, Default)]
+pub struct LevelInputs {
+    /// Contact-thermometer readings (references.csv and `[[references]]`).
+    pub references: Vec<Reference>,
+    /// The camera's stated absolute accuracy (K), used when no reading is usable.
+    pub camera_accuracy_k: f64,
+}
+
+impl LevelInputs {
+    /// The recording's references.csv (when present) and the project's `[[references]]`.
+    pub fn of(rec: &Recording, p: &Project) -> Result<Self> {
+        let csv = rec.dir.join("references.csv");
+        let mut references = if csv.exists() {
+            read_references(&csv)?
+        } else {
+            Vec::new()
+        };
+        references.extend(p.references.iter().cloned());
+        Ok(Self {
+            references,
+            camera_accuracy_k: rec
+                .rig
+                .thermal_accuracy_k
+                .unwrap_or(DEFAULT_CAMERA_ACCURACY_K),
+        })
+    }
+}
+
+/// The scene's temperatures carried to the level: (T − α)/β, uncertainties scaled by 1/β, and
+/// the level's uncertainty recorded.
+fn apply_level(scene: &mut RadiantScene, level: &Level) {
+    let fix = |t: &mut Temperature| {
+        *t = Temperature::from_celsius(level.correct(t.celsius()));
+    };
+    let scale = |s: &mut Option<f64>| {
+        if let Some(v) = s {
+            *v /= level.beta.abs();
+        }
+    };
+    for s in &mut scene.surfaces {
+        fix(&mut s.temperature);
+        scale(&mut s.temperature_std_k);
+        if let Some(r) = &mut s.raster {
+            r.map_celsius(|c| level.correct(c));
+        }
+        for f in &mut s.features {
+            fix(&mut f.temperature);
+            scale(&mut f.temperature_std_k);
+        }
+    }
+    for o in &mut scene.occluders {
+        fix(&mut o.temperature);
+    }
+    scene.temperature_level_std_k = level.std_k;
+}
+
+/// The area-weighted mean temperature of a scene's surfaces (°C).
+fn mean_temperature_c(scene: &RadiantScene) -> f64 {
+    let (mut a, mut t) = (0.0, 0.0);
+    for s in &scene.surfaces {
+        let area = mrtmap_geometry::polygon::area_3d(&s.polygon);
+        a += area;
+        t += area * s.temperature.celsius();
+    }
+    if a > 0.0 { t / a } else { 20.0 }
+}
+
+/// Segmentation's scene and tables carried to the level the readings of `level` fix: the
+/// readings are compared with what the cameras saw (the cloud `cloud` and texturing's samples:
+/// a contact reading on a window, where glass gives no depth, meets what texturing found), the
+/// level fitted, the scene's temperatures corrected, segment.json's tables with them, and the
+/// level's warnings added to segmentation's.
+pub fn level_segmentation(
+    seg: &mut Segmentation,
+    cloud: &ThermalCloud,
+    level: &LevelInputs,
+) -> Level {
+    let world_from_room = seg
+        .report
+        .world_from_room
+        .to_isometry()
+        .unwrap_or_else(Isometry3::identity);
+    // What the cameras saw, texturing's samples included: a contact reading on a window (glass
+    // gives no depth, so the cloud has nothing there) is compared with what texturing found.
+    let mut seen = cloud.clone();
+    seen.positions.extend_from_slice(&seg.textured.positions);
+    seen.normals.extend_from_slice(&seg.textured.normals);
+    seen.temperature_k
+        .extend_from_slice(&seg.textured.temperature_k);
+    seen.temperature_std_k
+        .extend_from_slice(&seg.textured.temperature_std_k);
+    seen.observations
+        .extend_from_slice(&seg.textured.observations);
+    let found = find_level(
+        &level.references,
+        &seen,
+        &world_from_room,
+        mean_temperature_c(&seg.scene),
+        level.camera_accuracy_k,
+    );
+    apply_level(&mut seg.scene, &found);
+    // segment.json's tables at the same level as scene.json (the report's Surfaces and Features
+    // tables showed the camera's uncorrected temperatures beside corrected maps).
+    for x in &mut seg.report.surfaces {
+        x.temperature_c = x.temperature_c.map(|c| found.correct(c));
+        x.temperature_std_k /= found.beta.abs();
+    }
+    for f in &mut seg.report.features {
+        f.temperature_c = found.correct(f.temperature_c);
+        f.contrast_k /= found.beta;
+    }
+    for f in &mut seg.report.furniture {
+        f.temperature_c = found.correct(f.temperature_c);
+    }
+    seg.report
+        .warnings
+        .extend(found.warnings.iter().map(|w| format!("level: {w}")));
+    found
 }
 
 #[cfg(test)]
