@@ -126,8 +126,13 @@ fn columns(c: &Connection, table: &str) -> Vec<String> {
         .unwrap_or_default()
 }
 
-/// 12 f32, row-major 3×4 [R|t] → isometry (rotation re-orthonormalised).
-pub(crate) fn pose_blob(b: &[u8], what: &str) -> Result<Isometry3<f64>, String> {
+/// 12 f32, row-major 3×4 [R|t] → isometry (rotation re-orthonormalised); the error names `what`.
+pub fn pose_blob(b: &[u8], what: &str) -> Result<Isometry3<f64>, BlobError> {
+    pose_words(b, what).map_err(BlobError)
+}
+
+/// [`pose_blob`] with its error as words, for the readers that add the row to them.
+fn pose_words(b: &[u8], what: &str) -> Result<Isometry3<f64>, String> {
     if b.len() != 48 {
         return Err(format!(
             "{what} is {} bytes, expected 48 (12 floats)",
@@ -293,7 +298,7 @@ fn optimised(c: &Connection, path: &Path) -> Result<Vec<(i64, Isometry3<f64>)>, 
         .map(|i| {
             let id =
                 i32::from_le_bytes([ids[4 * i], ids[4 * i + 1], ids[4 * i + 2], ids[4 * i + 3]]);
-            pose_blob(
+            pose_words(
                 &poses[48 * i..48 * i + 48],
                 &format!("optimised pose of node {id}"),
             )
@@ -529,7 +534,7 @@ pub fn graph(path: &Path) -> Result<Graph, FileError> {
         while let Some(r) = rows.next().map_err(|e| sql_err(path, e))? {
             let id: i64 = r.get(0).map_err(|e| sql_err(path, e))?;
             let b: Option<Vec<u8>> = r.get(1).unwrap_or(None);
-            match pose_blob(&b.unwrap_or_default(), "pose blob") {
+            match pose_words(&b.unwrap_or_default(), "pose blob") {
                 Ok(p) => {
                     nodes.insert(id, p);
                 }
@@ -556,7 +561,7 @@ pub fn graph(path: &Path) -> Result<Graph, FileError> {
             let to: i64 = r.get(1).map_err(|e| e.to_string())?;
             let kind: i64 = r.get(2).map_err(|e| e.to_string())?;
             let t: Option<Vec<u8>> = r.get(3).map_err(|e| e.to_string())?;
-            let transform = pose_blob(
+            let transform = pose_words(
                 &t.unwrap_or_default(),
                 &format!("link {from} → {to} transform"),
             )?;
@@ -623,7 +628,7 @@ pub fn for_each_node(
         let res: Result<Node, String> = (|| {
             let stamp: f64 = r.get(1).map_err(|e| format!("stamp: {e}"))?;
             let pose_b: Option<Vec<u8>> = r.get(2).map_err(|e| format!("pose: {e}"))?;
-            let odom = pose_blob(&pose_b.unwrap_or_default(), "pose blob")?;
+            let odom = pose_words(&pose_b.unwrap_or_default(), "pose blob")?;
             let pose = if opt.is_empty() {
                 odom
             } else {
@@ -981,6 +986,7 @@ mod tests {
         assert!(
             pose_blob(&skew, "p")
                 .unwrap_err()
+                .0
                 .contains("not a rotation")
         );
     }
