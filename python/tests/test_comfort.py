@@ -8,12 +8,15 @@ import pytest
 import mrtmap
 
 ptc_models = pytest.importorskip("pythermalcomfort.models")
-from pythermalcomfort.utilities import v_relative as ptc_v_relative  # noqa: E402
 
 try:
-    from pythermalcomfort.environment import mean_radiant_tmp as ptc_mrt, operative_tmp as ptc_to
-except ImportError:  # pythermalcomfort < 4.5
-    from pythermalcomfort.utilities import mean_radiant_tmp as ptc_mrt, operative_tmp as ptc_to
+    from pythermalcomfort.environment import mean_radiant_tmp as ptc_mrt
+    from pythermalcomfort.environment import operative_tmp as ptc_to
+    from pythermalcomfort.environment import v_relative as ptc_v_relative
+except ImportError:  # pythermalcomfort before 4.5 kept them in utilities
+    from pythermalcomfort.utilities import mean_radiant_tmp as ptc_mrt
+    from pythermalcomfort.utilities import operative_tmp as ptc_to
+    from pythermalcomfort.utilities import v_relative as ptc_v_relative
 
 N = 10_000
 warnings.filterwarnings("ignore")

@@ -451,7 +451,8 @@ fn pmv_ppd<'py>(
             )));
         }
     };
-    let cols = [&tdb, &tr, &vr, &rh, &met, &clo, &wme].map(|a| a.as_array().to_vec());
+    // Views, not copies: the arrays stay borrowed while the GIL is released.
+    let cols = [&tdb, &tr, &vr, &rh, &met, &clo, &wme].map(|a| a.as_array());
     let n = cols[0].len();
     let names = ["tdb", "tr", "vr", "rh", "met", "clo", "wme"];
     let lens: Vec<(&str, usize)> = names
