@@ -18,6 +18,7 @@ use mrtmap_physics::{Category, Posture, Temperature, pmv_ppd};
 /// PMV/PPD by edition of ISO 7730 and the operative temperature (mrtmap-physics').
 pub use mrtmap_physics::{
     Iso7730Edition, OperativeMethod, Pmv, PmvInputs, operative_temperature, pmv_ppd_edition,
+    pmv_ppd_many,
 };
 use mrtmap_radiation::{
     AsymmetryVerdict, GridSpec, MapFrame, MrtEngine, MrtError, MrtField, RadiantAsymmetry,

@@ -18,7 +18,7 @@ use std::path::PathBuf;
 use std::sync::Mutex;
 
 use mrtmap_pipeline::comfort::{
-    Iso7730Edition, OperativeMethod, PmvInputs, operative_temperature, pmv_ppd_edition,
+    Iso7730Edition, OperativeMethod, PmvInputs, operative_temperature, pmv_ppd_many,
 };
 use mrtmap_pipeline::maps::{GridSpec, RadiantScene, load_scene, map_arrays};
 use mrtmap_pipeline::points::{Facing, PointQuery, Posture, mrt_at_points};
@@ -461,27 +461,43 @@ fn pmv_ppd<'py>(
         .map(|(a, c)| (*a, c.len()))
         .collect();
     same_len(n, &lens)?;
+    // Blocks of inputs in parallel; within a block, several PMVs iterate interleaved.
+    const BLOCK: usize = 2048;
     let out: Result<Vec<(f64, f64, bool)>, String> = py.detach(|| {
-        (0..n)
+        let blocks: Vec<Result<Vec<(f64, f64, bool)>, String>> = (0..n.div_ceil(BLOCK))
             .into_par_iter()
-            .map(|k| {
-                let c = |i: usize| cols[i][k];
-                pmv_ppd_edition(
-                    &PmvInputs {
-                        air: Temperature::from_celsius(c(0)),
-                        mrt: Temperature::from_celsius(c(1)),
-                        relative_air_speed_m_s: c(2),
-                        relative_humidity_pct: c(3),
-                        met: c(4),
-                        clo: c(5),
-                        external_work_met: c(6),
-                    },
-                    edition,
-                )
-                .map(|p| (p.pmv, p.ppd_pct, p.within_iso_ranges))
-                .map_err(|e| format!("element {k}: {}", message(&e)))
+            .map(|b| {
+                let range = b * BLOCK..((b + 1) * BLOCK).min(n);
+                let inputs: Vec<PmvInputs> = range
+                    .clone()
+                    .map(|k| {
+                        let c = |i: usize| cols[i][k];
+                        PmvInputs {
+                            air: Temperature::from_celsius(c(0)),
+                            mrt: Temperature::from_celsius(c(1)),
+                            relative_air_speed_m_s: c(2),
+                            relative_humidity_pct: c(3),
+                            met: c(4),
+                            clo: c(5),
+                            external_work_met: c(6),
+                        }
+                    })
+                    .collect();
+                pmv_ppd_many(&inputs, edition)
+                    .into_iter()
+                    .zip(range)
+                    .map(|(r, k)| {
+                        r.map(|p| (p.pmv, p.ppd_pct, p.within_iso_ranges))
+                            .map_err(|e| format!("element {k}: {}", message(&e)))
+                    })
+                    .collect()
             })
-            .collect()
+            .collect();
+        let mut all = Vec::with_capacity(n);
+        for b in blocks {
+            all.extend(b?);
+        }
+        Ok(all)
     });
     let out = out.map_err(MrtmapError::new_err)?;
     Ok((

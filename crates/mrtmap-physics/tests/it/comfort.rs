@@ -1,6 +1,6 @@
 use mrtmap_physics::{
     AsymmetryKind, Iso7730Edition, OperativeMethod, PmvInputs, Temperature, operative_temperature,
-    pmv_ppd, pmv_ppd_edition, ppd_from_pmv, radiant_asymmetry_ppd,
+    pmv_ppd, pmv_ppd_edition, pmv_ppd_many, ppd_from_pmv, radiant_asymmetry_ppd,
 };
 
 fn c(x: f64) -> Temperature {
@@ -126,4 +126,35 @@ fn radiant_asymmetry_curves() {
     assert_eq!(at(AsymmetryKind::WarmWall, 0.0), 0.0);
     assert!(at(AsymmetryKind::CoolWall, 15.0) > at(AsymmetryKind::CoolWall, 10.0));
     assert!(radiant_asymmetry_ppd(AsymmetryKind::CoolWall, -1.0).is_err());
+}
+
+/// The interleaved batch gives each input's own answer, errors included, in order.
+#[test]
+fn pmv_many_equals_one_at_a_time() {
+    let mut inputs = Vec::new();
+    for k in 0..103 {
+        let x = k as f64;
+        inputs.push(PmvInputs {
+            air: c(10.0 + (x * 7.3) % 20.0),
+            mrt: c(10.0 + (x * 3.1) % 30.0),
+            relative_air_speed_m_s: (x * 0.137) % 1.0,
+            // Every 17th input is invalid: an error in its place, the others unaffected.
+            relative_humidity_pct: if k % 17 == 5 {
+                150.0
+            } else {
+                5.0 + (x * 11.0) % 90.0
+            },
+            met: 0.8 + (x * 0.29) % 3.2,
+            clo: (x * 0.071) % 2.0,
+            external_work_met: 0.0,
+        });
+    }
+    for edition in [Iso7730Edition::Y2005, Iso7730Edition::Y2025] {
+        let many = pmv_ppd_many(&inputs, edition);
+        assert_eq!(many.len(), inputs.len());
+        for (i, m) in inputs.iter().zip(&many) {
+            assert_eq!(m, &pmv_ppd_edition(i, edition));
+        }
+        assert_eq!(many.iter().filter(|r| r.is_err()).count(), 6);
+    }
 }
