@@ -410,10 +410,7 @@ def pmv_ppd_iso(
     if str(model).lower() not in editions:
         raise MrtmapError(f"model {model!r} is neither '7730-2025' nor '7730-2005'")
     shape, flat = _broadcast(tdb, tr, vr, rh, met, clo, wme)
-    pmv, ppd, ok = _mrtmap.pmv_ppd(*flat, editions[str(model).lower()])
-    if limit_inputs:
-        pmv = np.where(ok, pmv, np.nan)
-        ppd = np.where(ok, ppd, np.nan)
+    pmv, ppd = _mrtmap.pmv_ppd(*flat, editions[str(model).lower()], bool(limit_inputs))
     if round_output:
         pmv, ppd = np.round(pmv, 2), np.round(ppd, 1)
     return PMVPPD(pmv=pmv.reshape(shape), ppd=ppd.reshape(shape))

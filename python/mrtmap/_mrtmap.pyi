@@ -60,7 +60,8 @@ def pmv_ppd(
     clo: npt.ArrayLike,
     wme: npt.ArrayLike,
     edition: int,
-) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.bool_]]: ...
+    limit: bool,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
 def operative(
     tdb: npt.ArrayLike, tr: npt.ArrayLike, v: npt.ArrayLike, ashrae: bool
 ) -> npt.NDArray[np.float64]: ...

@@ -424,9 +424,10 @@ fn same_len(n: usize, arrays: &[(&str, usize)]) -> PyResult<()> {
     }
 }
 
-/// PMV, PPD and whether within ISO 7730's ranges, element by element over 1-D arrays.
+/// PMV and PPD element by element over 1-D arrays; with `limit`, NaN where the inputs or the PMV
+/// lie outside ISO 7730's ranges (pythermalcomfort's `limit_inputs`).
 #[pyfunction]
-#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+#[allow(clippy::too_many_arguments)]
 fn pmv_ppd<'py>(
     py: Python<'py>,
     tdb: PyArrayLike1<'py, f64, AllowTypeChange>,
@@ -437,11 +438,8 @@ fn pmv_ppd<'py>(
     clo: PyArrayLike1<'py, f64, AllowTypeChange>,
     wme: PyArrayLike1<'py, f64, AllowTypeChange>,
     edition: u32,
-) -> PyResult<(
-    Bound<'py, PyArray1<f64>>,
-    Bound<'py, PyArray1<f64>>,
-    Bound<'py, PyArray1<bool>>,
-)> {
+    limit: bool,
+) -> PyResult<Pair<'py>> {
     let edition = match edition {
         2005 => Iso7730Edition::Y2005,
         2025 => Iso7730Edition::Y2025,
@@ -461,50 +459,48 @@ fn pmv_ppd<'py>(
         .map(|(a, c)| (*a, c.len()))
         .collect();
     same_len(n, &lens)?;
-    // Blocks of inputs in parallel; within a block, several PMVs iterate interleaved.
+    // Blocks of inputs in parallel, written in place; within a block, several PMVs iterate
+    // interleaved. The first element refused, in order, is the one named.
     const BLOCK: usize = 2048;
-    let out: Result<Vec<(f64, f64, bool)>, String> = py.detach(|| {
-        let blocks: Vec<Result<Vec<(f64, f64, bool)>, String>> = (0..n.div_ceil(BLOCK))
-            .into_par_iter()
-            .map(|b| {
-                let range = b * BLOCK..((b + 1) * BLOCK).min(n);
-                let inputs: Vec<PmvInputs> = range
-                    .clone()
-                    .map(|k| {
-                        let c = |i: usize| cols[i][k];
-                        PmvInputs {
-                            air: Temperature::from_celsius(c(0)),
-                            mrt: Temperature::from_celsius(c(1)),
-                            relative_air_speed_m_s: c(2),
-                            relative_humidity_pct: c(3),
-                            met: c(4),
-                            clo: c(5),
-                            external_work_met: c(6),
-                        }
+    let mut pmv = vec![0.0; n];
+    let mut ppd = vec![0.0; n];
+    let refused: Option<String> = py.detach(|| {
+        pmv.par_chunks_mut(BLOCK)
+            .zip(ppd.par_chunks_mut(BLOCK))
+            .enumerate()
+            .map(|(b, (pmv, ppd))| {
+                let start = b * BLOCK;
+                let inputs: Vec<PmvInputs> = (start..start + pmv.len())
+                    .map(|k| PmvInputs {
+                        air: Temperature::from_celsius(cols[0][k]),
+                        mrt: Temperature::from_celsius(cols[1][k]),
+                        relative_air_speed_m_s: cols[2][k],
+                        relative_humidity_pct: cols[3][k],
+                        met: cols[4][k],
+                        clo: cols[5][k],
+                        external_work_met: cols[6][k],
                     })
                     .collect();
-                pmv_ppd_many(&inputs, edition)
-                    .into_iter()
-                    .zip(range)
-                    .map(|(r, k)| {
-                        r.map(|p| (p.pmv, p.ppd_pct, p.within_iso_ranges))
-                            .map_err(|e| format!("element {k}: {}", message(&e)))
-                    })
-                    .collect()
+                for (j, r) in pmv_ppd_many(&inputs, edition).into_iter().enumerate() {
+                    match r {
+                        Ok(p) if limit && !p.within_iso_ranges => {
+                            (pmv[j], ppd[j]) = (f64::NAN, f64::NAN);
+                        }
+                        Ok(p) => (pmv[j], ppd[j]) = (p.pmv, p.ppd_pct),
+                        Err(e) => return Some(format!("element {}: {}", start + j, message(&e))),
+                    }
+                }
+                None
             })
-            .collect();
-        let mut all = Vec::with_capacity(n);
-        for b in blocks {
-            all.extend(b?);
-        }
-        Ok(all)
+            .collect::<Vec<Option<String>>>()
+            .into_iter()
+            .flatten()
+            .next()
     });
-    let out = out.map_err(MrtmapError::new_err)?;
-    Ok((
-        PyArray1::from_vec(py, out.iter().map(|x| x.0).collect()),
-        PyArray1::from_vec(py, out.iter().map(|x| x.1).collect()),
-        PyArray1::from_vec(py, out.iter().map(|x| x.2).collect()),
-    ))
+    if let Some(e) = refused {
+        return Err(MrtmapError::new_err(e));
+    }
+    Ok((PyArray1::from_vec(py, pmv), PyArray1::from_vec(py, ppd)))
 }
 
 /// Operative temperature (°C) element by element: ISO 7726's formula, or ASHRAE 55's.
