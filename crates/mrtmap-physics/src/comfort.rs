@@ -136,18 +136,7 @@ pub fn pmv_ppd_many(
                 Err(e) => errors[k] = Some(e),
             }
         }
-        for _ in 0..MAX_ITERATIONS {
-            let mut all = true;
-            for (f, it, done) in lanes.iter_mut().flatten() {
-                if !*done {
-                    *done = it.step(f);
-                    all &= *done;
-                }
-            }
-            if all {
-                break;
-            }
-        }
+        step_lanes(&mut lanes);
         for k in 0..chunk.len() {
             out.push(match (&lanes[k], errors[k].take()) {
                 (Some((f, it, true)), _) => Ok(f.finish(it)),
@@ -157,6 +146,53 @@ pub fn pmv_ppd_many(
         }
     }
     out
+}
+
+/// The iterations of up to four inputs in lock step, branch-free so that the compiler can keep
+/// them in vector registers: every lane computes each step, and a lane that has converged keeps
+/// its values (the same numbers as [`Iteration::step`] one input at a time).
+fn step_lanes(lanes: &mut [Option<(Fanger, Iteration, bool)>; 4]) {
+    let mut c = [[0.0f64; 4]; 6]; // taa, hcf, p2, p3, p4, p5
+    let (mut xn, mut xf, mut hc) = ([1.0f64; 4], [1.0f64; 4], [0.0f64; 4]);
+    let mut done = [true; 4];
+    for (l, lane) in lanes.iter().enumerate() {
+        if let Some((f, it, _)) = lane {
+            for (k, v) in [f.taa, f.hcf, f.p2, f.p3, f.p4, f.p5]
+                .into_iter()
+                .enumerate()
+            {
+                c[k][l] = v;
+            }
+            (xn[l], xf[l], hc[l], done[l]) = (it.xn, it.xf, it.hc, false);
+        }
+    }
+    let [taa, hcf, p2, p3, p4, p5] = c;
+    for _ in 0..MAX_ITERATIONS {
+        for l in 0..4 {
+            let x = (xf[l] + xn[l]) / 2.0;
+            let hcn = 2.38 * (100.0 * x - taa[l]).abs().sqrt().sqrt();
+            let h = hcf[l].max(hcn);
+            let n = (p5[l] + p4[l] * h - p2[l] * x.powi(4)) / (100.0 + p3[l] * h);
+            let keep = done[l];
+            xf[l] = if keep { xf[l] } else { x };
+            xn[l] = if keep { xn[l] } else { n };
+            hc[l] = if keep { hc[l] } else { h };
+            done[l] = keep || (n - x).abs() <= 0.00015;
+        }
+        if done.iter().all(|d| *d) {
+            break;
+        }
+    }
+    for (l, lane) in lanes.iter_mut().enumerate() {
+        if let Some((_, it, converged)) = lane {
+            *it = Iteration {
+                xn: xn[l],
+                xf: xf[l],
+                hc: hc[l],
+            };
+            *converged = done[l];
+        }
+    }
 }
 
 /// The iteration's cap (ISO 7730's code iterates until it converges; pythermalcomfort stops at
