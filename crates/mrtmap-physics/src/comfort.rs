@@ -125,27 +125,42 @@ pub fn pmv_ppd_many(
     inputs: &[PmvInputs],
     edition: Iso7730Edition,
 ) -> Vec<Result<Pmv, PhysicsError>> {
-    const LANES: usize = 4;
     let mut out = Vec::with_capacity(inputs.len());
-    for chunk in inputs.chunks(LANES) {
+    pmv_ppd_each(inputs.len(), |k| inputs[k], edition, |_, r| out.push(r));
+    out
+}
+
+/// [`pmv_ppd_many`] without the vectors: the inputs `input(0..n)` are read as needed, and each
+/// answer is handed to `answer(k, …)` in order (a binding writes them into its arrays).
+pub fn pmv_ppd_each(
+    n: usize,
+    input: impl Fn(usize) -> PmvInputs,
+    edition: Iso7730Edition,
+    mut answer: impl FnMut(usize, Result<Pmv, PhysicsError>),
+) {
+    const LANES: usize = 4;
+    for start in (0..n).step_by(LANES) {
+        let len = LANES.min(n - start);
         let mut lanes: [Option<(Fanger, Iteration, bool)>; LANES] = [None; LANES];
         let mut errors: [Option<PhysicsError>; LANES] = Default::default();
-        for (k, i) in chunk.iter().enumerate() {
-            match Fanger::new(i, edition) {
+        for k in 0..len {
+            match Fanger::new(&input(start + k), edition) {
                 Ok(f) => lanes[k] = Some((f, Iteration::start(&f), false)),
                 Err(e) => errors[k] = Some(e),
             }
         }
         step_lanes(&mut lanes);
-        for k in 0..chunk.len() {
-            out.push(match (&lanes[k], errors[k].take()) {
-                (Some((f, it, true)), _) => Ok(f.finish(it)),
-                (_, Some(e)) => Err(e),
-                _ => Err(no_convergence()),
-            });
+        for k in 0..len {
+            answer(
+                start + k,
+                match (&lanes[k], errors[k].take()) {
+                    (Some((f, it, true)), _) => Ok(f.finish(it)),
+                    (_, Some(e)) => Err(e),
+                    _ => Err(no_convergence()),
+                },
+            );
         }
     }
-    out
 }
 
 /// The iterations of up to four inputs in lock step, branch-free so that the compiler can keep

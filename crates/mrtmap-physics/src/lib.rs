@@ -39,7 +39,7 @@ mod units;
 
 pub use comfort::{
     AsymmetryKind, Iso7730Edition, OperativeMethod, Pmv, PmvInputs, operative_temperature, pmv_ppd,
-    pmv_ppd_edition, pmv_ppd_many, ppd_from_pmv, radiant_asymmetry_ppd,
+    pmv_ppd_each, pmv_ppd_edition, pmv_ppd_many, ppd_from_pmv, radiant_asymmetry_ppd,
 };
 pub use error::PhysicsError;
 pub use globe::{

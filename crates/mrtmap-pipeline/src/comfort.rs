@@ -17,8 +17,8 @@ use mrtmap_physics::{Category, Posture, Temperature, pmv_ppd};
 /// The comfort formulas themselves, for callers with their own inputs (a binding's arrays):
 /// PMV/PPD by edition of ISO 7730 and the operative temperature (mrtmap-physics').
 pub use mrtmap_physics::{
-    Iso7730Edition, OperativeMethod, Pmv, PmvInputs, operative_temperature, pmv_ppd_edition,
-    pmv_ppd_many,
+    Iso7730Edition, OperativeMethod, Pmv, PmvInputs, operative_temperature, pmv_ppd_each,
+    pmv_ppd_edition, pmv_ppd_many,
 };
 use mrtmap_radiation::{
     AsymmetryVerdict, GridSpec, MapFrame, MrtEngine, MrtError, MrtField, RadiantAsymmetry,

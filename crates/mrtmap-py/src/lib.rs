@@ -18,7 +18,7 @@ use std::path::PathBuf;
 use std::sync::Mutex;
 
 use mrtmap_pipeline::comfort::{
-    Iso7730Edition, OperativeMethod, PmvInputs, operative_temperature, pmv_ppd_many,
+    Iso7730Edition, OperativeMethod, PmvInputs, operative_temperature, pmv_ppd_each,
 };
 use mrtmap_pipeline::maps::{GridSpec, RadiantScene, load_scene, map_arrays};
 use mrtmap_pipeline::points::{Facing, PointQuery, Posture, mrt_at_points};
@@ -470,27 +470,34 @@ fn pmv_ppd<'py>(
             .enumerate()
             .map(|(b, (pmv, ppd))| {
                 let start = b * BLOCK;
-                let inputs: Vec<PmvInputs> = (start..start + pmv.len())
-                    .map(|k| PmvInputs {
-                        air: Temperature::from_celsius(cols[0][k]),
-                        mrt: Temperature::from_celsius(cols[1][k]),
-                        relative_air_speed_m_s: cols[2][k],
-                        relative_humidity_pct: cols[3][k],
-                        met: cols[4][k],
-                        clo: cols[5][k],
-                        external_work_met: cols[6][k],
-                    })
-                    .collect();
-                for (j, r) in pmv_ppd_many(&inputs, edition).into_iter().enumerate() {
-                    match r {
+                let mut refused = None;
+                pmv_ppd_each(
+                    pmv.len(),
+                    |j| {
+                        let k = start + j;
+                        PmvInputs {
+                            air: Temperature::from_celsius(cols[0][k]),
+                            mrt: Temperature::from_celsius(cols[1][k]),
+                            relative_air_speed_m_s: cols[2][k],
+                            relative_humidity_pct: cols[3][k],
+                            met: cols[4][k],
+                            clo: cols[5][k],
+                            external_work_met: cols[6][k],
+                        }
+                    },
+                    edition,
+                    |j, r| match r {
                         Ok(p) if limit && !p.within_iso_ranges => {
                             (pmv[j], ppd[j]) = (f64::NAN, f64::NAN);
                         }
                         Ok(p) => (pmv[j], ppd[j]) = (p.pmv, p.ppd_pct),
-                        Err(e) => return Some(format!("element {}: {}", start + j, message(&e))),
-                    }
-                }
-                None
+                        Err(e) if refused.is_none() => {
+                            refused = Some(format!("element {}: {}", start + j, message(&e)));
+                        }
+                        Err(_) => {}
+                    },
+                );
+                refused
             })
             .collect::<Vec<Option<String>>>()
             .into_iter()
