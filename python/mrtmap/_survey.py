@@ -27,23 +27,27 @@ COLUMNS = [
 ]
 
 
+def _row(recording: str, out: str, **values) -> dict:
+    """A table row: every column, None where not given."""
+    row = {c: None for c in COLUMNS}
+    row.update(room=Path(recording).name, recording=str(recording), out=str(out), **values)
+    return row
+
+
 def map_room(recording: str, out: str, config: Any = None) -> dict:
     """One room: ``mrtmap.run`` into ``out``, summarised as one row of the survey table. Never
     raises: a failure is a row with status "failed" and the error's message."""
     import mrtmap
 
-    row = {c: None for c in COLUMNS}
-    row.update(room=Path(recording).name, recording=str(recording), out=str(out))
     try:
         r = mrtmap.run(recording, out, config)
     except Exception as e:  # noqa: BLE001 — one room's failure is data, not the survey's end
         msg = str(e) if isinstance(e, mrtmap.MrtmapError) else "".join(
             traceback.format_exception_only(type(e), e)).strip()
-        row.update(status="failed", error=msg)
-        return row
+        return _row(recording, out, status="failed", error=msg)
     m = r.maps[0] if r.maps else {}
-    row.update(
-        status="ok", error="", height_m=m.get("height_m"), nodes=m.get("nodes"),
+    row = _row(
+        recording, out, status="ok", error="", height_m=m.get("height_m"), nodes=m.get("nodes"),
         mrt_min_c=m.get("min_c"), mrt_mean_c=m.get("mean_c"), mrt_max_c=m.get("max_c"),
         max_std_error_k=m.get("max_std_error_k"), surfaces=r.surfaces, features=r.features,
         warnings=" | ".join(r.warnings), seconds=r.seconds,
@@ -105,10 +109,8 @@ def survey(
             try:
                 rows.append(fut.result())
             except Exception as e:  # noqa: BLE001 — a worker lost mid-task: report the room
-                row = {c: None for c in COLUMNS}
-                row.update(room=Path(rec).name, recording=rec, out=o, status="failed",
-                           error=f"the task failed on its worker: {e}")
-                rows.append(row)
+                rows.append(_row(rec, o, status="failed",
+                                 error=f"the task failed on its worker: {e}"))
     finally:
         if own:
             client.close()

@@ -19,6 +19,10 @@ use crate::units::Temperature;
 /// σ as used by ISO 7726 and pythermalcomfort (W m⁻² K⁻⁴).
 pub const STEFAN_BOLTZMANN: f64 = 5.67e-8;
 
+/// The globe diameters (m) the mixed-convection correction was fitted for (Teitelbaum et al.
+/// 2022): outside them it is not defined.
+pub const MIXED_CONVECTION_DIAMETERS_M: std::ops::RangeInclusive<f64> = 0.04..=0.15;
+
 /// A globe thermometer: diameter and emissivity.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Globe {
@@ -210,7 +214,12 @@ pub fn globe_convection(
             )
         }
         GlobeMethod::MixedConvection => {
-            in_range("globe diameter for mixed convection (m)", d, 0.04, 0.15)?;
+            in_range(
+                "globe diameter for mixed convection (m)",
+                d,
+                *MIXED_CONVECTION_DIAMETERS_M.start(),
+                *MIXED_CONVECTION_DIAMETERS_M.end(),
+            )?;
             const MU: f64 = 1.81e-5;
             const K: f64 = 0.02662;
             const BETA: f64 = 0.0034;

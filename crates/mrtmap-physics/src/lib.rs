@@ -43,8 +43,9 @@ pub use comfort::{
 };
 pub use error::PhysicsError;
 pub use globe::{
-    Convection, Globe, GlobeFormula, GlobeMethod, GlobeMrt, GlobeReading, STEFAN_BOLTZMANN,
-    globe_convection, globe_temperature, mrt_from_globe,
+    Convection, Globe, GlobeFormula, GlobeMethod, GlobeMrt, GlobeReading,
+    MIXED_CONVECTION_DIAMETERS_M, STEFAN_BOLTZMANN, globe_convection, globe_temperature,
+    mrt_from_globe,
 };
 pub use mrt::{MeanRadiant, RadiantAverage, RadiantSource, mean_radiant_temperature};
 pub use person::{

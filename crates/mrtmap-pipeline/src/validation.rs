@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 use mrtmap_geometry::nalgebra::Point3;
 /// Globe ↔ MRT conversions and why one fails (mrtmap-physics').
 pub use mrtmap_physics::{
-    Convection, Globe, GlobeFormula, GlobeMethod, GlobeReading, PhysicsError, Temperature,
-    globe_temperature, mrt_from_globe,
+    Convection, Globe, GlobeFormula, GlobeMethod, GlobeReading, MIXED_CONVECTION_DIAMETERS_M,
+    PhysicsError, Temperature, globe_temperature, mrt_from_globe,
 };
 use mrtmap_radiation::{Method, MonteCarlo, MrtEngine, RadiantScene};
 use mrtmap_report::{GlobeRow, ValidationRow, parse_globe_csv, validate, validation_csv};

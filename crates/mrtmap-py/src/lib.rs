@@ -26,9 +26,11 @@ use mrtmap_pipeline::report::run_recording;
 use mrtmap_pipeline::settings::PointFrame;
 use mrtmap_pipeline::source::SourceOptions;
 use mrtmap_pipeline::validation::{
-    Convection, Globe, GlobeFormulaChoice, GlobeInput, Temperature, convert_globe,
+    Convection, Globe, GlobeFormulaChoice, GlobeInput, MIXED_CONVECTION_DIAMETERS_M, Temperature,
+    convert_globe,
 };
 use mrtmap_pipeline::{MrtSection, Progress, Project};
+use numpy::ndarray::ArrayView1;
 use numpy::{AllowTypeChange, PyArray1, PyArray2, PyArrayLike1, PyArrayLike2, PyArrayMethods};
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
@@ -400,10 +402,14 @@ fn run(
 
 /// A run's figures for Python: stages, maps' summaries, comfort shares, level, warnings.
 fn outcome_json(o: &mrtmap_pipeline::run::RunOutcome) -> serde_json::Result<String> {
-    let maps: Vec<_> = o.maps.iter().map(|m| (&m.summary, &m.csv)).collect();
+    let maps: Vec<_> = o
+        .maps
+        .iter()
+        .map(|m| serde_json::json!({"summary": m.summary, "csv": m.csv}))
+        .collect();
     serde_json::to_string(&serde_json::json!({
         "stages": o.stages,
-        "maps": maps.iter().map(|(s, csv)| serde_json::json!({"summary": s, "csv": csv})).collect::<Vec<_>>(),
+        "maps": maps,
         "comfort": o.comfort.as_ref().map(|c| &c.summary),
         "level": o.level,
         "warnings": o.warnings,
@@ -414,13 +420,20 @@ fn outcome_json(o: &mrtmap_pipeline::run::RunOutcome) -> serde_json::Result<Stri
     }))
 }
 
-/// Checks that every array has `n` elements (broadcast already by the Python layer).
-fn same_len(n: usize, arrays: &[(&str, usize)]) -> PyResult<()> {
-    match arrays.iter().find(|(_, m)| *m != n) {
-        Some((name, m)) => Err(MrtmapError::new_err(format!(
-            "{name} has {m} values where the others have {n}"
+/// Views of 1-D arrays of one length (broadcast already by the Python layer), named in the error
+/// when one differs. Views, not copies: the arrays stay borrowed while the GIL is released.
+fn columns<'a, const N: usize>(
+    arrays: [&'a PyArrayLike1<'_, f64, AllowTypeChange>; N],
+    names: [&str; N],
+) -> PyResult<[ArrayView1<'a, f64>; N]> {
+    let cols = arrays.map(|a| a.as_array());
+    let n = cols.first().map_or(0, ArrayView1::len);
+    match cols.iter().zip(names).find(|(c, _)| c.len() != n) {
+        Some((c, name)) => Err(MrtmapError::new_err(format!(
+            "{name} has {} values where the others have {n}",
+            c.len()
         ))),
-        None => Ok(()),
+        None => Ok(cols),
     }
 }
 
@@ -449,16 +462,11 @@ fn pmv_ppd<'py>(
             )));
         }
     };
-    // Views, not copies: the arrays stay borrowed while the GIL is released.
-    let cols = [&tdb, &tr, &vr, &rh, &met, &clo, &wme].map(|a| a.as_array());
+    let cols = columns(
+        [&tdb, &tr, &vr, &rh, &met, &clo, &wme],
+        ["tdb", "tr", "vr", "rh", "met", "clo", "wme"],
+    )?;
     let n = cols[0].len();
-    let names = ["tdb", "tr", "vr", "rh", "met", "clo", "wme"];
-    let lens: Vec<(&str, usize)> = names
-        .iter()
-        .zip(&cols)
-        .map(|(a, c)| (*a, c.len()))
-        .collect();
-    same_len(n, &lens)?;
     // Blocks of inputs in parallel, written in place; within a block, several PMVs iterate
     // interleaved. The first element refused, in order, is the one named.
     const BLOCK: usize = 2048;
@@ -519,9 +527,8 @@ fn operative<'py>(
     v: PyArrayLike1<'py, f64, AllowTypeChange>,
     ashrae: bool,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let (a, b, c) = (tdb.as_array(), tr.as_array(), v.as_array());
+    let [a, b, c] = columns([&tdb, &tr, &v], ["tdb", "tr", "v"])?;
     let n = a.len();
-    same_len(n, &[("tr", b.len()), ("v", c.len())])?;
     let method = if ashrae {
         OperativeMethod::Ashrae55
     } else {
@@ -555,15 +562,11 @@ fn mrt_from_globe<'py>(
     emissivity: PyArrayLike1<'py, f64, AllowTypeChange>,
     mixed: bool,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    let cols = [&tg, &tdb, &v, &d, &emissivity].map(|a| a.as_array().to_vec());
+    let cols = columns(
+        [&tg, &tdb, &v, &d, &emissivity],
+        ["tg", "tdb", "v", "d", "emissivity"],
+    )?;
     let n = cols[0].len();
-    let names = ["tg", "tdb", "v", "d", "emissivity"];
-    let lens: Vec<(&str, usize)> = names
-        .iter()
-        .zip(&cols)
-        .map(|(a, c)| (*a, c.len()))
-        .collect();
-    same_len(n, &lens)?;
     let method = if mixed {
         GlobeFormulaChoice::Mixed
     } else {
@@ -576,7 +579,7 @@ fn mrt_from_globe<'py>(
                 diameter_m: cols[3][k],
                 emissivity: cols[4][k],
             };
-            if mixed && !(0.04..=0.15).contains(&globe.diameter_m) {
+            if mixed && !MIXED_CONVECTION_DIAMETERS_M.contains(&globe.diameter_m) {
                 return Ok(f64::NAN);
             }
             convert_globe(
