@@ -184,9 +184,18 @@ class Scene:
         self._scene = native
 
     @classmethod
-    def load(cls, path: PathLike) -> "Scene":
-        """Reads ``scene.json`` (format mrtmap-scene/1)."""
-        return cls(_mrtmap.Scene.load(str(path)))
+    def load(
+        cls,
+        path: PathLike,
+        temperatures: Optional[PathLike] = None,
+        room: Optional[str] = None,
+    ) -> "Scene":
+        """Reads ``scene.json`` (format mrtmap-scene/1), or a Honeybee model (``.hbjson``) with
+        its faces' temperatures from ``temperatures`` (a CSV of ``identifier,temperature_c``; a
+        ``*`` row for the rest) or from its own mrtmap ``user_data``; ``room`` picks one of
+        several rooms."""
+        t = None if temperatures is None else str(temperatures)
+        return cls(_mrtmap.Scene.load(str(path), t, room))
 
     @classmethod
     def example(cls) -> "Scene":

@@ -285,6 +285,30 @@ pub fn triangulate(poly: &[Point2<f64>]) -> Result<Vec<[usize; 3]>, GeometryErro
     Ok(idx.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect())
 }
 
+/// Triangulates a simple 2D polygon with holes (each hole simple, inside it, the holes apart):
+/// vertex index triples into the outline followed by each hole's vertices in order.
+pub fn triangulate_with_holes(
+    outline: &[Point2<f64>],
+    holes: &[Vec<Point2<f64>>],
+) -> Result<Vec<[usize; 3]>, GeometryError> {
+    if holes.is_empty() {
+        return triangulate(outline);
+    }
+    let mut flat: Vec<f64> = outline.iter().flat_map(|p| [p.x, p.y]).collect();
+    let mut starts = Vec::with_capacity(holes.len());
+    for h in holes {
+        starts.push(flat.len() / 2);
+        flat.extend(h.iter().flat_map(|p| [p.x, p.y]));
+    }
+    let vertices = flat.len() / 2;
+    let idx = earcutr::earcut(&flat, &starts, 2)
+        .map_err(|_| GeometryError::Triangulation { vertices })?;
+    if idx.is_empty() || idx.len() % 3 != 0 {
+        return Err(GeometryError::Triangulation { vertices });
+    }
+    Ok(idx.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect())
+}
+
 fn sample_points(poly: &[Point2<f64>]) -> Vec<Point2<f64>> {
     // Edge midpoints and triangle centroids: interior witnesses for containment and overlap.
     let n = poly.len();

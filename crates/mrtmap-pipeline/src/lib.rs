@@ -48,6 +48,7 @@ mod conversion;
 pub mod coverage;
 pub mod demo;
 mod error;
+pub mod export;
 pub mod level;
 pub mod maps;
 pub mod parse;

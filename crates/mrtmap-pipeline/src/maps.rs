@@ -1,7 +1,7 @@
 //! Computing an MRT map and writing it: `mrt_grid.csv`, `mrt_map.png`, `mrt_map.svg` and
 //! `summary.json` (shared by `map`, `run` and `demo`).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use mrtmap_geometry::nalgebra::{Point2, Point3};
@@ -332,15 +332,56 @@ pub fn make_map(
     })
 }
 
-/// The scene in `path`, or the built-in example office; the string says which, for people.
-pub fn load_scene(path: Option<&Path>) -> Result<(RadiantScene, String)> {
-    Ok(match path {
-        Some(p) => (RadiantScene::load(p)?, p.display().to_string()),
-        None => (
+/// Where a scene comes from (`--scene`, `--temperatures`, `--room`).
+#[derive(Clone, Debug, Default, PartialEq, clap::Args)]
+pub struct SceneSource {
+    /// The radiant scene file (`scene.json`, format mrtmap-scene/1) or a Honeybee model
+    /// (`.hbjson`, with `--temperatures`). Without it, the built-in example office (see
+    /// `mrtmap example-scene`).
+    #[arg(long, value_name = "FILE")]
+    pub scene: Option<PathBuf>,
+    /// For a Honeybee model: a CSV of `identifier,temperature_c` (optionally
+    /// `temperature_std_k`, `emissivity`) for its faces, apertures and doors; a `*` row for the
+    /// rest. Without it, the model's own mrtmap temperatures.
+    #[arg(long, value_name = "CSV", requires = "scene")]
+    pub temperatures: Option<PathBuf>,
+    /// For a Honeybee model with several rooms: the room's identifier.
+    #[arg(long, value_name = "ID", requires = "scene")]
+    pub room: Option<String>,
+}
+
+impl SceneSource {
+    /// A scene file, with nothing else.
+    pub fn file(path: &Path) -> Self {
+        Self {
+            scene: Some(path.to_path_buf()),
+            ..Self::default()
+        }
+    }
+}
+
+/// The scene `src` names (a scene file, a Honeybee model with its temperatures), or the built-in
+/// example office; the string says which, for people.
+pub fn load_scene(src: &SceneSource) -> Result<(RadiantScene, String)> {
+    let Some(p) = src.scene.as_deref() else {
+        return Ok((
             mrtmap_radiation::example_office(),
             "the built-in example office".to_string(),
-        ),
-    })
+        ));
+    };
+    if crate::export::is_hbjson(p) {
+        return crate::export::load_hbjson(p, src.temperatures.as_deref(), src.room.as_deref());
+    }
+    if src.temperatures.is_some() || src.room.is_some() {
+        return Err(Error::setting(
+            "--temperatures and --room",
+            format!(
+                "are for a Honeybee model (.hbjson); {} is a scene with its own temperatures",
+                p.display()
+            ),
+        ));
+    }
+    Ok((RadiantScene::load(p)?, p.display().to_string()))
 }
 
 /// A point of `frame` in the scene's own frame: a scan-frame point is carried through the scene's

@@ -574,11 +574,12 @@ pub fn write_run_outputs(
     recording: &Path,
     p: &Project,
     seconds: f64,
-) -> Result<()> {
+) -> Result<Vec<crate::export::ExportDone>> {
     mrtmap_io::write_atomic(
         &out.join("report.html"),
         mrtmap_report::render_html(data).as_bytes(),
     )?;
+    let exports = crate::export::export_run(out, &o.scene, &p.export)?;
     write_json(
         &out.join("run.json"),
         &RunFile {
@@ -588,7 +589,8 @@ pub fn write_run_outputs(
             seconds,
             project: p,
         },
-    )
+    )?;
+    Ok(exports)
 }
 
 #[cfg(test)]
@@ -622,6 +624,8 @@ pub struct RunDone {
     pub outcome: RunOutcome,
     /// Seconds, conversion included.
     pub secs: f64,
+    /// The exports `[export]` asked for.
+    pub exports: Vec<crate::export::ExportDone>,
 }
 
 impl RunDone {
@@ -643,6 +647,14 @@ impl RunDone {
             out.display()
         ));
         lines.extend(self.outcome.lines(out, self.secs));
+        for e in &self.exports {
+            lines.push(format!(
+                "wrote {} ({}, {:.1} kB)",
+                e.path.display(),
+                e.format.as_str(),
+                e.bytes as f64 / 1e3
+            ));
+        }
         lines
     }
 }
@@ -670,10 +682,11 @@ pub fn run_recording(
         project,
     );
     let secs = t0.elapsed().as_secs_f64();
-    write_run_outputs(out, &data, &outcome, recording, project, secs)?;
+    let exports = write_run_outputs(out, &data, &outcome, recording, project, secs)?;
     Ok(RunDone {
         prepared,
         outcome,
         secs,
+        exports,
     })
 }

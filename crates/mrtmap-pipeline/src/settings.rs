@@ -77,6 +77,10 @@ seed = 1
 directions = "fibonacci"  # fibonacci | random
 replicates = 8            # independent ray sets the standard error comes from
 placement_std_m = 0.01    # how well a point is placed relative to the walls (m, 1σ); adds the MRT's gradient × it to the MRT's ± (not a person's or a plane's); 0: leave out
+
+[export]
+formats = []              # also write the room to export/room.EXT: "hbjson", "gbxml", "gltf", "rad"
+# max_points = 200000     # thermal-cloud points in the glTF (evenly thinned); 0: leave the cloud out
 "#;
 
 /// `[map]`.
@@ -738,6 +742,8 @@ pub struct Project {
     pub references: Vec<crate::level::Reference>,
     /// View factors.
     pub mrt: MrtSection,
+    /// Exports of the measured room (`export/` of the run's output).
+    pub export: crate::export::ExportSection,
 }
 
 impl Project {
@@ -803,6 +809,7 @@ mod tests {
         assert_eq!(p.segment, SegmentSection::default());
         assert_eq!(p.mrt, MrtSection::default());
         assert_eq!(p.track, TrackSection::default());
+        assert_eq!(p.export, crate::export::ExportSection::default());
         assert_eq!(p.points.len(), 1);
         assert_eq!(p.air.temperature_c, Some(21.0));
         let (line, msg) = Project::parse("[map]\n\ngird = [1, 2]\n").unwrap_err();

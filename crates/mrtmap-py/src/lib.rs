@@ -20,7 +20,7 @@ use std::sync::Mutex;
 use mrtmap_pipeline::comfort::{
     Iso7730Edition, OperativeMethod, PmvInputs, operative_temperature, pmv_ppd_each,
 };
-use mrtmap_pipeline::maps::{GridSpec, RadiantScene, load_scene, map_arrays};
+use mrtmap_pipeline::maps::{GridSpec, RadiantScene, SceneSource, load_scene, map_arrays};
 use mrtmap_pipeline::points::{Facing, PointQuery, Posture, mrt_at_points};
 use mrtmap_pipeline::report::run_recording;
 use mrtmap_pipeline::settings::PointFrame;
@@ -135,15 +135,21 @@ struct PyScene {
 impl PyScene {
     /// Reads a scene file.
     #[staticmethod]
-    fn load(path: PathBuf) -> PyResult<Self> {
-        let (scene, source) = load_scene(Some(&path)).map_err(py_err)?;
+    #[pyo3(signature = (path, temperatures=None, room=None))]
+    fn load(path: PathBuf, temperatures: Option<PathBuf>, room: Option<String>) -> PyResult<Self> {
+        let src = SceneSource {
+            scene: Some(path),
+            temperatures,
+            room,
+        };
+        let (scene, source) = load_scene(&src).map_err(py_err)?;
         Ok(Self { scene, source })
     }
 
     /// The built-in example office.
     #[staticmethod]
     fn example() -> PyResult<Self> {
-        let (scene, source) = load_scene(None).map_err(py_err)?;
+        let (scene, source) = load_scene(&SceneSource::default()).map_err(py_err)?;
         Ok(Self { scene, source })
     }
 

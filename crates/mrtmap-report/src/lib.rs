@@ -12,6 +12,7 @@
 
 mod html;
 mod map;
+pub mod mesh;
 pub mod numbers;
 mod tables;
 mod validate;

@@ -4,6 +4,8 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use mrtmap_pipeline::MrtSection;
+use mrtmap_pipeline::export::{DEFAULT_MAX_POINTS, ExportFormat};
+use mrtmap_pipeline::maps::SceneSource;
 use mrtmap_pipeline::parse::{parse_facing, parse_grid, parse_mark, parse_on_off, parse_point};
 use mrtmap_pipeline::settings::{FuseSection, SegmentSection};
 use mrtmap_pipeline::settings::{PointFrame, Quantity};
@@ -73,6 +75,35 @@ pub enum Command {
     /// Convert a ROS 1 bag, ROS 2 bag (MCAP or SQLite), MCAP file or RTAB-Map database to the
     /// recording layout (or a recording folder to a bag, MCAP, .db3 or RTAB-Map-layout file).
     Convert(ConvertArgs),
+    /// Export a measured room to Honeybee (HBJSON), gbXML, glTF binary (with the thermal cloud)
+    /// or Radiance, with its measured temperatures.
+    Export(ExportArgs),
+}
+
+/// `mrtmap export`.
+#[derive(Debug, Args)]
+#[command(after_long_help = "Examples:
+  mrtmap export out/ --out room.hbjson          a run's room for Honeybee (format from the extension)
+  mrtmap export out/ --to gltf --out room.glb   with the thermal cloud, for Blender or a web viewer
+  mrtmap export scene.json --out room.xml       gbXML 6.01
+  mrtmap export model.hbjson --temperatures t.csv --out model.rad")]
+pub struct ExportArgs {
+    /// A scene file (scene.json, or a Honeybee model with --temperatures), a segmentation folder,
+    /// or a run's output folder (its scene and, for glTF, its thermal cloud). Without it, the
+    /// built-in example office.
+    pub input: Option<PathBuf>,
+    /// The format: hbjson, gbxml, gltf (binary .glb) or rad; by default from --out's extension.
+    #[arg(long, value_enum)]
+    pub to: Option<ExportFormat>,
+    /// The file to write.
+    #[arg(long, value_name = "FILE")]
+    pub out: PathBuf,
+    /// For a Honeybee model: its temperatures by identifier (CSV; see `mrtmap map --help`).
+    #[arg(long, value_name = "CSV")]
+    pub temperatures: Option<PathBuf>,
+    /// Most thermal-cloud points in a glTF (evenly thinned; 0 leaves the cloud out).
+    #[arg(long, default_value_t = DEFAULT_MAX_POINTS)]
+    pub max_points: usize,
 }
 
 /// `mrtmap inspect`.
@@ -566,20 +597,11 @@ pub struct RoomsArgs {
     pub name: Option<String>,
 }
 
-/// Where the scene comes from.
-#[derive(Debug, Args, Clone)]
-pub struct SceneArgs {
-    /// The radiant scene file (`scene.json`, format mrtmap-scene/1). Without it, the built-in
-    /// example office (see `mrtmap example-scene`).
-    #[arg(long, value_name = "FILE")]
-    pub scene: Option<PathBuf>,
-}
-
 /// `mrtmap map`.
 #[derive(Debug, Args)]
 pub struct MapArgs {
     #[command(flatten)]
-    pub scene: SceneArgs,
+    pub scene: SceneSource,
     /// Height of the map above the floor (m); 1.1 m is seated head height, 1.7 m standing.
     #[arg(long, default_value_t = 1.1)]
     pub height: f64,
@@ -616,7 +638,7 @@ pub struct MapArgs {
 #[derive(Debug, Args)]
 pub struct MrtArgs {
     #[command(flatten)]
-    pub scene: SceneArgs,
+    pub scene: SceneSource,
     /// A point X,Y,Z (m) in the scene file's frame: for a scanned room, its room frame (x, y along
     /// the floor from the origin corner, z above the floor). Repeatable.
     #[arg(long = "at", value_name = "X,Y,Z", required = true, allow_hyphen_values = true, value_parser = parse_point)]

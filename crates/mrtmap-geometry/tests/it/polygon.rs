@@ -2,7 +2,7 @@ use mrtmap_geometry::PlaneFrame;
 use mrtmap_geometry::nalgebra::{Point2, Point3, Unit, Vector3};
 use mrtmap_geometry::polygon::{
     self, Containment, NotSimple, check_simple, planarity_deviation, point_in_polygon,
-    polygon_inside, polygons_overlap, signed_area, triangulate,
+    polygon_inside, polygons_overlap, signed_area, triangulate, triangulate_with_holes,
 };
 
 fn q(x: f64, y: f64) -> Point2<f64> {
@@ -139,4 +139,23 @@ fn triangulation_covers_the_area() {
         .map(|t| signed_area(&[l[t[0]], l[t[1]], l[t[2]]]).abs())
         .sum();
     assert!((area - 3.0).abs() < 1e-12);
+}
+
+#[test]
+fn triangulation_with_a_hole_covers_the_outline_less_the_hole() {
+    let outline = [q(0.0, 0.0), q(4.0, 0.0), q(4.0, 3.0), q(0.0, 3.0)];
+    let hole = vec![q(1.0, 1.0), q(2.5, 1.0), q(2.5, 2.0), q(1.0, 2.0)];
+    let all: Vec<Point2<f64>> = outline.iter().chain(hole.iter()).copied().collect();
+    let tris = triangulate_with_holes(&outline, std::slice::from_ref(&hole)).unwrap();
+    let area: f64 = tris
+        .iter()
+        .map(|t| signed_area(&[all[t[0]], all[t[1]], all[t[2]]]).abs())
+        .sum();
+    assert!((area - (12.0 - 1.5)).abs() < 1e-9, "area {area}");
+    // No triangle's centroid lies in the hole.
+    for t in &tris {
+        let c = Point2::from((all[t[0]].coords + all[t[1]].coords + all[t[2]].coords) / 3.0);
+        assert!(!(c.x > 1.0 && c.x < 2.5 && c.y > 1.0 && c.y < 2.0), "{c:?}");
+    }
+    assert_eq!(triangulate_with_holes(&outline, &[]).unwrap().len(), 2);
 }

@@ -72,7 +72,7 @@ pub struct MapQuantity {
 }
 
 /// Colour of a value `t` in 0…1 on the map's palette (blue cold → red warm).
-fn palette(t: f64) -> RGBColor {
+pub(crate) fn palette(t: f64) -> RGBColor {
     let g = colorgrad::preset::rd_yl_bu();
     let c = colorgrad::Gradient::at(&g, (1.0 - t.clamp(0.0, 1.0)) as f32).to_rgba8();
     RGBColor(c[0], c[1], c[2])

@@ -22,7 +22,7 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
     if a.air_c.is_some() {
         project.air.temperature_c = a.air_c;
     }
-    let (scene, source) = load_scene(a.scene.scene.as_deref())?;
+    let (scene, source) = load_scene(&a.scene)?;
     project.mrt = a.method;
     let spec = GridSpec {
         nx: a.grid.0,

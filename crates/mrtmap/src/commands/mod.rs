@@ -7,6 +7,7 @@ mod convert;
 mod coverage;
 mod demo;
 mod example_scene;
+mod export;
 mod fuse;
 mod globe;
 mod inspect;
@@ -45,5 +46,6 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Thermal(a) => thermal::run(&a),
         Command::Inspect(a) => inspect::run(&a),
         Command::Convert(a) => convert::run(&a),
+        Command::Export(a) => export::run(&a),
     }
 }

@@ -7,7 +7,7 @@ use crate::cli::MrtArgs;
 use crate::output::{json, print_lines};
 
 pub fn run(a: &MrtArgs) -> anyhow::Result<()> {
-    let (scene, source) = load_scene(a.scene.scene.as_deref())?;
+    let (scene, source) = load_scene(&a.scene)?;
     let query = PointQuery {
         at: a.at.clone(),
         frame: a.frame,

@@ -1,0 +1,372 @@
+//! Exports of a measured room for the building trade's tools (`mrtmap export`, `[export]` in
+//! project.toml), and Honeybee models read as scenes (`--scene model.hbjson --temperatures t.csv`).
+
+use std::path::{Path, PathBuf};
+
+use mrtmap_io::{read_cloud_ply, write_atomic};
+use serde::{Deserialize, Serialize};
+
+pub use mrtmap_export::CloudPoints;
+pub use mrtmap_export::gbxml::{floor_area, room_volume};
+pub use mrtmap_export::hbjson::Temperatures;
+use mrtmap_export::{ImportError, gbxml, gltf, hbjson, radiance};
+use mrtmap_radiation::RadiantScene;
+
+use crate::{Error, Result};
+
+/// The formats a room is exported to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+#[value(rename_all = "snake_case")]
+pub enum ExportFormat {
+    /// Honeybee model (Ladybug Tools), `.hbjson`.
+    Hbjson,
+    /// gbXML 6.01, `.xml`.
+    Gbxml,
+    /// glTF 2.0 binary with the thermal cloud, `.glb`.
+    Gltf,
+    /// Radiance scene description, `.rad`.
+    Rad,
+}
+
+impl ExportFormat {
+    /// Every format.
+    pub const ALL: [Self; 4] = [Self::Hbjson, Self::Gbxml, Self::Gltf, Self::Rad];
+
+    /// The file name extension.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Self::Hbjson => "hbjson",
+            Self::Gbxml => "xml",
+            Self::Gltf => "glb",
+            Self::Rad => "rad",
+        }
+    }
+
+    /// The format a file name's extension names (.hbjson, .xml or .gbxml, .glb, .rad).
+    pub fn from_path(path: &Path) -> Option<Self> {
+        let e = path.extension()?.to_str()?.to_ascii_lowercase();
+        Some(match e.as_str() {
+            "hbjson" => Self::Hbjson,
+            "xml" | "gbxml" => Self::Gbxml,
+            "glb" => Self::Gltf,
+            "rad" => Self::Rad,
+            _ => return None,
+        })
+    }
+
+    /// Its name in flags and files.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Hbjson => "hbjson",
+            Self::Gbxml => "gbxml",
+            Self::Gltf => "gltf",
+            Self::Rad => "rad",
+        }
+    }
+}
+
+/// `[export]` in project.toml: what `mrtmap run` also writes (into `export/` of its output).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ExportSection {
+    /// Formats to write (`["hbjson", "gbxml", "gltf", "rad"]`); none by default.
+    pub formats: Vec<ExportFormat>,
+    /// Most points of the thermal cloud in the glTF (evenly thinned; 0 leaves the cloud out).
+    pub max_points: Option<usize>,
+}
+
+/// Most cloud points in a glTF by default: about 5 MB.
+pub const DEFAULT_MAX_POINTS: usize = 200_000;
+
+/// What an export starts from.
+#[derive(Clone, Debug)]
+pub struct ExportInput {
+    /// The scene.
+    pub scene: RadiantScene,
+    /// Where it came from, for people.
+    pub source: String,
+    /// The run's thermal cloud in the scene's frame, when the input was a run with one.
+    pub cloud: Option<CloudPoints>,
+    /// The name given to the room in the exports.
+    pub name: String,
+}
+
+/// One file written by [`export`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExportDone {
+    /// The format.
+    pub format: ExportFormat,
+    /// The file.
+    pub path: PathBuf,
+    /// Its size (bytes).
+    pub bytes: usize,
+}
+
+fn import_error(path: &Path, e: ImportError) -> Error {
+    match e {
+        ImportError::Table { line, problem } => Error::Config {
+            path: path.to_path_buf(),
+            line,
+            message: problem,
+        },
+        ImportError::Model { at, problem } => Error::source(path, format!("{at}: {problem}")),
+        _ => Error::source(path, e.to_string()),
+    }
+}
+
+/// Whether `path` names a Honeybee model (by its extension).
+pub fn is_hbjson(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("hbjson"))
+}
+
+/// A Honeybee model's room as a scene, with temperatures from `temperatures` (a table by
+/// identifier) or the model's own; `room` picks one of several rooms. The string says what was
+/// read, for people.
+pub fn load_hbjson(
+    path: &Path,
+    temperatures: Option<&Path>,
+    room: Option<&str>,
+) -> Result<(RadiantScene, String)> {
+    let text = std::fs::read_to_string(path).map_err(|e| mrtmap_io::FileError::io(path, e))?;
+    let table = match temperatures {
+        Some(t) => {
+            let tt = std::fs::read_to_string(t).map_err(|e| mrtmap_io::FileError::io(t, e))?;
+            Some(hbjson::parse_temperatures(&tt).map_err(|e| import_error(t, e))?)
+        }
+        None => None,
+    };
+    let read = hbjson::read(&text, room, table.as_ref()).map_err(|e| match (&e, temperatures) {
+        // A row of the table that names nothing in the model: the table's line.
+        (ImportError::Table { .. }, Some(t)) => import_error(t, e),
+        _ => import_error(path, e),
+    })?;
+    let scene = RadiantScene::new(&read.scene).map_err(|e| {
+        Error::source(
+            path,
+            format!("room `{}` is not a valid radiant scene: {e}", read.room),
+        )
+    })?;
+    let mut source = format!("{}, room {}", path.display(), read.room);
+    if read.shades_left_out > 0 {
+        source.push_str(&format!(
+            " ({} indoor shades left out: furniture must be closed)",
+            read.shades_left_out
+        ));
+    }
+    Ok((scene, source))
+}
+
+fn thin(cloud: CloudPoints, max_points: usize) -> CloudPoints {
+    let n = cloud.positions.len();
+    if n <= max_points {
+        return cloud;
+    }
+    if max_points == 0 {
+        return CloudPoints::default();
+    }
+    let keep: Vec<usize> = (0..max_points).map(|i| i * n / max_points).collect();
+    CloudPoints {
+        positions: keep.iter().map(|&i| cloud.positions[i]).collect(),
+        temperature_c: keep.iter().map(|&i| cloud.temperature_c[i]).collect(),
+    }
+}
+
+/// The thermal cloud at `ply` in `scene`'s frame (through its `world_from_room`).
+fn cloud_in_scene(ply: &Path, scene: &RadiantScene) -> Result<CloudPoints> {
+    let c = read_cloud_ply(ply)?.cloud;
+    let room_from_world = scene.world_from_room.map(|w| w.inverse());
+    let positions = c
+        .positions
+        .iter()
+        .map(|p| {
+            let q = mrtmap_geometry::nalgebra::Point3::new(
+                f64::from(p[0]),
+                f64::from(p[1]),
+                f64::from(p[2]),
+            );
+            let r = room_from_world.map_or(q, |t| t * q);
+            [r.x as f32, r.y as f32, r.z as f32]
+        })
+        .collect();
+    let temperature_c = c.temperature_k.iter().map(|t| t - 273.15).collect();
+    Ok(CloudPoints {
+        positions,
+        temperature_c,
+    })
+}
+
+/// The built-in example office, to export.
+pub fn example_for_export() -> ExportInput {
+    ExportInput {
+        scene: mrtmap_radiation::example_office(),
+        source: "the built-in example office".into(),
+        cloud: None,
+        name: "example-office".into(),
+    }
+}
+
+/// Opens what `mrtmap export` is given: a scene file (`scene.json`, or a Honeybee model with its
+/// temperatures), a segmentation folder, or a run's output folder (its scene and thermal cloud).
+pub fn open_for_export(
+    path: &Path,
+    temperatures: Option<&Path>,
+    max_points: usize,
+) -> Result<ExportInput> {
+    let name = |p: &Path| {
+        p.file_stem()
+            .and_then(|s| s.to_str())
+            .filter(|s| !s.is_empty() && *s != "scene")
+            .unwrap_or("room")
+            .to_string()
+    };
+    if path.is_dir() {
+        let scene_path = [path.join("segment").join("scene.json"), path.join("scene.json")]
+            .into_iter()
+            .find(|p| p.is_file())
+            .ok_or_else(|| {
+                Error::source(
+                    path,
+                    "has no scene.json (nor segment/scene.json): give a scene file, or the output folder of `mrtmap run` or `mrtmap segment`",
+                )
+            })?;
+        let scene = RadiantScene::load(&scene_path)?;
+        let ply = [path.join("fuse").join("cloud.ply"), path.join("cloud.ply")]
+            .into_iter()
+            .find(|p| p.is_file());
+        let cloud = match ply {
+            Some(p) => Some(thin(cloud_in_scene(&p, &scene)?, max_points)),
+            None => None,
+        };
+        let dir_name = path
+            .canonicalize()
+            .ok()
+            .and_then(|p| p.file_name().and_then(|s| s.to_str()).map(str::to_string))
+            .unwrap_or_else(|| "room".into());
+        return Ok(ExportInput {
+            scene,
+            source: scene_path.display().to_string(),
+            cloud,
+            name: dir_name,
+        });
+    }
+    let (scene, source) = if is_hbjson(path) {
+        load_hbjson(path, temperatures, None)?
+    } else {
+        if let Some(t) = temperatures {
+            return Err(Error::setting(
+                "--temperatures",
+                format!(
+                    "({}) is for a Honeybee model (.hbjson); {} is a scene with its own temperatures",
+                    t.display(),
+                    path.display()
+                ),
+            ));
+        }
+        (RadiantScene::load(path)?, path.display().to_string())
+    };
+    Ok(ExportInput {
+        scene,
+        source,
+        cloud: None,
+        name: name(path),
+    })
+}
+
+/// The bytes of `input` in `format`.
+pub fn export_bytes(input: &ExportInput, format: ExportFormat) -> Vec<u8> {
+    let s = &input.scene;
+    match format {
+        ExportFormat::Hbjson => hbjson::write(s, &input.name).into_bytes(),
+        ExportFormat::Gbxml => gbxml::write(s, &input.name).into_bytes(),
+        ExportFormat::Gltf => gltf::write(s, input.cloud.as_ref(), &input.name),
+        ExportFormat::Rad => radiance::write(s, &input.name).into_bytes(),
+    }
+}
+
+/// `mrtmap export` in one call: `input` (a scene file, a Honeybee model with `temperatures`, a
+/// segmentation or run folder; `None`: the built-in example office) written to `out` in `to`, or
+/// in the format `out`'s extension names. Returns what it read and wrote, as lines for people.
+pub fn export_file(
+    input: Option<&Path>,
+    to: Option<ExportFormat>,
+    out: &Path,
+    temperatures: Option<&Path>,
+    max_points: usize,
+) -> Result<Vec<String>> {
+    let Some(format) = to.or_else(|| ExportFormat::from_path(out)) else {
+        return Err(Error::setting(
+            format!("--out {}", out.display()),
+            "does not tell the format: name it .hbjson, .xml, .glb or .rad, or give --to",
+        ));
+    };
+    let input = match input {
+        Some(p) => open_for_export(p, temperatures, max_points)?,
+        None => example_for_export(),
+    };
+    let done = export(&input, format, out)?;
+    let s = &input.scene;
+    let mut what = format!(
+        "{} surfaces, {} features, {} furniture",
+        s.surfaces.len(),
+        s.surfaces.iter().map(|x| x.features.len()).sum::<usize>(),
+        s.occluders.len()
+    );
+    if let (Some(c), ExportFormat::Gltf) = (&input.cloud, format) {
+        what.push_str(&format!(", {} cloud points", c.positions.len()));
+    }
+    Ok(vec![
+        format!("scene: {}", input.source),
+        what,
+        format!(
+            "wrote {} ({}, {:.1} kB)",
+            done.path.display(),
+            format.as_str(),
+            done.bytes as f64 / 1e3
+        ),
+    ])
+}
+
+/// Writes `input` in `format` to `out` (atomically).
+pub fn export(input: &ExportInput, format: ExportFormat, out: &Path) -> Result<ExportDone> {
+    let bytes = export_bytes(input, format);
+    write_atomic(out, &bytes)?;
+    Ok(ExportDone {
+        format,
+        path: out.to_path_buf(),
+        bytes: bytes.len(),
+    })
+}
+
+/// The exports `[export]` asks of a run: `out/export/room.EXT`, with the run's cloud in the glTF.
+pub fn export_run(
+    out: &Path,
+    scene: &RadiantScene,
+    section: &ExportSection,
+) -> Result<Vec<ExportDone>> {
+    if section.formats.is_empty() {
+        return Ok(Vec::new());
+    }
+    let max_points = section.max_points.unwrap_or(DEFAULT_MAX_POINTS);
+    let ply = out.join("fuse").join("cloud.ply");
+    let cloud = if ply.is_file() && section.formats.contains(&ExportFormat::Gltf) {
+        Some(thin(cloud_in_scene(&ply, scene)?, max_points))
+    } else {
+        None
+    };
+    let input = ExportInput {
+        scene: scene.clone(),
+        source: out.display().to_string(),
+        cloud,
+        name: "room".into(),
+    };
+    let dir = out.join("export");
+    std::fs::create_dir_all(&dir).map_err(|e| mrtmap_io::FileError::io(&dir, e))?;
+    section
+        .formats
+        .iter()
+        .map(|f| export(&input, *f, &dir.join(format!("room.{}", f.extension()))))
+        .collect()
+}
