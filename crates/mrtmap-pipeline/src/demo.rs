@@ -315,6 +315,7 @@ fn write_demo_outputs(
         project,
     );
     data.comparison = d.rows.clone();
+    data.view3d = Some(crate::report::view3d_for_run(&d.run_dir, &d.run));
     data.grid_error = Some((d.grid.max_abs_error_k, d.grid.rmse_k, d.grid.nodes));
     let reused = if d.simulate.skipped { " (reused)" } else { "" };
     data.timing.insert(

@@ -175,7 +175,7 @@ fn thin(cloud: CloudPoints, max_points: usize) -> CloudPoints {
 }
 
 /// The thermal cloud at `ply` in `scene`'s frame (through its `world_from_room`).
-fn cloud_in_scene(ply: &Path, scene: &RadiantScene) -> Result<CloudPoints> {
+pub(crate) fn cloud_in_scene(ply: &Path, scene: &RadiantScene) -> Result<CloudPoints> {
     let c = read_cloud_ply(ply)?.cloud;
     let room_from_world = scene.world_from_room.map(|w| w.inverse());
     let positions = c

@@ -332,6 +332,31 @@ pub fn make_map(
     })
 }
 
+/// A map's nodes read back from its `mrt_grid.csv`: x, y, z (m) and the MRT (°C) of each node
+/// that has one.
+pub fn read_grid_nodes(csv: &Path) -> Result<Vec<[f64; 4]>> {
+    let text = std::fs::read_to_string(csv).map_err(|e| mrtmap_io::FileError::io(csv, e))?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .ok_or_else(|| Error::source(csv, format!("has no `{name}` column")))
+    };
+    let idx = [col("x")?, col("y")?, col("z")?, col("mrt_c")?];
+    Ok(lines
+        .filter_map(|l| {
+            let cells: Vec<&str> = l.split(',').collect();
+            let v: Option<Vec<f64>> = idx
+                .iter()
+                .map(|&i| cells.get(i).and_then(|c| c.parse().ok()))
+                .collect();
+            v.map(|v| [v[0], v[1], v[2], v[3]])
+        })
+        .collect())
+}
+
 /// Where a scene comes from (`--scene`, `--temperatures`, `--room`).
 #[derive(Clone, Debug, Default, PartialEq, clap::Args)]
 pub struct SceneSource {

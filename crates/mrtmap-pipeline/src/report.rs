@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use mrtmap_report::numbers::{fixed, signed, uncertainty};
+use mrtmap_report::view3d::GridLayer;
 use mrtmap_report::{KeyValues, ReportData, ReportMap};
 /// Numbers for people, and the ± parts and unseen patches in words (mrtmap-report's).
 pub use mrtmap_report::{numbers, parts_line, unseen_line};
@@ -659,6 +660,32 @@ impl RunDone {
     }
 }
 
+/// The report's 3D view of a run in `out`: its scene, its thermal cloud (fuse/cloud.ply) and each
+/// map's grid (read back from its mrt_grid.csv); a cloud or a grid that cannot be read is left
+/// out of the view.
+pub fn view3d_for_run(out: &Path, o: &RunOutcome) -> mrtmap_report::view3d::View3d {
+    let cloud = crate::export::cloud_in_scene(&out.join("fuse").join("cloud.ply"), &o.scene).ok();
+    let grids: Vec<GridLayer> = o
+        .maps
+        .iter()
+        .filter_map(|m| {
+            let nodes = crate::maps::read_grid_nodes(&out.join(&m.csv)).ok()?;
+            Some(GridLayer {
+                height_m: m.summary.map.height_m,
+                nodes,
+                u: m.summary.map.axes.u,
+                v: m.summary.map.axes.v,
+            })
+        })
+        .collect();
+    let c = cloud.as_ref();
+    mrtmap_report::view3d::view3d(
+        &o.scene,
+        c.map(|c| (c.positions.as_slice(), c.temperature_c.as_slice())),
+        &grids,
+    )
+}
+
 /// `mrtmap run` in one call: `recording` (a folder, or a bag, MCAP file or RTAB-Map database
 /// converted with `source` into `out/recording`) through every stage with `project` into `out`,
 /// then report.html and run.json. `force` reruns stages whose inputs have not changed.
@@ -681,6 +708,8 @@ pub fn run_recording(
         &recording.display().to_string(),
         project,
     );
+    let mut data = data;
+    data.view3d = Some(view3d_for_run(out, &outcome));
     let secs = t0.elapsed().as_secs_f64();
     let exports = write_run_outputs(out, &data, &outcome, recording, project, secs)?;
     Ok(RunDone {

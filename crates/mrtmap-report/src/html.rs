@@ -4,7 +4,7 @@ use base64::Engine;
 use mrtmap_radiation::PointRecord;
 use serde::Serialize;
 
-use crate::numbers::{signed, uncertainty, xyz};
+use crate::numbers::{fixed, signed, uncertainty, xyz};
 use crate::tables::MapSummary;
 use crate::validate::ValidationRow;
 
@@ -90,6 +90,8 @@ pub struct ReportData {
     pub level: KeyValues,
     /// Reference readings: label, reading, camera, residual, used.
     pub references: Vec<[String; 5]>,
+    /// The room in 3D (see [`crate::view3d::view3d`]), when there is a scene to show.
+    pub view3d: Option<crate::view3d::View3d>,
 }
 
 /// HTML-escapes text.
@@ -125,7 +127,80 @@ const STYLE: &str = "body{font-family:system-ui,sans-serif;margin:2em auto;max-w
 h1{font-size:1.6em}h2{margin-top:1.6em;border-bottom:1px solid #ccc}table{border-collapse:collapse;margin:.6em 0}\
 td,th{border:1px solid #ccc;padding:.25em .6em;text-align:right}th{background:#f3f3f3}td:first-child{text-align:left}\
 .ok{color:#176d1a}.bad{color:#b00020}.warn{background:#fff4d6;padding:.4em .8em;border-left:4px solid #e0a800}\
-img{max-width:100%;border:1px solid #ddd}table.kv td{text-align:left}pre{background:#f7f7f7;padding:.8em;overflow-x:auto}";
+img{max-width:100%;border:1px solid #ddd}table.kv td{text-align:left}pre{background:#f7f7f7;padding:.8em;overflow-x:auto}\
+#view3d{width:100%;height:560px;display:block;border:1px solid #ddd;cursor:grab}#view3d-stage{position:relative}\
+#view3d-labels{position:absolute;left:0;top:0;right:0;bottom:0;pointer-events:none;overflow:hidden}\
+.view3d-label{position:absolute;font-size:12px;background:rgba(255,255,255,.85);padding:0 3px;border:1px solid #999;white-space:nowrap}\
+#view3d-buttons button{margin:0 .3em .4em 0;padding:.25em .7em;border:1px solid #888;background:#fff;border-radius:3px;cursor:pointer}\
+#view3d-buttons button.on{background:#2b5d8a;color:#fff}#view3d-bars{display:flex;gap:2.5em;margin:.5em 0;font-size:.9em}\
+.view3d-gradient{height:12px;width:260px;border:1px solid #999}.view3d-ticks{display:flex;justify-content:space-between;width:260px;font-size:12px}\
+body.view3d-full{max-width:none;margin:.5em}body.view3d-full>*:not(#view3d-section){display:none}body.view3d-full #view3d{height:calc(100vh - 150px)}";
+
+/// The 3D view: canvas, layer buttons, colour bars, the data and the viewer.
+fn view3d_section(o: &mut String, d: &ReportData) {
+    let Some(view) = &d.view3d else {
+        return;
+    };
+    let mut marks: Vec<crate::view3d::ViewMark> = d
+        .points
+        .iter()
+        .map(|p| crate::view3d::ViewMark {
+            text: format!(
+                "{}: {} °C",
+                p.name.as_deref().unwrap_or("point"),
+                fixed(p.mrt_c, 2)
+            ),
+            xyz: p.xyz,
+            kind: "point",
+        })
+        .collect();
+    marks.extend(d.validation.iter().map(|v| crate::view3d::ViewMark {
+        text: match &v.mrt_iso_c {
+            Ok(t) => format!("globe {}: {} °C", v.globe.label, fixed(*t, 2)),
+            Err(_) => format!("globe {}", v.globe.label),
+        },
+        xyz: v.globe.xyz,
+        kind: "globe",
+    }));
+    let safe = |s: &str| s.replace("</", "<\\/");
+    o.push_str("<section id=\"view3d-section\"><h2>The room in 3D</h2><div id=\"view3d-buttons\">");
+    let mut buttons: Vec<(String, String)> = vec![
+        ("surfaces".into(), "Surfaces".into()),
+        ("features".into(), "Features".into()),
+        ("furniture".into(), "Furniture".into()),
+        ("cloud".into(), "Thermal cloud".into()),
+    ];
+    for (k, m) in d.maps.iter().enumerate() {
+        buttons.push((
+            format!("grid{k}"),
+            format!("MRT at {:.2} m", m.summary.height_m),
+        ));
+    }
+    buttons.push(("marks".into(), "Points and globes".into()));
+    for (layer, label) in buttons {
+        o.push_str(&format!(
+            "<button data-layer=\"{layer}\">{}</button>",
+            esc(&label)
+        ));
+    }
+    o.push_str(
+        "<button id=\"view3d-fullscreen\">Full window</button></div>\
+         <div id=\"view3d-stage\"><canvas id=\"view3d\"></canvas><div id=\"view3d-labels\"></div></div>\
+         <div id=\"view3d-bars\"><div id=\"view3d-bar\"></div><div id=\"view3d-gridbar\"></div></div>\
+         <p id=\"view3d-info\">Hover or click a surface to name it.</p>\
+         <p><small>Left drag turns the room, right drag (or shift and drag) moves it, the wheel zooms. \
+         Walls and ceiling facing you are left out, so you look in. The buttons show and hide each \
+         layer; the thermal cloud is thinned for the report. Open <code>report.html#3d</code> for \
+         the view alone.</small></p>",
+    );
+    o.push_str(&format!(
+        "<script type=\"application/json\" id=\"view3d-data\">{}</script>\
+         <script type=\"application/json\" id=\"view3d-marks\">{}</script><script>{}</script></section>",
+        safe(&view.0),
+        safe(&serde_json::to_string(&marks).unwrap_or_else(|_| "[]".into())),
+        crate::view3d::VIEWER_JS
+    ));
+}
 
 fn map_section(o: &mut String, m: &ReportMap) {
     let b64 = base64::engine::general_purpose::STANDARD;
@@ -408,6 +483,7 @@ pub fn render_html(d: &ReportData) -> String {
     for m in &d.maps {
         map_section(&mut o, m);
     }
+    view3d_section(&mut o, d);
     comfort_section(&mut o, d);
     comparison_section(&mut o, d);
     validation_section(&mut o, d);

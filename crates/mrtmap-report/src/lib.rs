@@ -16,6 +16,7 @@ pub mod mesh;
 pub mod numbers;
 mod tables;
 mod validate;
+pub mod view3d;
 
 pub use html::{ComparisonRow, KeyValues, ReportData, ReportMap, esc, render_html};
 pub use map::{MapInput, MapMark, MapQuantity, contour_step, render_png, render_svg};

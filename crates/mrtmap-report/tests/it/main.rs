@@ -1,1 +1,5 @@
+//! Report tests: globe validation, the 3D view.
+#![allow(clippy::unwrap_used)]
+
 mod validate;
+mod view3d;

@@ -306,6 +306,105 @@ fn report_numbers_match_the_csv_and_it_renders() {
         std::fs::metadata(&shot).unwrap().len() > 20_000,
         "a blank screenshot"
     );
+    // The 3D view alone (report.html#3d), drawn by WebGL (SwiftShader without a GPU): the
+    // canvas is not blank, the room fills its middle, and both the cold window and the warm
+    // room show in their colours.
+    let shot3d = dir.path().join("view3d.png");
+    let s = Command::new(chromium)
+        .args(common)
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .args([
+            "--window-size=1000,800",
+            "--virtual-time-budget=5000",
+            &format!("--screenshot={}", shot3d.display()),
+            &format!("{url}#3d"),
+        ])
+        .output()
+        .unwrap();
+    assert!(s.status.success());
+    let img = image::open(&shot3d).unwrap().to_rgb8();
+    let background = |p: &image::Rgb<u8>| {
+        p.0.iter()
+            .zip([245u8, 245, 242])
+            .all(|(a, b)| a.abs_diff(b) < 4)
+    };
+    let (mut n, mut room, mut blue, mut warm, mut centre, mut centre_room) = (0, 0, 0, 0, 0, 0);
+    for y in (150..700).step_by(4) {
+        for x in (50..950).step_by(4) {
+            let p = img.get_pixel(x, y);
+            let [r, _, b] = p.0.map(i32::from);
+            n += 1;
+            room += usize::from(!background(p));
+            blue += usize::from(b > r + 60);
+            warm += usize::from(r > b + 60);
+            if (400..600).contains(&x) && (325..525).contains(&y) {
+                centre += 1;
+                centre_room += usize::from(!background(p));
+            }
+        }
+    }
+    let share = |k: usize, of: usize| k as f64 / of as f64;
+    assert!(
+        share(room, n) > 0.15,
+        "the 3D view is blank: {room} of {n} pixels drawn"
+    );
+    assert!(
+        share(centre_room, centre) > 0.8,
+        "the room is not in the middle of the view"
+    );
+    assert!(
+        share(blue, n) > 0.003,
+        "no cold (blue) surface in view: {blue} of {n}"
+    );
+    assert!(
+        share(warm, n) > 0.05,
+        "no warm surface in view: {warm} of {n}"
+    );
+    // A click in the middle of the view names what is there, with its temperature and area.
+    let dom = Command::new(chromium)
+        .args(common)
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .args([
+            "--window-size=1000,800",
+            "--virtual-time-budget=5000",
+            "--dump-dom",
+            &format!("{url}#3d&pick=0.5,0.5"),
+        ])
+        .output()
+        .unwrap();
+    let dom = String::from_utf8_lossy(&dom.stdout);
+    let said = dom
+        .split("<p id=\"view3d-info\">")
+        .nth(1)
+        .and_then(|r| r.split('<').next())
+        .unwrap_or_default();
+    let scene = read_json(&out.join("segment/scene.json"));
+    let ids: Vec<&str> = scene["surfaces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|s| {
+            std::iter::once(&s["id"]).chain(
+                s["features"]
+                    .as_array()
+                    .into_iter()
+                    .flatten()
+                    .map(|f| &f["id"]),
+            )
+        })
+        .chain(
+            scene["occluders"]
+                .as_array()
+                .into_iter()
+                .flatten()
+                .map(|o| &o["id"]),
+        )
+        .filter_map(Value::as_str)
+        .collect();
+    assert!(
+        said.contains(" °C") && said.contains(" m²") && ids.iter().any(|id| said.starts_with(id)),
+        "the click named nothing: {said:?}"
+    );
 }
 
 #[test]
