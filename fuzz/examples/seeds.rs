@@ -58,6 +58,12 @@ fn messages(wire: Wire) -> Vec<(&'static str, &'static str, Vec<u8>)> {
 }
 
 fn main() {
+    // A Honeybee model (the example office as mrtmap exports it), alone and with a table.
+    let office = mrtmap_export::hbjson::write(&mrtmap_radiation::example_office(), "office");
+    put("hbjson", "office", office.as_bytes());
+    let mut with_table = office.into_bytes();
+    with_table.extend_from_slice(b"\0identifier,temperature_c,temperature_std_k\nwindow-1,10.5,0.2\n*,21\n");
+    put("hbjson", "office-table", &with_table);
     // The hand-written inputs: the formats' own examples.
     put(
         "references_csv",

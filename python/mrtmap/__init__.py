@@ -212,6 +212,12 @@ class Scene:
         """The scene as scene.json text."""
         return self._scene.to_json()
 
+    def export(self, path: PathLike, to: Optional[str] = None, name: str = "room") -> int:
+        """Writes the scene for another tool, as ``mrtmap export`` does: ``"hbjson"`` (Honeybee),
+        ``"gbxml"``, ``"gltf"`` (binary .glb) or ``"rad"`` (Radiance), by default from the
+        path's extension (.hbjson, .xml, .glb, .rad). Returns the bytes written."""
+        return self._scene.export(str(path), to, name)
+
     def __repr__(self) -> str:
         return f"Scene({self.source!r})"
 

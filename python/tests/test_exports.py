@@ -232,3 +232,18 @@ def test_export_refuses_an_unknown_extension_and_a_bad_table(tmp_path):
     r = mrtmap_cli("map", "--scene", hb, "--temperatures", bad, "--out", tmp_path / "m", check=False)
     assert r.returncode != 0
     assert "t.csv:2:" in r.stderr and "not-a-face" in r.stderr, r.stderr
+
+
+def test_python_scene_exports_each_format(tmp_path):
+    s = mrtmap.Scene.example()
+    for name in ("room.hbjson", "room.xml", "room.glb", "room.rad"):
+        assert s.export(tmp_path / name) > 1000
+    assert (tmp_path / "room.glb").read_bytes()[:4] == b"glTF"
+    assert s.export(tmp_path / "room.any", to="rad") > 1000
+    back = mrtmap.Scene.load(tmp_path / "room.hbjson")
+    a, b = s.mrt([[2.0, 1.5, 1.1]]), back.mrt([[2.0, 1.5, 1.1]])
+    assert abs(float(a.mrt[0]) - float(b.mrt[0])) < 0.01
+    with pytest.raises(mrtmap.MrtmapError, match="the formats are"):
+        s.export(tmp_path / "x.glb", to="obj")
+    with pytest.raises(mrtmap.MrtmapError, match="does not tell the format"):
+        s.export(tmp_path / "x.obj")

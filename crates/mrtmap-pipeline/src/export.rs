@@ -55,6 +55,11 @@ impl ExportFormat {
         })
     }
 
+    /// The format named `name` (hbjson, gbxml, gltf, rad; as in flags and files).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|f| f.as_str() == name)
+    }
+
     /// Its name in flags and files.
     pub fn as_str(self) -> &'static str {
         match self {
@@ -196,6 +201,29 @@ pub(crate) fn cloud_in_scene(ply: &Path, scene: &RadiantScene) -> Result<CloudPo
         positions,
         temperature_c,
     })
+}
+
+/// Writes `scene` (named `name`) to `out` in `to`, or in the format `out`'s extension names:
+/// the library call behind the Python binding's `Scene.export`.
+pub fn export_scene(
+    scene: &RadiantScene,
+    name: &str,
+    to: Option<ExportFormat>,
+    out: &Path,
+) -> Result<ExportDone> {
+    let format = to.or_else(|| ExportFormat::from_path(out)).ok_or_else(|| {
+        Error::setting(
+            out.display().to_string(),
+            "does not tell the format: name it .hbjson, .xml, .glb or .rad, or give the format",
+        )
+    })?;
+    let input = ExportInput {
+        scene: scene.clone(),
+        source: name.to_string(),
+        cloud: None,
+        name: name.to_string(),
+    };
+    export(&input, format, out)
 }
 
 /// The built-in example office, to export.

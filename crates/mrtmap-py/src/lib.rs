@@ -20,6 +20,7 @@ use std::sync::Mutex;
 use mrtmap_pipeline::comfort::{
     Iso7730Edition, OperativeMethod, PmvInputs, operative_temperature, pmv_ppd_each,
 };
+use mrtmap_pipeline::export::{ExportFormat, export_scene};
 use mrtmap_pipeline::maps::{GridSpec, RadiantScene, SceneSource, load_scene, map_arrays};
 use mrtmap_pipeline::points::{Facing, PointQuery, Posture, mrt_at_points};
 use mrtmap_pipeline::report::run_recording;
@@ -162,6 +163,23 @@ impl PyScene {
     /// The scene as scene.json text.
     fn to_json(&self) -> String {
         self.scene.to_json()
+    }
+
+    /// Writes the scene for another tool (hbjson, gbxml, gltf, rad; by default from the
+    /// extension); returns the bytes written.
+    #[pyo3(signature = (path, to=None, name=None))]
+    fn export(&self, path: PathBuf, to: Option<String>, name: Option<String>) -> PyResult<usize> {
+        let format = match to.as_deref() {
+            None => None,
+            Some(t) => Some(ExportFormat::from_name(t).ok_or_else(|| {
+                MrtmapError::new_err(format!(
+                    "to={t:?}: the formats are hbjson, gbxml, gltf and rad"
+                ))
+            })?),
+        };
+        let name = name.unwrap_or_else(|| "room".into());
+        let done = export_scene(&self.scene, &name, format, &path).map_err(py_err)?;
+        Ok(done.bytes)
     }
 
     /// Sphere MRT at points: (mrt °C, standard error K, ΣF, the answers as JSON).
