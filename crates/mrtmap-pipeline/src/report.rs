@@ -683,7 +683,50 @@ pub fn view3d_for_run(out: &Path, o: &RunOutcome) -> mrtmap_report::view3d::View
         &o.scene,
         c.map(|c| (c.positions.as_slice(), c.temperature_c.as_slice())),
         &grids,
+        &globes_of_run(out),
     )
+}
+
+/// The black-globe readings `mrtmap validate` wrote into the run's folder (validation.json), when
+/// they are newer than its scene (older ones compared another scene and are left out).
+fn globes_of_run(out: &Path) -> Vec<mrtmap_report::view3d::ViewMark> {
+    let file = out.join("validation.json");
+    let modified = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
+    let fresh = match (
+        modified(&file),
+        modified(&out.join("segment").join("scene.json")),
+    ) {
+        (Some(v), Some(s)) => v >= s,
+        _ => false,
+    };
+    let rows: Vec<serde_json::Value> = if fresh {
+        std::fs::read_to_string(&file)
+            .ok()
+            .and_then(|t| serde_json::from_str(&t).ok())
+            .unwrap_or_default()
+    } else {
+        Vec::new()
+    };
+    rows.iter()
+        .filter_map(|r| {
+            let g = r.get("globe")?;
+            let xyz: [f64; 3] = serde_json::from_value(g.get("xyz")?.clone()).ok()?;
+            let label = g.get("label")?.as_str()?;
+            let num = |k: &str| r.get(k).and_then(serde_json::Value::as_f64);
+            let text = match (num("mrt_iso_c"), num("ours_c")) {
+                (Some(t), Some(m)) => {
+                    format!("globe {label}: {} °C (map {})", fixed(t, 2), fixed(m, 2))
+                }
+                (Some(t), None) => format!("globe {label}: {} °C", fixed(t, 2)),
+                _ => format!("globe {label}"),
+            };
+            Some(mrtmap_report::view3d::ViewMark {
+                text,
+                xyz,
+                kind: "globe",
+            })
+        })
+        .collect()
 }
 
 /// `mrtmap run` in one call: `recording` (a folder, or a bag, MCAP file or RTAB-Map database

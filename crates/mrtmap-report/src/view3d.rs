@@ -70,11 +70,13 @@ fn spacing(nodes: &[[f64; 4]], axis: &[f64; 3]) -> f64 {
 }
 
 /// The view of `scene`, with `cloud` (positions in the scene's frame, °C; thinned evenly to
-/// [`MAX_VIEW_POINTS`]) and the maps' `grids`.
+/// [`MAX_VIEW_POINTS`]), the maps' `grids` and black-globe readings (`globes`; the report adds
+/// its named points).
 pub fn view3d(
     scene: &RadiantScene,
     cloud: Option<(&[[f32; 3]], &[f32])>,
     grids: &[GridLayer],
+    globes: &[ViewMark],
 ) -> View3d {
     let parts = scene_mesh(scene);
     let (lo, hi) = range_of(
@@ -156,7 +158,7 @@ pub fn view3d(
         .map(|n| [r3(n.x), r3(n.y), r3(n.z)]);
     let doc = json!({
         "range": [lo, hi], "bar": stops(lo, hi), "centre": centre, "size": size, "look": look,
-        "parts": json_parts, "cloud": cloud, "grids": grids,
+        "parts": json_parts, "cloud": cloud, "grids": grids, "globes": globes,
     });
     View3d(serde_json::to_string(&doc).unwrap_or_default())
 }

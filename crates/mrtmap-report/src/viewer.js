@@ -8,7 +8,7 @@
   "use strict";
   const $ = (id) => document.getElementById(id);
   const data = JSON.parse($("view3d-data").textContent);
-  const marks = JSON.parse($("view3d-marks").textContent);
+  const marks = JSON.parse($("view3d-marks").textContent).concat(data.globes || []);
   const canvas = $("view3d");
   const info = $("view3d-info");
   const gl = canvas.getContext("webgl", { antialias: true, preserveDrawingBuffer: true });

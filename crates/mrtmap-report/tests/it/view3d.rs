@@ -61,7 +61,7 @@ fn the_view_thins_the_cloud_and_lays_each_map_as_cells() {
         u: [1.0, 0.0, 0.0],
         v: [0.0, 1.0, 0.0],
     };
-    let v: Value = serde_json::from_str(&view3d(&s, Some((&pos, &t)), &[grid]).0).unwrap();
+    let v: Value = serde_json::from_str(&view3d(&s, Some((&pos, &t)), &[grid], &[]).0).unwrap();
     assert_eq!(
         v["cloud"]["p"].as_array().unwrap().len(),
         3 * MAX_VIEW_POINTS
@@ -88,7 +88,7 @@ fn the_report_embeds_the_view_safely() {
     let s = mrtmap_radiation::RadiantScene::new(&f).unwrap();
     let d = ReportData {
         title: "t".into(),
-        view3d: Some(view3d(&s, None, &[])),
+        view3d: Some(view3d(&s, None, &[], &[])),
         ..ReportData::default()
     };
     let html = render_html(&d);

@@ -481,6 +481,20 @@ fn validate_compares_globes_with_the_map() {
     assert_eq!(v[1]["meets_desired"], false);
     let vcsv = std::fs::read_to_string(out.join("validation.csv")).unwrap();
     assert_eq!(vcsv.lines().count(), 3);
+    // Run again (every stage reused): the report's 3D view shows the globes with their values.
+    ok(&[
+        "run",
+        rec.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--grid",
+        "6x5",
+    ]);
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(
+        html.contains("\"kind\":\"globe\",\"text\":\"globe G1: ") && html.contains("(map "),
+        "the 3D view lacks the globes"
+    );
     std::fs::write(&csv, "label,x,y,z,tg_c,ta_c,va_m_s,diameter_m,emissivity\nG1,0.2,0.5,1.0,warm,21,0.1,0.15,0.95\n").unwrap();
     let e = mrtmap(&[
         "validate",
