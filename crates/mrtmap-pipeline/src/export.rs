@@ -238,11 +238,8 @@ pub fn example_for_export() -> ExportInput {
 
 /// Opens what `mrtmap export` is given: a scene file (`scene.json`, or a Honeybee model with its
 /// temperatures), a segmentation folder, or a run's output folder (its scene and thermal cloud).
-pub fn open_for_export(
-    path: &Path,
-    temperatures: Option<&Path>,
-    max_points: usize,
-) -> Result<ExportInput> {
+pub fn open_for_export(path: &Path, src: &ExportSource, max_points: usize) -> Result<ExportInput> {
+    let temperatures = src.temperatures.as_deref();
     let name = |p: &Path| {
         p.file_stem()
             .and_then(|s| s.to_str())
@@ -281,14 +278,13 @@ pub fn open_for_export(
         });
     }
     let (scene, source) = if is_hbjson(path) {
-        load_hbjson(path, temperatures, None)?
+        load_hbjson(path, temperatures, src.room.as_deref())?
     } else {
-        if let Some(t) = temperatures {
+        if temperatures.is_some() || src.room.is_some() {
             return Err(Error::setting(
-                "--temperatures",
+                "--temperatures and --room",
                 format!(
-                    "({}) is for a Honeybee model (.hbjson); {} is a scene with its own temperatures",
-                    t.display(),
+                    "are for a Honeybee model (.hbjson); {} is a scene with its own temperatures",
                     path.display()
                 ),
             ));
@@ -314,14 +310,29 @@ pub fn export_bytes(input: &ExportInput, format: ExportFormat) -> Vec<u8> {
     }
 }
 
-/// `mrtmap export` in one call: `input` (a scene file, a Honeybee model with `temperatures`, a
-/// segmentation or run folder; `None`: the built-in example office) written to `out` in `to`, or
-/// in the format `out`'s extension names. Returns what it read and wrote, as lines for people.
+/// What `mrtmap export` reads (its positional argument, `--temperatures`, `--room`).
+#[derive(Clone, Debug, Default, PartialEq, clap::Args)]
+pub struct ExportSource {
+    /// A scene file (scene.json, or a Honeybee model with --temperatures), a segmentation folder,
+    /// or a run's output folder (its scene and, for glTF, its thermal cloud). Without it, the
+    /// built-in example office.
+    pub input: Option<PathBuf>,
+    /// For a Honeybee model: its temperatures by identifier (CSV of `identifier,temperature_c`,
+    /// optionally `temperature_std_k`, `emissivity`; a `*` row for the rest).
+    #[arg(long, value_name = "CSV", requires = "input")]
+    pub temperatures: Option<PathBuf>,
+    /// For a Honeybee model with several rooms: the room's identifier.
+    #[arg(long, value_name = "ID", requires = "input")]
+    pub room: Option<String>,
+}
+
+/// `mrtmap export` in one call: `src` (a scene file, a Honeybee model with its temperatures, a
+/// segmentation or run folder; no input: the built-in example office) written to `out` in `to`,
+/// or in the format `out`'s extension names. Returns what it read and wrote, as lines for people.
 pub fn export_file(
-    input: Option<&Path>,
+    src: &ExportSource,
     to: Option<ExportFormat>,
     out: &Path,
-    temperatures: Option<&Path>,
     max_points: usize,
 ) -> Result<Vec<String>> {
     let Some(format) = to.or_else(|| ExportFormat::from_path(out)) else {
@@ -330,8 +341,8 @@ pub fn export_file(
             "does not tell the format: name it .hbjson, .xml, .glb or .rad, or give --to",
         ));
     };
-    let input = match input {
-        Some(p) => open_for_export(p, temperatures, max_points)?,
+    let input = match &src.input {
+        Some(p) => open_for_export(p, src, max_points)?,
         None => example_for_export(),
     };
     let done = export(&input, format, out)?;

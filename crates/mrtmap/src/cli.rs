@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use mrtmap_pipeline::MrtSection;
-use mrtmap_pipeline::export::{DEFAULT_MAX_POINTS, ExportFormat};
+use mrtmap_pipeline::export::{DEFAULT_MAX_POINTS, ExportFormat, ExportSource};
 use mrtmap_pipeline::maps::SceneSource;
 use mrtmap_pipeline::parse::{parse_facing, parse_grid, parse_mark, parse_on_off, parse_point};
 use mrtmap_pipeline::settings::{FuseSection, SegmentSection};
@@ -88,19 +88,14 @@ pub enum Command {
   mrtmap export scene.json --out room.xml       gbXML 6.01
   mrtmap export model.hbjson --temperatures t.csv --out model.rad")]
 pub struct ExportArgs {
-    /// A scene file (scene.json, or a Honeybee model with --temperatures), a segmentation folder,
-    /// or a run's output folder (its scene and, for glTF, its thermal cloud). Without it, the
-    /// built-in example office.
-    pub input: Option<PathBuf>,
+    #[command(flatten)]
+    pub source: ExportSource,
     /// The format: hbjson, gbxml, gltf (binary .glb) or rad; by default from --out's extension.
     #[arg(long, value_enum)]
     pub to: Option<ExportFormat>,
     /// The file to write.
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
-    /// For a Honeybee model: its temperatures by identifier (CSV; see `mrtmap map --help`).
-    #[arg(long, value_name = "CSV")]
-    pub temperatures: Option<PathBuf>,
     /// Most thermal-cloud points in a glTF (evenly thinned; 0 leaves the cloud out).
     #[arg(long, default_value_t = DEFAULT_MAX_POINTS)]
     pub max_points: usize,

@@ -6,8 +6,7 @@ use crate::cli::ExportArgs;
 use crate::output::print_lines;
 
 pub fn run(a: &ExportArgs) -> anyhow::Result<()> {
-    let t = a.temperatures.as_deref();
-    let lines = export_file(a.input.as_deref(), a.to, &a.out, t, a.max_points)?;
+    let lines = export_file(&a.source, a.to, &a.out, a.max_points)?;
     print_lines(lines);
     Ok(())
 }

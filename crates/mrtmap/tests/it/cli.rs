@@ -991,6 +991,27 @@ fn export_writes_each_format_and_a_honeybee_export_maps_back_the_same() {
     );
 }
 
+#[test]
+fn export_takes_a_room_only_from_a_honeybee_model() {
+    let dir = tempfile::tempdir().unwrap();
+    let sj = dir.path().join("scene.json");
+    std::fs::write(&sj, mrtmap_pipeline_example()).unwrap();
+    let out = dir.path().join("x.glb");
+    let (sj, out) = (sj.to_str().unwrap(), out.to_str().unwrap());
+    fails_with(
+        &["export", sj, "--room", "R", "--out", out],
+        "are for a Honeybee model",
+    );
+    let hb = dir.path().join("x.hbjson");
+    let hb = hb.to_str().unwrap();
+    let done = mrtmap(&["export", sj, "--out", hb]);
+    assert!(done.status.success());
+    fails_with(
+        &["export", hb, "--room", "Kitchen", "--out", out],
+        "no room `Kitchen`; the model's rooms are room",
+    );
+}
+
 fn mrtmap_pipeline_example() -> Vec<u8> {
     mrtmap(&["example-scene"]).stdout
 }
