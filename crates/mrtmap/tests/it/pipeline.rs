@@ -162,6 +162,28 @@ fn run_produces_every_output_and_reuses_unchanged_stages() {
         err.contains("p.toml:3") && err.contains("hieghts_m"),
         "{err}"
     );
+    // [export] writes the room for other tools beside the report (stages reused).
+    std::fs::write(
+        &cfg,
+        "[map]\ngrid = [8, 6]\n[export]\nformats = [\"hbjson\", \"gltf\"]\nmax_points = 500\n",
+    )
+    .unwrap();
+    let said = ok(&["run", r, "--out", o, "--config", cfg.to_str().unwrap()]);
+    assert!(
+        said.contains("room.hbjson (hbjson,") && said.contains("room.glb (gltf,"),
+        "{said}"
+    );
+    let hb: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("export/room.hbjson")).unwrap())
+            .unwrap();
+    let scene = read_json(&out.join("segment/scene.json"));
+    assert_eq!(
+        hb["rooms"][0]["faces"].as_array().unwrap().len(),
+        scene["surfaces"].as_array().unwrap().len()
+    );
+    let glb = std::fs::read(out.join("export/room.glb")).unwrap();
+    assert_eq!(&glb[..4], b"glTF");
+    assert!(!out.join("export/room.xml").exists());
 }
 
 /// The report is self-contained, its numbers match the CSV, and it renders in headless Chromium.
