@@ -14,6 +14,7 @@
 
 use std::collections::{BTreeMap, HashMap, HashSet};
 
+use mrtmap_geometry::PlaneFrame;
 use mrtmap_geometry::nalgebra::{Point2, Point3};
 use mrtmap_geometry::polygon::point_segment_distance;
 use mrtmap_radiation::{
@@ -416,6 +417,52 @@ fn polygon(v: &Value, at: &str, scale: f64) -> Result<Vec<[f64; 3]>, ImportError
         .collect()
 }
 
+/// Honeybee's default model tolerance (m): faces may be this far from planar.
+const DEFAULT_TOLERANCE_M: f64 = 0.01;
+
+/// `p` projected onto `plane` (its own best fit when `None`) when every vertex lies within `tol`
+/// of it, as Honeybee's tolerance allows; refused, naming `at`, when one lies farther. Returns
+/// the points and the plane.
+fn flatten(
+    p: Vec<[f64; 3]>,
+    plane: Option<&PlaneFrame>,
+    tol: f64,
+    at: &str,
+) -> Result<(Vec<[f64; 3]>, Option<PlaneFrame>), ImportError> {
+    let pts: Vec<Point3<f64>> = p.iter().map(|c| Point3::new(c[0], c[1], c[2])).collect();
+    let Some(frame) = plane.cloned().or_else(|| PlaneFrame::of_polygon(&pts)) else {
+        // Degenerate: the scene's own checks name it.
+        return Ok((p, None));
+    };
+    let worst = pts
+        .iter()
+        .map(|q| frame.signed_distance(q).abs())
+        .fold(0.0, f64::max);
+    if worst > tol {
+        return Err(err(
+            at,
+            format!(
+                "a vertex lies {:.1} mm off the {}plane, more than the model's tolerance of {:.1} mm: make it planar in Honeybee",
+                worst * 1e3,
+                if plane.is_some() {
+                    "parent face's "
+                } else {
+                    "face's "
+                },
+                tol * 1e3
+            ),
+        ));
+    }
+    let flat = pts
+        .iter()
+        .map(|q| {
+            let r = q - frame.normal.into_inner() * frame.signed_distance(q);
+            [r.x, r.y, r.z]
+        })
+        .collect();
+    Ok((flat, Some(frame)))
+}
+
 /// What a Honeybee object's temperature comes from.
 struct Lookup<'a> {
     table: Option<&'a Temperatures>,
@@ -474,7 +521,7 @@ fn ident(v: &Value, at: &str) -> Result<String, ImportError> {
 fn read_face(
     f: &Value,
     at: &str,
-    scale: f64,
+    (scale, tol): (f64, f64),
     look: &mut Lookup<'_>,
 ) -> Result<Option<SurfaceFile>, ImportError> {
     let id = ident(f, at)?;
@@ -484,11 +531,9 @@ fn read_face(
         Some("Wall") => "wall",
         _ => "other",
     };
-    let poly = polygon(
-        f.get("geometry").unwrap_or(&Value::Null),
-        &format!("{at}.geometry"),
-        scale,
-    )?;
+    let g_at = format!("{at}.geometry");
+    let raw = polygon(f.get("geometry").unwrap_or(&Value::Null), &g_at, scale)?;
+    let (poly, plane) = flatten(raw, None, tol, &g_at)?;
     let data = f.get("user_data").and_then(|u| u.get("mrtmap"));
     let mut features = Vec::new();
     for (key, label) in [("apertures", "window"), ("doors", "door")] {
@@ -501,11 +546,9 @@ fn read_face(
         {
             let sat = format!("{at}.{key}[{j}]");
             let sid = ident(sub, &sat)?;
-            let sp = polygon(
-                sub.get("geometry").unwrap_or(&Value::Null),
-                &format!("{sat}.geometry"),
-                scale,
-            )?;
+            let s_at = format!("{sat}.geometry");
+            let raw = polygon(sub.get("geometry").unwrap_or(&Value::Null), &s_at, scale)?;
+            let (sp, _) = flatten(raw, plane.as_ref(), tol, &s_at)?;
             let label = sub
                 .get("user_data")
                 .and_then(|u| u.get("mrtmap"))
@@ -660,6 +703,11 @@ pub fn read(
         ));
     }
     let scale = units_to_m(model.get("units").and_then(Value::as_str))?;
+    let tol = model
+        .get("tolerance")
+        .and_then(Value::as_f64)
+        .filter(|t| t.is_finite() && *t > 0.0)
+        .map_or(DEFAULT_TOLERANCE_M, |t| (t * scale).min(0.05));
     let rooms = model
         .get("rooms")
         .and_then(Value::as_array)
@@ -708,12 +756,8 @@ pub fn read(
         .ok_or_else(|| err(format!("rooms[{k}].faces"), "the room has no faces"))?;
     let mut surfaces = Vec::new();
     for (i, f) in faces.iter().enumerate() {
-        surfaces.extend(read_face(
-            f,
-            &format!("rooms[{k}].faces[{i}]"),
-            scale,
-            &mut look,
-        )?);
+        let at = format!("rooms[{k}].faces[{i}]");
+        surfaces.extend(read_face(f, &at, (scale, tol), &mut look)?);
     }
     let (occluders, shades_left_out) = read_furniture(r, k, scale, &mut look)?;
     if !look.missing.is_empty() {

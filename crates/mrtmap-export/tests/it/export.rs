@@ -394,3 +394,34 @@ fn an_open_scene_file_still_exports() {
     assert!(hbjson::write(&s, "x").contains("\"Wall\""));
     assert!(!gltf::write(&s, None, "x").is_empty());
 }
+
+#[test]
+fn faces_within_the_models_tolerance_are_made_planar_and_beyond_it_refused() {
+    let t = parse_temperatures("identifier,temperature_c\n*,21\n").unwrap();
+    // 4 mm off on the ceiling, 3 mm off on the window (the model is in centimetres).
+    let skew = MODEL
+        .replace("[400,300,250],[0,300,250]", "[400,300,250.4],[0,300,250]")
+        .replace("[300,0,200]", "[300,0.3,200]");
+    let r = read(&skew, None, Some(&t)).unwrap();
+    let s = RadiantScene::new(&r.scene).unwrap();
+    let ceiling = s.surfaces.iter().find(|x| x.id == "f1").unwrap();
+    assert!(mrtmap_geometry::polygon::planarity_deviation(&ceiling.polygon) < 1e-9);
+    let bad = MODEL.replace("[400,300,250],[0,300,250]", "[400,300,256],[0,300,250]");
+    let e = read(&bad, None, Some(&t)).unwrap_err().to_string();
+    assert!(
+        e.contains("rooms[0].faces[1].geometry: a vertex lies")
+            && e.contains("more than the model's tolerance of 10.0 mm"),
+        "{e}"
+    );
+    // A model that states a tighter tolerance is held to it.
+    let tight = skew.replace(
+        "\"units\":\"Centimeters\"",
+        "\"units\":\"Centimeters\",\"tolerance\":0.1",
+    );
+    assert!(
+        read(&tight, None, Some(&t))
+            .unwrap_err()
+            .to_string()
+            .contains("tolerance of 1.0 mm")
+    );
+}
