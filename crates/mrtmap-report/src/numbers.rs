@@ -24,8 +24,9 @@ pub fn signed(x: f64, decimals: usize) -> String {
 /// An uncertainty (≥ 0) with at least `min_decimals` decimals and as many more as its first
 /// significant digit needs: 0.004 → "0.004", 0.0004 → "0.0004", 0.04 → "0.04" (two minimum), 0 → "0.00".
 pub fn uncertainty(x: f64, min_decimals: usize) -> String {
-    if !(x.is_finite() && x > 0.0) {
-        return fixed(x.max(0.0), min_decimals);
+    // Below a microkelvin a ± is rounding noise (a uniform room's 1e-12 K), not a digit to show.
+    if !(x.is_finite() && x >= 1e-6) {
+        return fixed(0.0, min_decimals);
     }
     let first_digit = (-x.log10()).ceil().max(0.0) as usize;
     fixed(x, first_digit.clamp(min_decimals, 9))
@@ -44,6 +45,13 @@ pub fn xyz(p: &[f64; 3]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_vanishing_uncertainty_is_zero_at_the_least_decimals() {
+        assert_eq!(uncertainty(3e-13, 3), "0.000");
+        assert_eq!(uncertainty(0.0004, 3), "0.0004");
+        assert_eq!(uncertainty(f64::NAN, 2), "0.00");
+    }
 
     #[test]
     fn no_negative_zero() {
