@@ -132,6 +132,23 @@ def test_glb_passes_the_khronos_validator_and_reads_back(scene_input, tmp_path):
     if scene_input is not None:
         assert counts["thermal cloud"] == 5000
         assert g.meshes[-1].primitives[0].mode == pygltflib.POINTS
+        # The cloud lies in the room (the scan's frame carried into the room's, then y up).
+        import numpy as np
+
+        blob = g.binary_blob()
+
+        def positions(name):
+            mesh = next(m for m in g.meshes if m.name == name)
+            a = g.accessors[mesh.primitives[0].attributes.POSITION]
+            v = g.bufferViews[a.bufferView]
+            raw = blob[v.byteOffset:v.byteOffset + v.byteLength]
+            return np.frombuffer(raw, dtype=np.float32).reshape(-1, 3)
+
+        room = np.vstack([positions(s["id"]) for s in scene["surfaces"]])
+        lo, hi = room.min(0) - 0.2, room.max(0) + 0.2
+        cloud = positions("thermal cloud")
+        assert np.all((cloud > lo) & (cloud < hi), axis=1).mean() > 0.95
+        assert abs(room[:, 1].min()) < 0.02  # the floor at glTF y = 0
 
 
 def test_radiance_parses_back(scene_input, tmp_path):
