@@ -17,7 +17,7 @@
     return;
   }
   // report.html#3d shows the view alone; #3d&pick=FX,FY also names what lies at that fraction
-  // of the canvas (as a click there would), for checks in a headless browser.
+  // of the canvas (as a click there would), for checks in a headless browser; &show= sets layers.
   const hash = new URLSearchParams(location.hash.slice(1));
   if (hash.has("3d")) document.body.classList.add("view3d-full");
 
@@ -116,6 +116,10 @@
   // Which layers show: the buttons toggle them.
   const shown = { surfaces: true, features: true, furniture: true, cloud: false, marks: true };
   data.grids.forEach((_, k) => { shown["grid" + k] = k === 0; });
+  // #3d&show=cloud,-grid0 turns layers on (or, with "-", off) from the address.
+  for (const w of (hash.get("show") || "").split(",").filter(Boolean)) {
+    if (w[0] === "-") shown[w.slice(1)] = false; else shown[w] = true;
+  }
   document.querySelectorAll("#view3d-buttons button[data-layer]").forEach((b) => {
     const name = b.dataset.layer;
     if (!layers[name]) { b.disabled = true; return; }
