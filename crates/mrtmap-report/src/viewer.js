@@ -106,7 +106,7 @@
     const pos = [], col = [], nor = [];
     for (const mk of marks) {
       pos.push(mk.xyz[0], mk.xyz[1], mk.xyz[2]);
-      const c = mk.kind === "globe" ? [0.1, 0.1, 0.1] : [1, 1, 1];
+      const c = mk.kind === "globe" ? [0.1, 0.1, 0.1] : [0.15, 0.3, 0.55];
       col.push(c[0], c[1], c[2]);
       nor.push(0, 0, 0);
     }
@@ -193,7 +193,7 @@
     gl.disable(gl.BLEND);
     gl.depthMask(true);
     const dpr = window.devicePixelRatio || 1;
-    for (const name of ["surfaces", "features", "furniture", "cloud", "marks"]) {
+    for (const name of ["surfaces", "features", "furniture", "cloud"]) {
       const d = layers[name];
       if (!d || !shown[name]) continue;
       // The envelope is wound outward: culling its front faces opens the near walls.
@@ -201,7 +201,7 @@
       else if (name === "furniture") { gl.enable(gl.CULL_FACE); gl.cullFace(gl.BACK); }
       else gl.disable(gl.CULL_FACE);
       gl.uniform1f(loc.lit, name === "furniture" ? 1 : 0);
-      gl.uniform1f(loc.ps, (name === "marks" ? 11 : 2.5) * dpr);
+      gl.uniform1f(loc.ps, 2.5 * dpr);
       bind(d);
       gl.drawArrays(d.mode, 0, d.count);
     }
@@ -216,6 +216,16 @@
       if (d && shown["grid" + k]) { bind(d); gl.drawArrays(d.mode, 0, d.count); }
     });
     gl.depthMask(true);
+    // Points and globes last, over everything, as their labels are.
+    if (layers.marks && shown.marks) {
+      gl.disable(gl.BLEND);
+      gl.disable(gl.DEPTH_TEST);
+      gl.uniform1f(loc.a, 1);
+      gl.uniform1f(loc.ps, 11 * dpr);
+      bind(layers.marks);
+      gl.drawArrays(layers.marks.mode, 0, layers.marks.count);
+      gl.enable(gl.DEPTH_TEST);
+    }
     placeLabels(m);
   }
 
