@@ -370,6 +370,12 @@ pub fn export_file(
 
 /// Writes `input` in `format` to `out` (atomically).
 pub fn export(input: &ExportInput, format: ExportFormat, out: &Path) -> Result<ExportDone> {
+    if out.is_dir() {
+        return Err(Error::setting(
+            out.display().to_string(),
+            "is a folder: name the file to write in it (room.hbjson, room.xml, room.glb or room.rad)",
+        ));
+    }
     let bytes = export_bytes(input, format);
     write_atomic(out, &bytes)?;
     Ok(ExportDone {

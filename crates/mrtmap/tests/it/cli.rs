@@ -956,6 +956,16 @@ fn export_writes_each_format_and_a_honeybee_export_maps_back_the_same() {
             "{x} vs {y}"
         );
     }
+    fails_with(
+        &[
+            "export",
+            "--to",
+            "gltf",
+            "--out",
+            dir.path().to_str().unwrap(),
+        ],
+        "is a folder: name the file to write in it",
+    );
     let obj = dir.path().join("room.obj");
     fails_with(
         &["export", "--out", obj.to_str().unwrap()],
