@@ -425,9 +425,9 @@ def pmv_ppd_iso(
     if str(model).lower() not in editions:
         raise MrtmapError(f"model {model!r} is neither '7730-2025' nor '7730-2005'")
     shape, flat = _broadcast(tdb, tr, vr, rh, met, clo, wme)
-    pmv, ppd = _mrtmap.pmv_ppd(*flat, editions[str(model).lower()], bool(limit_inputs))
-    if round_output:
-        pmv, ppd = np.round(pmv, 2), np.round(ppd, 1)
+    pmv, ppd = _mrtmap.pmv_ppd(
+        *flat, editions[str(model).lower()], bool(limit_inputs), bool(round_output)
+    )
     return PMVPPD(pmv=pmv.reshape(shape), ppd=ppd.reshape(shape))
 
 

@@ -62,6 +62,7 @@ def pmv_ppd(
     wme: npt.ArrayLike,
     edition: int,
     limit: bool,
+    round: bool,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
 def operative(
     tdb: npt.ArrayLike, tr: npt.ArrayLike, v: npt.ArrayLike, ashrae: bool

@@ -462,7 +462,9 @@ fn columns<'a, const N: usize>(
 }
 
 /// PMV and PPD element by element over 1-D arrays; with `limit`, NaN where the inputs or the PMV
-/// lie outside ISO 7730's ranges (pythermalcomfort's `limit_inputs`).
+/// lie outside ISO 7730's ranges (pythermalcomfort's `limit_inputs`); with `round`, PMV to 2 and
+/// PPD to 1 decimal as numpy's `round` does (x·10ᵈ rounded half to even, then ÷ 10ᵈ), in the
+/// parallel loop rather than two more passes over the arrays.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
 fn pmv_ppd<'py>(
@@ -476,6 +478,7 @@ fn pmv_ppd<'py>(
     wme: PyArrayLike1<'py, f64, AllowTypeChange>,
     edition: u32,
     limit: bool,
+    round: bool,
 ) -> PyResult<Pair<'py>> {
     let edition = match edition {
         2005 => Iso7730Edition::Y2005,
@@ -521,6 +524,10 @@ fn pmv_ppd<'py>(
                     |j, r| match r {
                         Ok(p) if limit && !p.within_iso_ranges => {
                             (pmv[j], ppd[j]) = (f64::NAN, f64::NAN);
+                        }
+                        Ok(p) if round => {
+                            pmv[j] = (p.pmv * 100.0).round_ties_even() / 100.0;
+                            ppd[j] = (p.ppd_pct * 10.0).round_ties_even() / 10.0;
                         }
                         Ok(p) => (pmv[j], ppd[j]) = (p.pmv, p.ppd_pct),
                         Err(e) if refused.is_none() => {
