@@ -517,6 +517,17 @@ fn ident(v: &Value, at: &str) -> Result<String, ImportError> {
         .ok_or_else(|| err(at, "has no identifier"))
 }
 
+/// The scene id an mrtmap export kept in `user_data["mrtmap"]["id"]` (Honeybee's identifier
+/// may have had to change it: "wall east" becomes "wall_east").
+fn own_id(obj: &Value) -> Option<String> {
+    obj.get("user_data")?
+        .get("mrtmap")?
+        .get("id")?
+        .as_str()
+        .filter(|s| !s.is_empty())
+        .map(str::to_string)
+}
+
 /// One face of room `k` as a surface (`None` when it has no temperature: `look` notes it).
 fn read_face(
     f: &Value,
@@ -557,7 +568,7 @@ fn read_face(
                 .unwrap_or(label);
             if let Some((t, s, e)) = look.get(&sid, sub) {
                 features.push(FeatureFile {
-                    id: sid,
+                    id: own_id(sub).unwrap_or(sid),
                     label: label.to_string(),
                     polygon: sp,
                     temperature_c: t,
@@ -591,7 +602,7 @@ fn read_face(
         .and_then(|d| d.get("raster"))
         .and_then(|r| serde_json::from_value(r.clone()).ok());
     Ok(look.get(&id, f).map(|(t, s, e)| SurfaceFile {
-        id,
+        id: own_id(f).unwrap_or(id),
         kind: kind.to_string(),
         label,
         polygon: poly,

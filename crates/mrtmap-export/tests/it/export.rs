@@ -425,3 +425,24 @@ fn faces_within_the_models_tolerance_are_made_planar_and_beyond_it_refused() {
             .contains("tolerance of 1.0 mm")
     );
 }
+
+#[test]
+fn ids_honeybee_would_refuse_are_changed_there_and_restored_on_reading() {
+    let mut f = example_office().to_file();
+    f.surfaces[0].id = "floor (carpet)".into();
+    f.surfaces[2].features[0].id = "window 1".into();
+    let host = f.surfaces[2].id.clone();
+    let s = RadiantScene::new(&f).unwrap();
+    let text = hbjson::write(&s, "office");
+    let model: Value = serde_json::from_str(&text).unwrap();
+    let faces = model["rooms"][0]["faces"].as_array().unwrap();
+    assert_eq!(faces[0]["identifier"], "floor__carpet_");
+    let back = RadiantScene::new(&read(&text, None, None).unwrap().scene).unwrap();
+    assert_eq!(back.surfaces[0].id, "floor (carpet)");
+    let h = back.surfaces.iter().find(|x| x.id == host).unwrap();
+    assert!(
+        h.features.iter().any(|x| x.id == "window 1"),
+        "{:?}",
+        h.features
+    );
+}
