@@ -15,10 +15,10 @@ use std::fmt::Write;
 
 use mrtmap_geometry::nalgebra::Point3;
 use mrtmap_geometry::polygon::area_3d;
-use mrtmap_radiation::{RadiantScene, SurfaceKind};
+use mrtmap_radiation::{RadiantScene, Surface, SurfaceKind};
 use mrtmap_report::mesh::{oriented, outward_normal};
 
-use crate::{Identifiers, is_door, is_glazing, num};
+use crate::{Identifiers, Opening, num, opening};
 
 /// Escapes text for XML content and attribute values.
 pub fn xml_escape(s: &str) -> String {
@@ -93,6 +93,80 @@ pub fn floor_area(scene: &RadiantScene) -> f64 {
         .sum()
 }
 
+/// One surface as a gbXML Surface in `space`, with its windows and doors as Openings and its other
+/// features in its Description.
+fn surface_xml(
+    o: &mut String,
+    scene: &RadiantScene,
+    s: &Surface,
+    ids: &mut Identifiers,
+    space: &str,
+) {
+    let out = outward_normal(scene, s);
+    let ty = match s.kind {
+        SurfaceKind::Floor => "InteriorFloor",
+        SurfaceKind::Ceiling => "Ceiling",
+        _ if s.features.iter().any(|f| opening(&f.label).is_some()) => "ExteriorWall",
+        _ => "InteriorWall",
+    };
+    let mut d = describe(
+        s.temperature.celsius(),
+        s.temperature_std_k,
+        s.emissivity,
+        &s.label,
+    );
+    if let Some(f) = s.observed_fraction {
+        let _ = write!(d, "; observed_fraction={}", num(f, 3));
+    }
+    for f in s.features.iter().filter(|f| opening(&f.label).is_none()) {
+        let _ = write!(
+            d,
+            "; feature={}|{}|{}|{}",
+            f.id.replace([';', '|'], "_"),
+            f.label.replace([';', '|'], "_"),
+            num(f.temperature.celsius(), 3),
+            num(area_3d(&f.polygon), 4)
+        );
+    }
+    let _ = writeln!(
+        o,
+        "    <Surface id=\"{}\" surfaceType=\"{ty}\" constructionIdRef=\"mrtmap-{}\">",
+        ids.make(&s.id),
+        s.kind.as_str()
+    );
+    let _ = writeln!(o, "      <Name>{}</Name>", xml_escape(&s.id));
+    let _ = writeln!(o, "      <Description>{}</Description>", xml_escape(&d));
+    let _ = writeln!(o, "      <AdjacentSpaceId spaceIdRef=\"{space}\"/>");
+    poly_loop(o, "      ", &oriented(&s.polygon, &out));
+    for f in &s.features {
+        let kind = match opening(&f.label) {
+            None => continue,
+            Some(Opening::Door) => "NonSlidingDoor",
+            Some(Opening::Window) if s.kind == SurfaceKind::Ceiling => "FixedSkylight",
+            Some(Opening::Window) => "FixedWindow",
+        };
+        let _ = writeln!(
+            o,
+            "      <Opening id=\"{}\" openingType=\"{kind}\">",
+            ids.make(&f.id)
+        );
+        let _ = writeln!(o, "        <Name>{}</Name>", xml_escape(&f.id));
+        let _ = writeln!(
+            o,
+            "        <Description>{}</Description>",
+            xml_escape(&describe(
+                f.temperature.celsius(),
+                f.temperature_std_k,
+                f.emissivity,
+                &f.label
+            ))
+        );
+        poly_loop(o, "        ", &oriented(&f.polygon, &out));
+        let _ = writeln!(o, "      </Opening>");
+    }
+    let _ = writeln!(o, "    </Surface>");
+}
+
 /// The scene as a gbXML 6.01 document named `name`, in metres and °C.
 pub fn write(scene: &RadiantScene, name: &str) -> String {
     let mut ids = Identifiers::default();
@@ -129,90 +203,14 @@ pub fn write(scene: &RadiantScene, name: &str) -> String {
     let _ = writeln!(o, "        <Volume>{}</Volume>", num(room_volume(scene), 4));
     let _ = writeln!(o, "      </Space>");
     let _ = writeln!(o, "    </Building>");
-    let mut kinds_used: Vec<&'static str> = Vec::new();
     for s in &scene.surfaces {
-        let out = outward_normal(scene, s);
-        let has_opening = s
-            .features
-            .iter()
-            .any(|f| is_glazing(&f.label) || is_door(&f.label));
-        let ty = match s.kind {
-            SurfaceKind::Floor => "InteriorFloor",
-            SurfaceKind::Ceiling => "Ceiling",
-            _ if has_opening => "ExteriorWall",
-            _ => "InteriorWall",
-        };
-        let construction = format!("mrtmap-{}", s.kind.as_str());
-        if !kinds_used.contains(&s.kind.as_str()) {
-            kinds_used.push(s.kind.as_str());
-        }
-        let mut d = describe(
-            s.temperature.celsius(),
-            s.temperature_std_k,
-            s.emissivity,
-            &s.label,
-        );
-        if let Some(f) = s.observed_fraction {
-            let _ = write!(d, "; observed_fraction={}", num(f, 3));
-        }
-        for f in s
-            .features
-            .iter()
-            .filter(|f| !is_glazing(&f.label) && !is_door(&f.label))
-        {
-            let _ = write!(
-                d,
-                "; feature={}|{}|{}|{}",
-                f.id.replace([';', '|'], "_"),
-                f.label.replace([';', '|'], "_"),
-                num(f.temperature.celsius(), 3),
-                num(area_3d(&f.polygon), 4)
-            );
-        }
-        let _ = writeln!(
-            o,
-            "    <Surface id=\"{}\" surfaceType=\"{ty}\" constructionIdRef=\"{construction}\">",
-            ids.make(&s.id)
-        );
-        let _ = writeln!(o, "      <Name>{}</Name>", xml_escape(&s.id));
-        let _ = writeln!(o, "      <Description>{}</Description>", xml_escape(&d));
-        let _ = writeln!(o, "      <AdjacentSpaceId spaceIdRef=\"{space}\"/>");
-        poly_loop(&mut o, "      ", &oriented(&s.polygon, &out));
-        for f in s
-            .features
-            .iter()
-            .filter(|f| is_glazing(&f.label) || is_door(&f.label))
-        {
-            let kind = if is_door(&f.label) {
-                "NonSlidingDoor"
-            } else if s.kind == SurfaceKind::Ceiling {
-                "FixedSkylight"
-            } else {
-                "FixedWindow"
-            };
-            let _ = writeln!(
-                o,
-                "      <Opening id=\"{}\" openingType=\"{kind}\">",
-                ids.make(&f.id)
-            );
-            let _ = writeln!(o, "        <Name>{}</Name>", xml_escape(&f.id));
-            let _ = writeln!(
-                o,
-                "        <Description>{}</Description>",
-                xml_escape(&describe(
-                    f.temperature.celsius(),
-                    f.temperature_std_k,
-                    f.emissivity,
-                    &f.label
-                ))
-            );
-            poly_loop(&mut o, "        ", &oriented(&f.polygon, &out));
-            let _ = writeln!(o, "      </Opening>");
-        }
-        let _ = writeln!(o, "    </Surface>");
+        surface_xml(&mut o, scene, s, &mut ids, &space);
     }
     let _ = writeln!(o, "  </Campus>");
-    for k in kinds_used {
+    let mut kinds: Vec<&str> = scene.surfaces.iter().map(|s| s.kind.as_str()).collect();
+    kinds.sort_unstable();
+    kinds.dedup();
+    for k in kinds {
         let _ = writeln!(
             o,
             "  <Construction id=\"mrtmap-{k}\"><Name>{k} as scanned (layers unknown)</Name></Construction>"

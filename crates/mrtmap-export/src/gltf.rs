@@ -6,7 +6,7 @@
 //! show the colours as they are.
 
 use mrtmap_radiation::RadiantScene;
-use mrtmap_report::mesh::{MeshPart, scene_mesh, temperature_rgb};
+use mrtmap_report::mesh::{MeshPart, colour_range, scene_mesh, temperature_rgb};
 use serde_json::{Value, json};
 
 use crate::CloudPoints;
@@ -120,27 +120,14 @@ fn part_extras(p: &MeshPart) -> Value {
     e
 }
 
-/// The range of temperatures the colours span (°C): the parts' vertices', widened to 1 K at least.
-pub fn colour_range(parts: &[MeshPart]) -> (f64, f64) {
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for t in parts.iter().flat_map(|p| p.vertex_temperature_c.iter()) {
-        lo = lo.min(*t);
-        hi = hi.max(*t);
-    }
-    if !lo.is_finite() {
-        return (20.0, 21.0);
-    }
-    if hi - lo < 1.0 {
-        let m = 0.5 * (lo + hi);
-        return (m - 0.5, m + 0.5);
-    }
-    (lo, hi)
-}
-
 /// The scene (and `cloud`, when given) as a glTF binary named `name`.
 pub fn write(scene: &RadiantScene, cloud: Option<&CloudPoints>, name: &str) -> Vec<u8> {
     let parts = scene_mesh(scene);
-    let (lo, hi) = colour_range(&parts);
+    let (lo, hi) = colour_range(
+        parts
+            .iter()
+            .flat_map(|p| p.vertex_temperature_c.iter().copied()),
+    );
     let mut b = Builder::default();
     let mut meshes = Vec::new();
     let mut nodes = vec![json!({ "name": name, "children": [] })];

@@ -18,13 +18,13 @@ use mrtmap_geometry::PlaneFrame;
 use mrtmap_geometry::nalgebra::{Point2, Point3};
 use mrtmap_geometry::polygon::point_segment_distance;
 use mrtmap_radiation::{
-    BoxFile, FeatureFile, FramePose, OccluderFile, OccluderShape, RadiantScene, SceneFile,
+    BoxFile, FeatureFile, FramePose, OccluderFile, OccluderShape, RadiantScene, SceneFile, Surface,
     SurfaceFile, SurfaceKind,
 };
 use mrtmap_report::mesh::{oriented, outward_normal};
 use serde_json::{Value, json};
 
-use crate::{Identifiers, ImportError, is_door, is_glazing};
+use crate::{Identifiers, ImportError, Opening, opening};
 
 fn pts(p: &[Point3<f64>]) -> Value {
     Value::Array(p.iter().map(|q| json!([q.x, q.y, q.z])).collect())
@@ -66,7 +66,7 @@ fn measured(
 /// centroid until every vertex is this far inside.
 pub const SUB_FACE_INSET_M: f64 = 0.005;
 
-fn inset(sub: &[Point3<f64>], host: &mrtmap_radiation::Surface) -> Vec<Point3<f64>> {
+fn inset(sub: &[Point3<f64>], host: &Surface) -> Vec<Point3<f64>> {
     let outline = &host.polygon_2d;
     let q: Vec<_> = sub.iter().map(|p| host.frame.to_2d(p)).collect();
     let c = centroid_2d(&q);
@@ -106,90 +106,80 @@ fn face_type(kind: SurfaceKind) -> &'static str {
     }
 }
 
-/// The scene as a Honeybee model (HBJSON text) named `name`, one room, in metres.
-pub fn write(scene: &RadiantScene, name: &str) -> String {
-    let mut ids = Identifiers::default();
-    let room_id = ids.make(name);
-    let mut faces = Vec::new();
-    for s in &scene.surfaces {
-        let out = outward_normal(scene, s);
-        let mut apertures = Vec::new();
-        let mut doors = Vec::new();
-        let mut other = Vec::new();
-        for f in &s.features {
-            let mut m = measured(
-                &f.id,
-                &f.label,
-                f.temperature.celsius(),
-                f.temperature_std_k,
-                f.emissivity,
-            );
-            let geometry = face3d(&oriented(&inset(&f.polygon, s), &out));
-            if is_glazing(&f.label) {
-                apertures.push(json!({
-                    "type": "Aperture",
-                    "identifier": ids.make(&f.id),
-                    "display_name": f.label,
-                    "geometry": geometry,
-                    "boundary_condition": outdoors(),
-                    "properties": { "type": "AperturePropertiesAbridged" },
-                    "user_data": { "mrtmap": m },
-                }));
-            } else if is_door(&f.label) {
-                doors.push(json!({
-                    "type": "Door",
-                    "identifier": ids.make(&f.id),
-                    "display_name": f.label,
-                    "geometry": geometry,
-                    "boundary_condition": outdoors(),
-                    "properties": { "type": "DoorPropertiesAbridged" },
-                    "user_data": { "mrtmap": m },
-                }));
-            } else {
+/// One surface as a Honeybee Face: its windows as Apertures and doors as Doors (kept inside its
+/// outline), its other features in its `user_data`.
+fn face_json(scene: &RadiantScene, s: &Surface, ids: &mut Identifiers) -> Value {
+    let out = outward_normal(scene, s);
+    let (mut apertures, mut doors, mut other) = (Vec::new(), Vec::new(), Vec::new());
+    for f in &s.features {
+        let mut m = measured(
+            &f.id,
+            &f.label,
+            f.temperature.celsius(),
+            f.temperature_std_k,
+            f.emissivity,
+        );
+        let (list, kind) = match opening(&f.label) {
+            Some(Opening::Window) => (&mut apertures, "Aperture"),
+            Some(Opening::Door) => (&mut doors, "Door"),
+            None => {
                 m.insert("polygon".into(), pts(&f.polygon));
                 other.push(Value::Object(m));
+                continue;
             }
-        }
-        let mut m = measured(
-            &s.id,
-            &s.label,
-            s.temperature.celsius(),
-            s.temperature_std_k,
-            s.emissivity,
-        );
-        m.insert("kind".into(), json!(s.kind.as_str()));
-        if let Some(o) = s.observed_fraction {
-            m.insert("observed_fraction".into(), json!(o));
-        }
-        if !other.is_empty() {
-            m.insert("features".into(), Value::Array(other));
-        }
-        if let Some(r) = &s.raster {
-            m.insert("raster".into(), json!(r.file));
-        }
-        let bc = if apertures.is_empty() && doors.is_empty() {
-            json!({ "type": "Adiabatic" })
-        } else {
-            outdoors()
         };
-        let mut face = json!({
-            "type": "Face",
-            "identifier": ids.make(&s.id),
-            "display_name": s.label,
-            "geometry": face3d(&oriented(&s.polygon, &out)),
-            "face_type": face_type(s.kind),
-            "boundary_condition": bc,
-            "properties": { "type": "FacePropertiesAbridged" },
+        list.push(json!({
+            "type": kind,
+            "identifier": ids.make(&f.id),
+            "display_name": f.label,
+            "geometry": face3d(&oriented(&inset(&f.polygon, s), &out)),
+            "boundary_condition": outdoors(),
+            "properties": { "type": format!("{kind}PropertiesAbridged") },
             "user_data": { "mrtmap": m },
-        });
-        if !apertures.is_empty() {
-            face["apertures"] = Value::Array(apertures);
-        }
-        if !doors.is_empty() {
-            face["doors"] = Value::Array(doors);
-        }
-        faces.push(face);
+        }));
     }
+    let mut m = measured(
+        &s.id,
+        &s.label,
+        s.temperature.celsius(),
+        s.temperature_std_k,
+        s.emissivity,
+    );
+    m.insert("kind".into(), json!(s.kind.as_str()));
+    if let Some(o) = s.observed_fraction {
+        m.insert("observed_fraction".into(), json!(o));
+    }
+    if !other.is_empty() {
+        m.insert("features".into(), Value::Array(other));
+    }
+    if let Some(r) = &s.raster {
+        m.insert("raster".into(), json!(r.file));
+    }
+    let bc = if apertures.is_empty() && doors.is_empty() {
+        json!({ "type": "Adiabatic" })
+    } else {
+        outdoors()
+    };
+    let mut face = json!({
+        "type": "Face",
+        "identifier": ids.make(&s.id),
+        "display_name": s.label,
+        "geometry": face3d(&oriented(&s.polygon, &out)),
+        "face_type": face_type(s.kind),
+        "boundary_condition": bc,
+        "properties": { "type": "FacePropertiesAbridged" },
+        "user_data": { "mrtmap": m },
+    });
+    for (key, list) in [("apertures", apertures), ("doors", doors)] {
+        if !list.is_empty() {
+            face[key] = Value::Array(list);
+        }
+    }
+    face
+}
+
+/// The furniture as Shades, one per triangle, each naming its piece in `user_data`.
+fn shades_json(scene: &RadiantScene, ids: &mut Identifiers) -> Vec<Value> {
     let mut shades = Vec::new();
     for o in &scene.occluders {
         for (k, t) in o.triangles().iter().enumerate() {
@@ -211,6 +201,19 @@ pub fn write(scene: &RadiantScene, name: &str) -> String {
             }));
         }
     }
+    shades
+}
+
+/// The scene as a Honeybee model (HBJSON text) named `name`, one room, in metres.
+pub fn write(scene: &RadiantScene, name: &str) -> String {
+    let mut ids = Identifiers::default();
+    let room_id = ids.make(name);
+    let faces: Vec<Value> = scene
+        .surfaces
+        .iter()
+        .map(|s| face_json(scene, s, &mut ids))
+        .collect();
+    let shades = shades_json(scene, &mut ids);
     let mut room_data = serde_json::Map::new();
     room_data.insert("temperature_unit".into(), json!("C"));
     room_data.insert(

@@ -85,8 +85,28 @@ impl Identifiers {
     }
 }
 
-/// Whether a feature's label names glazing (an aperture for Honeybee, a window opening for gbXML,
-/// glass for Radiance).
+/// What kind of opening in its surface a feature is, for Honeybee and gbXML.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Opening {
+    /// Glazing: a Honeybee Aperture, a gbXML window or skylight.
+    Window,
+    /// A door (a glass door too): a Honeybee Door, a gbXML door.
+    Door,
+}
+
+/// The opening a feature's label names, if any: a door when it says door, else a window when it
+/// names glazing; lights, paintings and radiators are no openings.
+pub fn opening(label: &str) -> Option<Opening> {
+    if is_door(label) {
+        Some(Opening::Door)
+    } else if is_glazing(label) {
+        Some(Opening::Window)
+    } else {
+        None
+    }
+}
+
+/// Whether a feature's label names glazing (glass for Radiance; see [`opening`]).
 pub fn is_glazing(label: &str) -> bool {
     let l = label.to_ascii_lowercase();
     ["window", "glaz", "glass", "skylight"]
@@ -95,7 +115,7 @@ pub fn is_glazing(label: &str) -> bool {
 }
 
 /// Whether a feature's label names a door.
-pub fn is_door(label: &str) -> bool {
+fn is_door(label: &str) -> bool {
     label.to_ascii_lowercase().contains("door")
 }
 

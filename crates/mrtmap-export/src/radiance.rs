@@ -9,9 +9,10 @@
 use std::fmt::Write;
 
 use mrtmap_geometry::nalgebra::Point3;
-use mrtmap_geometry::polygon::triangulate_with_holes;
 use mrtmap_radiation::RadiantScene;
-use mrtmap_report::mesh::{MeshPart, PartRole, oriented, outward_normal, scene_mesh};
+use mrtmap_report::mesh::{
+    MeshPart, PartRole, oriented, outline_triangles, outward_normal, scene_mesh,
+};
 
 use crate::{Identifiers, is_glazing, num};
 
@@ -74,17 +75,7 @@ pub fn write(scene: &RadiantScene, name: &str) -> String {
                     polygon(&mut o, &material, &id, &oriented(&s.polygon, &inward));
                     continue;
                 }
-                let holes: Vec<_> = s.features.iter().map(|f| f.polygon_2d.clone()).collect();
-                let Ok(tris) = triangulate_with_holes(&s.polygon_2d, &holes) else {
-                    polygon(&mut o, &material, &id, &oriented(&s.polygon, &inward));
-                    continue;
-                };
-                let pts: Vec<Point3<f64>> = s
-                    .polygon_2d
-                    .iter()
-                    .chain(holes.iter().flatten())
-                    .map(|q| s.frame.to_3d(q))
-                    .collect();
+                let (pts, tris) = outline_triangles(s);
                 for (k, t) in tris.iter().enumerate() {
                     let tri = [pts[t[0]], pts[t[1]], pts[t[2]]];
                     polygon(

@@ -315,7 +315,12 @@ fn write_demo_outputs(
         project,
     );
     data.comparison = d.rows.clone();
-    data.view3d = Some(crate::report::view3d_for_run(&d.run_dir, &d.run));
+    let cloud = crate::export::run_cloud(&d.run_dir, &d.run.scene);
+    data.view3d = Some(crate::report::view3d_for_run(
+        &d.run_dir,
+        &d.run,
+        cloud.as_ref(),
+    ));
     data.grid_error = Some((d.grid.max_abs_error_k, d.grid.rmse_k, d.grid.nodes));
     let reused = if d.simulate.skipped { " (reused)" } else { "" };
     data.timing.insert(

@@ -164,23 +164,22 @@ pub fn load_hbjson(
     Ok((scene, source))
 }
 
-fn thin(cloud: CloudPoints, max_points: usize) -> CloudPoints {
-    let n = cloud.positions.len();
-    if n <= max_points {
-        return cloud;
-    }
-    if max_points == 0 {
-        return CloudPoints::default();
-    }
-    let keep: Vec<usize> = (0..max_points).map(|i| i * n / max_points).collect();
+fn thin(cloud: &CloudPoints, max_points: usize) -> CloudPoints {
+    let keep = mrtmap_report::view3d::evenly_spaced(cloud.positions.len(), max_points);
     CloudPoints {
         positions: keep.iter().map(|&i| cloud.positions[i]).collect(),
         temperature_c: keep.iter().map(|&i| cloud.temperature_c[i]).collect(),
     }
 }
 
+/// A run's thermal cloud (`out/fuse/cloud.ply`) in its scene's frame, read once for the report's
+/// 3D view and the exports; `None` when it cannot be read (they then go without it).
+pub fn run_cloud(out: &Path, scene: &RadiantScene) -> Option<CloudPoints> {
+    cloud_in_scene(&out.join("fuse").join("cloud.ply"), scene).ok()
+}
+
 /// The thermal cloud at `ply` in `scene`'s frame (through its `world_from_room`).
-pub(crate) fn cloud_in_scene(ply: &Path, scene: &RadiantScene) -> Result<CloudPoints> {
+fn cloud_in_scene(ply: &Path, scene: &RadiantScene) -> Result<CloudPoints> {
     let c = read_cloud_ply(ply)?.cloud;
     let room_from_world = scene.world_from_room.map(|w| w.inverse());
     let positions = c
@@ -262,7 +261,7 @@ pub fn open_for_export(path: &Path, src: &ExportSource, max_points: usize) -> Re
             .into_iter()
             .find(|p| p.is_file());
         let cloud = match ply {
-            Some(p) => Some(thin(cloud_in_scene(&p, &scene)?, max_points)),
+            Some(p) => Some(thin(&cloud_in_scene(&p, &scene)?, max_points)),
             None => None,
         };
         let dir_name = path
@@ -385,22 +384,21 @@ pub fn export(input: &ExportInput, format: ExportFormat, out: &Path) -> Result<E
     })
 }
 
-/// The exports `[export]` asks of a run: `out/export/room.EXT`, with the run's cloud in the glTF.
+/// The exports `[export]` asks of a run: `out/export/room.EXT`, with the run's `cloud` (see
+/// [`run_cloud`]) in the glTF.
 pub fn export_run(
     out: &Path,
     scene: &RadiantScene,
     section: &ExportSection,
+    cloud: Option<&CloudPoints>,
 ) -> Result<Vec<ExportDone>> {
     if section.formats.is_empty() {
         return Ok(Vec::new());
     }
     let max_points = section.max_points.unwrap_or(DEFAULT_MAX_POINTS);
-    let ply = out.join("fuse").join("cloud.ply");
-    let cloud = if ply.is_file() && section.formats.contains(&ExportFormat::Gltf) {
-        Some(thin(cloud_in_scene(&ply, scene)?, max_points))
-    } else {
-        None
-    };
+    let cloud = cloud
+        .filter(|_| section.formats.contains(&ExportFormat::Gltf))
+        .map(|c| thin(c, max_points));
     let input = ExportInput {
         scene: scene.clone(),
         source: out.display().to_string(),

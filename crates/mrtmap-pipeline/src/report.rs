@@ -567,7 +567,8 @@ struct RunFile<'a> {
     project: &'a Project,
 }
 
-/// Writes `report.html` of `data` and `run.json` into `out`.
+/// Writes `report.html` of `data`, the exports `[export]` asks for (with the run's `cloud`) and
+/// `run.json` into `out`.
 pub fn write_run_outputs(
     out: &Path,
     data: &ReportData,
@@ -575,12 +576,13 @@ pub fn write_run_outputs(
     recording: &Path,
     p: &Project,
     seconds: f64,
+    cloud: Option<&crate::export::CloudPoints>,
 ) -> Result<Vec<crate::export::ExportDone>> {
     mrtmap_io::write_atomic(
         &out.join("report.html"),
         mrtmap_report::render_html(data).as_bytes(),
     )?;
-    let exports = crate::export::export_run(out, &o.scene, &p.export)?;
+    let exports = crate::export::export_run(out, &o.scene, &p.export, cloud)?;
     write_json(
         &out.join("run.json"),
         &RunFile {
@@ -660,11 +662,14 @@ impl RunDone {
     }
 }
 
-/// The report's 3D view of a run in `out`: its scene, its thermal cloud (fuse/cloud.ply) and each
-/// map's grid (read back from its mrt_grid.csv); a cloud or a grid that cannot be read is left
-/// out of the view.
-pub fn view3d_for_run(out: &Path, o: &RunOutcome) -> mrtmap_report::view3d::View3d {
-    let cloud = crate::export::cloud_in_scene(&out.join("fuse").join("cloud.ply"), &o.scene).ok();
+/// The report's 3D view of a run in `out`: its scene, its thermal `cloud` (see
+/// [`crate::export::run_cloud`]) and each map's grid (read back from its mrt_grid.csv); a grid
+/// that cannot be read is left out of the view.
+pub fn view3d_for_run(
+    out: &Path,
+    o: &RunOutcome,
+    cloud: Option<&crate::export::CloudPoints>,
+) -> mrtmap_report::view3d::View3d {
     let grids: Vec<GridLayer> = o
         .maps
         .iter()
@@ -678,10 +683,9 @@ pub fn view3d_for_run(out: &Path, o: &RunOutcome) -> mrtmap_report::view3d::View
             })
         })
         .collect();
-    let c = cloud.as_ref();
     mrtmap_report::view3d::view3d(
         &o.scene,
-        c.map(|c| (c.positions.as_slice(), c.temperature_c.as_slice())),
+        cloud.map(|c| (c.positions.as_slice(), c.temperature_c.as_slice())),
         &grids,
         &globes_of_run(out),
     )
@@ -751,10 +755,19 @@ pub fn run_recording(
         &recording.display().to_string(),
         project,
     );
+    let cloud = crate::export::run_cloud(out, &outcome.scene);
     let mut data = data;
-    data.view3d = Some(view3d_for_run(out, &outcome));
+    data.view3d = Some(view3d_for_run(out, &outcome, cloud.as_ref()));
     let secs = t0.elapsed().as_secs_f64();
-    let exports = write_run_outputs(out, &data, &outcome, recording, project, secs)?;
+    let exports = write_run_outputs(
+        out,
+        &data,
+        &outcome,
+        recording,
+        project,
+        secs,
+        cloud.as_ref(),
+    )?;
     Ok(RunDone {
         prepared,
         outcome,

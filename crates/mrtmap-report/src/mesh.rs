@@ -148,18 +148,30 @@ fn surface_part(scene: &RadiantScene, s: &Surface) -> MeshPart {
         }
         return part;
     }
+    let (pts, tris) = outline_triangles(s);
+    push_triangles(&mut part, &pts, &tris, &|_| t_surface, &out);
+    part
+}
+
+/// A surface's outline with its features cut out, as triangles over points in its plane (the
+/// whole outline when the features cannot be cut out of it); wound either way.
+pub fn outline_triangles(s: &Surface) -> (Vec<Point3<f64>>, Vec<[usize; 3]>) {
     let holes: Vec<_> = s.features.iter().map(|f| f.polygon_2d.clone()).collect();
-    let tris = triangulate_with_holes(&s.polygon_2d, &holes)
-        .or_else(|_| mrtmap_geometry::polygon::triangulate(&s.polygon_2d))
-        .unwrap_or_else(|_| fan(s.polygon.len()));
-    let pts: Vec<Point3<f64>> = s
+    let (tris, holes) = match triangulate_with_holes(&s.polygon_2d, &holes) {
+        Ok(t) => (t, holes),
+        Err(_) => (
+            mrtmap_geometry::polygon::triangulate(&s.polygon_2d)
+                .unwrap_or_else(|_| fan(s.polygon.len())),
+            Vec::new(),
+        ),
+    };
+    let pts = s
         .polygon_2d
         .iter()
         .chain(holes.iter().flatten())
         .map(|q| s.frame.to_3d(q))
         .collect();
-    push_triangles(&mut part, &pts, &tris, &|_| t_surface, &out);
-    part
+    (pts, tris)
 }
 
 /// The room as named parts: surfaces, then each surface's features, then furniture.
@@ -221,6 +233,22 @@ pub fn scene_mesh(scene: &RadiantScene) -> Vec<MeshPart> {
         parts.push(part);
     }
     parts
+}
+
+/// The range of temperatures a colour scale spans (°C): the values' own, widened about its middle to
+/// 1 K at least (a uniform room still gets a scale); 20…21 °C for no values.
+pub fn colour_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), t| {
+        (a.min(t), b.max(t))
+    });
+    if !lo.is_finite() {
+        return (20.0, 21.0);
+    }
+    if hi - lo < 1.0 {
+        let m = 0.5 * (lo + hi);
+        return (m - 0.5, m + 0.5);
+    }
+    (lo, hi)
 }
 
 /// The colour of `t_c` on the maps' palette (blue cold → red warm) over `lo…hi` (°C).

@@ -41,18 +41,11 @@ fn stops(lo: f64, hi: f64) -> Vec<String> {
         .collect()
 }
 
-fn range_of(values: impl Iterator<Item = f64>) -> (f64, f64) {
-    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), t| {
-        (a.min(t), b.max(t))
-    });
-    if !lo.is_finite() {
-        return (20.0, 21.0);
-    }
-    if hi - lo < 0.5 {
-        let m = 0.5 * (lo + hi);
-        return (m - 0.25, m + 0.25);
-    }
-    (lo, hi)
+/// `keep` of the indices `0..n`, evenly spaced (all of them when `n ≤ keep`): how a cloud is
+/// thinned for the view and for exports.
+pub fn evenly_spaced(n: usize, keep: usize) -> Vec<usize> {
+    let keep = keep.min(n);
+    (0..keep).map(|i| i * n / keep).collect()
 }
 
 /// Node spacing along `axis`: the smallest gap between distinct projections.
@@ -79,7 +72,7 @@ pub fn view3d(
     globes: &[ViewMark],
 ) -> View3d {
     let parts = scene_mesh(scene);
-    let (lo, hi) = range_of(
+    let (lo, hi) = crate::mesh::colour_range(
         parts
             .iter()
             .flat_map(|p| p.vertex_temperature_c.iter().copied()),
@@ -118,8 +111,7 @@ pub fn view3d(
     };
     let cloud = cloud.filter(|(p, _)| !p.is_empty()).map(|(pos, t)| {
         let n = pos.len();
-        let keep = n.min(MAX_VIEW_POINTS);
-        let idx: Vec<usize> = (0..keep).map(|i| i * n / keep).collect();
+        let idx = evenly_spaced(n, MAX_VIEW_POINTS);
         json!({
             "p": idx.iter().flat_map(|&i| pos[i].map(|c| r3(f64::from(c)))).collect::<Vec<_>>(),
             "c": idx.iter().flat_map(|&i| temperature_rgb(f64::from(t[i]), lo, hi)).collect::<Vec<_>>(),
@@ -129,7 +121,7 @@ pub fn view3d(
         .iter()
         .filter(|g| !g.nodes.is_empty())
         .map(|g| {
-            let (glo, ghi) = range_of(g.nodes.iter().map(|n| n[3]));
+            let (glo, ghi) = crate::mesh::colour_range(g.nodes.iter().map(|n| n[3]));
             json!({
                 "height": g.height_m, "range": [glo, ghi], "bar": stops(glo, ghi),
                 "cell": [spacing(&g.nodes, &g.u), spacing(&g.nodes, &g.v)],

@@ -300,12 +300,15 @@ fn report_numbers_match_the_csv_and_it_renders() {
         "--disable-sync",
     ];
     let url = format!("file://{}", out.join("report.html").display());
-    let dom = Command::new(chromium)
-        .args(common)
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .args(["--dump-dom", &url])
-        .output()
-        .unwrap();
+    let chrome = |args: &[&str]| {
+        Command::new(chromium)
+            .args(common)
+            .arg(format!("--user-data-dir={}", profile.display()))
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let dom = chrome(&["--dump-dom", &url]);
     let dom = String::from_utf8_lossy(&dom.stdout);
     assert!(
         dom.contains("Mean radiant temperature at 1.10 m") && dom.contains("id=\"map-1.10-min\""),
@@ -313,38 +316,78 @@ fn report_numbers_match_the_csv_and_it_renders() {
         &dom[..dom.len().min(300)]
     );
     let shot = dir.path().join("report.png");
-    let s = Command::new(chromium)
-        .args(common)
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .args([
-            "--window-size=1200,1600",
-            &format!("--screenshot={}", shot.display()),
-            &url,
-        ])
-        .output()
-        .unwrap();
+    let s = chrome(&[
+        "--window-size=1200,1600",
+        &format!("--screenshot={}", shot.display()),
+        &url,
+    ]);
     assert!(s.status.success());
     assert!(
         std::fs::metadata(&shot).unwrap().len() > 20_000,
         "a blank screenshot"
     );
-    // The 3D view alone (report.html#3d), drawn by WebGL (SwiftShader without a GPU): the
-    // canvas is not blank, the room fills its middle, and both the cold window and the warm
-    // room show in their colours.
+    // The 3D view alone (report.html#3d), drawn by WebGL (SwiftShader without a GPU).
     let shot3d = dir.path().join("view3d.png");
-    let s = Command::new(chromium)
-        .args(common)
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .args([
-            "--window-size=1000,800",
-            "--virtual-time-budget=5000",
-            &format!("--screenshot={}", shot3d.display()),
-            &format!("{url}#3d"),
-        ])
-        .output()
-        .unwrap();
+    let view = ["--window-size=1000,800", "--virtual-time-budget=5000"];
+    let s = chrome(
+        &[
+            &view[..],
+            &[
+                &format!("--screenshot={}", shot3d.display()),
+                &format!("{url}#3d"),
+            ],
+        ]
+        .concat(),
+    );
     assert!(s.status.success());
-    let img = image::open(&shot3d).unwrap().to_rgb8();
+    assert_view3d_drawn(&shot3d);
+    // A click in the middle of the view names what is there, with its temperature and area.
+    let dom = chrome(
+        &[
+            &view[..],
+            &["--dump-dom", &format!("{url}#3d&pick=0.5,0.5")],
+        ]
+        .concat(),
+    );
+    let dom = String::from_utf8_lossy(&dom.stdout);
+    let said = dom
+        .split("<p id=\"view3d-info\">")
+        .nth(1)
+        .and_then(|r| r.split('<').next())
+        .unwrap_or_default();
+    let scene = read_json(&out.join("segment/scene.json"));
+    let ids: Vec<&str> = scene["surfaces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|s| {
+            std::iter::once(&s["id"]).chain(
+                s["features"]
+                    .as_array()
+                    .into_iter()
+                    .flatten()
+                    .map(|f| &f["id"]),
+            )
+        })
+        .chain(
+            scene["occluders"]
+                .as_array()
+                .into_iter()
+                .flatten()
+                .map(|o| &o["id"]),
+        )
+        .filter_map(Value::as_str)
+        .collect();
+    assert!(
+        said.contains(" °C") && said.contains(" m²") && ids.iter().any(|id| said.starts_with(id)),
+        "the click named nothing: {said:?}"
+    );
+}
+
+/// A 1000×800 screenshot of the 3D view is not blank, the room fills its middle, and both the
+/// cold window and the warm room show in their colours.
+fn assert_view3d_drawn(png: &Path) {
+    let img = image::open(png).unwrap().to_rgb8();
     let background = |p: &image::Rgb<u8>| {
         p.0.iter()
             .zip([245u8, 245, 242])
@@ -381,51 +424,6 @@ fn report_numbers_match_the_csv_and_it_renders() {
     assert!(
         share(warm, n) > 0.05,
         "no warm surface in view: {warm} of {n}"
-    );
-    // A click in the middle of the view names what is there, with its temperature and area.
-    let dom = Command::new(chromium)
-        .args(common)
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .args([
-            "--window-size=1000,800",
-            "--virtual-time-budget=5000",
-            "--dump-dom",
-            &format!("{url}#3d&pick=0.5,0.5"),
-        ])
-        .output()
-        .unwrap();
-    let dom = String::from_utf8_lossy(&dom.stdout);
-    let said = dom
-        .split("<p id=\"view3d-info\">")
-        .nth(1)
-        .and_then(|r| r.split('<').next())
-        .unwrap_or_default();
-    let scene = read_json(&out.join("segment/scene.json"));
-    let ids: Vec<&str> = scene["surfaces"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .flat_map(|s| {
-            std::iter::once(&s["id"]).chain(
-                s["features"]
-                    .as_array()
-                    .into_iter()
-                    .flatten()
-                    .map(|f| &f["id"]),
-            )
-        })
-        .chain(
-            scene["occluders"]
-                .as_array()
-                .into_iter()
-                .flatten()
-                .map(|o| &o["id"]),
-        )
-        .filter_map(Value::as_str)
-        .collect();
-    assert!(
-        said.contains(" °C") && said.contains(" m²") && ids.iter().any(|id| said.starts_with(id)),
-        "the click named nothing: {said:?}"
     );
 }
 
