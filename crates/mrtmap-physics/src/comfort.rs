@@ -1,6 +1,7 @@
 //! Operative temperature (ISO 7726 / ASHRAE 55), PMV and PPD (ISO 7730), radiant asymmetry.
 
 use serde::{Deserialize, Serialize};
+use wide::{CmpGt, CmpLe, f64x2};
 
 use crate::error::{PhysicsError, finite, in_range};
 use crate::units::Temperature;
@@ -118,10 +119,12 @@ pub fn pmv_ppd_edition(inp: &PmvInputs, edition: Iso7730Edition) -> Result<Pmv, 
     Err(no_convergence())
 }
 
-/// [`pmv_ppd_edition`] over many inputs: the same numbers, element by element, computed several
-/// at a time (the clothing temperature's iterations of eight inputs interleaved, so that their
-/// square roots and divisions overlap: on 345,000 random inputs, 8 lanes took 36–38 ms on one
-/// thread, 4 lanes 42–43 ms, 16 lanes 50–67 ms (a lane waits for the slowest of its group)).
+/// [`pmv_ppd_edition`] over many inputs, computed several at a time: the inputs are checked one
+/// by one, and the rest runs on vectors of two lanes, `LANES` inputs in lock step (their square
+/// roots and divisions overlap), with the clothing temperature's step under forced convection
+/// (a constant coefficient, most steps) without them, and exponentials by polynomial (`wide`).
+/// The numbers equal [`pmv_ppd_edition`]'s within 1e-12 (an exponential can differ in its last
+/// bit, and a division is a multiplication by the reciprocal).
 pub fn pmv_ppd_many(
     inputs: &[PmvInputs],
     edition: Iso7730Edition,
@@ -141,76 +144,229 @@ pub fn pmv_ppd_each(
 ) {
     for start in (0..n).step_by(LANES) {
         let len = LANES.min(n - start);
-        let mut lanes: [Option<(Fanger, Iteration, bool)>; LANES] = [None; LANES];
-        let mut errors: [Option<PhysicsError>; LANES] = Default::default();
+        // Refused inputs keep a filler in their lane; the message is theirs.
+        let mut lanes = [Checked::FILLER; LANES];
+        let mut refused: [Option<PhysicsError>; LANES] = Default::default();
         for k in 0..len {
-            match Fanger::new(&input(start + k), edition) {
-                Ok(f) => lanes[k] = Some((f, Iteration::start(&f), false)),
-                Err(e) => errors[k] = Some(e),
+            match Checked::new(&input(start + k)) {
+                Ok(c) => lanes[k] = c,
+                Err(e) => refused[k] = Some(e),
             }
         }
-        step_lanes(&mut lanes);
-        for k in 0..len {
+        let mut block = Block::new(&lanes, edition);
+        for _ in 0..MAX_ITERATIONS {
+            if block.step() {
+                break;
+            }
+        }
+        let done = block.finish();
+        for (k, (c, refused)) in lanes.iter().zip(refused).take(len).enumerate() {
             answer(
                 start + k,
-                match (&lanes[k], errors[k].take()) {
-                    (Some((f, it, true)), _) => Ok(f.finish(it)),
-                    (_, Some(e)) => Err(e),
-                    _ => Err(no_convergence()),
+                match refused {
+                    Some(e) => Err(e),
+                    None if !done.converged[k] => Err(no_convergence()),
+                    None => Ok(c.judge(done.pmv[k], done.ppd[k], done.pa[k])),
                 },
             );
         }
     }
 }
 
-/// The iterations of up to `LANES` inputs in lock step, branch-free so that the compiler can keep
-/// them in vector registers: every lane computes each step, and a lane that has converged keeps
-/// its values (the same numbers as [`Iteration::step`] one input at a time).
-fn step_lanes(lanes: &mut [Option<(Fanger, Iteration, bool)>; LANES]) {
-    let mut c = [[0.0f64; LANES]; 6]; // taa, hcf, p2, p3, p4, p5
-    let (mut xn, mut xf, mut hc) = ([1.0f64; LANES], [1.0f64; LANES], [0.0f64; LANES]);
-    let mut done = [true; LANES];
-    for (l, lane) in lanes.iter().enumerate() {
-        if let Some((f, it, _)) = lane {
-            for (k, v) in [f.taa, f.hcf, f.p2, f.p3, f.p4, f.p5]
+/// A block's answers, lane by lane.
+struct Finished {
+    pmv: [f64; LANES],
+    ppd: [f64; LANES],
+    /// Water vapour pressure (Pa), for the range check.
+    pa: [f64; LANES],
+    converged: [bool; LANES],
+}
+
+/// Lanes per vector, and vectors per block.
+const W: usize = 2;
+const G: usize = LANES / W;
+type V = f64x2;
+type Vs = [V; G];
+
+/// Whether any lane's mask is set.
+fn any_lane(m: &Vs) -> bool {
+    let mut or = m[0];
+    for v in &m[1..] {
+        or |= *v;
+    }
+    or.any()
+}
+
+/// Whether every lane's mask is set.
+fn all_lanes(m: &Vs) -> bool {
+    let mut and = m[0];
+    for v in &m[1..] {
+        and &= *v;
+    }
+    and.all()
+}
+
+/// One vector per `g` from `f(g)`.
+fn each(f: impl FnMut(usize) -> V) -> Vs {
+    std::array::from_fn(f)
+}
+
+/// `LANES` inputs' constants and iterates as vectors, annex D's names (a refused input's lane
+/// computes a filler and is converged from the start).
+struct Block {
+    ta: Vs,
+    m: Vs,
+    mw: Vs,
+    pa: Vs,
+    fcl: Vs,
+    /// (tra / 100)⁴.
+    tra4: Vs,
+    taa: Vs,
+    hcf: Vs,
+    /// (hcf / 2.38)⁴: natural convection wins (hcn > hcf) where |100·x − taa| exceeds it.
+    natural_above: Vs,
+    p2: Vs,
+    p3: Vs,
+    p4: Vs,
+    p5: Vs,
+    /// The numerator's constant part and the denominator's reciprocal with forced convection.
+    forced_num: Vs,
+    forced_inv_den: Vs,
+    xn: Vs,
+    xf: Vs,
+    hc: Vs,
+    /// All bits set in a converged lane.
+    done: Vs,
+}
+
+impl Block {
+    fn new(lanes: &[Checked; LANES], edition: Iso7730Edition) -> Self {
+        let mut columns = [[0.0; LANES]; 8];
+        for (l, c) in lanes.iter().enumerate() {
+            let empty = if c.filler { f64::NAN } else { 0.0 };
+            for (k, x) in [c.ta, c.tr, c.vr, c.rh, c.met, c.clo, c.wme, empty]
                 .into_iter()
                 .enumerate()
             {
-                c[k][l] = v;
+                columns[k][l] = x;
             }
-            (xn[l], xf[l], hc[l], done[l]) = (it.xn, it.xf, it.hc, false);
         }
-    }
-    let [taa, hcf, p2, p3, p4, p5] = c;
-    for _ in 0..MAX_ITERATIONS {
-        for l in 0..LANES {
-            let x = (xf[l] + xn[l]) / 2.0;
-            let hcn = 2.38 * (100.0 * x - taa[l]).abs().sqrt().sqrt();
-            let h = hcf[l].max(hcn);
-            let n = (p5[l] + p4[l] * h - p2[l] * x.powi(4)) / (100.0 + p3[l] * h);
-            let keep = done[l];
-            xf[l] = if keep { xf[l] } else { x };
-            xn[l] = if keep { xn[l] } else { n };
-            hc[l] = if keep { hc[l] } else { h };
-            done[l] = keep || (n - x).abs() <= 0.00015;
-        }
-        if done.iter().all(|d| *d) {
-            break;
-        }
-    }
-    for (l, lane) in lanes.iter_mut().enumerate() {
-        if let Some((_, it, converged)) = lane {
-            *it = Iteration {
-                xn: xn[l],
-                xf: xf[l],
-                hc: hc[l],
+        let [ta, tr, vr, rh, met, clo, wme, empty] =
+            columns.map(|c| each(|g| V::new([c[W * g], c[W * g + 1]])));
+        let s = V::splat;
+        let pa = each(|g| rh[g] * s(10.0) * (s(16.6536) - s(4030.183) / (ta[g] + s(235.0))).exp());
+        let icl = each(|g| s(0.155) * clo[g]);
+        let m = each(|g| met[g] * s(58.15));
+        let mw = each(|g| m[g] - wme[g] * s(58.15));
+        let fcl = each(|g| {
+            icl[g]
+                .cmp_le(s(0.078))
+                .blend(s(1.0) + s(1.29) * icl[g], s(1.05) + s(0.645) * icl[g])
+        });
+        let hcf = each(|g| s(12.1) * vr[g].sqrt());
+        let taa = each(|g| ta[g] + s(273.0));
+        let tra = each(|g| (tr[g] + s(273.0)) / s(100.0));
+        let tra4 = each(|g| (tra[g] * tra[g]) * (tra[g] * tra[g]));
+        let tcla = each(|g| {
+            let den = match edition {
+                Iso7730Edition::Y2005 => s(3.5) * icl[g] + s(0.1),
+                Iso7730Edition::Y2025 => s(3.5) * (s(6.45) * icl[g] + s(0.1)),
             };
-            *converged = done[l];
+            taa[g] + (s(35.5) - ta[g]) / den
+        });
+        let p1 = each(|g| icl[g] * fcl[g]);
+        let p2 = each(|g| p1[g] * s(3.96));
+        let p3 = each(|g| p1[g] * s(100.0));
+        let p4 = each(|g| p1[g] * taa[g]);
+        let p5 = each(|g| s(308.7) - s(0.028) * mw[g] + p2[g] * tra4[g]);
+        let natural_above = each(|g| {
+            let q = hcf[g] / s(2.38);
+            (q * q) * (q * q)
+        });
+        Self {
+            forced_num: each(|g| p5[g] + p4[g] * hcf[g]),
+            forced_inv_den: each(|g| s(1.0) / (s(100.0) + p3[g] * hcf[g])),
+            xn: each(|g| tcla[g] / s(100.0)),
+            xf: each(|g| tcla[g] / s(50.0)),
+            hc: hcf,
+            done: empty.map(V::is_nan),
+            ta,
+            m,
+            mw,
+            pa,
+            fcl,
+            tra4,
+            taa,
+            hcf,
+            natural_above,
+            p2,
+            p3,
+            p4,
+            p5,
+        }
+    }
+
+    /// One step of [`Iteration::step`] in each lane not yet converged; whether all have.
+    fn step(&mut self) -> bool {
+        let s = V::splat;
+        let x = each(|g| (self.xf[g] + self.xn[g]) / s(2.0));
+        let d = each(|g| (s(100.0) * x[g] - self.taa[g]).abs());
+        let x2 = each(|g| x[g] * x[g]);
+        let x4 = each(|g| x2[g] * x2[g]);
+        let natural = each(|g| d[g].cmp_gt(self.natural_above[g]));
+        let mut h = self.hcf;
+        let mut n = each(|g| (self.forced_num[g] - self.p2[g] * x4[g]) * self.forced_inv_den[g]);
+        if any_lane(&natural) {
+            // The square roots and the division only when natural convection wins somewhere.
+            let r = each(|g| d[g].sqrt());
+            let r = each(|g| r[g].sqrt());
+            let hn = each(|g| self.hcf[g].fast_max(s(2.38) * r[g]));
+            let num = each(|g| self.p5[g] + self.p4[g] * hn[g] - self.p2[g] * x4[g]);
+            let nn = each(|g| num[g] / (s(100.0) + self.p3[g] * hn[g]));
+            h = each(|g| natural[g].blend(hn[g], h[g]));
+            n = each(|g| natural[g].blend(nn[g], n[g]));
+        }
+        let keep = self.done;
+        self.xf = each(|g| keep[g].blend(self.xf[g], x[g]));
+        self.xn = each(|g| keep[g].blend(self.xn[g], n[g]));
+        self.hc = each(|g| keep[g].blend(self.hc[g], h[g]));
+        self.done = each(|g| keep[g] | (n[g] - x[g]).abs().cmp_le(s(0.00015)));
+        all_lanes(&self.done)
+    }
+
+    /// The heat balance at each lane's clothing temperature ([`Fanger::finish`]).
+    fn finish(&self) -> Finished {
+        let s = V::splat;
+        let pmv = each(|g| {
+            let (ta, m, mw, pa, fcl) = (self.ta[g], self.m[g], self.mw[g], self.pa[g], self.fcl[g]);
+            let (xn, hc) = (self.xn[g], self.hc[g]);
+            let tcl = s(100.0) * xn - s(273.0);
+            let hl1 = s(3.05e-3) * (s(5733.0) - s(6.99) * mw - pa);
+            let hl2 = mw.cmp_gt(s(58.15)).blend(s(0.42) * (mw - s(58.15)), s(0.0));
+            let hl3 = s(1.7e-5) * m * (s(5867.0) - pa);
+            let hl4 = s(0.0014) * m * (s(34.0) - ta);
+            let xn2 = xn * xn;
+            let hl5 = s(3.96) * fcl * (xn2 * xn2 - self.tra4[g]);
+            let hl6 = fcl * hc * (tcl - ta);
+            let ts = s(0.303) * (s(-0.036) * m).exp() + s(0.028);
+            ts * (mw - hl1 - hl2 - hl3 - hl4 - hl5 - hl6)
+        });
+        let ppd = each(|g| {
+            let p2 = pmv[g] * pmv[g];
+            s(100.0) - s(95.0) * (s(-0.03353) * (p2 * p2) - s(0.2179) * p2).exp()
+        });
+        let lanes =
+            |v: &Vs| -> [f64; LANES] { std::array::from_fn(|l| v[l / W].to_array()[l % W]) };
+        Finished {
+            pmv: lanes(&pmv),
+            ppd: lanes(&ppd),
+            pa: lanes(&self.pa),
+            converged: lanes(&self.done).map(f64::is_nan),
         }
     }
 }
 
-/// Inputs whose iterations run interleaved (see [`pmv_ppd_many`] for the measurement behind 8).
+/// Inputs whose iterations run in lock step (see [`pmv_ppd_many`]).
 const LANES: usize = 8;
 
 /// The iteration's cap (ISO 7730's code iterates until it converges; pythermalcomfort stops at
@@ -226,11 +382,8 @@ fn no_convergence() -> PhysicsError {
 /// One PMV's inputs checked and its constants (annex D's names).
 #[derive(Clone, Copy, Debug)]
 struct Fanger {
+    checked: Checked,
     ta: f64,
-    tr: f64,
-    vr: f64,
-    met: f64,
-    clo: f64,
     pa: f64,
     m: f64,
     mw: f64,
@@ -273,8 +426,58 @@ impl Iteration {
     }
 }
 
-impl Fanger {
-    fn new(inp: &PmvInputs, edition: Iso7730Edition) -> Result<Self, PhysicsError> {
+/// One PMV's inputs, each within the range the formulas accept (°C, m/s, %, met, clo).
+#[derive(Clone, Copy, Debug)]
+struct Checked {
+    ta: f64,
+    tr: f64,
+    vr: f64,
+    rh: f64,
+    met: f64,
+    clo: f64,
+    wme: f64,
+    /// A lane of a block with no input in it.
+    filler: bool,
+}
+
+impl Checked {
+    /// Ordinary indoor values for a block's empty lanes.
+    const FILLER: Self = Self {
+        ta: 20.0,
+        tr: 20.0,
+        vr: 0.1,
+        rh: 50.0,
+        met: 1.2,
+        clo: 0.5,
+        wme: 0.0,
+        filler: true,
+    };
+
+    fn new(inp: &PmvInputs) -> Result<Self, PhysicsError> {
+        let c = Self {
+            ta: inp.air.celsius(),
+            tr: inp.mrt.celsius(),
+            vr: inp.relative_air_speed_m_s,
+            rh: inp.relative_humidity_pct,
+            met: inp.met,
+            clo: inp.clo,
+            wme: inp.external_work_met,
+            filler: false,
+        };
+        // All within range (NaN is not), else the first one outside, named.
+        let within = (-50.0..=100.0).contains(&c.ta)
+            && (-50.0..=150.0).contains(&c.tr)
+            && (0.1..=10.0).contains(&c.met)
+            && (0.0..=10.0).contains(&c.vr)
+            && (0.0..=100.0).contains(&c.rh)
+            && (0.0..=5.0).contains(&c.clo)
+            && (0.0..=10.0).contains(&c.wme);
+        if within { Ok(c) } else { Self::refused(inp) }
+    }
+
+    /// The message for the first input outside its range.
+    #[cold]
+    fn refused(inp: &PmvInputs) -> Result<Self, PhysicsError> {
         let ta = in_range("air temperature (°C)", inp.air.celsius(), -50.0, 100.0)?;
         let tr = in_range(
             "mean radiant temperature (°C)",
@@ -299,7 +502,40 @@ impl Fanger {
         )?;
         let clo = in_range("clothing (clo)", inp.clo, 0.0, 5.0)?;
         let wme = in_range("external work (met)", inp.external_work_met, 0.0, 10.0)?;
+        Ok(Self {
+            ta,
+            tr,
+            vr,
+            rh,
+            met,
+            clo,
+            wme,
+            filler: false,
+        })
+    }
 
+    /// The answer, with whether the inputs, the vapour pressure `pa` (Pa) and the PMV lie in
+    /// ISO 7730's ranges.
+    fn judge(&self, pmv: f64, ppd_pct: f64, pa: f64) -> Pmv {
+        let within = (10.0..=30.0).contains(&self.ta)
+            && (10.0..=40.0).contains(&self.tr)
+            && (0.0..=1.0).contains(&self.vr)
+            && (0.8..=4.0).contains(&self.met)
+            && (0.0..=2.0).contains(&self.clo)
+            && (0.0..=2700.0).contains(&pa)
+            && (-2.0..=2.0).contains(&pmv);
+        Pmv {
+            pmv,
+            ppd_pct,
+            within_iso_ranges: within,
+        }
+    }
+}
+
+impl Fanger {
+    fn new(inp: &PmvInputs, edition: Iso7730Edition) -> Result<Self, PhysicsError> {
+        let c = Checked::new(inp)?;
+        let (ta, tr, vr, rh, met, clo, wme) = (c.ta, c.tr, c.vr, c.rh, c.met, c.clo, c.wme);
         let pa = rh * 10.0 * (16.6536 - 4030.183 / (ta + 235.0)).exp();
         let icl = 0.155 * clo;
         let m = met * 58.15;
@@ -319,11 +555,8 @@ impl Fanger {
         let p1 = icl * fcl;
         let p2 = p1 * 3.96;
         Ok(Self {
+            checked: c,
             ta,
-            tr,
-            vr,
-            met,
-            clo,
             pa,
             m,
             mw,
@@ -352,18 +585,7 @@ impl Fanger {
         let hl6 = fcl * hc * (tcl - ta);
         let ts = 0.303 * (-0.036 * m).exp() + 0.028;
         let pmv = ts * (mw - hl1 - hl2 - hl3 - hl4 - hl5 - hl6);
-        let within = (10.0..=30.0).contains(&ta)
-            && (10.0..=40.0).contains(&self.tr)
-            && (0.0..=1.0).contains(&self.vr)
-            && (0.8..=4.0).contains(&self.met)
-            && (0.0..=2.0).contains(&self.clo)
-            && (0.0..=2700.0).contains(&pa)
-            && (-2.0..=2.0).contains(&pmv);
-        Pmv {
-            pmv,
-            ppd_pct: ppd_from_pmv(pmv),
-            within_iso_ranges: within,
-        }
+        self.checked.judge(pmv, ppd_from_pmv(pmv), pa)
     }
 }
 

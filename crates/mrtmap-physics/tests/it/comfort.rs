@@ -128,7 +128,7 @@ fn radiant_asymmetry_curves() {
     assert!(radiant_asymmetry_ppd(AsymmetryKind::CoolWall, -1.0).is_err());
 }
 
-/// The interleaved batch gives each input's own answer, errors included, in order.
+/// The vectorised batch gives each input's own answer, errors included, in order.
 #[test]
 fn pmv_many_equals_one_at_a_time() {
     let mut inputs = Vec::new();
@@ -153,8 +153,61 @@ fn pmv_many_equals_one_at_a_time() {
         let many = pmv_ppd_many(&inputs, edition);
         assert_eq!(many.len(), inputs.len());
         for (i, m) in inputs.iter().zip(&many) {
-            assert_eq!(m, &pmv_ppd_edition(i, edition));
+            match (m, &pmv_ppd_edition(i, edition)) {
+                (Ok(m), Ok(one)) => {
+                    // Polynomial exponentials and a reciprocal: the last bits may differ.
+                    assert!((m.pmv - one.pmv).abs() <= 1e-12, "{m:?} vs {one:?}");
+                    assert!((m.ppd_pct - one.ppd_pct).abs() <= 1e-10, "{m:?} vs {one:?}");
+                    assert_eq!(m.within_iso_ranges, one.within_iso_ranges);
+                }
+                (m, one) => assert_eq!(m, one),
+            }
         }
         assert_eq!(many.iter().filter(|r| r.is_err()).count(), 6);
     }
+}
+
+/// Over the whole range the formulas accept (not only ISO 7730's), in blocks that mix natural
+/// and forced convection, converged and not: the batch equals one at a time to the last bits.
+#[test]
+fn pmv_many_equals_one_at_a_time_over_all_accepted_inputs() {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7730);
+    let inputs: Vec<PmvInputs> = (0..20_000)
+        .map(|k| PmvInputs {
+            air: c(rng.random_range(-50.0..=100.0)),
+            mrt: c(rng.random_range(-50.0..=150.0)),
+            // Still air in a quarter of them: natural convection throughout.
+            relative_air_speed_m_s: if k % 4 == 0 {
+                0.0
+            } else {
+                rng.random_range(0.0..=10.0)
+            },
+            relative_humidity_pct: rng.random_range(0.0..=100.0),
+            met: rng.random_range(0.1..=10.0),
+            clo: rng.random_range(0.0..=5.0),
+            external_work_met: rng.random_range(0.0..=2.0),
+        })
+        .collect();
+    let many = pmv_ppd_many(&inputs, Iso7730Edition::Y2025);
+    let mut answered = 0;
+    for (i, m) in inputs.iter().zip(&many) {
+        match (m, &pmv_ppd_edition(i, Iso7730Edition::Y2025)) {
+            (Ok(m), Ok(one)) => {
+                let scale = one.pmv.abs().max(1.0);
+                assert!(
+                    (m.pmv - one.pmv).abs() <= 1e-12 * scale,
+                    "{i:?}: {m:?} vs {one:?}"
+                );
+                assert!(
+                    (m.ppd_pct - one.ppd_pct).abs() <= 1e-10,
+                    "{i:?}: {m:?} vs {one:?}"
+                );
+                assert_eq!(m.within_iso_ranges, one.within_iso_ranges, "{i:?}");
+                answered += 1;
+            }
+            (m, one) => assert_eq!(m, one, "{i:?}"),
+        }
+    }
+    assert!(answered > 15_000, "only {answered} of 20000 answered");
 }
