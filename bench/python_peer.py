@@ -11,7 +11,7 @@
    beside `mrtmap map --grid 100x100` (wall time of the process, which also draws the PNG and SVG)
    and beside the map's own compute time the CLI reports; and `scene.mrt` at the same 10,000
    points. Exact view factors (medians of 15; about 40 ms each, so noisy) and Monte Carlo with
-   4,000 rays per node (medians of 3; seconds each).
+   4,000 rays per node (medians of 5; seconds each). Python's and the CLI's runs alternate.
 Prints one JSON object.
 """
 import json
@@ -77,23 +77,25 @@ def grid(bin_path, runs, **mrt):
     import mrtmap
 
     scene = mrtmap.Scene.example()
-    t_py, m = median_time(lambda: scene.map(height=1.1, grid=(100, 100), **mrt), runs)
+    flags = [a for k, v in mrt.items() for a in (f"--{k}", str(v))]
+    # Python's map and the CLI's alternated, so that the machine's slow and fast moments fall on
+    # both alike; the CLI's own compute time (summary.json) beside its process's wall time.
+    py, walls, computes = [], [], []
+    with tempfile.TemporaryDirectory() as d:
+        for _ in range(runs):
+            t0 = time.perf_counter()
+            m = scene.map(height=1.1, grid=(100, 100), **mrt)
+            t1 = time.perf_counter()
+            subprocess.run([bin_path, "map", "--grid", "100x100", "--out", d, *flags], check=True,
+                           capture_output=True)
+            walls.append(time.perf_counter() - t1)
+            py.append(t1 - t0)
+            summary = json.load(open(f"{d}/summary.json"))
+            computes.append(summary["compute_secs"])
+    t_py, t_cli, cli_compute = (statistics.median(x) for x in (py, walls, computes))
     ok = np.isfinite(m.mrt)
     pts = m.xyz[ok]
     t_pts, r = median_time(lambda: scene.mrt(pts, **mrt), runs)
-    flags = [a for k, v in mrt.items() for a in (f"--{k}", str(v))]
-    with tempfile.TemporaryDirectory() as d:
-        computes = []
-
-        def cli():
-            subprocess.run([bin_path, "map", "--grid", "100x100", "--out", d, *flags], check=True,
-                           capture_output=True)
-            s = json.load(open(f"{d}/summary.json"))
-            computes.append(s["compute_secs"])
-            return s
-
-        t_cli, summary = median_time(cli, runs)
-    cli_compute = statistics.median(computes)
     return {
         "settings": mrt or "exact (the example's auto)",
         "nodes": int(ok.sum()),
@@ -113,5 +115,5 @@ if __name__ == "__main__":
     print(json.dumps({
         "pmv_ppd_777x444": comfort(),
         "mrt_100x100_exact": grid(sys.argv[1], 15),
-        "mrt_100x100_montecarlo": grid(sys.argv[1], 3, method="montecarlo", rays=4000),
+        "mrt_100x100_montecarlo": grid(sys.argv[1], 5, method="montecarlo", rays=4000),
     }, indent=1))

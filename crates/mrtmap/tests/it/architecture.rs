@@ -85,3 +85,70 @@ fn the_crate_table_lists_every_crate_and_what_it_uses() {
     );
     assert!(crates.len() >= 12, "{crates:?}");
 }
+
+/// The paths in a "file" cell of the method's table (backticked names with a file extension or a
+/// trailing slash; function names are left out).
+fn paths_in(cell: &str) -> Vec<String> {
+    cell.split('`')
+        .skip(1)
+        .step_by(2)
+        .filter(|w| w.ends_with('/') || [".rs", ".js", ".py"].iter().any(|e| w.ends_with(e)))
+        .map(str::to_string)
+        .collect()
+}
+
+/// Every file that "Where each step of the method lives" names exists, so that a reader who
+/// follows it lands on the code. A full path starts with a crate (under `crates/`) or `python/`;
+/// a shorter one (`board.rs`, `rtabmap/convert.rs`) is beside, or under a folder above, a full
+/// path of the same cell, up to that crate.
+#[test]
+fn the_method_table_names_files_that_exist() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let doc = std::fs::read_to_string(root.join("ARCHITECTURE.md")).unwrap();
+    let section = doc
+        .split("## Where each step of the method lives")
+        .nth(1)
+        .and_then(|s| s.split("\n## ").next())
+        .expect("ARCHITECTURE.md has a section \"Where each step of the method lives\"");
+    let mut checked = 0;
+    for line in section.lines().filter(|l| l.starts_with('|')) {
+        let cells: Vec<&str> = line.split(" | ").collect();
+        let Some(cell) = cells.last().filter(|_| cells.len() >= 2) else {
+            continue;
+        };
+        let paths = paths_in(cell);
+        let full: Vec<std::path::PathBuf> = paths
+            .iter()
+            .filter_map(|p| {
+                if p.starts_with("mrtmap-") {
+                    Some(root.join("crates").join(p))
+                } else if p.starts_with("python/") {
+                    Some(root.join(p))
+                } else {
+                    None
+                }
+            })
+            .collect();
+        for p in &paths {
+            let found = if p.starts_with("mrtmap-") || p.starts_with("python/") {
+                full.iter()
+                    .any(|f| f.ends_with(p.trim_end_matches('/')) && f.exists())
+            } else {
+                // Beside a full path of the cell, or under one of its folders up to the crate.
+                full.iter().any(|f| {
+                    f.ancestors()
+                        .skip(1)
+                        .take_while(|a| *a != root.join("crates") && *a != root)
+                        .any(|a| a.join(p).exists())
+                })
+            };
+            assert!(
+                found,
+                "ARCHITECTURE.md's method table names {p} in \"{}\", which is not there",
+                cells[0].trim_start_matches("| ")
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked >= 40, "only {checked} paths in the method table");
+}
