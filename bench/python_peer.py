@@ -80,7 +80,7 @@ def grid(bin_path, runs, **mrt):
     flags = [a for k, v in mrt.items() for a in (f"--{k}", str(v))]
     # Python's map and the CLI's alternated, so that the machine's slow and fast moments fall on
     # both alike; the CLI's own compute time (summary.json) beside its process's wall time.
-    py, walls, computes = [], [], []
+    py, py_computes, walls, computes = [], [], [], []
     with tempfile.TemporaryDirectory() as d:
         for _ in range(runs):
             t0 = time.perf_counter()
@@ -90,9 +90,11 @@ def grid(bin_path, runs, **mrt):
                            capture_output=True)
             walls.append(time.perf_counter() - t1)
             py.append(t1 - t0)
+            py_computes.append(m.compute_secs)
             summary = json.load(open(f"{d}/summary.json"))
             computes.append(summary["compute_secs"])
-    t_py, t_cli, cli_compute = (statistics.median(x) for x in (py, walls, computes))
+    t_py, py_compute, t_cli, cli_compute = (
+        statistics.median(x) for x in (py, py_computes, walls, computes))
     ok = np.isfinite(m.mrt)
     pts = m.xyz[ok]
     t_pts, r = median_time(lambda: scene.mrt(pts, **mrt), runs)
@@ -100,11 +102,13 @@ def grid(bin_path, runs, **mrt):
         "settings": mrt or "exact (the example's auto)",
         "nodes": int(ok.sum()),
         "python_map_s": round(t_py, 4),
+        "python_map_compute_s": round(py_compute, 4),
         "python_points_s": round(t_pts, 4),
         "cli_map_wall_s": round(t_cli, 4),
         "cli_map_compute_s": round(cli_compute, 4),
         "python_map_over_cli_wall": round(t_py / t_cli, 3),
         "python_map_over_cli_compute": round(t_py / cli_compute, 3),
+        "computes_ratio": round(py_compute / cli_compute, 3),
         "same_mean_c": abs(float(np.nanmean(m.mrt)) - summary["mean_c"]) < 1e-9,
         "points_equal_map": bool(np.allclose(r.mrt, m.mrt[ok], atol=1e-9, rtol=0))
         if not mrt else "streams differ (point k vs node j·nx+i)",
