@@ -252,7 +252,7 @@ impl Block {
             }
         }
         let [ta, tr, vr, rh, met, clo, wme, empty] =
-            columns.map(|c| each(|g| V::new([c[W * g], c[W * g + 1]])));
+            columns.map(|c| each(|g| V::new(std::array::from_fn(|l| c[W * g + l]))));
         let s = V::splat;
         let pa = each(|g| rh[g] * s(10.0) * (s(16.6536) - s(4030.183) / (ta[g] + s(235.0))).exp());
         let icl = each(|g| s(0.155) * clo[g]);
@@ -440,6 +440,17 @@ struct Checked {
     filler: bool,
 }
 
+/// What the formulas accept, in the order inputs are checked (names for the messages).
+const INPUT_RANGES: [(&str, f64, f64); 7] = [
+    ("air temperature (°C)", -50.0, 100.0),
+    ("mean radiant temperature (°C)", -50.0, 150.0),
+    ("metabolic rate (met)", 0.1, 10.0),
+    ("relative air speed (m/s)", 0.0, 10.0),
+    ("relative humidity (%)", 0.0, 100.0),
+    ("clothing (clo)", 0.0, 5.0),
+    ("external work (met)", 0.0, 10.0),
+];
+
 impl Checked {
     /// Ordinary indoor values for a block's empty lanes.
     const FILLER: Self = Self {
@@ -464,54 +475,16 @@ impl Checked {
             wme: inp.external_work_met,
             filler: false,
         };
-        // All within range (NaN is not), else the first one outside, named.
-        let within = (-50.0..=100.0).contains(&c.ta)
-            && (-50.0..=150.0).contains(&c.tr)
-            && (0.1..=10.0).contains(&c.met)
-            && (0.0..=10.0).contains(&c.vr)
-            && (0.0..=100.0).contains(&c.rh)
-            && (0.0..=5.0).contains(&c.clo)
-            && (0.0..=10.0).contains(&c.wme);
-        if within { Ok(c) } else { Self::refused(inp) }
-    }
-
-    /// The message for the first input outside its range.
-    #[cold]
-    fn refused(inp: &PmvInputs) -> Result<Self, PhysicsError> {
-        let ta = in_range("air temperature (°C)", inp.air.celsius(), -50.0, 100.0)?;
-        let tr = in_range(
-            "mean radiant temperature (°C)",
-            inp.mrt.celsius(),
-            -50.0,
-            150.0,
-        )?;
-        // The metabolic rate first: the relative air speed is derived from it (v + 0.3 (met − 1)),
-        // and `--met 50` should be refused as a metabolic rate.
-        let met = in_range("metabolic rate (met)", inp.met, 0.1, 10.0)?;
-        let vr = in_range(
-            "relative air speed (m/s)",
-            inp.relative_air_speed_m_s,
-            0.0,
-            10.0,
-        )?;
-        let rh = in_range(
-            "relative humidity (%)",
-            inp.relative_humidity_pct,
-            0.0,
-            100.0,
-        )?;
-        let clo = in_range("clothing (clo)", inp.clo, 0.0, 5.0)?;
-        let wme = in_range("external work (met)", inp.external_work_met, 0.0, 10.0)?;
-        Ok(Self {
-            ta,
-            tr,
-            vr,
-            rh,
-            met,
-            clo,
-            wme,
-            filler: false,
-        })
+        // The metabolic rate before the air speed: the relative air speed is derived from it
+        // (v + 0.3 (met − 1)), and `--met 50` should be refused as a metabolic rate.
+        let values = [c.ta, c.tr, c.met, c.vr, c.rh, c.clo, c.wme];
+        for ((name, min, max), value) in INPUT_RANGES.into_iter().zip(values) {
+            // NaN is outside every range; the message says which input and how.
+            if !(min..=max).contains(&value) {
+                in_range(name, value, min, max)?;
+            }
+        }
+        Ok(c)
     }
 
     /// The answer, with whether the inputs, the vapour pressure `pa` (Pa) and the PMV lie in

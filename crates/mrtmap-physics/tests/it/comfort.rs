@@ -211,3 +211,47 @@ fn pmv_many_equals_one_at_a_time_over_all_accepted_inputs() {
     }
     assert!(answered > 15_000, "only {answered} of 20000 answered");
 }
+
+/// An input outside what the formulas accept is refused by name, the metabolic rate before the
+/// air speed derived from it, NaN as not a number, and the batch says the same as one at a time.
+#[test]
+fn pmv_refusals_name_the_input() {
+    let ok = PmvInputs {
+        air: c(22.0),
+        mrt: c(22.0),
+        relative_air_speed_m_s: 0.1,
+        relative_humidity_pct: 50.0,
+        met: 1.2,
+        clo: 0.5,
+        external_work_met: 0.0,
+    };
+    let cases = [
+        (
+            PmvInputs {
+                met: 50.0,
+                relative_air_speed_m_s: 14.8,
+                ..ok
+            },
+            "metabolic rate (met) = 50 is outside",
+        ),
+        (
+            PmvInputs {
+                relative_humidity_pct: f64::NAN,
+                ..ok
+            },
+            "relative humidity (%) is not a finite number",
+        ),
+        (
+            PmvInputs { clo: 6.0, ..ok },
+            "clothing (clo) = 6 is outside",
+        ),
+    ];
+    let inputs: Vec<PmvInputs> = cases.iter().map(|(i, _)| *i).collect();
+    let many = pmv_ppd_many(&inputs, Iso7730Edition::Y2025);
+    for ((inp, want), batch) in cases.iter().zip(many) {
+        let one = pmv_ppd(inp).unwrap_err().to_string();
+        assert!(one.starts_with(want), "{one}");
+        assert_eq!(batch.unwrap_err().to_string(), one);
+    }
+    assert!(pmv_ppd(&ok).is_ok());
+}
