@@ -36,7 +36,8 @@ pub struct RasterFile {
     /// Radiant temperature of each texel (°C), row after row (index = row · cols + col); `null`
     /// for a texel off the surface.
     pub temperature_c: Vec<Option<f64>>,
-    /// Texels not observed, whose temperature was filled from their neighbours (indices).
+    /// Texels not observed, whose temperature was filled in from the texels seen around them
+    /// (indices).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub filled: Vec<usize>,
     /// Patches of texels the scan never saw, each with the temperatures its seen surroundings

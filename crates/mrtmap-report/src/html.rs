@@ -523,7 +523,7 @@ pub fn render_html(d: &ReportData) -> String {
         o.push_str(
             "<h3>What the scan saw of each surface</h3><p><small>Each surface's 15 cm texels as seen \
              facing it (walls upright): <span style=\"color:#5a8f3a\">■</span> seen, \
-             <span style=\"color:#999\">■</span> filled from its neighbours (next to a feature or an \
+             <span style=\"color:#999\">■</span> filled in from the texels seen around it (next to a feature or an \
              edge, where blur is left out, or behind furniture), <span style=\"color:#d62728\">■</span> never seen (an \
              unseen patch: part of every MRT's ±).</small></p><div class=\"coverage\">",
         );

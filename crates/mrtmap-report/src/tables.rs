@@ -133,7 +133,7 @@ pub fn unseen_line(u: &UnseenImpact) -> String {
 }
 
 /// A surface's raster as a small inline SVG of what the scan saw: seen texels green, texels
-/// filled from their neighbours grey, texels of unseen patches red; row 0 at the bottom (a wall's
+/// filled in grey, texels of unseen patches red; row 0 at the bottom (a wall's
 /// floor edge). At most 240 × 160 px.
 pub fn coverage_svg(r: &RasterFile) -> String {
     let (cols, rows) = (r.cols.max(1), r.rows.max(1));

@@ -229,6 +229,9 @@ pub struct Timing {
     pub merge: f64,
     /// Building the output cloud (wall).
     pub output: f64,
+    /// The first pass over the scan's first frames that estimates the vignetting (wall).
+    #[serde(default)]
+    pub vignetting_warm_up: f64,
     /// Whole run (wall).
     pub total: f64,
 }
@@ -422,7 +425,81 @@ struct Fuser<'a> {
     calibrator: Calibrator,
 }
 
-impl Fuser<'_> {
+/// A first pass for the vignetting fuses at most this share of the scan's chunks (one in …).
+const WARM_UP_SHARE: usize = 4;
+
+/// … and stops once its frames estimate the vignetting with this many times the spread in ρ the
+/// estimate needs.
+const WARM_UP_SPREAD: f64 = 4.0;
+
+impl<'a> Fuser<'a> {
+    /// A fuser with an empty map.
+    fn new(
+        rec: &'a Recording,
+        params: &'a FuseParams,
+        limits: InterpolationLimits,
+        report: FusionReport,
+        calibrator: Calibrator,
+    ) -> Self {
+        Fuser {
+            rec,
+            params,
+            limits,
+            report,
+            map: VoxelMap::new(params.voxel_m),
+            target: None,
+            since_rebuild: 0,
+            correction: Isometry3::identity(),
+            steps: Steps::default(),
+            fit_sum: 0.0,
+            rmse_sum: 0.0,
+            iterations_sum: 0,
+            poses: Vec::new(),
+            frames: Vec::new(),
+            anchor: Vec::new(),
+            timing: Timing::default(),
+            done: 0,
+            calibrator,
+        }
+    }
+
+    /// Fuses `chunks` in order, until `enough` says so after a chunk; the next chunk is read
+    /// while the current one is registered, observed and merged (ICP and merging are partly
+    /// sequential, reading is not). Returns the chunks fused.
+    fn run(
+        &mut self,
+        rays: &RayTable,
+        chunks: &[&[(usize, usize)]],
+        total: u64,
+        progress: &(dyn Fn(u64, u64) + Sync),
+        enough: &(dyn Fn(&Self) -> bool + Sync),
+    ) -> usize {
+        let (rec, params) = (self.rec, self.params);
+        let mut next = chunks.first().map(|c| prepare(rec, rays, params, c));
+        for i in 0..chunks.len() {
+            let Some((prepared, cpu)) = next.take() else {
+                return i;
+            };
+            self.timing.read_cpu += cpu;
+            let (following, stop) = rayon::join(
+                || chunks.get(i + 1).map(|c| prepare(rec, rays, params, c)),
+                || {
+                    let ready = self.posed(prepared);
+                    let work = self.register(ready);
+                    let results = self.observe(&work);
+                    self.record_frames(&work, &results);
+                    self.merge(results, total, progress);
+                    enough(self)
+                },
+            );
+            if stop {
+                return i + 1;
+            }
+            next = following;
+        }
+        chunks.len()
+    }
+
     /// Counts a frame skipped for `r`.
     fn skip(&mut self, r: SkipReason) {
         *self
@@ -877,59 +954,46 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
     };
     report.icp.enabled = params.icp.enabled;
     let clock_s = t_start.elapsed().as_secs_f64();
-    let mut fuser = Fuser {
-        rec,
-        params,
-        limits,
-        report,
-        map: VoxelMap::new(params.voxel_m),
-        target: None,
-        since_rebuild: 0,
-        correction: Isometry3::identity(),
-        steps: Steps::default(),
-        fit_sum: 0.0,
-        rmse_sum: 0.0,
-        iterations_sum: 0,
-        poses: Vec::new(),
-        frames: Vec::new(),
-        anchor: Vec::new(),
-        timing: Timing {
-            clock: clock_s,
-            ..Timing::default()
-        },
-        done: 0,
-        calibrator: Calibrator::default(),
-    };
     let mut usable: Vec<(usize, usize)> = Vec::new();
+    let mut dropped: Vec<SkipReason> = Vec::new();
     for p in &pairs {
         match p.depth {
             Ok(d) => usable.push((p.thermal, d)),
-            Err(r) => fuser.drop_frame(r),
+            Err(r) => dropped.push(r),
         }
     }
     let total = rec.thermal.len() as u64;
-    // The next chunk is read while the current one is registered, observed and merged (ICP and
-    // merging are partly sequential, reading is not).
     let rays = RayTable::new(&rec.rig.depth);
     let chunks: Vec<&[(usize, usize)]> = usable.chunks(params.chunk.max(1)).collect();
-    let mut next = chunks.first().map(|c| prepare(rec, &rays, params, c));
-    for i in 0..chunks.len() {
-        let Some((prepared, cpu)) = next.take() else {
-            break;
-        };
-        fuser.timing.read_cpu += cpu;
-        let (following, ()) = rayon::join(
-            || chunks.get(i + 1).map(|c| prepare(rec, &rays, params, c)),
-            || {
-                let ready = fuser.posed(prepared);
-                let work = fuser.register(ready);
-                let results = fuser.observe(&work);
-                fuser.record_frames(&work, &results);
-                fuser.merge(results, total, progress);
-            },
-        );
-        next = following;
+    // The vignetting is the camera's, the same in every frame, but self-calibration estimates it
+    // from frames compared with the map fused before them: the first frames would be fused
+    // without it, and what only they saw would keep it (on 30 s walks of the panel room a patch
+    // of wall seen in three of the first frames, near the image's corner, read 0.33 K cold and
+    // became a feature). A first pass over the first frames estimates it, and the fusion then
+    // applies it from the first frame on.
+    let t_warm = Instant::now();
+    let calibrator = if params.radiometric.enabled && params.radiometric.warm_up {
+        let mut warm = Fuser::new(rec, params, limits, report.clone(), Calibrator::default());
+        let most = chunks.len().div_ceil(WARM_UP_SHARE);
+        let done = warm.run(&rays, &chunks[..most], total, &|_, _| {}, &|f| {
+            f.calibrator.vignetting_ready(WARM_UP_SPREAD)
+        });
+        if warm.calibrator.vignetting_ready(1.0) && done < chunks.len() {
+            let frames = chunks[..done].iter().map(|c| c.len()).sum();
+            Calibrator::with_prior(warm.calibrator.vignetting(), frames)
+        } else {
+            Calibrator::default()
+        }
+    } else {
+        Calibrator::default()
+    };
+    let mut fuser = Fuser::new(rec, params, limits, report, calibrator);
+    fuser.timing.clock = clock_s;
+    fuser.timing.vignetting_warm_up = t_warm.elapsed().as_secs_f64();
+    for r in dropped {
+        fuser.drop_frame(r);
     }
+    fuser.run(&rays, &chunks, total, progress, &|_| false);
     fuser.finish(t_start)
 }
 

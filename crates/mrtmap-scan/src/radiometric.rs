@@ -27,6 +27,9 @@ pub struct SelfCalibration {
     pub max_map_spread_k: f64,
     /// Residuals farther than this from the frame's median are left out (K).
     pub outlier_k: f64,
+    /// Whether a first pass over the scan's first frames estimates the vignetting, so that it
+    /// applies from the first frame on (else those frames are fused without it).
+    pub warm_up: bool,
 }
 
 impl Default for SelfCalibration {
@@ -37,6 +40,7 @@ impl Default for SelfCalibration {
             min_map_observations: 4,
             max_map_spread_k: 0.4,
             outlier_k: 1.0,
+            warm_up: true,
         }
     }
 }
@@ -108,13 +112,22 @@ pub struct RadiometricReport {
     pub residual_rms_after_k: f64,
     /// Largest and smallest offset removed (K).
     pub offset_range_k: [f64; 2],
+    /// Frames a first pass took to estimate the vignetting, which then applied from the first
+    /// frame on (0: none was needed or possible).
+    #[serde(default)]
+    pub vignetting_warm_up_frames: usize,
 }
+
+/// The spread in ρ (Σ (ρ − ρ̄)² over the frames' samples) the vignetting needs before it is used.
+const VIGNETTING_MIN_SXX: f64 = 50.0;
 
 /// The running state: the vignetting estimate and the last offset.
 #[derive(Clone, Debug, Default)]
 pub struct Calibrator {
     sxy: f64,
     sxx: f64,
+    /// The vignetting in force until the frames' own estimate is ready: a first pass's (K).
+    prior_vignetting: f64,
     last_offset: f64,
     sum_sq_before: f64,
     sum_sq_after: f64,
@@ -123,12 +136,30 @@ pub struct Calibrator {
 }
 
 impl Calibrator {
-    /// The vignetting in force (K at the corners); none until enough spread in ρ was seen.
+    /// A calibrator whose vignetting is `prior_k` until the frames' own estimate is ready (a
+    /// first pass's estimate over the scan's first frames, `warm_up_frames` of them).
+    pub fn with_prior(prior_k: f64, warm_up_frames: usize) -> Self {
+        let mut c = Self {
+            prior_vignetting: prior_k,
+            ..Self::default()
+        };
+        c.report.vignetting_warm_up_frames = warm_up_frames;
+        c
+    }
+
+    /// Whether the frames recorded so far estimate the vignetting (`spread` times the spread in ρ
+    /// it needs).
+    pub fn vignetting_ready(&self, spread: f64) -> bool {
+        self.sxx > spread * VIGNETTING_MIN_SXX
+    }
+
+    /// The vignetting in force (K at the corners): the frames' own estimate once enough spread
+    /// in ρ was seen, else the prior (none without one).
     pub fn vignetting(&self) -> f64 {
-        if self.sxx > 50.0 {
+        if self.vignetting_ready(1.0) {
             self.sxy / self.sxx
         } else {
-            0.0
+            self.prior_vignetting
         }
     }
 
@@ -156,13 +187,10 @@ impl Calibrator {
 
     /// The report.
     pub fn finish(mut self, enabled: bool) -> RadiometricReport {
+        let vignetting = self.vignetting();
         let r = &mut self.report;
         r.enabled = enabled;
-        r.vignetting_k = if self.sxx > 50.0 {
-            self.sxy / self.sxx
-        } else {
-            0.0
-        };
+        r.vignetting_k = vignetting;
         let n = self.n_resid.max(1) as f64;
         r.residual_rms_before_k = (self.sum_sq_before / n).sqrt();
         r.residual_rms_after_k = (self.sum_sq_after / n).sqrt();
