@@ -360,6 +360,28 @@ fn components(g: &Grid, mask: &[bool]) -> Vec<Vec<usize>> {
     out
 }
 
+/// Why region `comp` (of `area` m²) is the next surface's temperature blurred in at the corner
+/// (optics, registration, voxels) and not a feature of this one: it lies mostly within
+/// [`EDGE_STRIP_M`] of the surface's edge (`near_edge`), or is faint and lies mostly within
+/// [`EDGE_BLUR_M`] (`near_edge_wide`); `None` when it is not.
+fn edge_blur(
+    comp: &[usize],
+    area: f64,
+    resid: &dyn Fn(usize) -> f64,
+    (near_edge, near_edge_wide): (&[bool], &[bool]),
+) -> Option<String> {
+    let strip = comp.iter().filter(|&&c| near_edge[c]).count();
+    let wide = comp.iter().filter(|&&c| near_edge_wide[c]).count();
+    let contrast = comp.iter().map(|&c| resid(c)).sum::<f64>() / comp.len() as f64;
+    (strip * 5 >= comp.len() * 4
+        || (wide * 5 >= comp.len() * 4 && contrast.abs() < EDGE_BLUR_MAX_K))
+        .then(|| {
+            format!(
+                "a {area:.2} m² strip along the surface's edge ({contrast:+.1} K): the next surface's temperature blurred in"
+            )
+        })
+}
+
 /// Hysteresis: the region grown or shrunk to the texels beyond half its core contrast, connected
 /// to its texels that are; `None` when no texel of it was observed. It grows only into texels
 /// within [`GROWTH_CEILING`] times its core contrast (plus [`GROWTH_SLACK_K`]): a faint region
@@ -958,17 +980,8 @@ pub fn analyse_surface(
             if area < p.feature_min_area_m2 {
                 continue;
             }
-            // A strip along the surface's edge is the next surface's temperature blurred in at
-            // the corner (optics, registration, voxels), not a feature of this one.
-            let strip = comp.iter().filter(|&&c| near_edge[c]).count();
-            let wide = comp.iter().filter(|&&c| near_edge_wide[c]).count();
-            let contrast = comp.iter().map(|&c| resid(c)).sum::<f64>() / comp.len() as f64;
-            if strip * 5 >= comp.len() * 4
-                || (wide * 5 >= comp.len() * 4 && contrast.abs() < EDGE_BLUR_MAX_K)
-            {
-                out.dropped.push(format!(
-                    "a {area:.2} m² strip along the surface's edge ({contrast:+.1} K): the next surface's temperature blurred in"
-                ));
+            if let Some(why) = edge_blur(&comp, area, &resid, (&near_edge, &near_edge_wide)) {
+                out.dropped.push(why);
                 continue;
             }
             let (core, plateau) = half_contrast_core(&g, &comp, &resid, sign);
@@ -1159,49 +1172,7 @@ fn background_raster(
     // 20 s radiant-ceiling walk's 2.5 m² wall patch, filled from its lower edge, differed from
     // the gradient by enough to state 0.30 K at a node where the error was 0.15 K).
     let model = |r: usize| bg.a + bg.b * (g.lo.y + ((r / cols) as f64 + 0.5) * k as f64 * g.t);
-    let mut departure: Vec<Option<f64>> = value
-        .iter()
-        .enumerate()
-        .map(|(r, t)| t.map(|t| t - model(r)))
-        .collect();
-    let mut filled = Vec::new();
-    loop {
-        let mut next = departure.clone();
-        let mut changed = false;
-        for r in 0..cols * rows {
-            if !on_surface[r] || departure[r].is_some() {
-                continue;
-            }
-            let (col, row) = (r % cols, r / cols);
-            let (mut n, mut sum) = (0usize, 0.0);
-            for rr in row.saturating_sub(1)..(row + 2).min(rows) {
-                for cc in col.saturating_sub(1)..(col + 2).min(cols) {
-                    if let Some(d) = departure[rr * cols + cc] {
-                        n += 1;
-                        sum += d;
-                    }
-                }
-            }
-            if n > 0 {
-                next[r] = Some(sum / n as f64);
-                filled.push(r);
-                changed = true;
-            }
-        }
-        departure = next;
-        if !changed {
-            break;
-        }
-    }
-    for (r, t) in value.iter_mut().enumerate() {
-        if on_surface[r] && t.is_none() {
-            *t = Some(model(r) + departure[r].unwrap_or(0.0));
-            if departure[r].is_none() {
-                filled.push(r);
-            }
-        }
-    }
-    filled.sort_unstable();
+    let filled = fill_on_model(&mut value, &on_surface, (cols, rows), model);
     let reaches: Vec<Reach> = outlines.iter().map(|o| Reach::of(g, o, bg)).collect();
     let unseen = unseen_patches(
         g,
@@ -1326,6 +1297,126 @@ impl Reach {
     }
 }
 
+/// The 8-connected patch of `unseen` raster texels (`cols` × `rows`) holding `start`, marked in
+/// `done`, in index order.
+fn grow_patch(
+    start: usize,
+    unseen: &[bool],
+    done: &mut [bool],
+    (cols, rows): (usize, usize),
+) -> Vec<usize> {
+    let mut texels = vec![start];
+    done[start] = true;
+    let mut next = 0;
+    while next < texels.len() {
+        let r = texels[next];
+        next += 1;
+        let (col, row) = (r % cols, r / cols);
+        for rr in row.saturating_sub(1)..(row + 2).min(rows) {
+            for cc in col.saturating_sub(1)..(col + 2).min(cols) {
+                let q = rr * cols + cc;
+                if unseen[q] && !done[q] {
+                    done[q] = true;
+                    texels.push(q);
+                }
+            }
+        }
+    }
+    texels.sort_unstable();
+    texels
+}
+
+/// The analysis texels of raster texel `r` (`k` × `k` of them, `cols` raster texels per row).
+fn raster_cells(g: &Grid, k: usize, cols: usize, r: usize) -> impl Iterator<Item = usize> + '_ {
+    let (col, row) = (r % cols, r / cols);
+    (row * k..((row + 1) * k).min(g.ny))
+        .flat_map(move |j| (col * k..((col + 1) * k).min(g.nx)).map(move |i| j * g.nx + i))
+}
+
+/// Whether the scan never saw a raster texel of analysis texels `cells`: under a quarter of
+/// those on the surface observed, and mostly outside every feature's outline (`in_feature`).
+fn never_seen(g: &Grid, cells: impl Iterator<Item = usize>, in_feature: &[bool]) -> bool {
+    let (mut inside, mut seen, mut feature) = (0usize, 0usize, 0usize);
+    for c in cells.filter(|&c| g.inside[c]) {
+        inside += 1;
+        seen += usize::from(g.observed(c));
+        feature += usize::from(in_feature[c]);
+    }
+    inside > 0 && seen * 4 < inside && feature * 2 < inside
+}
+
+/// The box, in analysis texels `[i0, j0, i1, j1)`, of raster texels `texels` (`k` × `k` analysis
+/// texels each, `cols` per row), grown by `ring` analysis texels and clipped to the grid.
+fn patch_box(g: &Grid, texels: &[usize], k: usize, cols: usize, ring: usize) -> [usize; 4] {
+    let (mut i0, mut j0, mut i1, mut j1) = (usize::MAX, usize::MAX, 0, 0);
+    for &r in texels {
+        let (col, row) = (r % cols, r / cols);
+        i0 = i0.min(col * k);
+        j0 = j0.min(row * k);
+        i1 = i1.max(((col + 1) * k).min(g.nx));
+        j1 = j1.max(((row + 1) * k).min(g.ny));
+    }
+    [
+        i0.saturating_sub(ring),
+        j0.saturating_sub(ring),
+        (i1 + ring).min(g.nx),
+        (j1 + ring).min(g.ny),
+    ]
+}
+
+/// Fills the raster texels on the surface (`on_surface`, `cols` × `rows`) that have no value as
+/// `model` (the background model at a texel) plus the departure from it of their neighbours,
+/// spread in from the texels that have one; where nothing reaches, the model alone. Returns the
+/// texels filled.
+fn fill_on_model(
+    value: &mut [Option<f64>],
+    on_surface: &[bool],
+    (cols, rows): (usize, usize),
+    model: impl Fn(usize) -> f64,
+) -> Vec<usize> {
+    let mut departure: Vec<Option<f64>> = value
+        .iter()
+        .enumerate()
+        .map(|(r, t)| t.map(|t| t - model(r)))
+        .collect();
+    let mut filled = Vec::new();
+    loop {
+        let mut next = departure.clone();
+        let mut changed = false;
+        for r in (0..cols * rows).filter(|&r| on_surface[r] && departure[r].is_none()) {
+            let (col, row) = (r % cols, r / cols);
+            let (mut n, mut sum) = (0usize, 0.0);
+            for rr in row.saturating_sub(1)..(row + 2).min(rows) {
+                for cc in col.saturating_sub(1)..(col + 2).min(cols) {
+                    if let Some(d) = departure[rr * cols + cc] {
+                        n += 1;
+                        sum += d;
+                    }
+                }
+            }
+            if n > 0 {
+                next[r] = Some(sum / n as f64);
+                filled.push(r);
+                changed = true;
+            }
+        }
+        departure = next;
+        if !changed {
+            break;
+        }
+    }
+    for (r, t) in value.iter_mut().enumerate() {
+        if on_surface[r] && t.is_none() {
+            *t = Some(model(r) + departure[r].unwrap_or(0.0));
+            if departure[r].is_none() {
+                filled.push(r);
+            }
+        }
+    }
+    filled.sort_unstable();
+    filled
+}
+
 /// How far around an unseen patch the seen texels bound its temperature (m).
 const UNSEEN_SURROUNDINGS_M: f64 = 0.5;
 
@@ -1352,24 +1443,9 @@ fn unseen_patches(
     (cols, rows): (usize, usize),
     on_surface: &[bool],
 ) -> Vec<UnseenPatch> {
-    let cells_of = |r: usize| {
-        let (col, row) = (r % cols, r / cols);
-        (row * k..((row + 1) * k).min(g.ny))
-            .flat_map(move |j| (col * k..((col + 1) * k).min(g.nx)).map(move |i| j * g.nx + i))
-    };
+    let cells_of = |r: usize| raster_cells(g, k, cols, r);
     let unseen: Vec<bool> = (0..cols * rows)
-        .map(|r| {
-            if !on_surface[r] {
-                return false;
-            }
-            let (mut inside, mut seen, mut feature) = (0usize, 0usize, 0usize);
-            for c in cells_of(r).filter(|&c| g.inside[c]) {
-                inside += 1;
-                seen += usize::from(g.observed(c));
-                feature += usize::from(in_feature[c]);
-            }
-            inside > 0 && seen * 4 < inside && feature * 2 < inside
-        })
+        .map(|r| on_surface[r] && never_seen(g, cells_of(r), in_feature))
         .collect();
     // Temperatures seen are taken relative to the surface's background model (a wall's vertical
     // gradient), and the range is placed on the background over the patch: a patch on a
@@ -1392,35 +1468,8 @@ fn unseen_patches(
         if !unseen[start] || done[start] {
             continue;
         }
-        let mut texels = vec![start];
-        done[start] = true;
-        let mut next = 0;
-        while next < texels.len() {
-            let r = texels[next];
-            next += 1;
-            let (col, row) = (r % cols, r / cols);
-            for rr in row.saturating_sub(1)..(row + 2).min(rows) {
-                for cc in col.saturating_sub(1)..(col + 2).min(cols) {
-                    let q = rr * cols + cc;
-                    if unseen[q] && !done[q] {
-                        done[q] = true;
-                        texels.push(q);
-                    }
-                }
-            }
-        }
-        texels.sort_unstable();
-        // The patch's box in analysis texels, grown by the surroundings.
-        let (mut i0, mut j0, mut i1, mut j1) = (usize::MAX, usize::MAX, 0, 0);
-        for &r in &texels {
-            let (col, row) = (r % cols, r / cols);
-            i0 = i0.min(col * k);
-            j0 = j0.min(row * k);
-            i1 = i1.max(((col + 1) * k).min(g.nx));
-            j1 = j1.max(((row + 1) * k).min(g.ny));
-        }
-        let (i0, j0) = (i0.saturating_sub(ring), j0.saturating_sub(ring));
-        let (i1, j1) = ((i1 + ring).min(g.nx), (j1 + ring).min(g.ny));
+        let texels = grow_patch(start, &unseen, &mut done, (cols, rows));
+        let [i0, j0, i1, j1] = patch_box(g, &texels, k, cols, ring);
         // Does the patch touch a feature's outline (one within a raster texel of an unseen
         // cell of it: the patch's texels start where a raster texel is mostly unseen)?
         let reach = k + 1;
@@ -1463,13 +1512,8 @@ fn unseen_patches(
             std::collections::BTreeMap::new();
         for &r in &texels {
             let q = raster_centre(r);
-            let by: Vec<usize> = touching
-                .iter()
-                .enumerate()
-                .filter(|(_, f)| f.may_hold(&q, half_texel))
-                .map(|(i, _)| i)
-                .collect();
-            groups.entry(by).or_default().push(r);
+            let by = (0..touching.len()).filter(|&i| touching[i].may_hold(&q, half_texel));
+            groups.entry(by.collect()).or_default().push(r);
         }
         let around = |features: bool| {
             observed_range(
