@@ -49,6 +49,7 @@ fn measured(
     t_c: f64,
     std_k: Option<f64>,
     emissivity: f64,
+    surface: Option<(f64, f64)>,
 ) -> serde_json::Map<String, Value> {
     let mut m = serde_json::Map::new();
     m.insert("id".into(), json!(id));
@@ -58,7 +59,21 @@ fn measured(
         m.insert("temperature_std_k".into(), json!(s));
     }
     m.insert("emissivity".into(), json!(emissivity));
+    if let Some((t, s)) = surface {
+        m.insert("surface_temperature_c".into(), json!(round_c(t)));
+        m.insert("surface_temperature_std_k".into(), json!(s));
+    }
     m
+}
+
+/// The true surface temperature and its ± that a face or sub-face's `user_data` carries.
+fn surface_of(v: &Value) -> (Option<f64>, Option<f64>) {
+    let d = v.get("user_data").and_then(|u| u.get("mrtmap"));
+    let get = |k: &str| d.and_then(|d| d.get(k)).and_then(Value::as_f64);
+    (
+        get("surface_temperature_c"),
+        get("surface_temperature_std_k"),
+    )
 }
 
 /// How far inside its face's edge a sub-face is kept (m): Honeybee refuses an aperture or door
@@ -118,6 +133,7 @@ fn face_json(scene: &RadiantScene, s: &Surface, ids: &mut Identifiers) -> Value 
             f.temperature.celsius(),
             f.temperature_std_k,
             f.emissivity,
+            f.surface_temperature.map(|(t, s)| (t.celsius(), s)),
         );
         let (list, kind) = match opening(&f.label) {
             Some(Opening::Window) => (&mut apertures, "Aperture"),
@@ -144,6 +160,7 @@ fn face_json(scene: &RadiantScene, s: &Surface, ids: &mut Identifiers) -> Value 
         s.temperature.celsius(),
         s.temperature_std_k,
         s.emissivity,
+        s.surface_temperature.map(|(t, s)| (t.celsius(), s)),
     );
     m.insert("kind".into(), json!(s.kind.as_str()));
     if let Some(o) = s.observed_fraction {
@@ -183,7 +200,14 @@ fn shades_json(scene: &RadiantScene, ids: &mut Identifiers) -> Vec<Value> {
     let mut shades = Vec::new();
     for o in &scene.occluders {
         for (k, t) in o.triangles().iter().enumerate() {
-            let mut m = measured(&o.id, &o.label, o.temperature.celsius(), None, o.emissivity);
+            let mut m = measured(
+                &o.id,
+                &o.label,
+                o.temperature.celsius(),
+                None,
+                o.emissivity,
+                None,
+            );
             m.insert("furniture".into(), json!(o.id));
             if let OccluderShape::Box { min, max } = &o.shape {
                 m.insert(
@@ -220,6 +244,9 @@ pub fn write(scene: &RadiantScene, name: &str) -> String {
         "temperature_level_std_k".into(),
         json!(scene.temperature_level_std_k),
     );
+    if let Some(k) = scene.temperatures {
+        room_data.insert("temperatures".into(), json!(k));
+    }
     if let Some(w) = &scene.world_from_room {
         room_data.insert("frame".into(), json!("room"));
         room_data.insert("world_from_room".into(), json!(FramePose::from_isometry(w)));
@@ -570,6 +597,7 @@ fn read_face(
                 .and_then(Value::as_str)
                 .unwrap_or(label);
             if let Some((t, s, e)) = look.get(&sid, sub) {
+                let (st, ss) = surface_of(sub);
                 features.push(FeatureFile {
                     id: own_id(sub).unwrap_or(sid),
                     label: label.to_string(),
@@ -577,6 +605,8 @@ fn read_face(
                     temperature_c: t,
                     emissivity: e,
                     temperature_std_k: s,
+                    surface_temperature_c: st,
+                    surface_temperature_std_k: ss,
                 });
             }
         }
@@ -612,6 +642,8 @@ fn read_face(
         temperature_c: t,
         emissivity: e,
         temperature_std_k: s,
+        surface_temperature_c: surface_of(f).0,
+        surface_temperature_std_k: surface_of(f).1,
         observed_fraction: data
             .and_then(|d| d.get("observed_fraction"))
             .and_then(Value::as_f64),
@@ -813,6 +845,9 @@ pub fn read(
             temperature_level_std_k: rdata
                 .and_then(|d| d.get("temperature_level_std_k"))
                 .and_then(Value::as_f64),
+            temperatures: rdata
+                .and_then(|d| d.get("temperatures"))
+                .and_then(|w| serde_json::from_value(w.clone()).ok()),
             surfaces,
             occluders,
         },

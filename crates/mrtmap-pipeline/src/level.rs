@@ -23,15 +23,17 @@
 
 use std::path::Path;
 
+use mrtmap_geometry::nalgebra::Vector3;
 use mrtmap_geometry::nalgebra::{Isometry3, Point3};
 use mrtmap_io::{Recording, ThermalCloud};
 use mrtmap_physics::{Temperature, ZERO_CELSIUS_K};
 use mrtmap_radiation::RadiantScene;
+use mrtmap_radiation::grey;
 use mrtmap_scan::segment::Segmentation;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-use crate::settings::{PointFrame, Project};
+use crate::settings::{EmissivitySection, MrtSection, PointFrame, Project};
 
 /// A thermal camera's absolute accuracy when the rig does not state one (K): the Lepton 3.5's
 /// datasheet (high gain).
@@ -53,10 +55,18 @@ pub struct Reference {
     /// The frame of `xyz`: room (project.toml's default) or scan (references.csv's).
     #[serde(default)]
     pub frame: PointFrame,
+    /// The emissivity of the surface read; unset: the emissivity of the scene's surface or
+    /// feature under the point.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub emissivity: Option<f64>,
 }
 
 fn default_std() -> f64 {
     0.2
+}
+
+fn one() -> f64 {
+    1.0
 }
 
 /// Reads `references.csv`; errors name the file and line.
@@ -87,7 +97,7 @@ pub fn parse_references(text: &str, path: &Path) -> Result<Vec<Reference>> {
                     return Err(bad(
                         k + 1,
                         format!(
-                            "the header has no column '{need}' (needs label,x,y,z,temperature_c and optionally std_k and frame)"
+                            "the header has no column '{need}' (needs label,x,y,z,temperature_c and optionally std_k, frame and emissivity)"
                         ),
                     ));
                 }
@@ -122,12 +132,27 @@ pub fn parse_references(text: &str, path: &Path) -> Result<Vec<Reference>> {
                 ));
             }
         };
+        let emissivity = match col("emissivity") {
+            Some(s) if !s.is_empty() => Some(num("emissivity")?),
+            _ => None,
+        };
+        if let Some(e) = emissivity
+            && !(e > 0.0 && e <= 1.0)
+        {
+            return Err(bad(
+                k + 1,
+                format!(
+                    "emissivity {e} is outside 0 < ε ≤ 1 (leave the cell empty for the emissivity of the surface under the point)"
+                ),
+            ));
+        }
         out.push(Reference {
             label: col("label").map_or(String::new(), |s| s.to_string()),
             xyz: [num("x")?, num("y")?, num("z")?],
             temperature_c: num("temperature_c")?,
             std_k,
             frame,
+            emissivity,
         });
     }
     Ok(out)
@@ -138,11 +163,19 @@ pub fn parse_references(text: &str, path: &Path) -> Result<Vec<Reference>> {
 pub struct ReferenceUse {
     /// Label.
     pub label: String,
-    /// The reading (°C).
+    /// The reading (°C): the surface's true temperature.
     pub reference_c: f64,
+    /// The emissivity taken for the surface read.
+    #[serde(default = "one")]
+    pub emissivity: f64,
+    /// What the camera should read there (°C): the radiant temperature of a surface at the
+    /// reading with that emissivity, in the irradiance the scene gives that spot (the reading
+    /// itself where the emissivity is 1). The level is fitted to these.
+    #[serde(default)]
+    pub radiant_c: f64,
     /// The camera's (fused) temperature there (°C), when the scan saw the point.
     pub camera_c: Option<f64>,
-    /// Corrected camera temperature − reading (K), when used or judged.
+    /// Corrected camera temperature − what the camera should read (K), when used or judged.
     pub residual_k: Option<f64>,
     /// Whether the fit used it; else why not.
     pub used: bool,
@@ -236,15 +269,38 @@ fn fit(pts: &[(f64, f64, f64)], at_c: f64, gain: bool) -> (f64, f64, f64) {
     (alpha, beta, var.sqrt() / beta.abs())
 }
 
-/// A reading seen by the camera (true, camera, σ, index into the uses) for the fit.
+/// A reading seen by the camera (what the camera should read, camera, σ, index into the uses) for
+/// the fit.
 type Seen = (f64, f64, f64, usize);
+
+/// What the camera should read at a reading: the radiant temperature of the surface read (°C) and
+/// the emissivity taken for it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Expected {
+    /// The radiant temperature (°C).
+    pub radiant_c: f64,
+    /// The emissivity.
+    pub emissivity: f64,
+}
+
+impl Expected {
+    /// A black surface: the camera should read the reading itself.
+    pub fn black(r: &Reference) -> Self {
+        Self {
+            radiant_c: r.temperature_c,
+            emissivity: 1.0,
+        }
+    }
+}
 
 /// Each reading placed and compared with what the camera saw around it: its use (unseen, or
 /// farther from the camera than the camera can be off: its stated accuracy, at least 1 K since
 /// the fused temperature at a point carries blur and placement too, plus the reading's own 3σ)
-/// and, when usable, its point for the fit.
+/// and, when usable, its point for the fit. `expected` gives what the camera should read at each
+/// (a grey surface's radiant temperature).
 fn judge_readings(
     refs: &[Reference],
+    expected: &[Expected],
     cloud: &ThermalCloud,
     world_from_room: &Isometry3<f64>,
     camera_accuracy_k: f64,
@@ -252,7 +308,11 @@ fn judge_readings(
     let allowed = camera_accuracy_k.max(1.0);
     let mut uses: Vec<ReferenceUse> = Vec::new();
     let mut pts: Vec<Seen> = Vec::new();
-    for r in refs {
+    for (i, r) in refs.iter().enumerate() {
+        let ex = expected
+            .get(i)
+            .copied()
+            .unwrap_or_else(|| Expected::black(r));
         let p = match r.frame {
             PointFrame::Scan => Point3::from(r.xyz),
             PointFrame::Room => world_from_room * Point3::from(r.xyz),
@@ -261,7 +321,7 @@ fn judge_readings(
         // A reading farther from what the camera saw there than the camera can be off (its
         // stated accuracy, and the reading's own 3σ) is not a reading of that surface.
         let implausible = seen.and_then(|(c, _)| {
-            let off = (c - r.temperature_c).abs();
+            let off = (c - ex.radiant_c).abs();
             (off > allowed + 3.0 * r.std_k).then(|| {
                 format!(
                     "disagrees with what the camera saw there ({c:.1} °C) by {off:.1} K, more than the camera can be off ({allowed} K): left out; check the reading (a typo?) and its coordinates"
@@ -271,11 +331,13 @@ fn judge_readings(
         if let Some((c, se)) = seen
             && implausible.is_none()
         {
-            pts.push((r.temperature_c, c, r.std_k.hypot(se), uses.len()));
+            pts.push((ex.radiant_c, c, r.std_k.hypot(se), uses.len()));
         }
         uses.push(ReferenceUse {
             label: r.label.clone(),
             reference_c: r.temperature_c,
+            emissivity: ex.emissivity,
+            radiant_c: ex.radiant_c,
             camera_c: seen.map(|s| s.0),
             residual_k: None,
             used: seen.is_some() && implausible.is_none(),
@@ -290,14 +352,18 @@ fn judge_readings(
 
 /// The level from `refs` (in the scan's frame, or the room's through `world_from_room`) seen in
 /// `cloud`, for a scene whose mean temperature is `mean_c`; `camera_accuracy_k` when none is usable.
+/// `expected` is what the camera should read at each reading (empty: the readings themselves, as
+/// on black surfaces).
 pub fn find_level(
     refs: &[Reference],
+    expected: &[Expected],
     cloud: &ThermalCloud,
     world_from_room: &Isometry3<f64>,
     mean_c: f64,
     camera_accuracy_k: f64,
 ) -> Level {
-    let (mut uses, mut pts) = judge_readings(refs, cloud, world_from_room, camera_accuracy_k);
+    let (mut uses, mut pts) =
+        judge_readings(refs, expected, cloud, world_from_room, camera_accuracy_k);
     let span = |p: &[(f64, f64, f64, usize)]| {
         p.iter().map(|x| x.0).fold(f64::NEG_INFINITY, f64::max)
             - p.iter().map(|x| x.0).fold(f64::INFINITY, f64::min)
@@ -385,7 +451,7 @@ pub fn find_level(
     }
     for u in &mut uses {
         if let Some(c) = u.camera_c {
-            u.residual_k = Some((c - alpha) / beta - u.reference_c);
+            u.residual_k = Some((c - alpha) / beta - u.radiant_c);
         }
     }
     Level {
@@ -410,13 +476,19 @@ impl Level {
     }
 }
 
-/// What fixes the temperatures' absolute level: reference readings and the camera's accuracy.
+/// What fixes the temperatures' absolute level: reference readings and the camera's accuracy;
+/// and what turns the camera's radiant temperatures into surface temperatures: the emissivities
+/// and the engine that gives each surface's irradiance.
 #[derive(Clone, Debug, Default)]
 pub struct LevelInputs {
     /// Contact-thermometer readings (references.csv and `[[references]]`).
     pub references: Vec<Reference>,
     /// The camera's stated absolute accuracy (K), used when no reading is usable.
     pub camera_accuracy_k: f64,
+    /// The emissivities.
+    pub emissivity: EmissivitySection,
+    /// The view-factor settings the irradiances are computed with.
+    pub mrt: MrtSection,
 }
 
 impl LevelInputs {
@@ -435,6 +507,8 @@ impl LevelInputs {
                 .rig
                 .thermal_accuracy_k
                 .unwrap_or(DEFAULT_CAMERA_ACCURACY_K),
+            emissivity: p.emissivity.clone(),
+            mrt: p.mrt.clone(),
         })
     }
 }
@@ -465,6 +539,50 @@ fn apply_level(scene: &mut RadiantScene, level: &Level) {
         fix(&mut o.temperature);
     }
     scene.temperature_level_std_k = level.std_k;
+}
+
+/// Where a reading lies: on which element (its emissivity), the foot of the point on its plane
+/// and the plane's normal.
+struct Spot {
+    emissivity: f64,
+    foot: Point3<f64>,
+    normal: Vector3<f64>,
+}
+
+/// How far from a surface's plane a reading may lie and still be of it (m).
+const READING_PLANE_M: f64 = 0.10;
+
+/// The element under `p` (room frame): the nearest surface plane within 10 cm whose polygon holds
+/// the point's foot (within 5 cm), and the feature on it that holds the foot, if any.
+fn spot_at(scene: &RadiantScene, p: &Point3<f64>) -> Option<Spot> {
+    use mrtmap_geometry::polygon::{Containment, point_in_polygon};
+    let mut best: Option<(f64, Spot)> = None;
+    for s in &scene.surfaces {
+        let n = s.frame.normal.into_inner();
+        let d = (p - s.frame.origin).dot(&n);
+        if d.abs() > READING_PLANE_M || best.as_ref().is_some_and(|b| b.0 <= d.abs()) {
+            continue;
+        }
+        let foot = p - n * d;
+        let q = s.frame.to_2d(&foot);
+        if point_in_polygon(&q, &s.polygon_2d, 0.05) == Containment::Outside {
+            continue;
+        }
+        let emissivity = s
+            .features
+            .iter()
+            .find(|f| point_in_polygon(&q, &f.polygon_2d, 0.0) != Containment::Outside)
+            .map_or(s.emissivity, |f| f.emissivity);
+        best = Some((
+            d.abs(),
+            Spot {
+                emissivity,
+                foot,
+                normal: n,
+            },
+        ));
+    }
+    best.map(|b| b.1)
 }
 
 /// The area-weighted mean temperature of a scene's surfaces (°C).
@@ -504,14 +622,94 @@ pub fn level_segmentation(
         .extend_from_slice(&seg.textured.temperature_std_k);
     seen.observations
         .extend_from_slice(&seg.textured.observations);
-    let found = find_level(
+    // Grey surfaces: the camera reads radiant temperatures; a contact reading is a surface
+    // temperature, compared with what the camera should read there (its emissivity, and the
+    // irradiance the scene gives the spot, at the level being fitted: three rounds settle it,
+    // since a level error moves that prediction by only 1 − ε of itself).
+    level.emissivity.apply(&mut seg.scene);
+    let spots: Vec<Option<Spot>> = level
+        .references
+        .iter()
+        .map(|r| {
+            let p = match r.frame {
+                PointFrame::Room => Point3::from(r.xyz),
+                PointFrame::Scan => world_from_room.inverse() * Point3::from(r.xyz),
+            };
+            spot_at(&seg.scene, &p)
+        })
+        .collect();
+    let irradiance_cam: Vec<Option<Temperature>> = match level.mrt.engine(&seg.scene) {
+        Ok(engine) => spots
+            .iter()
+            .enumerate()
+            .map(|(k, s)| {
+                s.as_ref().and_then(|s| {
+                    grey::irradiance(&engine, &[s.foot], &s.normal, 7_000 + k as u64).map(|x| x.0)
+                })
+            })
+            .collect(),
+        Err(_) => vec![None; spots.len()],
+    };
+    let mean_c = mean_temperature_c(&seg.scene);
+    let mut found = find_level(
         &level.references,
+        &[],
         &seen,
         &world_from_room,
-        mean_temperature_c(&seg.scene),
+        mean_c,
         level.camera_accuracy_k,
     );
+    for _ in 0..3 {
+        let expected: Vec<Expected> = level
+            .references
+            .iter()
+            .zip(&spots)
+            .zip(&irradiance_cam)
+            .map(|((r, spot), irr)| {
+                let e = r
+                    .emissivity
+                    .or(spot.as_ref().map(|s| s.emissivity))
+                    .unwrap_or(1.0);
+                match irr {
+                    Some(t) if e < 1.0 => Expected {
+                        radiant_c: grey::radiant_temperature(
+                            Temperature::from_celsius(r.temperature_c),
+                            Temperature::from_celsius(found.correct(t.celsius())),
+                            e,
+                        )
+                        .celsius(),
+                        emissivity: e,
+                    },
+                    _ => Expected::black(r),
+                }
+            })
+            .collect();
+        found = find_level(
+            &level.references,
+            &expected,
+            &seen,
+            &world_from_room,
+            mean_c,
+            level.camera_accuracy_k,
+        );
+    }
     apply_level(&mut seg.scene, &found);
+    // The surfaces' true temperatures, from the irradiance at the level found.
+    let std = level.emissivity.std;
+    match grey::derive_surface_temperatures(
+        &mut seg.scene,
+        |s| level.mrt.engine(s),
+        std,
+    ) {
+        Ok(unexplained) if !unexplained.is_empty() => seg.report.warnings.push(format!(
+            "level: no surface temperature explains the radiant temperature of {} with the emissivity taken (colder than what it reflects): check its emissivity in [emissivity]",
+            unexplained.join(", ")
+        )),
+        Ok(_) => {}
+        Err(e) => seg.report.warnings.push(format!(
+            "level: surface temperatures not derived: {e}"
+        )),
+    }
     // segment.json's tables at the same level as scene.json (the report's Surfaces and Features
     // tables showed the camera's uncorrected temperatures beside corrected maps).
     for x in &mut seg.report.surfaces {
@@ -524,6 +722,32 @@ pub fn level_segmentation(
     }
     for f in &mut seg.report.furniture {
         f.temperature_c = found.correct(f.temperature_c);
+    }
+    // ... and with each element's emissivity and true temperature.
+    let grey_of = |id: &str| {
+        seg.scene.surfaces.iter().find_map(|s| {
+            if s.id == id {
+                return Some((s.emissivity, s.surface_temperature));
+            }
+            s.features
+                .iter()
+                .find(|f| f.id == id)
+                .map(|f| (f.emissivity, f.surface_temperature))
+        })
+    };
+    for x in &mut seg.report.surfaces {
+        if let Some((e, st)) = grey_of(&x.id) {
+            x.emissivity = Some(e);
+            x.surface_temperature_c = st.map(|t| t.0.celsius());
+            x.surface_temperature_std_k = st.map(|t| t.1);
+        }
+    }
+    for x in &mut seg.report.features {
+        if let Some((e, st)) = grey_of(&x.id) {
+            x.emissivity = Some(e);
+            x.surface_temperature_c = st.map(|t| t.0.celsius());
+            x.surface_temperature_std_k = st.map(|t| t.1);
+        }
     }
     seg.report
         .warnings
@@ -561,6 +785,7 @@ mod tests {
             temperature_c: t,
             std_k: 0.1,
             frame: PointFrame::Scan,
+            emissivity: None,
         }
     }
 
@@ -568,14 +793,14 @@ mod tests {
     fn one_reading_fixes_the_offset_two_the_gain() {
         let c = cloud([10.0, 20.0, 30.0], 1.5, 1.02);
         let id = Isometry3::identity();
-        let one = find_level(&[reading("a", 5.0, 20.0)], &c, &id, 20.0, 5.0);
+        let one = find_level(&[reading("a", 5.0, 20.0)], &[], &c, &id, 20.0, 5.0);
         assert_eq!(one.basis, "references (offset)");
         assert!((one.correct(1.5 + 1.02 * 20.0) - 20.0).abs() < 1e-3);
         assert!((one.std_k - 0.1).abs() < 0.01, "{}", one.std_k);
         // One reading of the window (10 °C) for a room at 20 °C: the camera's 2 % gain error is
         // 0.2 K there, which the ± must hold (a 20 s walk whose wall reading the scan missed
         // stated 0.10 K and was 0.28-0.34 K off).
-        let window = find_level(&[reading("w", 0.0, 10.0)], &c, &id, 20.0, 5.0);
+        let window = find_level(&[reading("w", 0.0, 10.0)], &[], &c, &id, 20.0, 5.0);
         assert_eq!(window.basis, "references (offset)");
         let err = window.correct(1.5 + 1.02 * 20.0) - 20.0;
         assert!((err - 0.2).abs() < 0.01, "{err}");
@@ -587,6 +812,7 @@ mod tests {
         );
         let two = find_level(
             &[reading("a", 0.0, 10.0), reading("b", 10.0, 30.0)],
+            &[],
             &c,
             &id,
             20.0,
@@ -608,6 +834,7 @@ mod tests {
                 reading("c", 10.0, 30.0),
                 reading("far", 50.0, 20.0),
             ],
+            &[],
             &c,
             &id,
             20.0,
@@ -625,7 +852,7 @@ mod tests {
             (l.beta - 1.0).abs() < 1e-5 && l.alpha_c.abs() < 1e-3,
             "{l:?}"
         );
-        let none = find_level(&[], &c, &id, 20.0, 5.0);
+        let none = find_level(&[], &[], &c, &id, 20.0, 5.0);
         assert_eq!((none.basis.as_str(), none.std_k), ("camera", 5.0));
     }
 
@@ -638,6 +865,7 @@ mod tests {
         let id = Isometry3::identity();
         let l = find_level(
             &[reading("window", 0.0, 10.0), reading("wall", 5.0, 40.0)],
+            &[],
             &c,
             &id,
             20.0,
@@ -657,6 +885,7 @@ mod tests {
         // Both within the camera's accuracy, but 5 K apart where the camera saw 10 K apart.
         let l = find_level(
             &[reading("window", 0.0, 12.0), reading("wall", 5.0, 17.0)],
+            &[],
             &c,
             &id,
             20.0,

@@ -25,7 +25,15 @@ const WHAT_PLUS_MINUS_COVERS: &str = "five parts in quadrature: view-factor samp
      references' fit, or the camera's stated accuracy: a common offset passes one to one into MRT); \
      not emissivity or the room's shape: check against a black globe (mrtmap validate)";
 
-fn surface_rows(s: &SegmentReport) -> Vec<[String; 6]> {
+/// A surface temperature with its ± ("11.52 ± 0.3"), or a dash.
+fn surface_cell(t: Option<f64>, std_k: Option<f64>) -> String {
+    match t {
+        Some(t) => format!("{t:.2} ± {}", uncertainty(std_k.unwrap_or(0.0), 2)),
+        None => "—".into(),
+    }
+}
+
+fn surface_rows(s: &SegmentReport) -> Vec<[String; 8]> {
     s.surfaces
         .iter()
         .map(|x| {
@@ -39,6 +47,8 @@ fn surface_rows(s: &SegmentReport) -> Vec<[String; 6]> {
                 x.temperature_c
                     .map_or("not observed".into(), |t| format!("{t:.2}")),
                 format!("{:.3}", x.temperature_std_k),
+                x.emissivity.map_or("—".into(), |e| format!("{e:.2}")),
+                surface_cell(x.surface_temperature_c, x.surface_temperature_std_k),
                 format!(
                     "{:.0} % ({:.0} % texturing only; {:.0} % unseen)",
                     x.observed_fraction * 100.0,
@@ -51,7 +61,7 @@ fn surface_rows(s: &SegmentReport) -> Vec<[String; 6]> {
         .collect()
 }
 
-fn feature_rows(s: &SegmentReport) -> Vec<[String; 6]> {
+fn feature_rows(s: &SegmentReport) -> Vec<[String; 8]> {
     s.features
         .iter()
         .map(|f| {
@@ -65,6 +75,8 @@ fn feature_rows(s: &SegmentReport) -> Vec<[String; 6]> {
                 f.host.clone(),
                 format!("{} ({}{share})", f.label, f.label_source),
                 format!("{:.2}", f.temperature_c),
+                f.emissivity.map_or("—".into(), |e| format!("{e:.2}")),
+                surface_cell(f.surface_temperature_c, f.surface_temperature_std_k),
                 signed(f.contrast_k, 2),
                 if f.completed_m2 > 0.0 {
                     format!(
@@ -390,7 +402,7 @@ fn gain_row(l: &crate::level::Level, o: &RunOutcome) -> Option<(String, String)>
 
 /// "What the temperatures rest on": the level and the self-calibration; the references table.
 #[allow(clippy::type_complexity)]
-fn level_rows(o: &RunOutcome) -> (KeyValues, Vec<[String; 5]>) {
+fn level_rows(o: &RunOutcome) -> (KeyValues, Vec<[String; 7]>) {
     let mut rows: KeyValues = Vec::new();
     let mut refs = Vec::new();
     if let Some(l) = &o.level {
@@ -419,6 +431,8 @@ fn level_rows(o: &RunOutcome) -> (KeyValues, Vec<[String; 5]>) {
                 [
                     r.label.clone(),
                     format!("{:.2}", r.reference_c),
+                    format!("{:.2}", r.emissivity),
+                    format!("{:.2}", r.radiant_c),
                     r.camera_c.map_or("not seen".into(), |c| format!("{c:.2}")),
                     r.residual_k.map_or("—".into(), |x| signed(x, 2)),
                     if r.used {

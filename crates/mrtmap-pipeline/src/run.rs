@@ -149,6 +149,7 @@ pub fn segment_folder(job: &SegmentJob<'_>) -> Result<SegmentReport> {
             None => Vec::new(),
         },
         camera_accuracy_k: DEFAULT_CAMERA_ACCURACY_K,
+        ..LevelInputs::default()
     };
     segment_into(job.fused, &inputs, &section.params(&room), &level, job.out)
 }
@@ -449,6 +450,8 @@ fn segment_stage(
                 .as_deref(),
         )
         .setting("references", &p.references)
+        .setting("emissivity", &p.emissivity)
+        .setting("mrt", &p.mrt)
         .setting("camera_accuracy_k", &rec.rig.thermal_accuracy_k);
     let stage = Stage::in_dir(
         "segment",

@@ -673,7 +673,7 @@ impl<'a> MrtEngine<'a> {
             .patches
             .iter()
             .zip(f)
-            .map(|(pa, &f)| pa.emissivity * f.max(0.0))
+            .map(|(pa, &f)| self.scene.radiant_weight(pa.emissivity) * f.max(0.0))
             .sum();
         if seen.unseen.is_empty() || total <= 0.0 {
             return (0.0, Vec::new());
@@ -684,8 +684,10 @@ impl<'a> MrtEngine<'a> {
             .iter()
             .filter_map(|&(si, k, j, u)| {
                 let fj = f[k].max(0.0) * u.share;
-                let dtr_dt =
-                    self.patches[k].emissivity * fj * u.filled.kelvin().powi(3) / (tr3 * total);
+                let dtr_dt = self.scene.radiant_weight(self.patches[k].emissivity)
+                    * fj
+                    * u.filled.kelvin().powi(3)
+                    / (tr3 * total);
                 let part = dtr_dt * u.std_k;
                 (part > 0.0).then_some(UnseenPart {
                     surface: si,
@@ -716,7 +718,7 @@ impl<'a> MrtEngine<'a> {
             .map(|((k, pa), &f)| RadiantSource {
                 view_factor: f.min(1.0),
                 temperature: seen.map_or(pa.temperature, |s| s[k]),
-                emissivity: pa.emissivity,
+                emissivity: self.scene.radiant_weight(pa.emissivity),
                 temperature_std_k: pa.temperature_std_k,
             })
             .collect();

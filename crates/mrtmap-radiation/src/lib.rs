@@ -23,6 +23,7 @@
 mod bounds;
 mod engine;
 mod field;
+pub mod grey;
 mod person;
 mod raster;
 mod scene;
@@ -42,7 +43,7 @@ pub use scene::{
     BoxFile, FEATURE_PLANE_TOLERANCE_M, Feature, FeatureFile, FramePose, MAX_COORDINATE_M,
     Occluder, OccluderFile, OccluderShape, PLANARITY_TOLERANCE_M, RadiantScene, SCENE_FORMAT,
     SceneError, SceneFile, SceneLoadError, SceneLoadErrorKind, Surface, SurfaceFile, SurfaceKind,
-    TEMPERATURE_RANGE_C, slug,
+    TEMPERATURE_RANGE_C, TemperatureKind, slug,
 };
 
 use serde::{Deserialize, Serialize};

@@ -97,6 +97,13 @@ pub struct SceneFile {
     /// it passes one to one into every MRT's standard error.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub temperature_level_std_k: Option<f64>,
+    /// What `temperature_c` is: `radiant` (what a thermal camera set to emissivity 1 reads: the
+    /// radiation leaving the surface, emitted and reflected; segmentation writes this) or
+    /// `surface` (true surface temperatures, as a contact thermometer reads them). Absent: as the
+    /// format's version 1 says, radiant where the emissivity is 1 and, where it is below 1, true
+    /// surface temperatures weighted by emissivity (Tr⁴ = Σ εFT⁴ / Σ εF).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub temperatures: Option<TemperatureKind>,
     /// The room's surfaces.
     pub surfaces: Vec<SurfaceFile>,
     /// Optional occluders (boxes or triangle meshes).
@@ -124,6 +131,14 @@ pub struct SurfaceFile {
     /// Standard uncertainty of the temperature (K), written by segmentation.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub temperature_std_k: Option<f64>,
+    /// The true surface temperature (°C; what a contact thermometer reads), derived from the
+    /// radiant temperature, the emissivity and the irradiance the surface receives from the rest
+    /// of the scene; written by segmentation, not read by the MRT.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface_temperature_c: Option<f64>,
+    /// Its standard uncertainty (K), the emissivity's included.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface_temperature_std_k: Option<f64>,
     /// Observed fraction of the surface, 0…1, written by segmentation.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub observed_fraction: Option<f64>,
@@ -154,6 +169,23 @@ pub struct FeatureFile {
     /// Standard uncertainty of the temperature (K).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub temperature_std_k: Option<f64>,
+    /// The true surface temperature (°C), as on surfaces.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface_temperature_c: Option<f64>,
+    /// Its standard uncertainty (K), the emissivity's included.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface_temperature_std_k: Option<f64>,
+}
+
+/// What a scene's `temperature_c` values are.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TemperatureKind {
+    /// Radiant (apparent) temperatures: what leaves the surface, emitted and reflected, as a
+    /// thermal camera set to emissivity 1 reads it. The MRT uses them as they are.
+    Radiant,
+    /// True surface temperatures: the MRT weights them by emissivity.
+    Surface,
 }
 
 /// An axis-aligned box.
@@ -477,6 +509,8 @@ pub struct Surface {
     pub emissivity: f64,
     /// Temperature uncertainty (K), if known.
     pub temperature_std_k: Option<f64>,
+    /// The true surface temperature and its uncertainty (K), when derived.
+    pub surface_temperature: Option<(Temperature, f64)>,
     /// Observed fraction, if known.
     pub observed_fraction: Option<f64>,
     /// Features on it.
@@ -504,6 +538,8 @@ pub struct Feature {
     pub emissivity: f64,
     /// Temperature uncertainty (K), if known.
     pub temperature_std_k: Option<f64>,
+    /// The true surface temperature and its uncertainty (K), when derived.
+    pub surface_temperature: Option<(Temperature, f64)>,
     /// The polygon in the host's 2D frame.
     pub polygon_2d: Vec<Point2<f64>>,
     /// Axis-aligned bounds of `polygon_2d`: (min, max).
@@ -647,6 +683,8 @@ pub struct RadiantScene {
     pub world_from_room: Option<Isometry3<f64>>,
     /// Standard uncertainty of the temperatures' common level (K; 0 when not stated).
     pub temperature_level_std_k: f64,
+    /// What the temperatures are, as the file said (see [`SceneFile::temperatures`]).
+    pub temperatures: Option<TemperatureKind>,
     /// Surfaces.
     pub surfaces: Vec<Surface>,
     /// Occluders.
@@ -688,6 +726,27 @@ fn check_emissivity(element: &'static str, id: &str, e: f64) -> Result<f64, Scen
         });
     }
     Ok(e)
+}
+
+/// An optional true surface temperature with its uncertainty.
+fn check_surface_temperature(
+    element: &'static str,
+    id: &str,
+    c: Option<f64>,
+    std_k: Option<f64>,
+) -> Result<Option<(Temperature, f64)>, SceneError> {
+    let Some(c) = c else { return Ok(None) };
+    if !(c.is_finite() && (TEMPERATURE_RANGE_C.0..=TEMPERATURE_RANGE_C.1).contains(&c)) {
+        return Err(SceneError::BadValue {
+            element,
+            id: id.into(),
+            what: "surface_temperature_c",
+            value: c,
+            rule: "within −60…200 °C",
+        });
+    }
+    let std_k = check_std(element, id, std_k)?.unwrap_or(0.0);
+    Ok(Some((Temperature::from_celsius(c), std_k)))
 }
 
 fn check_std(element: &'static str, id: &str, s: Option<f64>) -> Result<Option<f64>, SceneError> {
@@ -844,6 +903,12 @@ fn check_feature(
         temperature: check_temperature("feature", &f.id, f.temperature_c)?,
         emissivity: check_emissivity("feature", &f.id, f.emissivity)?,
         temperature_std_k: check_std("feature", &f.id, f.temperature_std_k)?,
+        surface_temperature: check_surface_temperature(
+            "feature",
+            &f.id,
+            f.surface_temperature_c,
+            f.surface_temperature_std_k,
+        )?,
         bounds_2d: bounds(&f2),
         polygon_2d: f2,
     })
@@ -872,6 +937,12 @@ fn check_surface(s: &SurfaceFile, si: usize, ids: &mut Ids) -> Result<Surface, S
     let temperature = check_temperature("surface", &s.id, s.temperature_c)?;
     let emissivity = check_emissivity("surface", &s.id, s.emissivity)?;
     let temperature_std_k = check_std("surface", &s.id, s.temperature_std_k)?;
+    let surface_temperature = check_surface_temperature(
+        "surface",
+        &s.id,
+        s.surface_temperature_c,
+        s.surface_temperature_std_k,
+    )?;
     if let Some(f) = s.observed_fraction
         && !(0.0..=1.0).contains(&f)
     {
@@ -901,6 +972,7 @@ fn check_surface(s: &SurfaceFile, si: usize, ids: &mut Ids) -> Result<Surface, S
         temperature,
         emissivity,
         temperature_std_k,
+        surface_temperature,
         observed_fraction: s.observed_fraction,
         raster,
         features,
@@ -1052,6 +1124,17 @@ fn element_named(text: &str, path: &serde_path_to_error::Path) -> Option<String>
 }
 
 impl RadiantScene {
+    /// The weight of an element of emissivity `emissivity` in a radiant average: 1 when the
+    /// temperatures are radiant (the camera's reading already holds what the surface reflects),
+    /// the emissivity when they are true surface temperatures (or the file does not say: the
+    /// format's version 1).
+    pub fn radiant_weight(&self, emissivity: f64) -> f64 {
+        match self.temperatures {
+            Some(TemperatureKind::Radiant) => 1.0,
+            Some(TemperatureKind::Surface) | None => emissivity,
+        }
+    }
+
     /// Validates a scene file against every rule of the spec.
     pub fn new(file: &SceneFile) -> Result<Self, SceneError> {
         if file.format != SCENE_FORMAT {
@@ -1096,6 +1179,7 @@ impl RadiantScene {
             up_given,
             world_from_room,
             temperature_level_std_k: level,
+            temperatures: file.temperatures,
             surfaces,
             occluders,
         };
@@ -1169,6 +1253,7 @@ impl RadiantScene {
             world_from_room: self.world_from_room.as_ref().map(FramePose::from_isometry),
             temperature_level_std_k: (self.temperature_level_std_k > 0.0)
                 .then_some(self.temperature_level_std_k),
+            temperatures: self.temperatures,
             surfaces: self
                 .surfaces
                 .iter()
@@ -1180,6 +1265,8 @@ impl RadiantScene {
                     temperature_c: s.temperature.celsius(),
                     emissivity: s.emissivity,
                     temperature_std_k: s.temperature_std_k,
+                    surface_temperature_c: s.surface_temperature.map(|t| t.0.celsius()),
+                    surface_temperature_std_k: s.surface_temperature.map(|t| t.1),
                     observed_fraction: s.observed_fraction,
                     raster: s.raster.as_ref().map(|r| r.file.clone()),
                     features: s
@@ -1192,6 +1279,8 @@ impl RadiantScene {
                             temperature_c: f.temperature.celsius(),
                             emissivity: f.emissivity,
                             temperature_std_k: f.temperature_std_k,
+                            surface_temperature_c: f.surface_temperature.map(|t| t.0.celsius()),
+                            surface_temperature_std_k: f.surface_temperature.map(|t| t.1),
                         })
                         .collect(),
                 })

@@ -54,9 +54,9 @@ pub struct ReportData {
     /// MRT at named points with their view factors.
     pub points: Vec<PointRecord>,
     /// Surfaces: id, kind, temperature, uncertainty, observed fraction, area.
-    pub surfaces: Vec<[String; 6]>,
+    pub surfaces: Vec<[String; 8]>,
     /// Features: id, host, label (source, vote share), temperature, contrast, area.
-    pub features: Vec<[String; 6]>,
+    pub features: Vec<[String; 8]>,
     /// Furniture: id, label, size, temperature.
     pub furniture: Vec<[String; 4]>,
     /// Coverage and uncertainty.
@@ -89,7 +89,7 @@ pub struct ReportData {
     /// What the temperatures rest on: the level, the self-calibration.
     pub level: KeyValues,
     /// Reference readings: label, reading, camera, residual, used.
-    pub references: Vec<[String; 5]>,
+    pub references: Vec<[String; 7]>,
     /// The room in 3D (see [`crate::view3d::view3d`]), when there is a scene to show.
     pub view3d: Option<crate::view3d::View3d>,
 }
@@ -420,9 +420,11 @@ fn level_section(o: &mut String, d: &ReportData) {
         o,
         &[
             "reference",
-            "reading (°C)",
+            "reading: surface T (°C)",
+            "ε",
+            "the camera should read: radiant T (°C)",
             "camera (°C)",
-            "corrected − reading (K)",
+            "corrected − should read (K)",
             "used",
         ],
         &refs,
@@ -488,14 +490,25 @@ pub fn render_html(d: &ReportData) -> String {
     comparison_section(&mut o, d);
     validation_section(&mut o, d);
     points_section(&mut o, d);
+    if !d.surfaces.is_empty() {
+        o.push_str(
+            "<p><small>Radiant T is what the thermal camera reads (set to ε = 1): the radiation leaving the \
+             surface, emitted and reflected, which is what a person exchanges radiation with and what every MRT \
+             here uses. Surface T is the surface's own temperature, what a contact thermometer reads (judge \
+             condensation or down-draught by it): the radiant T less what the surface reflects, from its \
+             emissivity ε and the irradiance the rest of the room gives it; its ± includes ε's.</small></p>",
+        );
+    }
     plain_table(
         &mut o,
         "Surfaces",
         &[
             "id",
             "kind",
-            "T (°C)",
+            "radiant T (°C)",
             "± (K)",
+            "ε",
+            "surface T (°C, ± K)",
             "seen (by thermal texturing only; unseen)",
             "area (m²)",
         ],
@@ -504,7 +517,16 @@ pub fn render_html(d: &ReportData) -> String {
     plain_table(
         &mut o,
         "Features",
-        &["id", "on", "label", "T (°C)", "contrast (K)", "area (m²)"],
+        &[
+            "id",
+            "on",
+            "label",
+            "radiant T (°C)",
+            "ε",
+            "surface T (°C, ± K)",
+            "contrast (K)",
+            "area (m²)",
+        ],
         &d.features,
     );
     plain_table(

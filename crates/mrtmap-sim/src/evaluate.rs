@@ -132,12 +132,12 @@ pub fn truth_at(room: &Room, p: &Point3<f64>) -> (f64, f64, f64) {
         };
         let dist = off.hypot(outside);
         if dist < best.1 {
-            let mut t = room.background_temperature_c(s, p.z);
+            let mut t = room.background_radiant_c(s, p.z);
             let mut border = edge_distance(&q, &poly);
-            for f in room.features.iter().filter(|f| f.on == s) {
+            for (k, f) in room.features.iter().enumerate().filter(|(_, f)| f.on == s) {
                 border = border.min(edge_distance(&q, &f.polygon_2d));
                 if point_in_polygon(&q, &f.polygon_2d, 0.0) != Containment::Outside {
-                    t = f.temperature_c;
+                    t = room.feature_radiant_c(k);
                 }
             }
             best = (t, dist, border);

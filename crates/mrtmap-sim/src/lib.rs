@@ -15,6 +15,7 @@
 
 mod evaluate;
 mod evaluate_scene;
+mod grey;
 mod radiometric;
 mod render;
 mod room;
@@ -25,6 +26,9 @@ mod walk;
 
 pub use evaluate::{CloudScore, score_cloud, truth_at};
 pub use evaluate_scene::{FeatureScore, PointScore, SceneScore, SurfaceScore, score_scene};
+pub use grey::{
+    GLASS_EMISSIVITY, GREY_EMISSIVITY, Grey, OPERATOR_C, Operator, Surfaces, radiant_c,
+};
 pub use radiometric::{
     CameraErrors, FfcPeriod, RadiometricModel, ReferenceReading, reference_readings,
 };

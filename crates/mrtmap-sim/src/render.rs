@@ -357,16 +357,17 @@ fn polygon_area(p: &[Point2<f64>]) -> f64 {
     mrtmap_geometry::polygon::signed_area(p).abs()
 }
 
-/// Temperature (°C) at a hit point (room frame).
+/// Radiant temperature (°C) at a hit point (room frame): what a thermal camera reads of a diffuse
+/// surface there (its own temperature in a black room, its radiosity's in a grey one).
 pub fn temperature_at(room: &Room, hit: &Hit, point: &Point3<f64>) -> f64 {
     match hit.element {
         Element::Surface {
             feature: Some(f), ..
-        } => room.features[f].temperature_c,
+        } => room.feature_radiant_c(f),
         Element::Surface {
             surface,
             feature: None,
-        } => room.background_temperature_c(RoomRenderer::surface_ref(room, surface), point.z),
+        } => room.background_radiant_c(RoomRenderer::surface_ref(room, surface), point.z),
         Element::Furniture(b) => room.file.furniture[b].temperature_c,
     }
 }

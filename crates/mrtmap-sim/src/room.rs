@@ -27,6 +27,15 @@ pub struct TemperaturesFile {
     /// Vertical gradient of every wall unless overridden (K/m, positive = warmer up).
     #[serde(default)]
     pub wall_gradient_k_per_m: f64,
+    /// The floor's emissivity (unset: 1 in black rooms, drawn in grey ones).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub floor_emissivity: Option<f64>,
+    /// The ceiling's emissivity.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ceiling_emissivity: Option<f64>,
+    /// Every wall's emissivity unless overridden.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub walls_emissivity: Option<f64>,
 }
 
 /// A per-wall override.
@@ -43,6 +52,9 @@ pub struct WallFile {
     /// Label (default "wall").
     #[serde(default)]
     pub label: Option<String>,
+    /// Emissivity.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub emissivity: Option<f64>,
 }
 
 /// A feature: a rectangle or polygon on a surface with its own temperature.
@@ -61,6 +73,9 @@ pub struct FeatureSpec {
     /// Or a polygon in the same 2D coordinates.
     #[serde(default)]
     pub polygon: Option<Vec<[f64; 2]>>,
+    /// Emissivity (unset: 1 in black rooms; glass 0.84 and others drawn in grey ones).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub emissivity: Option<f64>,
 }
 
 /// A furniture box (an occluder with a temperature).
@@ -176,6 +191,10 @@ pub struct Room {
     pub walls: Vec<(f64, f64, String)>,
     /// Features placed on their surfaces.
     pub features: Vec<PlacedFeature>,
+    /// Each wall's emissivity as the file gives it, by wall index.
+    pub wall_emissivity: Vec<Option<f64>>,
+    /// Emissivities and irradiances, once [`Room::with_surfaces`] has set them (none: black).
+    pub grey: Option<crate::grey::Grey>,
 }
 
 fn finite(name: &str, v: f64) -> Result<f64, RoomError> {
@@ -407,12 +426,43 @@ impl Room {
         let walls = wall_settings(&file, n, reversed)?;
         let features = place_features(&file, &plan, reversed)?;
         check_furniture_and_points(&file, &plan)?;
+        let mut wall_emissivity = vec![None; n];
+        for w in &file.walls {
+            wall_emissivity[plan_wall(w.index, n, reversed)] = w.emissivity;
+        }
+        let t = &file.temperatures;
+        for (what, e) in [
+            ("floor_emissivity", t.floor_emissivity),
+            ("ceiling_emissivity", t.ceiling_emissivity),
+            ("walls_emissivity", t.walls_emissivity),
+        ]
+        .into_iter()
+        .chain(
+            file.walls
+                .iter()
+                .map(|w| ("a wall's emissivity", w.emissivity)),
+        )
+        .chain(
+            file.features
+                .iter()
+                .map(|f| ("a feature's emissivity", f.emissivity)),
+        ) {
+            if let Some(e) = e
+                && !(e > 0.0 && e <= 1.0)
+            {
+                return Err(RoomError::Invalid(format!(
+                    "{what} {e} is outside 0 < ε ≤ 1"
+                )));
+            }
+        }
         let room = Self {
             file,
             plan,
             convex,
             walls,
             features,
+            wall_emissivity,
+            grey: None,
         };
         // Validate the geometry through the scene rules (features inside hosts, no overlaps…).
         room.scene(&Isometry3::identity(), false)?;
@@ -499,6 +549,87 @@ impl Room {
         }
     }
 
+    /// The room with its surfaces black or grey (the room file's emissivities where it gives them;
+    /// see [`crate::grey::Grey::emissivities`]) and, grey, its radiosities solved.
+    pub fn with_surfaces(
+        mut self,
+        surfaces: crate::grey::Surfaces,
+        seed: u64,
+        rays: usize,
+    ) -> Result<Self, crate::SimError> {
+        let g = crate::grey::Grey::emissivities(&self, surfaces, seed);
+        self.grey = g.is_grey().then_some(g);
+        crate::grey::solve(&mut self, rays, seed)?;
+        Ok(self)
+    }
+
+    /// Whether any surface is grey.
+    pub fn is_grey(&self) -> bool {
+        self.grey.is_some()
+    }
+
+    /// The index of a surface in [`Room::surfaces`].
+    pub fn surface_index(&self, s: SurfaceRef) -> usize {
+        match s {
+            SurfaceRef::Floor => 0,
+            SurfaceRef::Ceiling => 1,
+            SurfaceRef::Wall(i) => 2 + i,
+        }
+    }
+
+    /// A surface's emissivity (1 in a black room).
+    pub fn emissivity(&self, s: SurfaceRef) -> f64 {
+        self.grey
+            .as_ref()
+            .map_or(1.0, |g| g.surface_emissivity[self.surface_index(s)])
+    }
+
+    /// Feature `k`'s emissivity.
+    pub fn feature_emissivity(&self, k: usize) -> f64 {
+        self.grey.as_ref().map_or(1.0, |g| g.feature_emissivity[k])
+    }
+
+    fn surface_irradiance_k(&self, s: SurfaceRef) -> Option<f64> {
+        self.grey
+            .as_ref()
+            .and_then(|g| g.surface_irradiance_k.get(self.surface_index(s)).copied())
+    }
+
+    fn feature_irradiance_k(&self, k: usize) -> Option<f64> {
+        self.grey
+            .as_ref()
+            .and_then(|g| g.feature_irradiance_k.get(k).copied())
+    }
+
+    /// The radiant temperature (°C: what the camera reads, what the MRT uses) of a surface's
+    /// background at height `z`: its own temperature in a black room.
+    pub fn background_radiant_c(&self, s: SurfaceRef, z: f64) -> f64 {
+        crate::grey::radiant_c(
+            self.background_temperature_c(s, z),
+            self.emissivity(s),
+            self.surface_irradiance_k(s),
+        )
+    }
+
+    /// Feature `k`'s radiant temperature (°C).
+    pub fn feature_radiant_c(&self, k: usize) -> f64 {
+        crate::grey::radiant_c(
+            self.features[k].temperature_c,
+            self.feature_emissivity(k),
+            self.feature_irradiance_k(k),
+        )
+    }
+
+    /// The radiant (T⁴ area-average) temperature of a surface's background as the camera reads
+    /// it (°C): [`Room::surface_radiant_temperature_c`] in a black room.
+    pub fn surface_apparent_c(&self, s: SurfaceRef) -> f64 {
+        crate::grey::radiant_c(
+            self.surface_radiant_temperature_c(s),
+            self.emissivity(s),
+            self.surface_irradiance_k(s),
+        )
+    }
+
     /// All surfaces in a fixed order: floor, ceiling, walls 0….
     pub fn surfaces(&self) -> Vec<SurfaceRef> {
         let mut v = vec![SurfaceRef::Floor, SurfaceRef::Ceiling];
@@ -538,6 +669,9 @@ impl Room {
             up: Some([up.x, up.y, up.z]),
             world_from_room: None,
             temperature_level_std_k: None,
+            temperatures: self
+                .is_grey()
+                .then_some(mrtmap_radiation::TemperatureKind::Radiant),
             surfaces,
             occluders: self.occluder_files(world_from_room),
         })
@@ -576,8 +710,14 @@ impl Room {
             SurfaceRef::Wall(i) => ("wall", self.walls[i].2.clone()),
         };
         let poly2 = self.surface_polygon_2d(s);
-        let feats: Vec<&PlacedFeature> = self.features.iter().filter(|f| f.on == s).collect();
+        let feats: Vec<(usize, &PlacedFeature)> = self
+            .features
+            .iter()
+            .enumerate()
+            .filter(|(_, f)| f.on == s)
+            .collect();
         let bands = self.bands(s, strips);
+        let grey = self.is_grey();
         let whole = bands.len() == 1;
         let clip = |p: &[Point2<f64>], z0, z1| {
             if whole {
@@ -595,13 +735,19 @@ impl Room {
         };
         let mut out = Vec::new();
         for (bi, &(z0, z1)) in bands.iter().enumerate() {
-            let temperature_c = if whole {
-                self.surface_radiant_temperature_c(s)
+            let (temperature_c, true_c) = if whole {
+                (
+                    self.surface_apparent_c(s),
+                    self.surface_radiant_temperature_c(s),
+                )
             } else {
-                self.background_temperature_c(s, (z0 + z1) / 2.0)
+                (
+                    self.background_radiant_c(s, (z0 + z1) / 2.0),
+                    self.background_temperature_c(s, (z0 + z1) / 2.0),
+                )
             };
             let mut features = Vec::new();
-            for f in &feats {
+            for &(k, f) in &feats {
                 let fp = clip(&f.polygon_2d, z0, z1);
                 if fp.len() < 3 || polygon::signed_area(&fp).abs() < 1e-9 {
                     continue;
@@ -610,9 +756,11 @@ impl Room {
                     id: name(&f.id, bi),
                     label: f.label.clone(),
                     polygon: fp.iter().map(|q| w(self.on_surface(s, q))).collect(),
-                    temperature_c: f.temperature_c,
-                    emissivity: 1.0,
+                    temperature_c: self.feature_radiant_c(k),
+                    emissivity: self.feature_emissivity(k),
                     temperature_std_k: None,
+                    surface_temperature_c: grey.then_some(f.temperature_c),
+                    surface_temperature_std_k: None,
                 });
             }
             out.push(SurfaceFile {
@@ -624,8 +772,10 @@ impl Room {
                     .map(|q| w(self.on_surface(s, q)))
                     .collect(),
                 temperature_c,
-                emissivity: 1.0,
+                emissivity: self.emissivity(s),
                 temperature_std_k: None,
+                surface_temperature_c: grey.then_some(true_c),
+                surface_temperature_std_k: None,
                 observed_fraction: None,
                 features,
                 raster: None,

@@ -310,7 +310,19 @@ pub fn render_thermal<R: Rng>(
         .iter()
         .map(|p| {
             let o: Point3<f64> = p.translation.vector.into();
-            (o, renderer.view(p), p.rotation.to_rotation_matrix())
+            (
+                o,
+                renderer.view(p),
+                p.rotation.to_rotation_matrix(),
+                crate::grey::Operator::behind(p),
+            )
+        })
+        .collect();
+    // Grey glass is specular: it mirrors the room and the operator.
+    let mirrors: Vec<Option<f64>> = (0..room.features.len())
+        .map(|k| {
+            let e = room.feature_emissivity(k);
+            (e < 1.0 && crate::render::is_glass(&room.features[k].label)).then_some(e)
         })
         .collect();
     let n_views = views.len().max(1);
@@ -320,12 +332,30 @@ pub fn render_thermal<R: Rng>(
     for (k, chunk) in rays.chunks(ss).enumerate() {
         let mut acc = 0.0;
         for (j, d) in chunk.iter().enumerate() {
-            let (o, view, rot) = &views[(5 * j) % n_views];
+            let (o, view, rot, operator) = &views[(5 * j) % n_views];
             let dw = rot * d;
             let t4 = match view.cast(d) {
                 Some(hit) => {
                     let p = o + dw * hit.t;
-                    let t4 = (temperature_at(room, &hit, &p) + ZERO_CELSIUS_K).powi(4);
+                    let mirror = match hit.element {
+                        Element::Surface {
+                            feature: Some(k), ..
+                        } => mirrors[k].map(|e| (k, e)),
+                        _ => None,
+                    };
+                    let t4 = match mirror {
+                        Some((k, e)) => crate::grey::specular_t4(
+                            room,
+                            renderer,
+                            k,
+                            e,
+                            &p,
+                            &dw.normalize(),
+                            &hit.normal,
+                            operator,
+                        ),
+                        None => (temperature_at(room, &hit, &p) + ZERO_CELSIUS_K).powi(4),
+                    };
                     if noise.grazing_emissivity {
                         let e = grazing_emissivity((hit.normal.dot(&dw) / dw.norm()).abs());
                         e * t4 + (1.0 - e) * t_refl4

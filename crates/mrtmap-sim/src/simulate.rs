@@ -18,6 +18,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::SimError;
+use crate::grey::Surfaces;
 use crate::radiometric::{CameraErrors, RadiometricModel, ReferenceReading, reference_readings};
 use crate::render::RoomRenderer;
 use crate::room::Room;
@@ -121,6 +122,10 @@ pub struct SimConfig {
     /// level's default (on with realistic noise, off without: panes then return depth like a
     /// wall, an idealised camera).
     pub glass: Option<bool>,
+    /// Black or grey surfaces (see [`Surfaces`]); `None`: the noise level's default (grey with
+    /// realistic noise: real rooms are grey, and window glass mirrors the operator; black without).
+    #[serde(default)]
+    pub surfaces: Option<Surfaces>,
 }
 
 /// Where a realistic thermal lag is drawn from (s).
@@ -130,6 +135,14 @@ impl SimConfig {
     /// Whether the depth camera sees through glass in this configuration.
     pub fn glass_on(&self) -> bool {
         self.glass.unwrap_or(self.noise == NoiseLevel::Realistic)
+    }
+
+    /// Whether the room's surfaces are black or grey in this configuration.
+    pub fn surfaces(&self) -> Surfaces {
+        self.surfaces.unwrap_or(match self.noise {
+            NoiseLevel::Realistic => Surfaces::Grey,
+            NoiseLevel::None => Surfaces::Black,
+        })
     }
 
     /// The thermal stamps' lag this configuration gives (s).
@@ -178,6 +191,7 @@ impl Default for SimConfig {
             poses_in_recording: true,
             thermal_lag_s: None,
             glass: None,
+            surfaces: None,
         }
     }
 }
@@ -608,13 +622,16 @@ fn write_camera_truth(
 ) -> Result<(), SimError> {
     let refs = reference_readings(room, cfg.references, cfg.reference_std_k, cfg.seed);
     if !refs.is_empty() {
+        // A black room's readings say so (emissivity 1: the camera reads them as they are); a grey
+        // room's leave it to the surface under the point, as a user with a contact probe would.
         let mut csv = String::from(
-            "# contact-thermometer readings of surface points (x, y, z in the frame of trajectory.txt: frame scan)\nlabel,x,y,z,temperature_c,std_k,frame\n",
+            "# contact-thermometer readings of surface points (x, y, z in the frame of trajectory.txt: frame scan)\nlabel,x,y,z,temperature_c,std_k,frame,emissivity\n",
         );
+        let black = if room.is_grey() { "" } else { "1" };
         for r in &refs {
             let p = world_from_room * Point3::from(r.xyz_room);
             csv.push_str(&format!(
-                "{},{:.4},{:.4},{:.4},{:.3},{},scan\n",
+                "{},{:.4},{:.4},{:.4},{:.3},{},scan,{black}\n",
                 r.label, p.x, p.y, p.z, r.temperature_c, r.std_k
             ));
         }
@@ -648,6 +665,16 @@ pub fn simulate(
     progress: Progress<'_>,
 ) -> Result<SimSummary, SimError> {
     check(cfg)?;
+    // The room's surfaces as the configuration asks (a room already made grey stays as it is).
+    let greyed;
+    let room = if room.grey.is_none() && cfg.surfaces() == Surfaces::Grey {
+        greyed = room
+            .clone()
+            .with_surfaces(cfg.surfaces(), cfg.seed, 20_000)?;
+        &greyed
+    } else {
+        room
+    };
     let dir = PartialDir::create(out)?;
     let root = dir.path().to_path_buf();
     for sub in ["depth", "thermal", "rgb", "masks"] {

@@ -10,7 +10,7 @@ use mrtmap_pipeline::parse::{parse_facing, parse_grid, parse_mark, parse_on_off,
 use mrtmap_pipeline::settings::{FuseSection, SegmentSection};
 use mrtmap_pipeline::settings::{PointFrame, Quantity};
 use mrtmap_pipeline::simulation::CameraErrorArgs;
-use mrtmap_pipeline::simulation::NoiseLevel;
+use mrtmap_pipeline::simulation::{NoiseLevel, Surfaces};
 use mrtmap_pipeline::source::SourceOptions;
 use mrtmap_pipeline::thermal_image::ThermalReading;
 use mrtmap_pipeline::validation::GlobeFormulaChoice;
@@ -578,6 +578,13 @@ pub struct SimulateArgs {
     /// realistic, off with none.
     #[arg(long, value_enum, default_value_t = AutoOnOff::Auto)]
     pub glass: AutoOnOff,
+    /// The room's surfaces: grey (window glass emissivity 0.84 mirroring the room and the
+    /// operator holding the camera, every other surface 0.90–0.95 drawn from the seed, unless the
+    /// room's TOML gives emissivities; the camera reads radiosities, the contact readings true
+    /// temperatures) or black (ε = 1: the camera reads each surface's own temperature). Default:
+    /// grey with --noise realistic, black with none.
+    #[arg(long, value_enum)]
+    pub surfaces: Option<Surfaces>,
     /// Monte Carlo rays per truth point (rooms with furniture or not convex).
     #[arg(long, default_value_t = 100_000)]
     pub truth_rays: usize,

@@ -26,6 +26,8 @@ pub fn surface(id: &str, kind: &str, polygon: Vec<[f64; 3]>, t: f64) -> SurfaceF
         temperature_c: t,
         emissivity: 1.0,
         temperature_std_k: None,
+        surface_temperature_c: None,
+        surface_temperature_std_k: None,
         observed_fraction: None,
         features: Vec::new(),
         raster: None,
@@ -40,6 +42,8 @@ pub fn feature(id: &str, polygon: Vec<[f64; 3]>, t: f64) -> FeatureFile {
         temperature_c: t,
         emissivity: 1.0,
         temperature_std_k: None,
+        surface_temperature_c: None,
+        surface_temperature_std_k: None,
     }
 }
 
@@ -62,6 +66,7 @@ pub fn box_room(sx: f64, sy: f64, sz: f64, t: [f64; 6]) -> SceneFile {
         up: None,
         world_from_room: None,
         temperature_level_std_k: None,
+        temperatures: None,
         surfaces: vec![
             surface(
                 "floor",
@@ -141,6 +146,7 @@ pub fn l_room() -> SceneFile {
         up: None,
         world_from_room: None,
         temperature_level_std_k: None,
+        temperatures: None,
         surfaces,
         occluders: Vec::new(),
     }

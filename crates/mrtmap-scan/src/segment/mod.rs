@@ -181,6 +181,15 @@ pub struct SurfaceSummary {
     pub points: usize,
     /// Background model: level at the surface's centre (°C) and vertical gradient (K/m, walls).
     pub background_c: f64,
+    /// The emissivity taken (set with the level, from project.toml's `[emissivity]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub emissivity: Option<f64>,
+    /// The true surface temperature (°C) and its ± (K), derived with the level.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface_temperature_c: Option<f64>,
+    /// Its standard uncertainty (K).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface_temperature_std_k: Option<f64>,
     /// Vertical gradient of the background (K/m).
     pub gradient_k_per_m: f64,
 }
@@ -208,6 +217,15 @@ pub struct FeatureSummary {
     /// The part of that area the scan never saw, completed from the shape of what it saw (m²).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub completed_m2: f64,
+    /// The emissivity taken (set with the level).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub emissivity: Option<f64>,
+    /// The true surface temperature (°C), derived with the level.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface_temperature_c: Option<f64>,
+    /// Its standard uncertainty (K).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface_temperature_std_k: Option<f64>,
 }
 
 fn is_zero(x: &f64) -> bool {
@@ -401,6 +419,7 @@ pub fn segment_textured(
             &mut pts,
             &mut weights,
             &mut members,
+            &up.into_inner(),
             p,
         )
     });

@@ -78,6 +78,8 @@ pub(super) fn build_features(
             temperature_c: f.temperature_k - ZERO_CELSIUS_K,
             emissivity: 1.0,
             temperature_std_k: Some(f.temperature_std_k),
+            surface_temperature_c: None,
+            surface_temperature_std_k: None,
         });
         out.summaries.push(FeatureSummary {
             id,
@@ -89,6 +91,9 @@ pub(super) fn build_features(
             contrast_k: f.contrast_k,
             area_m2: f.area_m2,
             completed_m2: f.completed_m2,
+            emissivity: None,
+            surface_temperature_c: None,
+            surface_temperature_std_k: None,
         });
     }
     out
@@ -137,6 +142,8 @@ pub(super) fn build_surfaces(
             temperature_c: t - ZERO_CELSIUS_K,
             emissivity: 1.0,
             temperature_std_k: Some(a.temperature_std_k),
+            surface_temperature_c: None,
+            surface_temperature_std_k: None,
             observed_fraction: Some(a.observed_fraction),
             features: std::mem::take(&mut per_surface[s]),
             raster: a.raster.clone(),
@@ -152,6 +159,9 @@ pub(super) fn build_surfaces(
             points: members[s].len(),
             background_c: a.background.a - ZERO_CELSIUS_K,
             gradient_k_per_m: a.background.b,
+            emissivity: None,
+            surface_temperature_c: None,
+            surface_temperature_std_k: None,
         });
     }
     (surfaces, summaries)
@@ -220,6 +230,7 @@ pub(super) fn room_scene(
         up: Some([up.x, up.y, up.z]),
         world_from_room: None,
         temperature_level_std_k: None,
+        temperatures: None,
         surfaces,
         occluders,
     };

@@ -63,6 +63,18 @@ pub struct TextureParams {
     /// box found 3 cm lower than the real one and landed on the wall behind: a 1.4 m², 0.6 K warm
     /// "feature" above the L-shaped room's bookcase on the field study's walks 1-3.
     pub furniture_margin_m: f64,
+    /// The person holding the rig, whom glass mirrors, as seen from the camera: a vertical cylinder
+    /// of this radius about the camera (m), from [`TextureParams::operator_below_m`] under it to
+    /// [`TextureParams::operator_above_m`] over it. A pixel whose ray, mirrored by the surface it
+    /// lands on, passes through it may show the operator's reflection rather than the surface (a
+    /// 34 °C body in glass of emissivity 0.84: about +1.5 K in the middle of the pane, moving
+    /// with the camera): it is not used. Only texels the cloud left empty are textured, and glass
+    /// is where that happens. 0: keep every pixel.
+    pub operator_radius_m: f64,
+    /// How far the operator's body reaches below the camera (m).
+    pub operator_below_m: f64,
+    /// How far above the camera (m).
+    pub operator_above_m: f64,
 }
 
 impl Default for TextureParams {
@@ -74,6 +86,11 @@ impl Default for TextureParams {
             min_pixels: 3,
             edge_clearance_m: 0.12,
             furniture_margin_m: 0.06,
+            // The simulator's operator: a 0.2 m body 0.25 m behind the camera (0.45 m), with a
+            // margin for the blur; from the floor (a camera held at most 2 m up) to the head.
+            operator_radius_m: 0.5,
+            operator_below_m: 2.0,
+            operator_above_m: 0.35,
         }
     }
 }
@@ -116,6 +133,9 @@ pub struct TextureReport {
     pub pixels_occluded: u64,
     /// Pixels that landed on furniture.
     pub pixels_on_furniture: u64,
+    /// Pixels left out because the surface could mirror the operator there.
+    #[serde(default)]
+    pub pixels_mirroring_operator: u64,
     /// Texels the cloud had left empty that texturing filled, per surface index.
     pub texels_filled: Vec<usize>,
     /// Time it took (s, wall).
@@ -226,6 +246,48 @@ fn distance_to_outline(q: &Point2<f64>, poly: &[Point2<f64>]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// Whether the ray from `o` along `d` (unit) that meets a surface of normal `n` at `x` comes back,
+/// mirrored, through the operator's body: the vertical cylinder about the camera of `params`, with
+/// `up` the room's up.
+fn mirrors_operator(
+    o: &Point3<f64>,
+    x: &Point3<f64>,
+    d: &Vector3<f64>,
+    n: &Vector3<f64>,
+    up: &Vector3<f64>,
+    params: &TextureParams,
+) -> bool {
+    let r = d - n * (2.0 * d.dot(n));
+    let v = x - o;
+    let vh = v - up * v.dot(up);
+    let rh = r - up * r.dot(up);
+    let rad = params.operator_radius_m;
+    let a = rh.norm_squared();
+    let b = 2.0 * vh.dot(&rh);
+    let c = vh.norm_squared() - rad * rad;
+    // The stretch of the mirrored ray (s ≥ 0) within the cylinder's radius.
+    let (s0, s1) = if a < 1e-12 {
+        if c > 0.0 {
+            return false;
+        }
+        (0.0, 100.0)
+    } else {
+        let disc = b * b - 4.0 * a * c;
+        if disc < 0.0 {
+            return false;
+        }
+        let q = disc.sqrt();
+        ((-b - q) / (2.0 * a), (-b + q) / (2.0 * a))
+    };
+    if s1 <= 0.0 {
+        return false;
+    }
+    let s0 = s0.max(0.0);
+    // Its height relative to the camera is linear in s: does it overlap the body's?
+    let (h0, h1) = (v.dot(up) + s0 * r.dot(up), v.dot(up) + s1 * r.dot(up));
+    h0.min(h1) <= params.operator_above_m && h0.max(h1) >= -params.operator_below_m
+}
+
 /// Per-texel sums: (Σw, Σw·T, pixels).
 type TexelSums = HashMap<(usize, i64, i64), (f64, f64, u32)>;
 
@@ -237,13 +299,15 @@ struct Caster<'a> {
     texel_m: f64,
     params: &'a TextureParams,
     rays: Vec<Vector3<f64>>,
+    /// The room's up (unit).
+    up: Vector3<f64>,
 }
 
 impl Caster<'_> {
     /// One frame's pixels cast onto the model: per-texel sums of the texels the cloud left empty,
     /// and the pixels (used, hidden by something nearer, on furniture). `None` when its images
     /// cannot be read or the thermal image is not the rig's size.
-    fn frame(&self, f: &FusedFrame) -> Option<(TexelSums, [u64; 3])> {
+    fn frame(&self, f: &FusedFrame) -> Option<(TexelSums, [u64; 4])> {
         let rec = self.input.recording;
         let cam = &rec.rig.thermal;
         let (w, h) = (cam.width as usize, cam.height as usize);
@@ -262,7 +326,7 @@ impl Caster<'_> {
         let observation = crate::observe::ObservationParams::default();
         let rmax2 = (cam.cx.powi(2) + cam.cy.powi(2)).max(1e-9);
         let mut sums = TexelSums::new();
-        let mut counts = [0u64; 3];
+        let mut counts = [0u64; 4];
         for v in 0..h {
             for u in 0..w {
                 let d = wt.rotation * self.rays[v * w + u];
@@ -299,6 +363,12 @@ impl Caster<'_> {
                 if m.covered.contains(&key) {
                     continue;
                 }
+                if self.params.operator_radius_m > 0.0
+                    && mirrors_operator(&o, &x, &d, &m.frame.normal, &self.up, self.params)
+                {
+                    counts[3] += 1;
+                    continue;
+                }
                 let px = Point2::new(u as f64, v as f64);
                 let rho = ((px.x - cam.cx).powi(2) + (px.y - cam.cy).powi(2)) / rmax2;
                 let temp =
@@ -321,6 +391,7 @@ pub(crate) fn texture(
     input: &TextureInput<'_>,
     surfaces: &[ModelSurface<'_>],
     boxes: &[[Point3<f64>; 8]],
+    up: &Vector3<f64>,
     texel_m: f64,
     params: &TextureParams,
 ) -> (Textured, TextureReport) {
@@ -341,13 +412,14 @@ pub(crate) fn texture(
             .flat_map(|v| (0..w).map(move |u| (u, v)))
             .map(|(u, v)| cam.unproject(&Point2::new(u as f64, v as f64)).normalize())
             .collect(),
+        up: up.normalize(),
     };
     let n = input.frames.len();
     let take = params.max_frames.min(n);
     let picked: Vec<&FusedFrame> = (0..take)
         .map(|j| &input.frames[j * n / take.max(1)])
         .collect();
-    let per_frame: Vec<(TexelSums, [u64; 3])> =
+    let per_frame: Vec<(TexelSums, [u64; 4])> =
         picked.par_iter().filter_map(|f| caster.frame(f)).collect();
     let mut report = TextureReport {
         frames: per_frame.len(),
@@ -359,6 +431,7 @@ pub(crate) fn texture(
         report.pixels_used += c[0];
         report.pixels_occluded += c[1];
         report.pixels_on_furniture += c[2];
+        report.pixels_mirroring_operator += c[3];
         for (k, v) in sums {
             let e = all.entry(k).or_insert((0.0, 0.0, 0));
             e.0 += v.0;
@@ -444,6 +517,7 @@ pub(super) fn fill_from_texture(
     pts: &mut Points,
     weights: &mut Vec<f64>,
     members: &mut [Vec<usize>],
+    up: &Vector3<f64>,
     p: &SegmentParams,
 ) -> TextureReport {
     let surfaces: Vec<ModelSurface<'_>> = geoms
@@ -468,6 +542,7 @@ pub(super) fn fill_from_texture(
         input,
         &surfaces,
         &boxes,
+        up,
         p.texel_m,
         &TextureParams::default(),
     );

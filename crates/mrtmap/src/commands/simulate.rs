@@ -4,7 +4,7 @@ use std::time::Instant;
 
 use mrtmap_pipeline::Progress;
 use mrtmap_pipeline::simulation::{Drift, SimConfig, ThermalNoise, simulate};
-use mrtmap_pipeline::simulation::{load_room, set_depth_size};
+use mrtmap_pipeline::simulation::{Surfaces, load_room, set_depth_size};
 
 use crate::cli::{DriftArg, SimulateArgs};
 use crate::output::Bar;
@@ -29,6 +29,7 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<()> {
         ..ThermalNoise::REALISTIC
     };
     cfg.glass = a.glass.choice();
+    cfg.surfaces = a.surfaces;
     if let Some(ms) = a.thermal_lag_ms {
         cfg.thermal_lag_s = Some(ms / 1000.0);
     }
@@ -58,12 +59,17 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<()> {
         summary.out.display()
     );
     outln!(
-        "thermal frames stamped {:.1} ms after their exposure (truth.json: thermal_lag_s); glass {}",
+        "thermal frames stamped {:.1} ms after their exposure (truth.json: thermal_lag_s); glass {}; surfaces {}",
         cfg.lag_s() * 1000.0,
         if cfg.glass_on() {
             "gives no depth"
         } else {
             "returns depth like a wall"
+        },
+        match cfg.surfaces() {
+            Surfaces::Grey =>
+                "grey (the camera reads radiosities; truth.json's scene gives each surface's emissivity and true temperature)",
+            Surfaces::Black => "black",
         }
     );
     outln!(

@@ -1,0 +1,268 @@
+//! Grey rooms: each surface's emissivity and the radiosity it leaves, and the person holding the
+//! camera, whom window glass mirrors.
+//!
+//! A grey diffuse surface at T with emissivity ε receiving irradiance σT_irr⁴ leaves
+//! J = εσT⁴ + (1 − ε)σT_irr⁴, the radiosity a thermal camera (set to ε = 1) reads and a person
+//! exchanges radiation with. The irradiance comes from the other surfaces' radiosities, so the
+//! radiosities are solved by iteration (the radiosity method with one node per surface or feature,
+//! as building simulation does it): start from J = σT⁴, compute each element's irradiance from the
+//! room's scene at those radiosities ([`mrtmap_radiation::grey::irradiance`], the T⁴ mean over up
+//! to nine points on it), update J, three times (each round shrinks the error by 1 − ε, ≤ 0.16).
+//!
+//! Glass is specular in the long-wave: the thermal camera sees εσT⁴ plus 1 − ε of what the mirrored
+//! ray meets, the operator included ([`Operator`]), while its radiosity for the MRT (and the truth)
+//! is the diffuse one above.
+
+use mrtmap_geometry::nalgebra::{Isometry3, Point2, Point3, Vector3};
+use mrtmap_geometry::sampling::DirectionSet;
+use mrtmap_physics::ZERO_CELSIUS_K;
+use mrtmap_radiation::{Method, MonteCarlo, MrtEngine};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+
+use crate::render::is_glass;
+use crate::room::{Room, SurfaceRef};
+
+/// Whether the room's surfaces are black (ε = 1 everywhere unless the room file says otherwise)
+/// or grey (window glass 0.84, every other surface and feature drawn from 0.90–0.95 per seed,
+/// unless the room file says otherwise).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+pub enum Surfaces {
+    /// Black: the camera reads each surface's own temperature.
+    Black,
+    /// Grey: the camera reads radiosities, glass mirrors the operator.
+    Grey,
+}
+
+/// Window glass's emissivity in grey rooms (uncoated soda-lime glass).
+pub const GLASS_EMISSIVITY: f64 = 0.84;
+/// Where the other surfaces' emissivities are drawn from in grey rooms (paint, plaster, tiles).
+pub const GREY_EMISSIVITY: std::ops::Range<f64> = 0.90..0.95;
+
+/// The room's emissivities and the irradiance on each element (by [`Room::surfaces`] index and
+/// feature index).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Grey {
+    /// Emissivity by surface.
+    pub surface_emissivity: Vec<f64>,
+    /// Emissivity by feature.
+    pub feature_emissivity: Vec<f64>,
+    /// Irradiance temperature (K) by surface, once solved.
+    pub surface_irradiance_k: Vec<f64>,
+    /// Irradiance temperature (K) by feature, once solved.
+    pub feature_irradiance_k: Vec<f64>,
+}
+
+/// The person holding the rig: a vertical cylinder behind the camera, which glass mirrors.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Operator {
+    /// The body's axis on the floor plan (room frame).
+    pub axis: Point2<f64>,
+    /// Its radius (m).
+    pub radius_m: f64,
+    /// The top of the head above the floor (m).
+    pub top_m: f64,
+}
+
+/// The operator's clothed body's surface temperature (°C).
+pub const OPERATOR_C: f64 = 34.0;
+/// How far behind the camera the body's axis stands (m).
+pub const OPERATOR_BEHIND_M: f64 = 0.25;
+/// The body's radius (m).
+pub const OPERATOR_RADIUS_M: f64 = 0.2;
+/// How far above the camera the head's top reaches (m).
+pub const OPERATOR_ABOVE_M: f64 = 0.25;
+
+impl Operator {
+    /// The operator of a camera at `room_from_cam` (looking along its +z).
+    pub fn behind(room_from_cam: &Isometry3<f64>) -> Self {
+        let o = room_from_cam.translation.vector;
+        let f = room_from_cam.rotation * Vector3::z();
+        let h = Vector3::new(f.x, f.y, 0.0);
+        let back = if h.norm() > 1e-6 {
+            -h.normalize()
+        } else {
+            Vector3::zeros()
+        };
+        Self {
+            axis: Point2::new(
+                o.x + OPERATOR_BEHIND_M * back.x,
+                o.y + OPERATOR_BEHIND_M * back.y,
+            ),
+            radius_m: OPERATOR_RADIUS_M,
+            top_m: o.z + OPERATOR_ABOVE_M,
+        }
+    }
+
+    /// The distance along `d` from `p` at which the ray enters the body, if it does.
+    pub fn hit(&self, p: &Point3<f64>, d: &Vector3<f64>) -> Option<f64> {
+        let (px, py) = (p.x - self.axis.x, p.y - self.axis.y);
+        let a = d.x * d.x + d.y * d.y;
+        if a < 1e-12 {
+            return None;
+        }
+        let b = 2.0 * (px * d.x + py * d.y);
+        let c = px * px + py * py - self.radius_m * self.radius_m;
+        let disc = b * b - 4.0 * a * c;
+        if disc < 0.0 {
+            return None;
+        }
+        let t = (-b - disc.sqrt()) / (2.0 * a);
+        let z = p.z + t * d.z;
+        (t > 1e-6 && (0.0..=self.top_m).contains(&z)).then_some(t)
+    }
+}
+
+impl Grey {
+    /// The emissivities of `room`: the room file's where it gives them, else 1 (black) or, grey,
+    /// glass 0.84 and the rest drawn from [`GREY_EMISSIVITY`] with `seed`. Irradiances unsolved.
+    pub fn emissivities(room: &Room, surfaces: Surfaces, seed: u64) -> Self {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x9e_e5_11);
+        let mut draw = |glass: bool| match surfaces {
+            Surfaces::Black => 1.0,
+            Surfaces::Grey if glass => GLASS_EMISSIVITY,
+            Surfaces::Grey => rng.random_range(GREY_EMISSIVITY),
+        };
+        let t = &room.file.temperatures;
+        let surface_emissivity = room
+            .surfaces()
+            .into_iter()
+            .map(|s| {
+                let drawn = draw(false);
+                let given = match s {
+                    SurfaceRef::Floor => t.floor_emissivity,
+                    SurfaceRef::Ceiling => t.ceiling_emissivity,
+                    SurfaceRef::Wall(i) => room.wall_emissivity[i].or(t.walls_emissivity),
+                };
+                given.unwrap_or(drawn)
+            })
+            .collect();
+        let feature_emissivity = room
+            .features
+            .iter()
+            .enumerate()
+            .map(|(k, f)| {
+                let drawn = draw(is_glass(&f.label));
+                room.file.features[k].emissivity.unwrap_or(drawn)
+            })
+            .collect();
+        Self {
+            surface_irradiance_k: Vec::new(),
+            feature_irradiance_k: Vec::new(),
+            surface_emissivity,
+            feature_emissivity,
+        }
+    }
+
+    /// Whether any element is grey.
+    pub fn is_grey(&self) -> bool {
+        self.surface_emissivity
+            .iter()
+            .chain(&self.feature_emissivity)
+            .any(|e| *e < 1.0)
+    }
+}
+
+/// The radiant temperature (°C) of an element at `t_c` with emissivity `e` and irradiance
+/// temperature `irr_k` (K; none: black).
+pub fn radiant_c(t_c: f64, e: f64, irr_k: Option<f64>) -> f64 {
+    match irr_k {
+        Some(g) if e < 1.0 => {
+            let t4 = e * (t_c + ZERO_CELSIUS_K).powi(4) + (1.0 - e) * g.powi(4);
+            t4.powf(0.25) - ZERO_CELSIUS_K
+        }
+        _ => t_c,
+    }
+}
+
+/// Solves the radiosities of `room` (whose `grey` holds its emissivities): three rounds of
+/// irradiance from the scene at the current radiosities. `rays` for rooms that need Monte Carlo.
+pub fn solve(room: &mut Room, rays: usize, seed: u64) -> Result<(), crate::SimError> {
+    let Some(g) = room.grey.as_ref() else {
+        return Ok(());
+    };
+    if !g.is_grey() {
+        return Ok(());
+    }
+    let exact = room.convex && room.file.furniture.is_empty();
+    let method = if exact {
+        Method::Exact
+    } else {
+        Method::MonteCarlo(MonteCarlo {
+            rays,
+            seed,
+            directions: DirectionSet::Fibonacci,
+            replicates: 4,
+        })
+    };
+    // Sample points of each element (surface backgrounds without their features; features).
+    let mut elements: Vec<(Vec<Point3<f64>>, Vector3<f64>)> = Vec::new();
+    for s in room.surfaces() {
+        let holes: Vec<&[Point2<f64>]> = room
+            .features
+            .iter()
+            .filter(|f| f.on == s)
+            .map(|f| f.polygon_2d.as_slice())
+            .collect();
+        let pts = mrtmap_radiation::grey::sample_points(&room.surface_polygon_2d(s), &holes, |q| {
+            room.on_surface(s, q)
+        });
+        elements.push((pts, room.inward_normal(s)));
+    }
+    for f in &room.features {
+        let pts =
+            mrtmap_radiation::grey::sample_points(&f.polygon_2d, &[], |q| room.on_surface(f.on, q));
+        elements.push((pts, room.inward_normal(f.on)));
+    }
+    let ns = room.surfaces().len();
+    for _round in 0..3 {
+        let scene = room.scene(&Isometry3::identity(), true)?;
+        let engine = MrtEngine::new(&scene, method)?;
+        let irr: Vec<f64> = elements
+            .iter()
+            .enumerate()
+            .map(|(k, (pts, n))| {
+                mrtmap_radiation::grey::irradiance(&engine, pts, n, 50_000 + k as u64)
+                    .map_or(room.file.air_temperature_c + ZERO_CELSIUS_K, |t| {
+                        t.0.kelvin()
+                    })
+            })
+            .collect();
+        if let Some(g) = room.grey.as_mut() {
+            g.surface_irradiance_k = irr[..ns].to_vec();
+            g.feature_irradiance_k = irr[ns..].to_vec();
+        }
+    }
+    Ok(())
+}
+
+#[allow(clippy::too_many_arguments)]
+/// What the thermal camera sees of glass feature `k` at `p` looking along `d` (unit): its emission
+/// and what the mirrored ray meets (the operator, a surface's radiosity, or the air), as T⁴ (K⁴).
+pub fn specular_t4(
+    room: &Room,
+    renderer: &crate::render::RoomRenderer,
+    k: usize,
+    e: f64,
+    p: &Point3<f64>,
+    d: &Vector3<f64>,
+    normal: &Vector3<f64>,
+    operator: &Operator,
+) -> f64 {
+    let r = d - normal * (2.0 * d.dot(normal));
+    let start = p + r * 1e-6;
+    let hit = renderer.cast(&start, &r);
+    let by_operator = operator
+        .hit(&start, &r)
+        .filter(|t| hit.is_none_or(|h| *t < h.t));
+    let reflected_c = match (by_operator, hit) {
+        (Some(_), _) => OPERATOR_C,
+        (None, Some(h)) => crate::render::temperature_at(room, &h, &(start + r * h.t)),
+        (None, None) => room.file.air_temperature_c,
+    };
+    let t = room.features[k].temperature_c + ZERO_CELSIUS_K;
+    e * t.powi(4) + (1.0 - e) * (reflected_c + ZERO_CELSIUS_K).powi(4)
+}
