@@ -6,7 +6,7 @@ pipeline, and compare the map with the truth.
                   [--noise realistic,none] [--drift none] [--seconds 60]
                   [--camera-errors auto|none|realistic] [--depth-hz 30] [--glass auto|on|off]
                   [--thermal-lag-ms MS] [--thermal-time-constant-ms MS]
-                  [--score-scene BIN] [--keep]
+                  [--surfaces auto|black|grey] [--score-scene BIN] [--keep]
 
 Prints one row per scan and a summary per room and noise; writes WORKDIR/robustness.json. Each
 row also says how many nodes' errors lie within twice the standard error the run states. A scan
@@ -21,7 +21,9 @@ thermal clock offset found against the truth's -(lag + time constant), and the f
 recording has simulated contact readings, each row also gives their own error's effect on the level
 (the simulated thermometer has sigma 0.1 K, so with two readings a walk in twenty is 0.2 K off from
 the readings alone) and the grid's worst error with exact readings. With --keep the
-recordings stay in WORKDIR and a later study reuses them (only the pipeline runs again)."""
+recordings stay in WORKDIR and a later study reuses them (only the pipeline runs again). In grey
+rooms (the simulator's default with realistic noise: --surfaces) each row also gives every window's
+surface_temperature_c (what a contact thermometer reads) against its true temperature."""
 import argparse
 import json
 import tomllib
@@ -117,6 +119,37 @@ def features_and_clock(score_bin, rec, run):
     return out
 
 
+def window_surface_errors(rec, run):
+    """Each true window's surface_temperature_c in the run's scene (the window feature nearest to
+    it) minus its true temperature (K); empty in black rooms."""
+    truth = json.load(open(os.path.join(rec, "truth.json")))
+    scene = json.load(open(os.path.join(run, "segment", "scene.json")))
+    pose = scene.get("world_from_room")
+    if not pose:
+        return []
+    x, y, z, w = pose["rotation_xyzw"]
+    rot = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+           [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+           [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    to_world = lambda p: [sum(rot[i][j] * p[j] for j in range(3)) + pose["translation"][i]
+                          for i in range(3)]
+    centre = lambda poly: [sum(p[i] for p in poly) / len(poly) for i in range(3)]
+    found = [(to_world(centre(f["polygon"])), f.get("surface_temperature_c"))
+             for s in scene["surfaces"] for f in s.get("features", []) if "window" in f["label"]]
+    out = []
+    for s in truth["scene"]["surfaces"]:
+        for f in s.get("features", []):
+            if "window" not in f["label"] or f.get("surface_temperature_c") is None:
+                continue
+            c = centre(f["polygon"])
+            near = min(found, key=lambda g: sum((a - b) ** 2 for a, b in zip(g[0], c)), default=None)
+            if near is None or near[1] is None or math.dist(near[0], c) > 0.5:
+                out.append(None)
+            else:
+                out.append(round(near[1] - f["surface_temperature_c"], 3))
+    return out
+
+
 def reference_level(rec):
     """What the simulated contact thermometer's own reading errors do to the level: the level
     fit's change at temperature T (K) when the readings are replaced by the truth
@@ -140,8 +173,10 @@ def reference_level(rec):
 
 
 def one(mrtmap, work, room, seed, noise, drift, secs, keep, camera, reuse_fusion=False,
-        depth_hz=None, glass="auto", score_bin=None, lag_ms=None, tau_ms=None):
+        depth_hz=None, glass="auto", score_bin=None, lag_ms=None, tau_ms=None, surfaces="auto"):
     name = f"{room_label(room)}-s{seed}-{noise}-{drift}-cam{camera}"
+    if surfaces != "auto":
+        name += f"-{surfaces}"
     if depth_hz:
         name += f"-d{depth_hz}"
     if glass != "auto":
@@ -159,6 +194,7 @@ def one(mrtmap, work, room, seed, noise, drift, secs, keep, camera, reuse_fusion
         extra = (["--depth-hz", str(depth_hz)] if depth_hz else []) + ["--glass", glass]
         extra += ["--thermal-lag-ms", str(lag_ms)] if lag_ms is not None else []
         extra += ["--thermal-time-constant-ms", str(tau_ms)] if tau_ms is not None else []
+        extra += ["--surfaces", surfaces] if surfaces != "auto" else []
         subprocess.run([mrtmap, "simulate", "--room", room, "--seed", str(seed), "--noise", noise,
                         "--drift", drift, "--camera-errors", camera, "--seconds", str(secs),
                         "--out", rec] + extra,
@@ -207,6 +243,7 @@ def one(mrtmap, work, room, seed, noise, drift, secs, keep, camera, reuse_fusion
             "points_k": pts,
         })
         row.update(features_and_clock(score_bin, rec, run))
+        row["window_surface_dt_k"] = window_surface_errors(rec, run)
     if not keep:
         shutil.rmtree(rec, ignore_errors=True)
         shutil.rmtree(run, ignore_errors=True)
@@ -236,6 +273,7 @@ def main():
     ap.add_argument("--score-scene", default=None,
                     help="the mrtmap-sim example score_scene, to score features against the truth")
     ap.add_argument("--keep", action="store_true")
+    ap.add_argument("--surfaces", default="auto", help="the simulator's surfaces: auto, black, grey")
     ap.add_argument("--reuse-fusion", action="store_true",
                     help="with --keep: keep the fusion of an earlier study (segmentation work)")
     a = ap.parse_args()
@@ -247,7 +285,8 @@ def main():
                 for seed in seeds(a.seeds):
                     row = one(a.mrtmap, a.work, room, seed, noise, drift, a.seconds, a.keep,
                               a.camera_errors, a.reuse_fusion, a.depth_hz, a.glass,
-                              a.score_scene, a.thermal_lag_ms, a.thermal_time_constant_ms)
+                              a.score_scene, a.thermal_lag_ms, a.thermal_time_constant_ms,
+                              a.surfaces)
                     rows.append(row)
                     if "error" in row:
                         desc = "FAILED: " + row["error"]
@@ -269,7 +308,10 @@ def main():
                                     f"ΔT {w['dt_k']:+.2f} K, area x{w['area_ratio']:.2f}"
                                     if w["found"] else "MISSED") for w in row.get("windows", [])) +
                                 (f"; spurious {row['spurious_over_0_2']}"
-                                 if row.get("spurious_over_0_2") else ""))
+                                 if row.get("spurious_over_0_2") else "") +
+                                "".join(f"; window surface T {d:+.2f} K" if d is not None
+                                        else "; window surface T —"
+                                        for d in row.get("window_surface_dt_k", [])))
                     print(f"{room:<16} seed {seed:>3} {noise:<9} {drift:<8} run {row['run_s']:5.1f} s  {desc}",
                           flush=True)
     print("\nsummary (room, noise, drift: scans, failures, worst grid max |Δ| and RMSE (over nodes 10 cm "
@@ -286,11 +328,13 @@ def main():
         times = sorted(r["run_s"] for r in rs)
         cover = min((r["within_2se"] for r in ok), default=float("nan"))
         exact = [r["exact_refs_max_abs_k"] for r in ok if r.get("exact_refs_max_abs_k") is not None]
+        win = [abs(d) for r in ok for d in r.get("window_surface_dt_k", []) if d is not None]
         print(f"  {room:<16} {noise:<9} {drift:<8} {len(rs):>3} scans, {len(rs) - len(ok)} failed, "
               f"max |Δ| {worst:.3f} K, RMSE {rmse:.3f} K (clear of furniture: {clear:.3f}, "
               f"{clear_rmse:.3f} K), at least {100 * cover:.0f} % of nodes within 2σ, "
               f"run {times[len(times) // 2]:.1f} s" +
-              (f"; with exact contact readings max |Δ| {max(exact):.3f} K" if exact else ""))
+              (f"; with exact contact readings max |Δ| {max(exact):.3f} K" if exact else "") +
+              (f"; windows' surface T worst |Δ| {max(win):.2f} K" if win else ""))
     json.dump(rows, open(os.path.join(a.work, "robustness.json"), "w"), indent=1)
 
 

@@ -53,12 +53,26 @@ fn poly_loop(out: &mut String, indent: &str, p: &[Point3<f64>]) {
     let _ = writeln!(out, "{indent}</PlanarGeometry>");
 }
 
-fn describe(t_c: f64, std_k: Option<f64>, emissivity: f64, label: &str) -> String {
+fn describe(
+    t_c: f64,
+    std_k: Option<f64>,
+    emissivity: f64,
+    surface: Option<(f64, f64)>,
+    label: &str,
+) -> String {
     let mut d = format!("mrtmap: temperature_c={}", num(t_c, 3));
     if let Some(s) = std_k {
         let _ = write!(d, "; temperature_std_k={}", num(s, 3));
     }
     let _ = write!(d, "; emissivity={}", num(emissivity, 3));
+    if let Some((t, s)) = surface {
+        let _ = write!(
+            d,
+            "; surface_temperature_c={}; surface_temperature_std_k={}",
+            num(t, 3),
+            num(s, 3)
+        );
+    }
     let _ = write!(d, "; label={}", label.replace(';', ","));
     d
 }
@@ -113,6 +127,7 @@ fn surface_xml(
         s.temperature.celsius(),
         s.temperature_std_k,
         s.emissivity,
+        s.surface_temperature.map(|(t, e)| (t.celsius(), e)),
         &s.label,
     );
     if let Some(f) = s.observed_fraction {
@@ -158,6 +173,7 @@ fn surface_xml(
                 f.temperature.celsius(),
                 f.temperature_std_k,
                 f.emissivity,
+                f.surface_temperature.map(|(t, e)| (t.celsius(), e)),
                 &f.label
             ))
         );

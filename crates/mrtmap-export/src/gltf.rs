@@ -117,6 +117,11 @@ fn part_extras(p: &MeshPart) -> Value {
     if let Some(o) = p.observed_fraction {
         e["observed_fraction"] = json!(o);
     }
+    e["emissivity"] = json!(p.emissivity);
+    if let Some((t, s)) = p.surface_temperature {
+        e["surface_temperature_c"] = json!(t);
+        e["surface_temperature_std_k"] = json!(s);
+    }
     e
 }
 

@@ -901,6 +901,39 @@ mod tests {
         assert!(l.std_k > 1.5, "{}", l.std_k);
     }
 
+    /// Issue 52: a window (true 10 °C, ε 0.84) in a 20 °C room looks 11.6 °C to a perfect camera.
+    /// Taken as black, its reading and a wall's imply a gain of 0.84, which is refused, and the
+    /// offset fitted to both is off; compared with what the camera should read, they fit exactly.
+    #[test]
+    fn a_reading_on_glass_is_compared_with_what_the_camera_should_read() {
+        let window_seen = grey::radiant_temperature(
+            Temperature::from_celsius(10.0),
+            Temperature::from_celsius(20.0),
+            0.84,
+        )
+        .celsius();
+        let c = cloud([window_seen, 20.0, 30.0], 0.0, 1.0);
+        let id = Isometry3::identity();
+        let refs = [reading("window", 0.0, 10.0), reading("wall", 5.0, 20.0)];
+        let black = find_level(&refs, &[], &c, &id, 20.0, 5.0);
+        assert_eq!(black.basis, "references (offset)", "{black:?}");
+        assert!((black.correct(20.0) - 20.0).abs() > 0.5, "{black:?}");
+        let expected = [
+            Expected {
+                radiant_c: window_seen,
+                emissivity: 0.84,
+            },
+            Expected::black(&refs[1]),
+        ];
+        let grey = find_level(&refs, &expected, &c, &id, 20.0, 5.0);
+        assert_eq!(grey.basis, "references (offset and gain)", "{grey:?}");
+        assert!(
+            (grey.beta - 1.0).abs() < 1e-3 && grey.alpha_c.abs() < 1e-2,
+            "{grey:?}"
+        );
+        assert!(grey.references.iter().all(|r| r.used));
+    }
+
     #[test]
     fn references_csv_errors_name_the_line() {
         let dir = tempfile::tempdir().unwrap();
@@ -939,5 +972,20 @@ mod tests {
         std::fs::write(&p, "label,x,y,z,temperature_c,frame\nw,1,2,3,20,world\n").unwrap();
         let e = read_references(&p).unwrap_err().to_string();
         assert!(e.contains(":2: frame 'world' is neither room"), "{e}");
+        // An emissivity column: a number in (0, 1], or empty for the surface's.
+        std::fs::write(
+            &p,
+            "label,x,y,z,temperature_c,emissivity\nw,1,2,3,11.5,0.84\nv,1,2,3,20,\n",
+        )
+        .unwrap();
+        let r = read_references(&p).unwrap();
+        assert_eq!((r[0].emissivity, r[1].emissivity), (Some(0.84), None));
+        std::fs::write(
+            &p,
+            "label,x,y,z,temperature_c,emissivity\nw,1,2,3,11.5,84\n",
+        )
+        .unwrap();
+        let e = read_references(&p).unwrap_err().to_string();
+        assert!(e.contains(":2: emissivity 84 is outside"), "{e}");
     }
 }

@@ -384,6 +384,101 @@ mod tests {
         assert!((lv - moved).abs() < 0.01, "{lv} {moved}");
     }
 
+    /// Radiant temperatures are used as they are, whatever the emissivity; true surface
+    /// temperatures (or a file that does not say) are weighted by it, as the format's version 1 says.
+    #[test]
+    fn radiant_scenes_ignore_emissivity_in_the_mrt_and_surface_ones_weight_by_it() {
+        use crate::engine::{Method, MrtEngine};
+        use crate::scene::TemperatureKind;
+        use mrtmap_geometry::nalgebra::Point3;
+        let mut scene = crate::example_office();
+        let p = Point3::new(2.0, 1.5, 1.1);
+        let black = MrtEngine::new(&scene, Method::Exact)
+            .unwrap()
+            .at(&p, 0)
+            .unwrap()
+            .mrt;
+        for s in &mut scene.surfaces {
+            for f in &mut s.features {
+                f.emissivity = 0.5;
+            }
+        }
+        let legacy = MrtEngine::new(&scene, Method::Exact)
+            .unwrap()
+            .at(&p, 0)
+            .unwrap()
+            .mrt;
+        assert!((legacy.kelvin() - black.kelvin()).abs() > 0.01);
+        scene.temperatures = Some(TemperatureKind::Radiant);
+        let radiant = MrtEngine::new(&scene, Method::Exact)
+            .unwrap()
+            .at(&p, 0)
+            .unwrap()
+            .mrt;
+        assert!((radiant.kelvin() - black.kelvin()).abs() < 1e-12);
+        scene.temperatures = Some(TemperatureKind::Surface);
+        let surface = MrtEngine::new(&scene, Method::Exact)
+            .unwrap()
+            .at(&p, 0)
+            .unwrap()
+            .mrt;
+        assert!((surface.kelvin() - legacy.kelvin()).abs() < 1e-12);
+    }
+
+    /// In a uniform room every surface receives the room's temperature: a grey surface's true
+    /// temperature is its radiant one; a cold window's comes out colder than it looks.
+    #[test]
+    fn the_scene_gives_each_surface_its_irradiance() {
+        use crate::engine::{Method, MrtEngine};
+        use crate::scene::TemperatureKind;
+        let mut scene = crate::example_office();
+        scene.temperatures = Some(TemperatureKind::Radiant);
+        for s in &mut scene.surfaces {
+            s.emissivity = 0.9;
+            s.temperature = c(20.0);
+            for f in &mut s.features {
+                f.emissivity = 0.84;
+                f.temperature = c(20.0);
+            }
+        }
+        let unexplained = derive_surface_temperatures(
+            &mut scene,
+            |s| MrtEngine::new(s, Method::Exact),
+            EMISSIVITY_STD,
+        )
+        .unwrap();
+        assert!(unexplained.is_empty(), "{unexplained:?}");
+        for s in &scene.surfaces {
+            let (t, sd) = s.surface_temperature.unwrap();
+            assert!(
+                (t.celsius() - 20.0).abs() < 1e-6,
+                "{}: {}",
+                s.id,
+                t.celsius()
+            );
+            assert!(sd < 1e-6, "{sd}");
+        }
+        let window = scene
+            .surfaces
+            .iter_mut()
+            .flat_map(|s| s.features.iter_mut())
+            .find(|f| f.label.contains("window"))
+            .unwrap();
+        window.temperature = c(13.0);
+        derive_surface_temperatures(&mut scene, |s| MrtEngine::new(s, Method::Exact), 0.02)
+            .unwrap();
+        let w = scene
+            .surfaces
+            .iter()
+            .flat_map(|s| s.features.iter())
+            .find(|f| f.label.contains("window"))
+            .unwrap();
+        let (t, sd) = w.surface_temperature.unwrap();
+        // 13 °C radiant in a room near 20 °C: about 11.7 °C true, ± the emissivity's ~0.2 K.
+        assert!(t.celsius() < 12.0 && t.celsius() > 11.0, "{}", t.celsius());
+        assert!(sd > 0.1 && sd < 0.4, "{sd}");
+    }
+
     #[test]
     fn labels_give_the_table_s_emissivities() {
         assert_eq!(default_emissivity("window", None), 0.84);

@@ -49,6 +49,10 @@ pub struct MeshPart {
     pub temperature_std_k: Option<f64>,
     /// Area (m²): a surface's whole outline, features included.
     pub area_m2: f64,
+    /// Its emissivity.
+    pub emissivity: f64,
+    /// Its true surface temperature (°C) and ± (K), when the scene gives one.
+    pub surface_temperature: Option<(f64, f64)>,
     /// Share of it observed, when the scene states it.
     pub observed_fraction: Option<f64>,
     /// Vertices in the scene's frame (m).
@@ -129,6 +133,8 @@ fn surface_part(scene: &RadiantScene, s: &Surface) -> MeshPart {
         temperature_c: s.temperature.celsius(),
         temperature_std_k: s.temperature_std_k,
         area_m2: area_3d(&s.polygon),
+        emissivity: s.emissivity,
+        surface_temperature: s.surface_temperature.map(|(t, e)| (t.celsius(), e)),
         observed_fraction: s.observed_fraction,
         positions: Vec::new(),
         vertex_temperature_c: Vec::new(),
@@ -197,6 +203,8 @@ pub fn scene_mesh(scene: &RadiantScene) -> Vec<MeshPart> {
                 temperature_c: t,
                 temperature_std_k: f.temperature_std_k,
                 area_m2: area_3d(&f.polygon),
+                emissivity: f.emissivity,
+                surface_temperature: f.surface_temperature.map(|(t, e)| (t.celsius(), e)),
                 observed_fraction: None,
                 positions: Vec::new(),
                 vertex_temperature_c: Vec::new(),
@@ -216,6 +224,8 @@ pub fn scene_mesh(scene: &RadiantScene) -> Vec<MeshPart> {
             detail: String::new(),
             temperature_c: t,
             temperature_std_k: None,
+            emissivity: o.emissivity,
+            surface_temperature: None,
             area_m2: tris
                 .iter()
                 .map(|t| 0.5 * (t[1] - t[0]).cross(&(t[2] - t[0])).norm())

@@ -86,6 +86,8 @@ pub fn view3d(
                 "id": p.id, "label": p.label, "role": p.role.as_str(), "detail": p.detail,
                 "t": p.temperature_c, "std": p.temperature_std_k, "area": p.area_m2,
                 "seen": p.observed_fraction,
+                "e": p.emissivity,
+                "st": p.surface_temperature.map(|x| x.0), "sst": p.surface_temperature.map(|x| x.1),
                 "p": p.positions.iter().flat_map(|q| q.map(r3)).collect::<Vec<_>>(),
                 "i": p.triangles.iter().flatten().collect::<Vec<_>>(),
                 "c": p.vertex_temperature_c.iter().flat_map(|t| temperature_rgb(*t, lo, hi)).collect::<Vec<_>>(),

@@ -302,6 +302,7 @@
   function describe(p) {
     let s = p.id + (p.label && p.label !== p.id ? " (" + p.label + ")" : "") + ": " + p.t.toFixed(2) + " °C";
     if (p.std != null) s += " ± " + (p.std < 0.005 ? "< 0.01" : p.std.toFixed(2)) + " K";
+    if (p.st != null) s += " radiant; surface " + p.st.toFixed(2) + " °C ± " + p.sst.toFixed(2) + " K (ε " + p.e.toFixed(2) + ")";
     s += "; " + p.area.toFixed(2) + " m²";
     if (p.seen != null) s += "; " + Math.round(100 * p.seen) + " % seen";
     if (p.role === "feature") s += "; on " + p.detail;

@@ -14,7 +14,11 @@ fn main() {
     let voxel: f64 = args.get(3).map_or(0.03, |v| v.parse().unwrap());
     let file: RoomFile =
         toml::from_str(&std::fs::read_to_string(rec.join("room.toml")).unwrap()).unwrap();
-    let room = Room::new(file).unwrap();
+    // A recording's room.toml gives the emissivities simulated: the room as the camera saw it.
+    let room = Room::new(file)
+        .unwrap()
+        .with_surfaces(mrtmap_sim::Surfaces::Black, 0, mrtmap_sim::IRRADIANCE_RAYS)
+        .unwrap();
     let truth: Truth =
         serde_json::from_str(&std::fs::read_to_string(rec.join("truth.json")).unwrap()).unwrap();
     let q = mrtmap_io::unit_quaternion(truth.world_from_room.rotation_xyzw).unwrap();

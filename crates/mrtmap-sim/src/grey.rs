@@ -24,6 +24,20 @@ use serde::{Deserialize, Serialize};
 use crate::render::is_glass;
 use crate::room::{Room, SurfaceRef};
 
+/// `room` with its surfaces as `cfg` asks (see [`crate::SimConfig::surfaces`]): what
+/// [`crate::simulate`] renders and computes the truth of. A room already grey, or one whose file
+/// gives the emissivities simulated (a recording's room.toml), keeps them.
+pub fn room_as_simulated(room: &Room, cfg: &crate::SimConfig) -> Result<Room, crate::SimError> {
+    if room.grey.is_some() {
+        return Ok(room.clone());
+    }
+    room.clone()
+        .with_surfaces(cfg.surfaces(), cfg.seed, IRRADIANCE_RAYS)
+}
+
+/// Monte Carlo rays per irradiance point in rooms that need them (furniture, not convex).
+pub const IRRADIANCE_RAYS: usize = 20_000;
+
 /// Whether the room's surfaces are black (ε = 1 everywhere unless the room file says otherwise)
 /// or grey (window glass 0.84, every other surface and feature drawn from 0.90–0.95 per seed,
 /// unless the room file says otherwise).
@@ -120,6 +134,14 @@ impl Grey {
     /// The emissivities of `room`: the room file's where it gives them, else 1 (black) or, grey,
     /// glass 0.84 and the rest drawn from [`GREY_EMISSIVITY`] with `seed`. Irradiances unsolved.
     pub fn emissivities(room: &Room, surfaces: Surfaces, seed: u64) -> Self {
+        if let Some(e) = &room.file.emissivities {
+            return Self {
+                surface_emissivity: e.surfaces.clone(),
+                feature_emissivity: e.features.clone(),
+                surface_irradiance_k: Vec::new(),
+                feature_irradiance_k: Vec::new(),
+            };
+        }
         let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x9e_e5_11);
         let mut draw = |glass: bool| match surfaces {
             Surfaces::Black => 1.0,
@@ -265,4 +287,59 @@ pub fn specular_t4(
     };
     let t = room.features[k].temperature_c + ZERO_CELSIUS_K;
     e * t.powi(4) + (1.0 - e) * (reflected_c + ZERO_CELSIUS_K).powi(4)
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use mrtmap_geometry::nalgebra::UnitQuaternion;
+
+    /// A camera 1.4 m up at x = 2, looking along +x: the body stands behind it (x ≈ 1.75); a ray
+    /// coming back along −x at chest height meets it, one passing a metre aside or above the head
+    /// does not.
+    #[test]
+    fn the_operator_stands_behind_the_camera() {
+        // The camera's +z along the room's +x.
+        let rot = UnitQuaternion::rotation_between(&Vector3::z(), &Vector3::x()).unwrap();
+        let cam = Isometry3::from_parts(Vector3::new(2.0, 1.0, 1.4).into(), rot);
+        let op = Operator::behind(&cam);
+        assert!((op.axis.x - 1.75).abs() < 1e-9 && (op.axis.y - 1.0).abs() < 1e-9);
+        let back = -Vector3::x();
+        let t = op.hit(&Point3::new(4.0, 1.0, 1.2), &back).unwrap();
+        assert!((t - (4.0 - 1.95)).abs() < 1e-9, "{t}");
+        assert!(op.hit(&Point3::new(4.0, 2.0, 1.2), &back).is_none());
+        assert!(op.hit(&Point3::new(4.0, 1.0, 1.8), &back).is_none());
+    }
+
+    /// The radiosity of grey rooms: a preset made grey reads the window warmer than it is, walls
+    /// within a tenth of a kelvin, and black rooms are unchanged.
+    #[test]
+    fn grey_rooms_read_radiosities() {
+        let room = crate::preset("office").unwrap().unwrap();
+        let grey = room
+            .clone()
+            .with_surfaces(Surfaces::Grey, 1, 2_000)
+            .unwrap();
+        let k = room
+            .features
+            .iter()
+            .position(|f| f.label == "window")
+            .unwrap();
+        assert_eq!(grey.feature_emissivity(k), GLASS_EMISSIVITY);
+        let seen = grey.feature_radiant_c(k);
+        assert!(seen > 12.7 && seen < 13.5, "window reads {seen} °C");
+        for s in grey.surfaces() {
+            let e = grey.emissivity(s);
+            assert!(GREY_EMISSIVITY.contains(&e), "{e}");
+            let d = grey.background_radiant_c(s, 1.2) - grey.background_temperature_c(s, 1.2);
+            assert!(d.abs() < 0.2, "{s:?}: {d}");
+        }
+        let black = room
+            .clone()
+            .with_surfaces(Surfaces::Black, 1, 2_000)
+            .unwrap();
+        assert!(!black.is_grey());
+        assert_eq!(black.feature_radiant_c(k), 11.5);
+    }
 }

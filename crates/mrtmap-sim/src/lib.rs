@@ -27,15 +27,16 @@ mod walk;
 pub use evaluate::{CloudScore, score_cloud, truth_at};
 pub use evaluate_scene::{FeatureScore, PointScore, SceneScore, SurfaceScore, score_scene};
 pub use grey::{
-    GLASS_EMISSIVITY, GREY_EMISSIVITY, Grey, OPERATOR_C, Operator, Surfaces, radiant_c,
+    GLASS_EMISSIVITY, GREY_EMISSIVITY, Grey, IRRADIANCE_RAYS, OPERATOR_C, Operator, Surfaces,
+    radiant_c, room_as_simulated,
 };
 pub use radiometric::{
     CameraErrors, FfcPeriod, RadiometricModel, ReferenceReading, reference_readings,
 };
 pub use render::{Element, Hit, RoomRenderer, is_glass, temperature_at};
 pub use room::{
-    FeatureSpec, FurnitureSpec, GRADIENT_STRIP_M, PRESETS, PlacedFeature, PointSpec, Room,
-    RoomError, RoomFile, SurfaceRef, TemperaturesFile, WallFile, preset,
+    EmissivitiesFile, FeatureSpec, FurnitureSpec, GRADIENT_STRIP_M, PRESETS, PlacedFeature,
+    PointSpec, Room, RoomError, RoomFile, SurfaceRef, TemperaturesFile, WallFile, preset,
 };
 pub use sensors::{
     DepthNoise, ThermalNoise, camera_rays, instance_label, instance_of, render_depth,

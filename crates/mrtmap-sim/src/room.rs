@@ -135,6 +135,19 @@ pub struct RoomFile {
     /// Validation points.
     #[serde(default)]
     pub points: Vec<PointSpec>,
+    /// Every surface's and feature's emissivity, as the simulator drew them (written into a
+    /// recording's room.toml, so that the room read back is the one simulated).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub emissivities: Option<EmissivitiesFile>,
+}
+
+/// The emissivities a simulation used, in order.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EmissivitiesFile {
+    /// By surface: floor, ceiling, walls 0… (in the plan's counter-clockwise order).
+    pub surfaces: Vec<f64>,
+    /// By feature, in the file's order.
+    pub features: Vec<f64>,
 }
 
 /// Why a room description is invalid.
@@ -446,7 +459,13 @@ impl Room {
             file.features
                 .iter()
                 .map(|f| ("a feature's emissivity", f.emissivity)),
-        ) {
+        )
+        .chain(file.emissivities.iter().flat_map(|e| {
+            e.surfaces
+                .iter()
+                .chain(&e.features)
+                .map(|v| ("[emissivities]", Some(*v)))
+        })) {
             if let Some(e) = e
                 && !(e > 0.0 && e <= 1.0)
             {
@@ -454,6 +473,17 @@ impl Room {
                     "{what} {e} is outside 0 < ε ≤ 1"
                 )));
             }
+        }
+        if let Some(e) = &file.emissivities
+            && (e.surfaces.len() != n + 2 || e.features.len() != features.len())
+        {
+            return Err(RoomError::Invalid(format!(
+                "[emissivities] gives {} surfaces and {} features; the room has {} and {}",
+                e.surfaces.len(),
+                e.features.len(),
+                n + 2,
+                features.len()
+            )));
         }
         let room = Self {
             file,
@@ -561,6 +591,18 @@ impl Room {
         self.grey = g.is_grey().then_some(g);
         crate::grey::solve(&mut self, rays, seed)?;
         Ok(self)
+    }
+
+    /// The room as written into a recording: its file with the emissivities simulated.
+    pub fn file_as_simulated(&self) -> RoomFile {
+        let mut f = self.file.clone();
+        if let Some(g) = &self.grey {
+            f.emissivities = Some(EmissivitiesFile {
+                surfaces: g.surface_emissivity.clone(),
+                features: g.feature_emissivity.clone(),
+            });
+        }
+        f
     }
 
     /// Whether any surface is grey.

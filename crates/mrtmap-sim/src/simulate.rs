@@ -727,7 +727,7 @@ pub fn simulate(
     frames.colour_and_masks(&rgb_t)?;
     let lag_s = cfg.lag_s();
     write_lists(&files, &header, &depth_t, &thermal_t, &rgb_t, lag_s)?;
-    let room_toml = toml::to_string(&room.file)?;
+    let room_toml = toml::to_string(&room.file_as_simulated())?;
     files.write("room.toml", room_toml.as_bytes())?;
     let mut truth = compute_truth(room, &world_from_room, cfg.truth_rays, cfg.seed)?;
     truth.thermal_lag_s = lag_s;

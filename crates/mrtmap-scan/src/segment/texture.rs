@@ -561,6 +561,38 @@ pub(super) fn fill_from_texture(
 mod tests {
     use super::*;
 
+    /// A camera 1.5 m from a pane (normal +x, up +z) looking square at it sees itself, and its
+    /// body below, mirrored; looking 30° aside it does not.
+    #[test]
+    fn the_operator_is_mirrored_only_near_the_pane_s_normal() {
+        let p = TextureParams::default();
+        let (o, n, up) = (
+            Point3::new(0.0, 0.0, 1.4),
+            Vector3::new(-1.0, 0.0, 0.0),
+            Vector3::z(),
+        );
+        let look = |yaw_deg: f64, pitch_deg: f64| {
+            let (y, q) = (yaw_deg.to_radians(), pitch_deg.to_radians());
+            let d = Vector3::new(y.cos() * q.cos(), y.sin() * q.cos(), q.sin());
+            let t = 1.5 / d.x;
+            (o + d * t, d)
+        };
+        for (yaw, pitch, mirrored) in [
+            (0.0, 0.0, true),
+            (5.0, -10.0, true),
+            (0.0, -25.0, true),
+            (30.0, 0.0, false),
+            (0.0, 30.0, false),
+        ] {
+            let (x, d) = look(yaw, pitch);
+            assert_eq!(
+                mirrors_operator(&o, &x, &d, &n, &up, &p),
+                mirrored,
+                "yaw {yaw}°, pitch {pitch}°"
+            );
+        }
+    }
+
     #[test]
     fn a_grown_box_reaches_the_margin_beyond_every_face() {
         let b =

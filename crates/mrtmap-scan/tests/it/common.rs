@@ -62,6 +62,9 @@ pub fn scan_glass(
             Room::from_toml(&std::fs::read_to_string(&path).unwrap()).unwrap()
         }
     };
+    // The room as simulated (grey with realistic noise), so that scores compare with what the
+    // camera saw.
+    let room = mrtmap_sim::room_as_simulated(&room, &cfg).unwrap();
     simulate(&room, &cfg, out, &|_, _| {}).unwrap();
     room
 }

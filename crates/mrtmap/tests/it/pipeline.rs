@@ -676,9 +676,10 @@ fn camera_errors_are_self_calibrated_and_anchored_by_references() {
         )),
     );
     let csv = std::fs::read_to_string(with.join("references.csv")).unwrap();
-    assert!(csv.contains(",frame\n"), "{csv}");
+    // A black room's readings say so: the camera reads them as they are.
+    assert!(csv.contains(",frame,emissivity\n"), "{csv}");
     let mut room_csv = String::from("label,x,y,z,temperature_c,std_k\n");
-    for line in csv.lines().filter(|l| l.ends_with(",scan")) {
+    for line in csv.lines().filter(|l| l.ends_with(",scan,1")) {
         let c: Vec<&str> = line.split(',').collect();
         let p: Vec<f64> = c[1..4].iter().map(|v| v.parse().unwrap()).collect();
         let q = world_from_room.inverse() * Point3::new(p[0], p[1], p[2]);
@@ -781,6 +782,176 @@ fn camera_errors_are_self_calibrated_and_anchored_by_references() {
         html.contains("differences between places")
             && html.contains("each 1 % of gain error stretches the map"),
         "the report says the gain is unknown"
+    );
+}
+
+/// Issue 52: real rooms are grey. A grey office (window glass 0.84 mirroring the operator, the rest
+/// 0.90–0.95), a camera with a unit offset and a 2 % gain, two contact readings of true surface
+/// temperatures, one on the glass. The readings are turned into what the camera should read before
+/// the level is fitted (the glass's helps fix the gain), the map matches the grey enclosure's
+/// truth, the window's surface temperature its true 11.5 °C, and texturing left out the pixels
+/// that could mirror the operator.
+#[test]
+fn grey_rooms_map_radiosities_and_give_true_surface_temperatures() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("grey");
+    ok(&[
+        "simulate",
+        "--room",
+        "office",
+        "--out",
+        rec.to_str().unwrap(),
+        "--seconds",
+        "20",
+        "--depth-size",
+        "160x120",
+        "--noise",
+        "none",
+        "--glass",
+        "on",
+        "--surfaces",
+        "grey",
+        "--truth-rays",
+        "1000",
+        "--camera-errors",
+        "realistic",
+        "--ffc-interval-s",
+        "5,8",
+        "--references",
+        "2",
+    ]);
+    let truth = read_json(&rec.join("truth.json"));
+    assert_eq!(truth["scene"]["temperatures"], "radiant");
+    let true_window = truth["scene"]["surfaces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|s| s["features"].as_array().cloned().unwrap_or_default())
+        .find(|f| f["label"] == "window")
+        .unwrap();
+    let (true_radiant, true_surface) = (
+        true_window["temperature_c"].as_f64().unwrap(),
+        true_window["surface_temperature_c"].as_f64().unwrap(),
+    );
+    assert!(
+        (true_surface - 11.5).abs() < 1e-9 && true_radiant > true_surface + 1.0,
+        "the camera sees the window warmer than it is: {true_radiant} vs {true_surface}"
+    );
+    let run = dir.path().join("run");
+    ok(&[
+        "run",
+        rec.to_str().unwrap(),
+        "--out",
+        run.to_str().unwrap(),
+        "--grid",
+        "8x6",
+    ]);
+    // The reading on the glass was compared with what the camera should read there, and used.
+    let level = read_json(&run.join("segment/level.json"));
+    assert_eq!(level["basis"], "references (offset and gain)", "{level}");
+    let window = level["references"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["label"] == "window")
+        .unwrap();
+    assert_eq!(window["used"], true, "{window}");
+    assert_eq!(window["emissivity"], 0.84);
+    let expected = window["radiant_c"].as_f64().unwrap();
+    assert!(
+        (expected - true_radiant).abs() < 0.3,
+        "the camera should read {expected} °C on the glass; the truth's radiosity is {true_radiant} °C"
+    );
+    let beta = level["beta"].as_f64().unwrap();
+    assert!((beta - 1.02).abs() < 0.015, "gain {beta}");
+    // scene.json: radiant temperatures, emissivities, and the window's true temperature.
+    let scene = read_json(&run.join("segment/scene.json"));
+    assert_eq!(scene["temperatures"], "radiant");
+    let found = scene["surfaces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|s| s["features"].as_array().cloned().unwrap_or_default())
+        .find(|f| f["label"] == "window")
+        .unwrap();
+    assert_eq!(found["emissivity"], 0.84);
+    let radiant = found["temperature_c"].as_f64().unwrap();
+    let surface = found["surface_temperature_c"].as_f64().unwrap();
+    let surface_sd = found["surface_temperature_std_k"].as_f64().unwrap();
+    assert!(
+        (radiant - true_radiant).abs() < 0.3,
+        "window radiant {radiant} °C, truth {true_radiant} °C (the operator's reflection left out)"
+    );
+    assert!(
+        (surface - 11.5).abs() < 0.5 && (surface - 11.5).abs() < 3.0 * surface_sd,
+        "window surface temperature {surface} ± {surface_sd} K, truth 11.5 °C"
+    );
+    let seg = read_json(&run.join("segment/segment.json"));
+    let mirrored = seg["texture"]["pixels_mirroring_operator"]
+        .as_u64()
+        .unwrap();
+    assert!(
+        mirrored > 1000,
+        "pixels left out as mirrors of the operator: {mirrored}"
+    );
+    // The report names both temperatures.
+    let html = std::fs::read_to_string(run.join("report.html")).unwrap();
+    assert!(html.contains("radiant T (°C)") && html.contains("surface T (°C, ± K)"));
+    // The map against the grey enclosure's truth, within the ± it states.
+    for p in truth["points"].as_array().unwrap() {
+        let w = p["xyz_world"].as_array().unwrap();
+        let at = format!("{},{},{}", w[0], w[1], w[2]);
+        let v: Value = serde_json::from_str(&ok(&[
+            "mrt",
+            "--scene",
+            run.join("segment/scene.json").to_str().unwrap(),
+            "--at",
+            &at,
+            "--frame",
+            "scan",
+            "--json",
+        ]))
+        .unwrap();
+        let q = &v["points"][0];
+        let e = q["mrt_c"].as_f64().unwrap() - p["mrt_c"].as_f64().unwrap();
+        let se = q["std_error_k"].as_f64().unwrap();
+        assert!(
+            e.abs() < 0.25 && e.abs() < 3.0 * se,
+            "{}: {e:+.3} K ± {se}",
+            p["name"]
+        );
+    }
+    // The same readings taken as black (emissivity 1 in references.csv): the glass's reading then
+    // disagrees with the camera by its reflection, and the gain it implies is refused.
+    let csv = std::fs::read_to_string(rec.join("references.csv")).unwrap();
+    let black: String = csv
+        .lines()
+        .map(|l| {
+            if l.ends_with(",scan,") {
+                format!("{l}1\n")
+            } else {
+                format!("{l}\n")
+            }
+        })
+        .collect();
+    let black_refs = dir.path().join("black.csv");
+    std::fs::write(&black_refs, black).unwrap();
+    let again = dir.path().join("segment-black");
+    ok(&[
+        "segment",
+        run.join("fuse").to_str().unwrap(),
+        "--recording",
+        rec.to_str().unwrap(),
+        "--references",
+        black_refs.to_str().unwrap(),
+        "--out",
+        again.to_str().unwrap(),
+    ]);
+    let black_level = read_json(&again.join("level.json"));
+    let black_beta = black_level["beta"].as_f64().unwrap();
+    assert!(
+        (black_beta - 1.02).abs() > 0.05 || black_level["basis"] == "references (offset)",
+        "taken as black, the glass's reading misleads the gain: {black_level}"
     );
 }
 
