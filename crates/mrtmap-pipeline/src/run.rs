@@ -143,12 +143,14 @@ pub fn segment_folder(job: &SegmentJob<'_>) -> Result<SegmentReport> {
         masks: section.masks,
         texture: section.texture,
     };
+    let (references, warnings) = crate::level::merge_same_spot(match job.references {
+        Some(f) => read_references(f)?,
+        None => Vec::new(),
+    });
     let level = LevelInputs {
-        references: match job.references {
-            Some(f) => read_references(f)?,
-            None => Vec::new(),
-        },
+        references,
         camera_accuracy_k: DEFAULT_CAMERA_ACCURACY_K,
+        warnings,
         ..LevelInputs::default()
     };
     segment_into(job.fused, &inputs, &section.params(&room), &level, job.out)
