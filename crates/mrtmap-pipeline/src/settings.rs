@@ -701,9 +701,17 @@ impl MrtSection {
         })
     }
 
-    /// Settings that need no scene: the placement uncertainty (checked before a run's fusion,
-    /// not after it).
+    /// Settings that need no scene: the placement uncertainty and the ray count (checked before a
+    /// run's fusion, not after it).
     pub fn check(&self) -> Result<()> {
+        if self.rays > MAX_RAYS {
+            return Err(Error::setting(
+                format!("--rays {} ([mrt] rays)", self.rays),
+                format!(
+                    "is more than the {MAX_RAYS} rays per point allowed (each ray holds about 42 bytes while a point is answered: 1e8 rays took 4.2 GB); 20000 give about ±0.01 K"
+                ),
+            ));
+        }
         if !(self.placement_std_m.is_finite() && (0.0..=1.0).contains(&self.placement_std_m)) {
             return Err(Error::setting(
                 format!(
@@ -725,6 +733,10 @@ impl MrtSection {
             .with_placement_std(self.placement_std_m))
     }
 }
+
+/// The most Monte Carlo rays per point a setting may ask for: 10 million (about 420 MB while a
+/// point is answered); issue 54 found 2e9 running out of memory and 1e15 aborting Python.
+pub const MAX_RAYS: usize = 10_000_000;
 
 /// A project: everything `mrtmap run` needs besides the recording.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -886,6 +898,25 @@ impl Project {
 mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
+
+    /// Issue 54: a ray count that cannot be answered is refused before anything runs.
+    #[test]
+    fn too_many_rays_are_refused_naming_the_flag() {
+        let mut m = MrtSection::default();
+        m.rays = MAX_RAYS;
+        assert!(m.check().is_ok());
+        m.rays = 1_000_000_000_000_000;
+        let e = m.check().unwrap_err().to_string();
+        assert!(
+            e.contains("--rays 1000000000000000") && e.contains("10000000"),
+            "{e}"
+        );
+        let p = Project {
+            mrt: m,
+            ..Project::default()
+        };
+        assert!(p.check().is_err());
+    }
 
     #[test]
     fn the_documented_example_parses_to_the_defaults_plus_its_point() {
