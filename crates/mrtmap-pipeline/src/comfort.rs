@@ -749,7 +749,7 @@ pub fn solar_gain_of(inputs: SolarInputs) -> Result<SolarAnswer> {
 }
 
 /// A SolarCal input refused, as its flag with the value given.
-fn solar_flag_error(e: PhysicsError) -> Error {
+pub(crate) fn solar_flag_error(e: PhysicsError) -> Error {
     let flag = |name: &str| SOLAR_FLAGS.iter().find(|f| f.0 == name).map(|f| (f.1, f.2));
     match e {
         PhysicsError::OutOfRange {

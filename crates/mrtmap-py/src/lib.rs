@@ -202,6 +202,7 @@ impl PyScene {
             frame: frame_of(frame)?,
             person: None,
             planes: false,
+            sun: None,
         };
         let mrt = mrt_settings(mrt_json)?;
         let a = py
@@ -247,6 +248,7 @@ impl PyScene {
             frame: frame_of(frame)?,
             person: Some((posture, facing)),
             planes: false,
+            sun: None,
         };
         let mrt = mrt_settings(mrt_json)?;
         let a = py
@@ -274,6 +276,7 @@ impl PyScene {
             frame: frame_of(frame)?,
             person: None,
             planes: true,
+            sun: None,
         };
         let mrt = mrt_settings(mrt_json)?;
         let a = py

@@ -26,6 +26,7 @@ mod field;
 mod person;
 mod raster;
 mod scene;
+mod sun;
 
 pub use bounds::{Outside, ROOM_TOLERANCE_M, RoomBounds};
 pub use engine::{
@@ -44,6 +45,7 @@ pub use scene::{
     SceneError, SceneFile, SceneLoadError, SceneLoadErrorKind, Surface, SurfaceFile, SurfaceKind,
     TEMPERATURE_RANGE_C, slug,
 };
+pub use sun::{BODY_WIDTH_M, SunDirection, SunExposure, SunTracer, is_window_label};
 
 use serde::{Deserialize, Serialize};
 

@@ -6,7 +6,9 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use mrtmap_pipeline::MrtSection;
 use mrtmap_pipeline::export::{DEFAULT_MAX_POINTS, ExportFormat, ExportSource};
 use mrtmap_pipeline::maps::SceneSource;
-use mrtmap_pipeline::parse::{parse_facing, parse_grid, parse_mark, parse_on_off, parse_point};
+use mrtmap_pipeline::parse::{
+    parse_facing, parse_grid, parse_mark, parse_on_off, parse_point, parse_sun,
+};
 use mrtmap_pipeline::settings::{FuseSection, SegmentSection};
 use mrtmap_pipeline::settings::{PointFrame, Quantity};
 use mrtmap_pipeline::simulation::CameraErrorArgs;
@@ -660,6 +662,29 @@ pub struct MrtArgs {
     /// asymmetries (vertical, and the worst horizontal pair every 15°) with ISO 7730's PD and category.
     #[arg(long)]
     pub plane: bool,
+    /// The sun on the person through the scene's windows (features labelled "window" or
+    /// "glass"): its altitude and its azimuth in the room's frame like --facing (0 = the sun
+    /// beyond the +x side), degrees. Adds SolarCal's ΔMRT beside the MRT, with the sky-vault view
+    /// fraction and the share of the body in the beam traced in the scene. Needs --facing, --dni
+    /// and --transmittance.
+    #[arg(long, value_name = "ALT,AZ", allow_hyphen_values = true, value_parser = parse_sun, requires_all = ["facing", "dni", "transmittance"])]
+    pub sun: Option<[f64; 2]>,
+    /// Direct normal irradiance outside (W/m²), with --sun.
+    #[arg(
+        long,
+        value_name = "W_M2",
+        allow_negative_numbers = true,
+        requires = "sun"
+    )]
+    pub dni: Option<f64>,
+    /// The windows' total solar transmittance with their shades (0…1), with --sun.
+    #[arg(
+        long,
+        value_name = "T",
+        allow_negative_numbers = true,
+        requires = "sun"
+    )]
+    pub transmittance: Option<f64>,
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,

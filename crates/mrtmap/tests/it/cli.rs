@@ -1079,3 +1079,67 @@ fn solar_gain_equals_solarcal_and_names_a_bad_flag() {
         "invalid value 'lying'",
     );
 }
+
+/// Issue 52: the sun through the example office's window (on the +x wall) onto a seated person
+/// facing it: ΔMRT beside the MRT, within 10 % of SolarCal for a person wholly in the beam
+/// (16.41 K); --sun needs --facing, --dni and --transmittance.
+#[test]
+fn mrt_adds_the_sun_through_the_window_for_a_person() {
+    let v = ok_json(&[
+        "mrt",
+        "--at",
+        "2.65,1.8,0.6",
+        "--person",
+        "seated",
+        "--facing",
+        "0",
+        "--sun",
+        "30,0",
+        "--dni",
+        "700",
+        "--transmittance",
+        "0.6",
+        "--json",
+    ]);
+    let p = &v["persons"][0];
+    let d = p["delta_mrt_k"].as_f64().unwrap();
+    assert!((d - 16.41).abs() < 1.641, "{p}");
+    assert!(p["f_bes"].as_f64().unwrap() > 0.95, "{p}");
+    assert_eq!(p["sharp_deg"], 0.0);
+    let with_sun = p["mrt_with_sun_c"].as_f64().unwrap();
+    assert!((with_sun - p["mrt_c"].as_f64().unwrap() - d).abs() < 1e-9);
+    fails_with(
+        &[
+            "mrt",
+            "--at",
+            "2.65,1.8,0.6",
+            "--person",
+            "seated",
+            "--sun",
+            "30,0",
+            "--dni",
+            "700",
+            "--transmittance",
+            "0.6",
+        ],
+        "--facing",
+    );
+    fails_with(
+        &[
+            "mrt",
+            "--at",
+            "2.65,1.8,0.6",
+            "--person",
+            "seated",
+            "--facing",
+            "0",
+            "--sun",
+            "30",
+            "--dni",
+            "700",
+            "--transmittance",
+            "0.6",
+        ],
+        "expected ALT,AZ",
+    );
+}
