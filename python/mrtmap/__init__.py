@@ -8,8 +8,9 @@ arrays in and out:
   (:meth:`Scene.plane_radiant`) and maps (:meth:`Scene.map`).
 - :func:`run` — the whole pipeline on a recording, as ``mrtmap run``.
 - :func:`survey` — many recordings as independent tasks on a Dask cluster, one table.
-- :func:`pmv_ppd_iso`, :func:`operative_tmp`, :func:`mean_radiant_tmp`, :func:`v_relative` —
-  vectorised with numpy broadcasting, named and unitised as pythermalcomfort's.
+- :func:`pmv_ppd_iso`, :func:`operative_tmp`, :func:`mean_radiant_tmp`, :func:`v_relative`,
+  :func:`solar_gain` (the sun on a person, SolarCal) and :func:`f_svv` — vectorised with numpy
+  broadcasting, named and unitised as pythermalcomfort's.
 
 Errors are :class:`MrtmapError` (a ``ValueError``) carrying the message the command line prints.
 Temperatures are °C, lengths metres, air speeds m/s, standard errors K.
@@ -45,6 +46,9 @@ __all__ = [
     "mean_radiant_tmp",
     "mrt_from_globe",
     "v_relative",
+    "solar_gain",
+    "SolarGain",
+    "f_svv",
 ]
 
 PathLike = Union[str, Path]
@@ -461,3 +465,49 @@ def v_relative(v, met):
     pythermalcomfort's ``v_relative``."""
     v, met = np.asarray(v, dtype=np.float64), np.asarray(met, dtype=np.float64)
     return np.where(met > 1, np.round(v + 0.3 * (met - 1), 3), v)
+
+
+@dataclass(frozen=True)
+class SolarGain:
+    """The sun's effective radiant field ``erf`` (W/m²) and the rise ``delta_mrt`` (K) of the mean
+    radiant temperature it causes (pythermalcomfort's fields): floats for scalar inputs, else
+    arrays of the inputs' broadcast shape."""
+
+    erf: Any
+    delta_mrt: Any
+
+
+def solar_gain(
+    sol_altitude, sharp, sol_radiation_dir, sol_transmittance, f_svv, f_bes, asw=0.7,
+    posture: str = "sitting", floor_reflectance=0.6, round_output: bool = True,
+) -> SolarGain:
+    """The sun on a person behind glass: SolarCal (ASHRAE 55-2023 Appendix C) —
+    pythermalcomfort's ``models.solar_gain``, same arguments and results.
+
+    sol_altitude solar altitude (deg, 0–90), sharp the sun's horizontal angle from the person's
+    front (deg, 0–180), sol_radiation_dir direct normal irradiance (W/m²), sol_transmittance the
+    glazing's total solar transmittance (0–1), f_svv the sky-vault view fraction (0–1, see
+    :func:`f_svv`), f_bes the fraction of the body in the beam (0–1), asw short-wave
+    absorptivity, posture "sitting", "standing" or "supine", floor_reflectance (0–1).
+    ``round_output`` rounds both to 1 decimal. As pythermalcomfort, an altitude or SHARP outside
+    its range gives NaN; any other input out of its range raises :class:`MrtmapError` naming the
+    element. ΔMRT = ERF / (f_eff · 6 W/m²K), to add to the long-wave MRT.
+    """
+    shape, flat = _broadcast(sol_altitude, sharp, sol_radiation_dir, sol_transmittance, f_svv,
+                             f_bes, asw, floor_reflectance)
+    erf, dmrt = _mrtmap.solar_gain(*flat, str(posture))
+    erf, dmrt = erf.reshape(shape), dmrt.reshape(shape)
+    if round_output:
+        erf, dmrt = np.round(erf, 1), np.round(dmrt, 1)
+    if shape == ():
+        return SolarGain(erf=float(erf), delta_mrt=float(dmrt))
+    return SolarGain(erf=erf, delta_mrt=dmrt)
+
+
+def f_svv(w, h, d):
+    """The sky-vault view fraction of a window ``w`` × ``h`` (m) straight ahead of a person at
+    distance ``d`` (m): atan(h/2d)° · atan(w/2d)° / 16200 — pythermalcomfort's
+    ``environment.f_svv`` (the CBE Comfort Tool's form); broadcasts, a float for scalars."""
+    shape, flat = _broadcast(w, h, d)
+    out = _mrtmap.f_svv(*flat).reshape(shape)
+    return float(out) if shape == () else out

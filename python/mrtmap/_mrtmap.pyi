@@ -75,4 +75,18 @@ def mrt_from_globe(
     emissivity: npt.ArrayLike,
     mixed: bool,
 ) -> npt.NDArray[np.float64]: ...
+def solar_gain(
+    sol_altitude: npt.ArrayLike,
+    sharp: npt.ArrayLike,
+    sol_radiation_dir: npt.ArrayLike,
+    sol_transmittance: npt.ArrayLike,
+    f_svv: npt.ArrayLike,
+    f_bes: npt.ArrayLike,
+    asw: npt.ArrayLike,
+    floor_reflectance: npt.ArrayLike,
+    posture: str,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+def f_svv(
+    w: npt.ArrayLike, h: npt.ArrayLike, d: npt.ArrayLike
+) -> npt.NDArray[np.float64]: ...
 def cli_main(argv: list[str]) -> int: ...

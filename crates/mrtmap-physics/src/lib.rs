@@ -3,13 +3,15 @@
 //! The comfort physics of mrtmap, with no I/O: temperature units that keep absolute temperature
 //! and temperature difference apart, the ISO 7726 mean radiant temperature (MRT) from view factors,
 //! globe thermometer conversions both ways, operative temperature, PMV/PPD and radiant asymmetry,
-//! and a person's projected-area factors (seated, standing) with ISO 7726's angle-factor fit.
+//! a person's projected-area factors (seated, standing) with ISO 7726's angle-factor fit, and the
+//! sun on a person (SolarCal, ASHRAE 55 Appendix C) with the sun's position (`solar`).
 //!
 //! ```text
 //!  view factors + surface temperatures ──► mean_radiant_temperature ──► Tr
 //!  globe Tg, air Ta, air speed v       ──► mrt_from_globe           ──► Tr
 //!  Tr, Ta, v                           ──► globe_temperature        ──► Tg (what a globe would read)
 //!  Ta, Tr, v, RH, met, clo             ──► pmv_ppd                  ──► PMV, PPD
+//!  sun β, SHARP, I_dir, window, body   ──► solar_gain               ──► ERF, ΔMRT
 //! ```
 //!
 //! ```
@@ -35,6 +37,7 @@ mod error;
 mod globe;
 mod mrt;
 mod person;
+mod solar;
 mod units;
 
 pub use comfort::{
@@ -51,5 +54,10 @@ pub use mrt::{MeanRadiant, RadiantAverage, RadiantSource, mean_radiant_temperatu
 pub use person::{
     Category, Posture, RectangleOrientation, angle_factor_fit, angle_factor_fit_rect,
     asymmetry_limits_k, projected_area_factor, projected_area_factor_averaged,
+};
+pub use solar::{
+    DEFAULT_ASW, DEFAULT_FLOOR_REFLECTANCE, MAX_DNI_W_M2, SOLAR_HR_W_M2K, SolarGain, SolarInputs,
+    SolarPosture, SunPosition, UtcTime, f_svv, room_azimuth_deg, sharp_deg, solar_gain,
+    solar_projected_area_factor, sun_position,
 };
 pub use units::{Temperature, TemperatureDelta, ZERO_CELSIUS_K};

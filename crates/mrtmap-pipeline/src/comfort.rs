@@ -14,6 +14,12 @@ use std::path::Path;
 use mrtmap_geometry::nalgebra::Point2;
 use mrtmap_io::FileError;
 use mrtmap_physics::{Category, Posture, Temperature, pmv_ppd};
+/// The sun on a person (SolarCal) and where the sun is, for callers with their own inputs
+/// (mrtmap-physics').
+pub use mrtmap_physics::{
+    DEFAULT_ASW, DEFAULT_FLOOR_REFLECTANCE, PhysicsError, SolarGain, SolarInputs, SolarPosture,
+    SunPosition, UtcTime, f_svv, room_azimuth_deg, sharp_deg, solar_gain, sun_position,
+};
 /// The comfort formulas themselves, for callers with their own inputs (a binding's arrays):
 /// PMV/PPD by edition of ISO 7730 and the operative temperature (mrtmap-physics').
 pub use mrtmap_physics::{
@@ -75,11 +81,7 @@ pub struct Thermal {
 }
 
 /// Operative temperature and PMV/PPD of a person at mean radiant temperature `tr_c` ± `tr_se_k`.
-pub fn thermal(
-    air: &Air,
-    tr_c: f64,
-    tr_se_k: f64,
-) -> std::result::Result<Thermal, mrtmap_physics::PhysicsError> {
+pub fn thermal(air: &Air, tr_c: f64, tr_se_k: f64) -> std::result::Result<Thermal, PhysicsError> {
     let c = Temperature::from_celsius;
     let vr = relative_air_speed(air.speed_m_s, air.met);
     let pmv_at = |tr: f64| {
@@ -669,4 +671,133 @@ pub fn comfort_csv(path: &Path) -> Result<Vec<String>> {
         });
     }
     Ok(lines)
+}
+
+/// What `mrtmap solar-gain` reports: the model, its inputs and its answer.
+pub const SOLAR_MODEL: &str =
+    "SolarCal (ASHRAE 55-2023 Appendix C), as pythermalcomfort 4.8 solar_gain; h_r 6 W/m²K";
+
+/// The sun's gain on a person: SolarCal's inputs and answer.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SolarAnswer {
+    /// The model.
+    pub model: &'static str,
+    /// The inputs.
+    #[serde(flatten)]
+    pub inputs: SolarInputs,
+    /// The effective radiant field (W/m²).
+    pub erf_w_m2: f64,
+    /// The rise of the mean radiant temperature (K).
+    pub delta_mrt_k: f64,
+}
+
+/// The command line's flag for each SolarCal input, by the name mrtmap-physics gives it, and
+/// what the flag is.
+const SOLAR_FLAGS: [(&str, &str, &str); 8] = [
+    (
+        "solar altitude (°)",
+        "--altitude",
+        "the solar altitude in degrees",
+    ),
+    (
+        "SHARP (°)",
+        "--sharp",
+        "the sun's angle from the person's front in degrees",
+    ),
+    (
+        "direct normal irradiance (W/m²)",
+        "--dni",
+        "the direct normal irradiance in W/m²",
+    ),
+    (
+        "solar transmittance",
+        "--transmittance",
+        "the glazing's solar transmittance",
+    ),
+    (
+        "sky-vault view fraction f_svv",
+        "--f-svv",
+        "the sky-vault view fraction",
+    ),
+    (
+        "fraction of the body in the beam f_bes",
+        "--f-bes",
+        "the fraction of the body in the beam",
+    ),
+    (
+        "short-wave absorptivity",
+        "--asw",
+        "the person's short-wave absorptivity",
+    ),
+    (
+        "floor reflectance",
+        "--floor-reflectance",
+        "the floor's reflectance",
+    ),
+];
+
+/// SolarCal for one person ([`solar_gain`]); an input out of its range is refused naming its
+/// `mrtmap solar-gain` flag.
+pub fn solar_gain_of(inputs: SolarInputs) -> Result<SolarAnswer> {
+    let g = solar_gain(&inputs).map_err(solar_flag_error)?;
+    Ok(SolarAnswer {
+        model: SOLAR_MODEL,
+        inputs,
+        erf_w_m2: g.erf_w_m2,
+        delta_mrt_k: g.delta_mrt_k,
+    })
+}
+
+/// A SolarCal input refused, as its flag with the value given.
+pub(crate) fn solar_flag_error(e: PhysicsError) -> Error {
+    let flag = |name: &str| SOLAR_FLAGS.iter().find(|f| f.0 == name).map(|f| (f.1, f.2));
+    match e {
+        PhysicsError::OutOfRange {
+            name,
+            value,
+            min,
+            max,
+        } => match flag(name) {
+            Some((f, what)) => Error::setting(
+                format!("{f} {value}"),
+                format!("is outside {min}…{max} ({what})"),
+            ),
+            None => e.into(),
+        },
+        PhysicsError::NotFinite { name, value } => match flag(name) {
+            Some((f, what)) => Error::setting(
+                format!("{f} {value}"),
+                format!("is not a finite number ({what})"),
+            ),
+            None => e.into(),
+        },
+        e => e.into(),
+    }
+}
+
+impl SolarAnswer {
+    /// The answer in lines.
+    pub fn lines(&self) -> Vec<String> {
+        let i = &self.inputs;
+        vec![
+            format!("model: {}", self.model),
+            format!(
+                "sun {:.1}° high, SHARP {:.0}°, {:.0} W/m² direct through transmittance {}; f_svv {:.4}, f_bes {}; {} person, α_sw {}, floor reflectance {}",
+                i.altitude_deg,
+                i.sharp_deg,
+                i.dni_w_m2,
+                i.transmittance,
+                i.f_svv,
+                i.f_bes,
+                i.posture.as_str(),
+                i.asw,
+                i.floor_reflectance
+            ),
+            format!("effective radiant field ERF {:.2} W/m²", self.erf_w_m2),
+            format!(
+                "ΔMRT {:+.2} K: add it to the long-wave MRT for the MRT in this sun",
+                self.delta_mrt_k
+            ),
+        ]
+    }
 }

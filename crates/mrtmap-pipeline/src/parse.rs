@@ -39,6 +39,17 @@ pub fn parse_facing(s: &str) -> Result<f64, ParseError> {
     }
 }
 
+/// The sun ALT,AZ in degrees: its altitude, and its azimuth in the room's frame as a heading
+/// (from +x towards +y; any finite number, as 0…360°).
+pub fn parse_sun(s: &str) -> Result<[f64; 2], ParseError> {
+    let v = numbers(
+        s,
+        &[2],
+        "ALT,AZ: the sun's altitude and its azimuth from +x towards +y, in degrees",
+    )?;
+    Ok([v[0], v[1].rem_euclid(360.0)])
+}
+
 /// "AxB" (also "A×B") as two numbers; `bad` says what was expected.
 pub fn parse_pair(s: &str, bad: &dyn Fn() -> ParseError) -> Result<(usize, usize), ParseError> {
     let (a, b) = s.split_once(['x', 'X', '×']).ok_or_else(bad)?;

@@ -4,17 +4,21 @@
 
 /// A person's posture and the asymmetry kinds (mrtmap-physics' types).
 pub use mrtmap_physics::{AsymmetryKind, Posture};
+use mrtmap_physics::{DEFAULT_ASW, DEFAULT_FLOOR_REFLECTANCE, SolarInputs, sharp_deg, solar_gain};
 /// A sphere's MRT at a point with its view-factor table (mrtmap-radiation's).
 pub use mrtmap_radiation::PointRecord;
 /// Which way a person faces, an asymmetry's verdict, the enclosure tolerance and the built-in
 /// example scene (mrtmap-radiation's).
 pub use mrtmap_radiation::{AsymmetryVerdict, ENCLOSURE_TOLERANCE, EXAMPLE_OFFICE_JSON, Facing};
-use mrtmap_radiation::{PersonMrt, RadiantAsymmetry, RadiantScene};
+use mrtmap_radiation::{PersonMrt, RadiantAsymmetry, RadiantScene, SunTracer};
+/// The sun in the room's frame and a person's exposure to it (mrtmap-radiation's).
+pub use mrtmap_radiation::{SunDirection, SunExposure};
 use mrtmap_report::numbers::{fixed, uncertainty};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::error::Result;
+use crate::comfort::solar_flag_error;
+use crate::error::{Error, Result};
 use crate::maps::to_scene_frame;
 use crate::settings::{MrtSection, PointFrame};
 
@@ -30,6 +34,64 @@ pub struct PointQuery {
     pub person: Option<(Posture, Facing)>,
     /// The six plane radiant temperatures and the radiant asymmetry as well.
     pub planes: bool,
+    /// The sun through the scene's windows on the person (SolarCal), which needs `person` with a
+    /// facing.
+    pub sun: Option<SunQuery>,
+}
+
+/// The sun outside and the glazing, for SolarCal at each person.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct SunQuery {
+    /// Where the sun is in the room's frame (altitude, and azimuth from +x towards +y).
+    pub direction: SunDirection,
+    /// Direct normal irradiance outside (W/m²).
+    pub dni_w_m2: f64,
+    /// The windows' total solar transmittance (0…1).
+    pub transmittance: f64,
+    /// The person's short-wave absorptivity.
+    pub asw: f64,
+    /// The floor's short-wave reflectance.
+    pub floor_reflectance: f64,
+}
+
+impl SunQuery {
+    /// The sun at `altitude_deg` and `azimuth_deg` (room frame) with SolarCal's default
+    /// absorptivity (0.7) and floor reflectance (0.6).
+    pub fn new(altitude_deg: f64, azimuth_deg: f64, dni_w_m2: f64, transmittance: f64) -> Self {
+        Self {
+            direction: SunDirection {
+                altitude_deg,
+                azimuth_deg,
+            },
+            dni_w_m2,
+            transmittance,
+            asw: DEFAULT_ASW,
+            floor_reflectance: DEFAULT_FLOOR_REFLECTANCE,
+        }
+    }
+}
+
+/// The sun on a person: the exposure traced in the scene and SolarCal's answer.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SunAnswer {
+    /// The sun's altitude (degrees).
+    pub sun_altitude_deg: f64,
+    /// The sun's azimuth in the room's frame (degrees from +x towards +y).
+    pub sun_azimuth_deg: f64,
+    /// The sun's angle from the person's front (degrees, 0…180).
+    pub sharp_deg: f64,
+    /// Sky-vault view fraction through the windows (traced).
+    pub f_svv: f64,
+    /// Fraction of the body in the beam (traced).
+    pub f_bes: f64,
+    /// The windows the beam reaches the body through.
+    pub beam_windows: Vec<String>,
+    /// SolarCal's effective radiant field (W/m²).
+    pub erf_w_m2: f64,
+    /// The rise of the MRT (K).
+    pub delta_mrt_k: f64,
+    /// The long-wave MRT plus ΔMRT (°C).
+    pub mrt_with_sun_c: f64,
 }
 
 /// The answers, in the order of the points; `mrtmap mrt --json` writes this.
@@ -72,6 +134,9 @@ pub struct PersonAnswer {
     pub angle_factors: Vec<(String, f64)>,
     /// Rays cast.
     pub rays: usize,
+    /// The sun on the person, when asked for: ΔMRT beside the long-wave MRT above.
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub sun: Option<SunAnswer>,
 }
 
 /// The plane radiant temperatures and the radiant asymmetry at a point.
@@ -112,7 +177,69 @@ fn person_answer(p: &PersonMrt, patches: &[mrtmap_radiation::Patch]) -> PersonAn
             .map(|(pa, f)| (pa.id.clone(), *f))
             .collect(),
         rays: p.rays,
+        sun: None,
     }
+}
+
+/// Refuses a sun without a person facing one way, or below the horizon, before any ray.
+fn check_sun(q: &PointQuery) -> Result<()> {
+    let Some(sun) = &q.sun else {
+        return Ok(());
+    };
+    let (alt, az) = (sun.direction.altitude_deg, sun.direction.azimuth_deg);
+    match q.person {
+        None => Err(Error::setting(
+            "--sun",
+            "is for a person: give --person seated|standing and --facing DEG",
+        )),
+        Some((_, Facing::Any)) => Err(Error::setting(
+            "--sun",
+            "needs --facing: SolarCal's SHARP is the sun's angle from the person's front",
+        )),
+        Some(_) if !(0.0..=90.0).contains(&alt) => Err(Error::setting(
+            format!("--sun {alt},{az}"),
+            "has its altitude outside 0…90°: no sun above the horizon, no beam",
+        )),
+        Some(_) => Ok(()),
+    }
+}
+
+/// SolarCal for the person `p` (body centre `at` in the scene's frame) in the sun `sun`.
+fn sun_on(
+    tracer: &SunTracer<'_>,
+    at: &mrtmap_geometry::nalgebra::Point3<f64>,
+    p: &PersonAnswer,
+    sun: &SunQuery,
+) -> Result<SunAnswer> {
+    let facing = match p.facing {
+        Facing::Azimuth(a) => a,
+        Facing::Any => 0.0,
+    };
+    let exposure = tracer.exposure(at, p.posture, &sun.direction);
+    let sharp = sharp_deg(facing, sun.direction.azimuth_deg);
+    let g = solar_gain(&SolarInputs {
+        altitude_deg: sun.direction.altitude_deg,
+        sharp_deg: sharp,
+        dni_w_m2: sun.dni_w_m2,
+        transmittance: sun.transmittance,
+        f_svv: exposure.f_svv,
+        f_bes: exposure.f_bes,
+        asw: sun.asw,
+        posture: p.posture.into(),
+        floor_reflectance: sun.floor_reflectance,
+    })
+    .map_err(solar_flag_error)?;
+    Ok(SunAnswer {
+        sun_altitude_deg: sun.direction.altitude_deg,
+        sun_azimuth_deg: sun.direction.azimuth_deg,
+        sharp_deg: sharp,
+        f_svv: exposure.f_svv,
+        f_bes: exposure.f_bes,
+        beam_windows: exposure.beam_windows,
+        erf_w_m2: g.erf_w_m2,
+        delta_mrt_k: g.delta_mrt_k,
+        mrt_with_sun_c: p.mrt_c + g.delta_mrt_k,
+    })
 }
 
 fn plane_answer(a: &RadiantAsymmetry) -> PlaneAnswer {
@@ -142,8 +269,10 @@ pub fn mrt_at_points(
     mrt: &MrtSection,
     q: &PointQuery,
 ) -> Result<PointAnswers> {
+    check_sun(q)?;
     let method = mrt.method(scene)?;
     let engine = mrt.engine(scene)?;
+    let tracer = q.sun.as_ref().map(|_| SunTracer::new(scene));
     let mut answers = PointAnswers {
         scene: source.to_string(),
         method_description: method.describe(engine.ray_engine()),
@@ -167,7 +296,11 @@ pub fn mrt_at_points(
                 let mut one: One = (None, None, None);
                 if let Some((posture, facing)) = q.person {
                     let r = engine.person_at(&at, posture, facing, k as u64)?;
-                    one.1 = Some(person_answer(&r, engine.patches()));
+                    let mut answer = person_answer(&r, engine.patches());
+                    if let (Some(sun), Some(tracer)) = (&q.sun, &tracer) {
+                        answer.sun = Some(sun_on(tracer, &at, &answer, sun)?);
+                    }
+                    one.1 = Some(answer);
                 } else {
                     let r = engine.at(&at, k as u64)?;
                     one.0 = Some(PointRecord::new(None, &r, engine.patches()));
@@ -282,6 +415,24 @@ fn person_and_plane_lines(persons: &[PersonAnswer], planes: &[PlaneAnswer]) -> V
             "  angle factors (sum {:.4}; fp's closure is about 0.99, the MRT is normalised by it):",
             p.angle_factor_sum
         ));
+        if let Some(s) = &p.sun {
+            lines.push(format!(
+                "  sun {:.1}° high towards {:.0}° (SHARP {:.0}°): f_svv {:.4}, f_bes {:.2}{}; ERF {:.2} W/m², ΔMRT {:+.2} K: MRT with the sun {:.2} °C (SolarCal)",
+                s.sun_altitude_deg,
+                s.sun_azimuth_deg,
+                s.sharp_deg,
+                s.f_svv,
+                s.f_bes,
+                if s.beam_windows.is_empty() {
+                    " (out of the beam)".to_string()
+                } else {
+                    format!(" through {}", s.beam_windows.join(", "))
+                },
+                s.erf_w_m2,
+                s.delta_mrt_k,
+                s.mrt_with_sun_c
+            ));
+        }
         for (id, f) in p.angle_factors.iter().filter(|(_, f)| *f > 0.0) {
             lines.push(format!("  {id:<28} {f:>9.5}"));
         }
@@ -330,6 +481,7 @@ mod tests {
             frame: PointFrame::Room,
             person: None,
             planes: true,
+            sun: None,
         };
         let a = mrt_at_points(&scene, "example", &mrt, &q).unwrap();
         assert_eq!((a.points.len(), a.persons.len(), a.planes.len()), (2, 0, 2));
@@ -343,5 +495,86 @@ mod tests {
         assert!((p.persons[0].mrt_c - sphere).abs() < 1.0);
         q.at = vec![[20.0, 1.5, 1.1]];
         assert!(mrt_at_points(&scene, "example", &mrt, &q).is_err());
+    }
+
+    /// Issue 52's acceptance: the example office's window is on the +x wall (x = 4.2 m, y
+    /// 0.9…2.7, z 0.9…2.2), so a sun 30° high due +x (azimuth 0 in the room's frame) shines
+    /// through it onto a seated person facing it 1.55 m away, centred on it; SolarCal for that
+    /// person wholly in the beam with the CBE form's f_svv for the window gives ΔMRT 16.41 K
+    /// (grey-and-sun.md). A person at y = 0.3, beside the beam, gets sky and floor only.
+    #[test]
+    fn the_sun_through_the_example_window() {
+        let scene = mrtmap_radiation::example_office();
+        let mrt = MrtSection::default();
+        let q = PointQuery {
+            at: vec![[2.65, 1.8, 0.6], [2.65, 0.3, 0.6]],
+            frame: PointFrame::Room,
+            person: Some((Posture::Seated, Facing::Azimuth(0.0))),
+            planes: false,
+            sun: Some(SunQuery::new(30.0, 0.0, 700.0, 0.6)),
+        };
+        let a = mrt_at_points(&scene, "example", &mrt, &q).unwrap();
+        let solarcal = solar_gain(&SolarInputs {
+            altitude_deg: 30.0,
+            sharp_deg: 0.0,
+            dni_w_m2: 700.0,
+            transmittance: 0.6,
+            f_svv: mrtmap_physics::f_svv(1.8, 1.3, 1.55).unwrap(),
+            f_bes: 1.0,
+            asw: 0.7,
+            posture: mrtmap_physics::SolarPosture::Seated,
+            floor_reflectance: 0.6,
+        })
+        .unwrap()
+        .delta_mrt_k;
+        assert!((solarcal - 16.41).abs() < 0.01);
+        let lit = a.persons[0].sun.as_ref().unwrap();
+        assert!(lit.f_bes > 0.95, "{lit:?}");
+        assert_eq!(lit.beam_windows, vec!["window-1".to_string()]);
+        assert!(
+            (lit.delta_mrt_k - solarcal).abs() < 0.1 * solarcal,
+            "{} against {solarcal}",
+            lit.delta_mrt_k
+        );
+        assert!((lit.mrt_with_sun_c - a.persons[0].mrt_c - lit.delta_mrt_k).abs() < 1e-9);
+        let beside = a.persons[1].sun.as_ref().unwrap();
+        assert_eq!(beside.f_bes, 0.0);
+        assert!(beside.delta_mrt_k > 0.0, "sky and floor still count");
+        assert!(beside.delta_mrt_k < 0.25 * lit.delta_mrt_k, "{beside:?}");
+        // The JSON has ΔMRT beside the long-wave MRT.
+        let json = serde_json::to_value(&a).unwrap();
+        let person = &json["persons"][0];
+        for key in [
+            "mrt_c",
+            "delta_mrt_k",
+            "f_svv",
+            "f_bes",
+            "sharp_deg",
+            "erf_w_m2",
+        ] {
+            assert!(person[key].is_number(), "{key}: {person}");
+        }
+        // A sun without a facing, without a person or below the horizon is refused.
+        let mut bad = q.clone();
+        bad.person = Some((Posture::Seated, Facing::Any));
+        assert!(
+            mrt_at_points(&scene, "example", &mrt, &bad)
+                .unwrap_err()
+                .to_string()
+                .contains("--facing")
+        );
+        bad.person = None;
+        assert!(mrt_at_points(&scene, "example", &mrt, &bad).is_err());
+        let mut low = q.clone();
+        low.sun = Some(SunQuery::new(-3.0, 0.0, 700.0, 0.6));
+        let e = mrt_at_points(&scene, "example", &mrt, &low)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("--sun -3,0 has its altitude outside"), "{e}");
+        low.sun = Some(SunQuery::new(30.0, 0.0, 700.0, 1.6));
+        let e = mrt_at_points(&scene, "example", &mrt, &low)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("--transmittance 1.6 is outside 0…1"), "{e}");
     }
 }

@@ -18,7 +18,8 @@ use std::path::PathBuf;
 use std::sync::Mutex;
 
 use mrtmap_pipeline::comfort::{
-    Iso7730Edition, OperativeMethod, PmvInputs, operative_temperature, pmv_ppd_each,
+    Iso7730Edition, OperativeMethod, PmvInputs, SolarInputs, SolarPosture, operative_temperature,
+    pmv_ppd_each, solar_gain as solarcal,
 };
 use mrtmap_pipeline::export::{ExportFormat, export_scene};
 use mrtmap_pipeline::maps::{GridSpec, RadiantScene, SceneSource, load_scene, map_arrays};
@@ -201,6 +202,7 @@ impl PyScene {
             frame: frame_of(frame)?,
             person: None,
             planes: false,
+            sun: None,
         };
         let mrt = mrt_settings(mrt_json)?;
         let a = py
@@ -246,6 +248,7 @@ impl PyScene {
             frame: frame_of(frame)?,
             person: Some((posture, facing)),
             planes: false,
+            sun: None,
         };
         let mrt = mrt_settings(mrt_json)?;
         let a = py
@@ -273,6 +276,7 @@ impl PyScene {
             frame: frame_of(frame)?,
             person: None,
             planes: true,
+            sun: None,
         };
         let mrt = mrt_settings(mrt_json)?;
         let a = py
@@ -627,6 +631,107 @@ fn mrt_from_globe<'py>(
     Ok(PyArray1::from_vec(py, out?))
 }
 
+/// SolarCal's ERF (W/m²) and ΔMRT (K) element by element (pythermalcomfort's `solar_gain`,
+/// unrounded): NaN where the altitude lies outside 0…90° or SHARP outside 0…180° (as
+/// pythermalcomfort, so that a year of sun positions with its nights goes through); any other
+/// input out of its range is refused, naming the element.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn solar_gain<'py>(
+    py: Python<'py>,
+    sol_altitude: PyArrayLike1<'py, f64, AllowTypeChange>,
+    sharp: PyArrayLike1<'py, f64, AllowTypeChange>,
+    sol_radiation_dir: PyArrayLike1<'py, f64, AllowTypeChange>,
+    sol_transmittance: PyArrayLike1<'py, f64, AllowTypeChange>,
+    f_svv: PyArrayLike1<'py, f64, AllowTypeChange>,
+    f_bes: PyArrayLike1<'py, f64, AllowTypeChange>,
+    asw: PyArrayLike1<'py, f64, AllowTypeChange>,
+    floor_reflectance: PyArrayLike1<'py, f64, AllowTypeChange>,
+    posture: &str,
+) -> PyResult<Pair<'py>> {
+    let posture = SolarPosture::from_name(posture).ok_or_else(|| {
+        MrtmapError::new_err(format!(
+            "posture '{posture}' is none of 'sitting', 'standing' and 'supine'"
+        ))
+    })?;
+    let c = columns(
+        [
+            &sol_altitude,
+            &sharp,
+            &sol_radiation_dir,
+            &sol_transmittance,
+            &f_svv,
+            &f_bes,
+            &asw,
+            &floor_reflectance,
+        ],
+        [
+            "sol_altitude",
+            "sharp",
+            "sol_radiation_dir",
+            "sol_transmittance",
+            "f_svv",
+            "f_bes",
+            "asw",
+            "floor_reflectance",
+        ],
+    )?;
+    let n = c[0].len();
+    // In parallel without the GIL; the first element refused, in order, is the one named.
+    let out: Vec<Result<(f64, f64), String>> = py.detach(|| {
+        (0..n)
+            .into_par_iter()
+            .map(|k| {
+                let inputs = SolarInputs {
+                    altitude_deg: c[0][k],
+                    sharp_deg: c[1][k],
+                    dni_w_m2: c[2][k],
+                    transmittance: c[3][k],
+                    f_svv: c[4][k],
+                    f_bes: c[5][k],
+                    asw: c[6][k],
+                    posture,
+                    floor_reflectance: c[7][k],
+                };
+                if !(0.0..=90.0).contains(&inputs.altitude_deg)
+                    || !(0.0..=180.0).contains(&inputs.sharp_deg)
+                {
+                    return Ok((f64::NAN, f64::NAN));
+                }
+                solarcal(&inputs)
+                    .map(|g| (g.erf_w_m2, g.delta_mrt_k))
+                    .map_err(|e| format!("element {k}: {}", message(&e)))
+            })
+            .collect()
+    });
+    let (mut erf, mut dmrt) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    for r in out {
+        let (e, d) = r.map_err(MrtmapError::new_err)?;
+        erf.push(e);
+        dmrt.push(d);
+    }
+    Ok((PyArray1::from_vec(py, erf), PyArray1::from_vec(py, dmrt)))
+}
+
+/// The sky-vault view fraction of a window `w` × `h` (m) straight ahead at distance `d` (m),
+/// element by element (pythermalcomfort's `f_svv`).
+#[pyfunction]
+fn f_svv<'py>(
+    py: Python<'py>,
+    w: PyArrayLike1<'py, f64, AllowTypeChange>,
+    h: PyArrayLike1<'py, f64, AllowTypeChange>,
+    d: PyArrayLike1<'py, f64, AllowTypeChange>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let [w, h, d] = columns([&w, &h, &d], ["w", "h", "d"])?;
+    let out: PyResult<Vec<f64>> = (0..w.len())
+        .map(|k| {
+            mrtmap_pipeline::comfort::f_svv(w[k], h[k], d[k])
+                .map_err(|e| MrtmapError::new_err(format!("element {k}: {}", message(&e))))
+        })
+        .collect();
+    Ok(PyArray1::from_vec(py, out?))
+}
+
 /// The `mrtmap` command line with `argv` (the program's name first); returns the exit code.
 #[pyfunction]
 fn cli_main(py: Python<'_>, argv: Vec<String>) -> i32 {
@@ -652,6 +757,8 @@ fn _mrtmap(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(pmv_ppd, m)?)?;
     m.add_function(wrap_pyfunction!(operative, m)?)?;
     m.add_function(wrap_pyfunction!(mrt_from_globe, m)?)?;
+    m.add_function(wrap_pyfunction!(solar_gain, m)?)?;
+    m.add_function(wrap_pyfunction!(f_svv, m)?)?;
     m.add_function(wrap_pyfunction!(cli_main, m)?)?;
     Ok(())
 }

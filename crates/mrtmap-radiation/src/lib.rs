@@ -27,6 +27,7 @@ pub mod grey;
 mod person;
 mod raster;
 mod scene;
+mod sun;
 
 pub use bounds::{Outside, ROOM_TOLERANCE_M, RoomBounds};
 pub use engine::{
@@ -45,6 +46,7 @@ pub use scene::{
     SceneError, SceneFile, SceneLoadError, SceneLoadErrorKind, Surface, SurfaceFile, SurfaceKind,
     TEMPERATURE_RANGE_C, TemperatureKind, slug,
 };
+pub use sun::{BODY_WIDTH_M, SunDirection, SunExposure, SunTracer, is_window_label};
 
 use serde::{Deserialize, Serialize};
 

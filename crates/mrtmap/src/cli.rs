@@ -6,7 +6,9 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use mrtmap_pipeline::MrtSection;
 use mrtmap_pipeline::export::{DEFAULT_MAX_POINTS, ExportFormat, ExportSource};
 use mrtmap_pipeline::maps::SceneSource;
-use mrtmap_pipeline::parse::{parse_facing, parse_grid, parse_mark, parse_on_off, parse_point};
+use mrtmap_pipeline::parse::{
+    parse_facing, parse_grid, parse_mark, parse_on_off, parse_point, parse_sun,
+};
 use mrtmap_pipeline::settings::{FuseSection, SegmentSection};
 use mrtmap_pipeline::settings::{PointFrame, Quantity};
 use mrtmap_pipeline::simulation::CameraErrorArgs;
@@ -40,6 +42,9 @@ pub enum Command {
     Globe(GlobeArgs),
     /// Operative temperature and PMV/PPD (ISO 7730) from air and mean radiant temperature.
     Comfort(ComfortArgs),
+    /// The sun on a person behind glass (SolarCal, ASHRAE 55 Appendix C): the effective radiant
+    /// field and the rise ΔMRT of the mean radiant temperature.
+    SolarGain(SolarGainArgs),
     /// Write the built-in example scene (an office with a cold window) as scene.json.
     ExampleScene(ExampleSceneArgs),
     /// Simulate a handheld thermal + RGB-D scan of a room, with exact truth.
@@ -664,6 +669,29 @@ pub struct MrtArgs {
     /// asymmetries (vertical, and the worst horizontal pair every 15°) with ISO 7730's PD and category.
     #[arg(long)]
     pub plane: bool,
+    /// The sun on the person through the scene's windows (features labelled "window" or
+    /// "glass"): its altitude and its azimuth in the room's frame like --facing (0 = the sun
+    /// beyond the +x side), degrees. Adds SolarCal's ΔMRT beside the MRT, with the sky-vault view
+    /// fraction and the share of the body in the beam traced in the scene. Needs --facing, --dni
+    /// and --transmittance.
+    #[arg(long, value_name = "ALT,AZ", allow_hyphen_values = true, value_parser = parse_sun, requires_all = ["facing", "dni", "transmittance"])]
+    pub sun: Option<[f64; 2]>,
+    /// Direct normal irradiance outside (W/m²), with --sun.
+    #[arg(
+        long,
+        value_name = "W_M2",
+        allow_negative_numbers = true,
+        requires = "sun"
+    )]
+    pub dni: Option<f64>,
+    /// The windows' total solar transmittance with their shades (0…1), with --sun.
+    #[arg(
+        long,
+        value_name = "T",
+        allow_negative_numbers = true,
+        requires = "sun"
+    )]
+    pub transmittance: Option<f64>,
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -695,6 +723,43 @@ pub struct ComfortArgs {
     #[arg(long, value_name = "FILE", conflicts_with_all = ["ta", "tr"])]
     pub csv: Option<PathBuf>,
     /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `mrtmap solar-gain`: SolarCal as pythermalcomfort's `solar_gain`.
+#[derive(Debug, Args)]
+pub struct SolarGainArgs {
+    /// Solar altitude above the horizon (degrees, 0…90).
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    pub altitude: f64,
+    /// The sun's horizontal angle from the person's front, SHARP (degrees, 0…180: 0 the sun
+    /// ahead, 90 beside, 180 behind).
+    #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
+    pub sharp: f64,
+    /// Direct normal irradiance outside (W/m²; ASHRAE 55 Table C-2 gives 200…1000).
+    #[arg(long, value_name = "W_M2", allow_negative_numbers = true)]
+    pub dni: f64,
+    /// Total solar transmittance of the glazing with its shades (0…1).
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
+    pub transmittance: f64,
+    /// Fraction of the sky vault the person sees through the windows (0…1; for a window
+    /// w × h straight ahead at distance d, atan(h/2d)° · atan(w/2d)° / 16200).
+    #[arg(long, value_name = "F", allow_negative_numbers = true)]
+    pub f_svv: f64,
+    /// Fraction of the body's projected area in the beam (0…1; ASHRAE 55 Figure C2-1).
+    #[arg(long, value_name = "F", allow_negative_numbers = true)]
+    pub f_bes: f64,
+    /// The person's short-wave absorptivity (0…1; 0.57 to 0.84 by skin and clothing).
+    #[arg(long, value_name = "A", allow_negative_numbers = true, default_value_t = mrtmap_pipeline::comfort::DEFAULT_ASW)]
+    pub asw: f64,
+    /// Posture ("sitting" is taken for seated).
+    #[arg(long, value_enum, default_value_t = mrtmap_pipeline::comfort::SolarPosture::Seated)]
+    pub posture: mrtmap_pipeline::comfort::SolarPosture,
+    /// Short-wave reflectance of the floor (0…1).
+    #[arg(long, value_name = "R", allow_negative_numbers = true, default_value_t = mrtmap_pipeline::comfort::DEFAULT_FLOOR_REFLECTANCE)]
+    pub floor_reflectance: f64,
+    /// Print JSON (the inputs, erf_w_m2 and delta_mrt_k).
     #[arg(long)]
     pub json: bool,
 }

@@ -5,4 +5,5 @@ mod comfort;
 mod globe;
 mod mrt;
 mod person;
+mod solar;
 mod units;

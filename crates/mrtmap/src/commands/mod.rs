@@ -18,6 +18,7 @@ mod run;
 mod segment;
 mod simulate;
 mod simulate_board;
+mod solar_gain;
 mod thermal;
 mod track;
 mod validate;
@@ -31,6 +32,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Mrt(a) => mrt::run(&a),
         Command::Globe(a) => globe::run(&a),
         Command::Comfort(a) => comfort::run(&a),
+        Command::SolarGain(a) => solar_gain::run(&a),
         Command::ExampleScene(a) => example_scene::run(&a),
         Command::Simulate(a) => simulate::run(&a),
         Command::Rooms(a) => rooms::run(&a),

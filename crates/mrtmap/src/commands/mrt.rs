@@ -1,7 +1,7 @@
 //! `mrtmap mrt`: MRT at points with view-factor tables.
 
 use mrtmap_pipeline::maps::load_scene;
-use mrtmap_pipeline::points::{Facing, PointQuery, mrt_at_points};
+use mrtmap_pipeline::points::{Facing, PointQuery, SunQuery, mrt_at_points};
 
 use crate::cli::MrtArgs;
 use crate::output::{json, print_lines};
@@ -15,6 +15,14 @@ pub fn run(a: &MrtArgs) -> anyhow::Result<()> {
             .person
             .map(|p| (p, a.facing.map_or(Facing::Any, Facing::Azimuth))),
         planes: a.plane,
+        sun: a.sun.map(|[alt, az]| {
+            SunQuery::new(
+                alt,
+                az,
+                a.dni.unwrap_or_default(),
+                a.transmittance.unwrap_or_default(),
+            )
+        }),
     };
     let answers = mrt_at_points(&scene, &source, &a.method, &query)?;
     if a.json {

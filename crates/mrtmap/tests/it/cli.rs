@@ -1025,3 +1025,121 @@ fn export_takes_a_room_only_from_a_honeybee_model() {
 fn mrtmap_pipeline_example() -> Vec<u8> {
     mrtmap(&["example-scene"]).stdout
 }
+
+#[test]
+fn solar_gain_equals_solarcal_and_names_a_bad_flag() {
+    // grey-and-sun.md, the first vector (pythermalcomfort 4.8.1 solar_gain, unrounded): seated,
+    // facing a 1.8 × 1.3 m window 1.55 m away, wholly in a 30° beam.
+    let args = [
+        "solar-gain",
+        "--altitude",
+        "30",
+        "--sharp",
+        "0",
+        "--dni",
+        "700",
+        "--transmittance",
+        "0.6",
+        "--f-svv",
+        "0.04233",
+        "--f-bes",
+        "1",
+    ];
+    let v = ok_json(&[&args[..], &["--posture", "sitting", "--json"]].concat());
+    assert!(
+        (v["erf_w_m2"].as_f64().unwrap() - 68.522).abs() < 0.01,
+        "{v}"
+    );
+    assert!(
+        (v["delta_mrt_k"].as_f64().unwrap() - 16.4084).abs() < 0.005,
+        "{v}"
+    );
+    // The inputs come back, with pythermalcomfort's defaults for those not given.
+    assert_eq!(v["posture"], "seated");
+    assert_eq!(v["asw"], 0.7);
+    assert_eq!(v["floor_reflectance"], 0.6);
+    assert_eq!(v["f_svv"], 0.04233);
+    let text = crate::ok(&args);
+    assert!(text.contains("ΔMRT +16.41 K"), "{text}");
+    // Out of range: one sentence naming the flag, exit code 1 as any refused input.
+    let mut bad = args.to_vec();
+    bad[2] = "95";
+    let out = mrtmap(&bad);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        err.trim(),
+        "error: --altitude 95 is outside 0…90 (the solar altitude in degrees)"
+    );
+    let mut bad = args.to_vec();
+    bad[10] = "NaN";
+    fails_with(&bad, "--f-svv NaN is not a finite number");
+    fails_with(
+        &[&args[..], &["--posture", "lying"]].concat(),
+        "invalid value 'lying'",
+    );
+}
+
+/// Issue 52: the sun through the example office's window (on the +x wall) onto a seated person
+/// facing it: ΔMRT beside the MRT, within 10 % of SolarCal for a person wholly in the beam
+/// (16.41 K); --sun needs --facing, --dni and --transmittance.
+#[test]
+fn mrt_adds_the_sun_through_the_window_for_a_person() {
+    let v = ok_json(&[
+        "mrt",
+        "--at",
+        "2.65,1.8,0.6",
+        "--person",
+        "seated",
+        "--facing",
+        "0",
+        "--sun",
+        "30,0",
+        "--dni",
+        "700",
+        "--transmittance",
+        "0.6",
+        "--json",
+    ]);
+    let p = &v["persons"][0];
+    let d = p["delta_mrt_k"].as_f64().unwrap();
+    assert!((d - 16.41).abs() < 1.641, "{p}");
+    assert!(p["f_bes"].as_f64().unwrap() > 0.95, "{p}");
+    assert_eq!(p["sharp_deg"], 0.0);
+    let with_sun = p["mrt_with_sun_c"].as_f64().unwrap();
+    assert!((with_sun - p["mrt_c"].as_f64().unwrap() - d).abs() < 1e-9);
+    fails_with(
+        &[
+            "mrt",
+            "--at",
+            "2.65,1.8,0.6",
+            "--person",
+            "seated",
+            "--sun",
+            "30,0",
+            "--dni",
+            "700",
+            "--transmittance",
+            "0.6",
+        ],
+        "--facing",
+    );
+    fails_with(
+        &[
+            "mrt",
+            "--at",
+            "2.65,1.8,0.6",
+            "--person",
+            "seated",
+            "--facing",
+            "0",
+            "--sun",
+            "30",
+            "--dni",
+            "700",
+            "--transmittance",
+            "0.6",
+        ],
+        "expected ALT,AZ",
+    );
+}
