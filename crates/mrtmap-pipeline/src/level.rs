@@ -281,6 +281,9 @@ pub struct Expected {
     pub radiant_c: f64,
     /// The emissivity.
     pub emissivity: f64,
+    /// The standard uncertainty the emissivity's puts on the radiant temperature (K): on glass
+    /// 8 K colder than the room, ±0.02 in ε is ±0.16 K.
+    pub std_k: f64,
 }
 
 impl Expected {
@@ -289,6 +292,7 @@ impl Expected {
         Self {
             radiant_c: r.temperature_c,
             emissivity: 1.0,
+            std_k: 0.0,
         }
     }
 }
@@ -331,7 +335,12 @@ fn judge_readings(
         if let Some((c, se)) = seen
             && implausible.is_none()
         {
-            pts.push((ex.radiant_c, c, r.std_k.hypot(se), uses.len()));
+            pts.push((
+                ex.radiant_c,
+                c,
+                r.std_k.hypot(se).hypot(ex.std_k),
+                uses.len(),
+            ));
         }
         uses.push(ReferenceUse {
             label: r.label.clone(),
@@ -724,15 +733,25 @@ pub fn level_segmentation(
                     .or(spot.as_ref().map(|s| s.emissivity))
                     .unwrap_or(1.0);
                 match irr {
-                    Some(t) if e < 1.0 => Expected {
-                        radiant_c: grey::radiant_temperature(
-                            Temperature::from_celsius(r.temperature_c),
-                            Temperature::from_celsius(found.correct(t.celsius())),
-                            e,
-                        )
-                        .celsius(),
-                        emissivity: e,
-                    },
+                    Some(t) if e < 1.0 => {
+                        let ts = Temperature::from_celsius(r.temperature_c);
+                        let ti = Temperature::from_celsius(found.correct(t.celsius()));
+                        let tr = grey::radiant_temperature(ts, ti, e);
+                        // ∂T_r/∂ε = (T⁴ − T_irr⁴) / 4T_r³; an emissivity the reading's column
+                        // gives is taken as known.
+                        let d_e = (ts.kelvin().powi(4) - ti.kelvin().powi(4))
+                            / (4.0 * tr.kelvin().powi(3));
+                        let sd_e = if r.emissivity.is_some() {
+                            0.0
+                        } else {
+                            level.emissivity.std
+                        };
+                        Expected {
+                            radiant_c: tr.celsius(),
+                            emissivity: e,
+                            std_k: (d_e * sd_e).abs(),
+                        }
+                    }
                     _ => Expected::black(r),
                 }
             })
@@ -979,6 +998,7 @@ mod tests {
             Expected {
                 radiant_c: window_seen,
                 emissivity: 0.84,
+                std_k: 0.0,
             },
             Expected::black(&refs[1]),
         ];
