@@ -606,6 +606,7 @@ pub struct RoomsArgs {
 
 /// `mrtmap map`.
 #[derive(Debug, Args)]
+#[command(allow_negative_numbers = true)]
 pub struct MapArgs {
     #[command(flatten)]
     pub scene: SceneSource,
@@ -643,6 +644,7 @@ pub struct MapArgs {
 
 /// `mrtmap mrt`.
 #[derive(Debug, Args)]
+#[command(allow_negative_numbers = true)]
 pub struct MrtArgs {
     #[command(flatten)]
     pub scene: SceneSource,
@@ -699,6 +701,7 @@ pub struct MrtArgs {
 
 /// `mrtmap comfort`.
 #[derive(Debug, Args)]
+#[command(allow_negative_numbers = true)]
 pub struct ComfortArgs {
     /// Air temperature (°C).
     #[arg(long, allow_negative_numbers = true, required_unless_present = "csv")]
@@ -729,6 +732,7 @@ pub struct ComfortArgs {
 
 /// `mrtmap solar-gain`: SolarCal as pythermalcomfort's `solar_gain`.
 #[derive(Debug, Args)]
+#[command(allow_negative_numbers = true)]
 pub struct SolarGainArgs {
     /// Solar altitude above the horizon (degrees, 0…90).
     #[arg(long, value_name = "DEG", allow_negative_numbers = true)]
@@ -767,6 +771,7 @@ pub struct SolarGainArgs {
 /// `mrtmap globe`.
 #[derive(Debug, Args)]
 #[command(group(clap::ArgGroup::new("reading").required(true).args(["tg", "tr"])))]
+#[command(allow_negative_numbers = true)]
 pub struct GlobeArgs {
     /// Globe temperature (°C): converts to MRT.
     #[arg(long, allow_negative_numbers = true)]

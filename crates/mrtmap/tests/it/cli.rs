@@ -1143,3 +1143,25 @@ fn mrt_adds_the_sun_through_the_window_for_a_person() {
         "expected ALT,AZ",
     );
 }
+
+/// Issue 54: a negative number after a flag is that flag's value, refused by its range, not
+/// "unexpected argument '-1' found".
+#[test]
+fn negative_values_are_judged_by_their_range() {
+    for (args, says) in [
+        (
+            &["comfort", "--ta", "22", "--tr", "24", "--clo", "-1"][..],
+            "clothing (clo) = -1",
+        ),
+        (
+            &["globe", "--tg", "25", "--ta", "22", "--va", "-1"][..],
+            "= -1 is outside",
+        ),
+        (
+            &["map", "--height", "-1", "--out", "unused"][..],
+            "-1.00 m above the floor",
+        ),
+    ] {
+        fails_with(args, says);
+    }
+}
