@@ -69,7 +69,7 @@ pub struct TextureParams {
     /// [`TextureParams::operator_above_m`] over it. A pixel whose ray, mirrored by the surface it
     /// lands on, passes through it may show the operator's reflection rather than the surface (a
     /// 34 °C body in glass of emissivity 0.84: about +1.5 K in the middle of the pane, moving
-    /// with the camera): it is not used. Only texels the cloud left empty are textured, and glass
+    /// with the camera): it is not used where other pixels saw the texel. Only texels the cloud left empty are textured, and glass
     /// is where that happens. 0: keep every pixel.
     pub operator_radius_m: f64,
     /// How far behind the camera the operator's body's axis stands (m).
@@ -140,9 +140,13 @@ pub struct TextureReport {
     pub pixels_occluded: u64,
     /// Pixels that landed on furniture.
     pub pixels_on_furniture: u64,
-    /// Pixels left out because the surface could mirror the operator there.
+    /// Pixels that could show the operator mirrored: left out of every texel that enough other
+    /// pixels saw.
     #[serde(default)]
     pub pixels_mirroring_operator: u64,
+    /// Texels only such pixels saw (taken from them rather than left unseen).
+    #[serde(default)]
+    pub texels_only_mirroring: u64,
     /// Texels the cloud had left empty that texturing filled, per surface index.
     pub texels_filled: Vec<usize>,
     /// Time it took (s, wall).
@@ -303,8 +307,9 @@ fn mirrors_operator(
     h0.min(h1) <= params.operator_above_m && h0.max(h1) >= -params.operator_below_m
 }
 
-/// Per-texel sums: (Σw, Σw·T, pixels).
-type TexelSums = HashMap<(usize, i64, i64), (f64, f64, u32)>;
+/// Per-texel sums (Σw, Σw·T, pixels) of the pixels that cannot mirror the operator, and of those
+/// that could.
+type TexelSums = HashMap<(usize, i64, i64), [(f64, f64, u32); 2]>;
 
 /// What every frame's cast shares: the model, the thermal camera's pixel rays, the settings.
 struct Caster<'a> {
@@ -379,7 +384,7 @@ impl Caster<'_> {
                 if m.covered.contains(&key) {
                     continue;
                 }
-                if self.params.operator_radius_m > 0.0
+                let mirrored = self.params.operator_radius_m > 0.0
                     && mirrors_operator(
                         &o,
                         &forward,
@@ -388,21 +393,17 @@ impl Caster<'_> {
                         &m.frame.normal,
                         &self.up,
                         self.params,
-                    )
-                {
-                    counts[3] += 1;
-                    continue;
-                }
+                    );
                 let px = Point2::new(u as f64, v as f64);
                 let rho = ((px.x - cam.cx).powi(2) + (px.y - cam.cy).powi(2)) / rmax2;
                 let temp =
                     f64::from(img.kelvin[v * w + u]) - f.offset_k - self.input.vignetting_k * rho;
                 let wgt = crate::observe::weight(cos, t, &px, 0.0, cam, &observation);
-                let e = sums.entry((s, key.0, key.1)).or_insert((0.0, 0.0, 0));
+                let e = &mut sums.entry((s, key.0, key.1)).or_default()[usize::from(mirrored)];
                 e.0 += wgt;
                 e.1 += wgt * temp;
                 e.2 += 1;
-                counts[0] += 1;
+                counts[if mirrored { 3 } else { 0 }] += 1;
             }
         }
         Some((sums, counts))
@@ -457,19 +458,37 @@ pub(crate) fn texture(
         report.pixels_on_furniture += c[2];
         report.pixels_mirroring_operator += c[3];
         for (k, v) in sums {
-            let e = all.entry(k).or_insert((0.0, 0.0, 0));
-            e.0 += v.0;
-            e.1 += v.1;
-            e.2 += v.2;
+            let e = all.entry(k).or_default();
+            for (a, b) in e.iter_mut().zip(v) {
+                a.0 += b.0;
+                a.1 += b.1;
+                a.2 += b.2;
+            }
         }
     }
     let mut keys: Vec<_> = all.keys().copied().collect();
     keys.sort_unstable();
     let mut out = Textured::default();
     for key in keys {
-        let (sw, swt, n) = all[&key];
+        // The pixels that cannot mirror the operator, where enough saw the texel; else all of them:
+        // a pane a kelvin or two warm where only square-on views saw it is nearer the truth than a
+        // hole filled in as the wall around it (an office walk's window lost 0.3 m that way, and
+        // the map was 1.3 K off in front of it).
+        let [clean, mirrored] = all[&key];
+        let (sw, swt, n) = if clean.2 >= params.min_pixels {
+            clean
+        } else {
+            (
+                clean.0 + mirrored.0,
+                clean.1 + mirrored.1,
+                clean.2 + mirrored.2,
+            )
+        };
         if n < params.min_pixels || sw <= 0.0 {
             continue;
+        }
+        if clean.2 < params.min_pixels {
+            report.texels_only_mirroring += 1;
         }
         let (s, i, j) = key;
         let m = &surfaces[s];
