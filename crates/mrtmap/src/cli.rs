@@ -420,6 +420,11 @@ pub struct ValidateArgs {
     /// MRT; they are then shown but not judged, and the others are compared.
     #[arg(long, value_name = "LABEL,…", value_delimiter = ',')]
     pub calibrate_with: Vec<String>,
+    /// A project.toml whose `[sun]` places the sun: a globe whose centre the beam reaches through
+    /// a window is flagged "in sun" and not judged (its reading includes short-wave radiation the
+    /// long-wave map does not).
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
     /// Where to write validation.csv and validation.json (default: the map folder).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
