@@ -595,6 +595,28 @@ pub struct SimulateArgs {
     /// grey with --noise realistic, black with none.
     #[arg(long, value_enum)]
     pub surfaces: Option<Surfaces>,
+    /// The sun outside the room, for truth.json only (the recording is unchanged: a long-wave
+    /// camera cannot see the beam): its altitude and azimuth in the room's frame (degrees, 0 = the
+    /// sun beyond the +x side). truth.json gets SolarCal's ΔMRT of a seated person facing the sun
+    /// at each grid node. Needs --dni and --transmittance.
+    #[arg(long, value_name = "ALT,AZ", allow_hyphen_values = true, value_parser = parse_sun, requires_all = ["dni", "transmittance"])]
+    pub sun: Option<[f64; 2]>,
+    /// Direct normal irradiance outside (W/m²), with --sun.
+    #[arg(
+        long,
+        value_name = "W_M2",
+        allow_negative_numbers = true,
+        requires = "sun"
+    )]
+    pub dni: Option<f64>,
+    /// The windows' total solar transmittance with their shades (0…1), with --sun.
+    #[arg(
+        long,
+        value_name = "T",
+        allow_negative_numbers = true,
+        requires = "sun"
+    )]
+    pub transmittance: Option<f64>,
     /// Monte Carlo rays per truth point (rooms with furniture or not convex).
     #[arg(long, default_value_t = 100_000)]
     pub truth_rays: usize,
