@@ -173,14 +173,18 @@ pub struct TruthSunNode {
     pub j: usize,
     /// The body centre in the room frame.
     pub xyz_room: [f64; 3],
-    /// Sky-vault view fraction through the windows (traced).
-    pub f_svv: f64,
+    /// Sky-vault view fraction through the windows (traced); absent when the body centre lies
+    /// inside furniture (as the values below).
+    pub f_svv: Option<f64>,
     /// Fraction of the body in the beam (traced).
-    pub f_bes: f64,
+    pub f_bes: Option<f64>,
     /// SolarCal's effective radiant field (W/m²).
-    pub erf_w_m2: f64,
+    pub erf_w_m2: Option<f64>,
     /// SolarCal's ΔMRT (K).
-    pub delta_mrt_k: f64,
+    pub delta_mrt_k: Option<f64>,
+    /// Why there is no value ("inside desk").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
 }
 
 /// SolarCal of a seated person (body centre 0.6 m) facing `sun` at each node of `grid`, with
@@ -203,6 +207,18 @@ pub fn sun_truth(room: &Room, grid: &TruthGrid, sun: &SimSun) -> Result<TruthSun
         .iter()
         .map(|n| {
             let p = Point3::new(n.xyz_room[0], n.xyz_room[1], centre);
+            if let Some(o) = fine.occluders.iter().find(|o| o.contains(&p)) {
+                return Ok(TruthSunNode {
+                    i: n.i,
+                    j: n.j,
+                    xyz_room: arr(&p),
+                    f_svv: None,
+                    f_bes: None,
+                    erf_w_m2: None,
+                    delta_mrt_k: None,
+                    note: Some(format!("inside {}", o.label)),
+                });
+            }
             let e = tracer.exposure(&p, posture, &direction);
             let g = solar_gain(&SolarInputs {
                 altitude_deg: sun.altitude_deg,
@@ -224,10 +240,11 @@ pub fn sun_truth(room: &Room, grid: &TruthGrid, sun: &SimSun) -> Result<TruthSun
                 i: n.i,
                 j: n.j,
                 xyz_room: arr(&p),
-                f_svv: e.f_svv,
-                f_bes: e.f_bes,
-                erf_w_m2: g.erf_w_m2,
-                delta_mrt_k: g.delta_mrt_k,
+                f_svv: Some(e.f_svv),
+                f_bes: Some(e.f_bes),
+                erf_w_m2: Some(g.erf_w_m2),
+                delta_mrt_k: Some(g.delta_mrt_k),
+                note: None,
             })
         })
         .collect::<Result<Vec<_>, crate::SimError>>()?;

@@ -1042,7 +1042,8 @@ fn coverage_says_whether_a_scan_is_good_enough_and_where_to_look() {
 /// `simulate --sun`: truth.json gets SolarCal on its grid for a seated person facing the sun. The
 /// office's window is on the +x wall (y 0.9…2.7, z 0.9…2.2); with the sun 30° high due +x a
 /// person at (2.65, 1.8) sits in the beam (SolarCal by hand: 16.4 K with the whole body lit), one
-/// at y ≈ 0.3 beside it gets sky and floor only.
+/// at y ≈ 0.3 beside it gets sky and floor only; a body centre inside the desk (x 2.5…3.8, y
+/// 0.25…1.05, up to 0.75 m) has no value.
 #[test]
 fn simulate_with_the_sun_writes_solarcal_into_the_truth() {
     let dir = tempfile::tempdir().unwrap();
@@ -1110,12 +1111,19 @@ fn simulate_with_the_sun_writes_solarcal_into_the_truth() {
     let d_lit = lit["delta_mrt_k"].as_f64().unwrap();
     assert!((d_lit - 16.4).abs() < 1.64, "{lit}");
     assert!(lit["f_bes"].as_f64().unwrap() > 0.9, "{lit}");
-    let beside = nearest(2.65, 0.3);
+    let in_desk = nearest(2.65, 0.3);
+    assert!(in_desk["delta_mrt_k"].is_null(), "{in_desk}");
+    assert_eq!(in_desk["note"], "inside desk");
+    let beside = nearest(2.0, 0.3);
     assert!(
         (beside["xyz_room"][1].as_f64().unwrap() - 0.3).abs() < 0.1,
         "{beside}"
     );
     let d_beside = beside["delta_mrt_k"].as_f64().unwrap();
     assert!(d_beside < d_lit / 4.0, "{beside}");
+    assert!(
+        beside["f_svv"].as_f64().unwrap() > 0.0,
+        "sky through the window: {beside}"
+    );
     assert_eq!(beside["f_bes"], 0.0);
 }
