@@ -392,10 +392,25 @@ pub struct ComfortSummary {
     pub asymmetry_category_share: Option<[f64; 3]>,
     /// The worst asymmetry on the grid and where (map x, y).
     pub worst_asymmetry: Option<(AsymmetrySummary, [f64; 2])>,
+    /// The sun on the grid (with `[sun]`): the share of the computed nodes whose person the beam
+    /// reaches (f_bes > 0), the largest ΔMRT and where (map x, y).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sun: Option<SunSummary>,
     /// The marked points' values.
     pub marks: Vec<(String, ComfortPoint)>,
     /// Seconds to compute.
     pub compute_secs: f64,
+}
+
+/// The sun over a comfort grid.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SunSummary {
+    /// Share of the computed nodes with part of the body in the beam.
+    pub sunlit_share: f64,
+    /// The largest SolarCal ΔMRT on the grid (K).
+    pub max_delta_mrt_k: f64,
+    /// Where (map x, y).
+    pub max_at: [f64; 2],
 }
 
 /// The PMV/PPD variant, in words.
@@ -625,7 +640,19 @@ fn summarise(
         .iter()
         .max_by(|a, b| a.0.worst.pd_pct.total_cmp(&b.0.worst.pd_pct))
         .copied();
+    let suns: Vec<(SunOnPerson, [f64; 2])> =
+        ok.iter().filter_map(|p| p.sun.map(|s| (s, p.xy))).collect();
+    let sun = suns
+        .iter()
+        .max_by(|a, b| a.0.delta_mrt_k.total_cmp(&b.0.delta_mrt_k))
+        .map(|(s, xy)| SunSummary {
+            sunlit_share: suns.iter().filter(|(s, _)| s.f_bes > 0.0).count() as f64
+                / suns.len() as f64,
+            max_delta_mrt_k: s.delta_mrt_k,
+            max_at: *xy,
+        });
     ComfortSummary {
+        sun,
         comfort: c.clone(),
         pmv_model: PMV_MODEL.into(),
         quantities: quantities.to_vec(),

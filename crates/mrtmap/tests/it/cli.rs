@@ -1236,12 +1236,19 @@ fn map_draws_the_mrt_with_the_sun_from_the_projects_sun() {
         o,
     ]);
     assert!(text.contains("mrt_sun"), "{text}");
+    assert!(text.contains("the beam reaches the person on"), "{text}");
     let csv = std::fs::read_to_string(out.join("mrt_sun.csv")).unwrap();
     assert_eq!(csv.lines().count(), 13, "{csv}");
     let c: Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("comfort.json")).unwrap()).unwrap();
     let lit = &c["marks"][0][1];
     let d = lit["sun"]["delta_mrt_k"].as_f64().unwrap();
+    let share = c["sun"]["sunlit_share"].as_f64().unwrap();
+    assert!(
+        share > 0.0 && share < 1.0,
+        "part of the floor is in the beam: {share}"
+    );
+    assert!(c["sun"]["max_delta_mrt_k"].as_f64().unwrap() > 10.0, "{c}");
     assert!(d > 10.0, "{lit}");
     let m = lit["mrt_sun"][0].as_f64().unwrap();
     let lw = lit["sun"]["mrt_long_wave_c"].as_f64().unwrap();
