@@ -651,9 +651,11 @@ pub struct MapArgs {
     pub marks: Vec<(String, Vec<f64>)>,
     #[command(flatten)]
     pub method: MrtSection,
-    /// What else to map, repeatable: a person's MRT (mrt_seated, mrt_standing), radiant asymmetry,
-    /// operative temperature, PMV, PPD; the person and the air come from --config's [comfort] and
-    /// [air]. Written as QUANTITY.png/.svg/.csv and comfort.json beside the MRT map.
+    /// What else to map, repeatable: a person's MRT (mrt_seated, mrt_standing), the MRT with the
+    /// sun (mrt_sun, needs --config's [sun]), radiant asymmetry, operative temperature, PMV, PPD;
+    /// the person and the air come from --config's [comfort] and [air], and with [sun] operative,
+    /// PMV and PPD include the sun. Written as QUANTITY.png/.svg/.csv and comfort.json beside the
+    /// MRT map.
     #[arg(long = "quantity", value_enum)]
     pub quantities: Vec<Quantity>,
     /// A project.toml whose [comfort] and [air] describe the person, and whose [map] quantities
