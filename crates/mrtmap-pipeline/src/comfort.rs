@@ -334,7 +334,7 @@ fn title_of(q: Quantity, c: &ComfortSection) -> (String, &'static str) {
         Quantity::MrtStanding => (format!("MRT of {} (°C)", who(Posture::Standing)), "°C"),
         Quantity::MrtSun => (
             format!(
-                "MRT with the sun (SolarCal) of a {} person (body centre {:.1} m), {} (°C)",
+                "MRT with the sun (SolarCal) of a {} person (body centre {:.1} m), {} (°C); orange: in the beam",
                 c.posture.as_str(),
                 c.posture.centre_height_m(),
                 match c.facing_deg {
@@ -565,6 +565,19 @@ fn write_maps(
                 unit: unit.into(),
                 values,
                 neutral: (q == Quantity::Pmv).then_some(0.0),
+                outlined: if q == Quantity::MrtSun {
+                    nodes
+                        .iter()
+                        .filter(|n| {
+                            n.point
+                                .as_ref()
+                                .is_ok_and(|p| p.sun.is_some_and(|s| s.f_bes > 0.0))
+                        })
+                        .map(|n| (n.i, n.j))
+                        .collect()
+                } else {
+                    Vec::new()
+                },
             }),
         };
         let png = render_png(&input)?;

@@ -569,6 +569,10 @@ mod tests {
             .comfort
             .unwrap();
         assert!(dir.path().join("mrt_sun.png").exists());
+        // The sunlit patch is outlined in orange on the mrt_sun map only.
+        let svg = |q: &str| std::fs::read_to_string(dir.path().join(format!("{q}.svg"))).unwrap();
+        assert!(svg("mrt_sun").contains("#FF8C00"));
+        assert!(!svg("operative").contains("#FF8C00"));
         let csv = std::fs::read_to_string(dir.path().join("mrt_sun.csv")).unwrap();
         assert_eq!(csv.lines().count(), 1 + 12, "{csv}");
         let lit = &with.summary.marks[0].1;
