@@ -27,8 +27,8 @@ pub use mrtmap_physics::{
     pmv_ppd_edition, pmv_ppd_many,
 };
 use mrtmap_radiation::{
-    AsymmetryVerdict, GridSpec, MapFrame, MrtEngine, MrtError, MrtField, RadiantAsymmetry,
-    RadiantScene,
+    AsymmetryVerdict, Facing, GridSpec, MapFrame, MrtEngine, MrtError, MrtField, RadiantAsymmetry,
+    RadiantScene, SunTracer,
 };
 use mrtmap_report::{MapInput, MapMark, MapQuantity, render_png, render_svg};
 use rayon::prelude::*;
@@ -36,6 +36,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::cache::write_json;
 use crate::error::{Error, Result};
+use crate::points::SunQuery;
 use crate::settings::{AirSection, ComfortSection, Quantity};
 
 /// The relative air speed ISO 7730 uses: v + 0.3 (met − 1) for met > 1.
@@ -133,8 +134,34 @@ pub struct ComfortPoint {
     /// Radiant asymmetry at the abdomen of the posture: vertical (signed, K), horizontal (K),
     /// and the worse of the two as ISO 7730 judges it.
     pub asymmetry: Option<AsymmetrySummary>,
-    /// Operative temperature, PMV, PPD (with the air given).
+    /// Operative temperature, PMV, PPD (with the air given; with `[sun]`, from the MRT with the
+    /// sun).
     pub thermal: Option<Thermal>,
+    /// The person's MRT with SolarCal's ΔMRT of `[sun]` (°C) and its standard error (K), when
+    /// asked for.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mrt_sun: Option<(f64, f64)>,
+    /// The sun on that person, when `[sun]` is given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sun: Option<SunOnPerson>,
+}
+
+/// The sun on the person at a map node (SolarCal, with the exposure traced through the windows).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SunOnPerson {
+    /// Which way the person faces (degrees from +x towards +y): `[comfort] facing_deg`, else
+    /// towards the sun.
+    pub facing_deg: f64,
+    /// The sun's angle from the person's front (degrees).
+    pub sharp_deg: f64,
+    /// Sky-vault view fraction through the windows.
+    pub f_svv: f64,
+    /// Fraction of the body in the beam.
+    pub f_bes: f64,
+    /// SolarCal's ΔMRT (K).
+    pub delta_mrt_k: f64,
+    /// The long-wave MRT of that person, facing that way (°C).
+    pub mrt_long_wave_c: f64,
 }
 
 /// Radiant asymmetry at a point, for files.
@@ -171,7 +198,13 @@ fn wants(quantities: &[Quantity], q: Quantity) -> bool {
     quantities.contains(&q)
 }
 
-/// The person's quantities at map coordinates `xy` (`stream` selects the random streams).
+/// The sun for a comfort map: the tracer on the scene and the sun.
+pub type SunContext<'s, 'a> = (&'s SunTracer<'a>, &'s SunQuery);
+
+/// The person's quantities at map coordinates `xy` (`stream` selects the random streams); with
+/// `sun`, the person of `[comfort]`'s posture gets SolarCal's ΔMRT, facing `[comfort] facing_deg`
+/// or, unset, the sun (SHARP 0), and operative temperature, PMV and PPD use that MRT.
+#[allow(clippy::too_many_arguments)]
 pub fn comfort_at(
     engine: &MrtEngine<'_>,
     frame: &MapFrame,
@@ -179,6 +212,7 @@ pub fn comfort_at(
     c: &ComfortSection,
     air: &AirSection,
     quantities: &[Quantity],
+    sun: Option<SunContext<'_, '_>>,
     stream: u64,
 ) -> std::result::Result<ComfortPoint, MrtError> {
     let facing = c.facing();
@@ -204,10 +238,39 @@ pub fn comfort_at(
                 .map(|a| AsymmetrySummary::of(&a))
         })
         .transpose()?;
-    let own = match c.posture {
+    let mut own = match c.posture {
         Posture::Seated => seated,
         Posture::Standing => standing,
     };
+    let needs_sun = wants(quantities, Quantity::MrtSun) || quantities.iter().any(|q| q.needs_air());
+    let mut sun_on = None;
+    let mut mrt_sun = None;
+    if let (Some((tracer, q)), true) = (sun, needs_sun) {
+        let facing_deg = c.facing_deg.unwrap_or(q.direction.azimuth_deg);
+        let centre = frame.point(&xy, c.posture.centre_height_m());
+        let long_wave = match (c.facing_deg, own) {
+            (Some(_), Some(m)) => m,
+            _ => engine
+                .person_at(&centre, c.posture, Facing::Azimuth(facing_deg), stream)
+                .map(|p| (p.mrt.celsius(), p.std_error_k))?,
+        };
+        if let Ok((e, sharp, g)) =
+            crate::points::solar_on(tracer, &centre, c.posture, facing_deg, q)
+        {
+            sun_on = Some(SunOnPerson {
+                facing_deg,
+                sharp_deg: sharp,
+                f_svv: e.f_svv,
+                f_bes: e.f_bes,
+                delta_mrt_k: g.delta_mrt_k,
+                mrt_long_wave_c: long_wave.0,
+            });
+            mrt_sun = Some((long_wave.0 + g.delta_mrt_k, long_wave.1));
+            own = mrt_sun;
+        } else {
+            own = None;
+        }
+    }
     let thermal = match (own, c.air_at(air, c.posture.centre_height_m())) {
         (Some((tr, se)), Some(ta)) if quantities.iter().any(|q| q.needs_air()) => {
             let a = Air {
@@ -228,6 +291,8 @@ pub fn comfort_at(
         mrt_standing: standing,
         asymmetry,
         thermal,
+        mrt_sun,
+        sun: sun_on,
     })
 }
 
@@ -237,6 +302,7 @@ pub fn value_of(p: &ComfortPoint, q: Quantity) -> Option<(f64, f64)> {
         Quantity::Mrt => None,
         Quantity::MrtSeated => p.mrt_seated,
         Quantity::MrtStanding => p.mrt_standing,
+        Quantity::MrtSun => p.mrt_sun,
         Quantity::Asymmetry => p.asymmetry.map(|a| (a.worst.delta_k, a.std_error_k)),
         Quantity::Operative => p.thermal.map(|t| (t.operative_c, t.operative_se_k)),
         Quantity::Pmv => p.thermal.map(|t| (t.pmv, t.pmv_se)),
@@ -266,6 +332,18 @@ fn title_of(q: Quantity, c: &ComfortSection) -> (String, &'static str) {
         Quantity::Mrt => ("Mean radiant temperature (°C)".into(), "°C"),
         Quantity::MrtSeated => (format!("MRT of {} (°C)", who(Posture::Seated)), "°C"),
         Quantity::MrtStanding => (format!("MRT of {} (°C)", who(Posture::Standing)), "°C"),
+        Quantity::MrtSun => (
+            format!(
+                "MRT with the sun (SolarCal) of a {} person (body centre {:.1} m), {} (°C); orange: in the beam",
+                c.posture.as_str(),
+                c.posture.centre_height_m(),
+                match c.facing_deg {
+                    Some(a) => format!("facing {a}°"),
+                    None => "facing the sun".into(),
+                }
+            ),
+            "°C",
+        ),
         Quantity::Asymmetry => (
             format!(
                 "Worst radiant asymmetry at {:.1} m, {} (K)",
@@ -314,10 +392,25 @@ pub struct ComfortSummary {
     pub asymmetry_category_share: Option<[f64; 3]>,
     /// The worst asymmetry on the grid and where (map x, y).
     pub worst_asymmetry: Option<(AsymmetrySummary, [f64; 2])>,
+    /// The sun on the grid (with `[sun]`): the share of the computed nodes whose person the beam
+    /// reaches (f_bes > 0), the largest ΔMRT and where (map x, y).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sun: Option<SunSummary>,
     /// The marked points' values.
     pub marks: Vec<(String, ComfortPoint)>,
     /// Seconds to compute.
     pub compute_secs: f64,
+}
+
+/// The sun over a comfort grid.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SunSummary {
+    /// Share of the computed nodes with part of the body in the beam.
+    pub sunlit_share: f64,
+    /// The largest SolarCal ΔMRT on the grid (K).
+    pub max_delta_mrt_k: f64,
+    /// Where (map x, y).
+    pub max_at: [f64; 2],
 }
 
 /// The PMV/PPD variant, in words.
@@ -332,7 +425,9 @@ pub struct ComfortOutput {
 }
 
 /// Computes the person's quantities of `quantities` over the floor grid and at `marks` (map x, y
-/// with names), writing `<quantity>.csv`, `.png`, `.svg` and `comfort.json` into `out`.
+/// with names), writing `<quantity>.csv`, `.png`, `.svg` and `comfort.json` into `out`. With
+/// `sun` (`[sun]`), `mrt_sun` can be mapped and operative temperature, PMV and PPD include the
+/// sun; `mrt_sun` without it is refused.
 #[allow(clippy::too_many_arguments)]
 pub fn make_comfort_maps(
     engine: &MrtEngine<'_>,
@@ -342,9 +437,15 @@ pub fn make_comfort_maps(
     c: &ComfortSection,
     air: &AirSection,
     quantities: &[Quantity],
+    sun: Option<&SunQuery>,
     marks: &[(String, [f64; 2])],
     out: &Path,
 ) -> Result<ComfortOutput> {
+    if quantities.contains(&Quantity::MrtSun) && sun.is_none() {
+        return Err(crate::settings::no_sun_error());
+    }
+    let tracer = sun.map(|_| SunTracer::new(scene));
+    let sun_ctx = tracer.as_ref().zip(sun);
     let frame = MapFrame::of_scene(scene).map_err(|e| Error::Map {
         scene: source.to_string(),
         source: e,
@@ -378,6 +479,7 @@ pub fn make_comfort_maps(
                 c,
                 air,
                 &person,
+                sun_ctx,
                 (j * grid[0] + i) as u64,
             )
             .map_err(|e| e.to_string()),
@@ -394,6 +496,7 @@ pub fn make_comfort_maps(
                 c,
                 air,
                 &person,
+                sun_ctx,
                 (grid[0] * grid[1] + k) as u64,
             )
             .map(|p| (name.clone(), p))
@@ -462,6 +565,19 @@ fn write_maps(
                 unit: unit.into(),
                 values,
                 neutral: (q == Quantity::Pmv).then_some(0.0),
+                outlined: if q == Quantity::MrtSun {
+                    nodes
+                        .iter()
+                        .filter(|n| {
+                            n.point
+                                .as_ref()
+                                .is_ok_and(|p| p.sun.is_some_and(|s| s.f_bes > 0.0))
+                        })
+                        .map(|n| (n.i, n.j))
+                        .collect()
+                } else {
+                    Vec::new()
+                },
             }),
         };
         let png = render_png(&input)?;
@@ -537,7 +653,19 @@ fn summarise(
         .iter()
         .max_by(|a, b| a.0.worst.pd_pct.total_cmp(&b.0.worst.pd_pct))
         .copied();
+    let suns: Vec<(SunOnPerson, [f64; 2])> =
+        ok.iter().filter_map(|p| p.sun.map(|s| (s, p.xy))).collect();
+    let sun = suns
+        .iter()
+        .max_by(|a, b| a.0.delta_mrt_k.total_cmp(&b.0.delta_mrt_k))
+        .map(|(s, xy)| SunSummary {
+            sunlit_share: suns.iter().filter(|(s, _)| s.f_bes > 0.0).count() as f64
+                / suns.len() as f64,
+            max_delta_mrt_k: s.delta_mrt_k,
+            max_at: *xy,
+        });
     ComfortSummary {
+        sun,
         comfort: c.clone(),
         pmv_model: PMV_MODEL.into(),
         quantities: quantities.to_vec(),

@@ -570,7 +570,7 @@ impl LevelInputs {
                 .thermal_accuracy_k
                 .unwrap_or(DEFAULT_CAMERA_ACCURACY_K),
             emissivity: p.emissivity.clone(),
-            mrt: p.mrt.clone(),
+            mrt: p.mrt,
         })
     }
 }

@@ -131,6 +131,11 @@ pub fn map_scene(
 ) -> Result<SceneMaps> {
     let person = crate::settings::Quantity::person(&project.map.quantities);
     project.comfort.check(&project.air, &person)?;
+    project.sun.check()?;
+    let sun = project.sun.query()?;
+    if person.contains(&crate::settings::Quantity::MrtSun) && sun.is_none() {
+        return Err(crate::settings::no_sun_error());
+    }
     let map = make_map(scene, source, &project.mrt, spec, marks, out)?;
     if person.is_empty() {
         return Ok(SceneMaps { map, comfort: None });
@@ -161,6 +166,7 @@ pub fn map_scene(
         &project.comfort,
         &project.air,
         &person,
+        sun.as_ref(),
         &xy_marks,
         out,
     )?;
@@ -508,5 +514,84 @@ mod tests {
         let both = map_scene(&scene, "example", &project, spec, &[], dir.path()).unwrap();
         assert_eq!(both.comfort.unwrap().summary.nodes, 30);
         assert!(dir.path().join("pmv.png").exists());
+    }
+
+    /// `[sun]` on the example office (window on the +x wall, sun 30° high due +x): `mrt_sun`
+    /// adds SolarCal's ΔMRT of a person facing the sun (facing unset), large in the beam and small
+    /// beside it, and the operative temperature includes it; `mrt_sun` without `[sun]` is refused.
+    #[test]
+    fn the_sun_map_adds_solarcal_in_the_beam() {
+        let scene = mrtmap_radiation::example_office();
+        let dir = tempfile::tempdir().unwrap();
+        let spec = GridSpec {
+            nx: 4,
+            ny: 3,
+            ..GridSpec::default()
+        };
+        let mut project = crate::Project::default();
+        project.map.quantities = vec![Quantity::MrtSun, Quantity::Operative];
+        project.air.temperature_c = Some(21.0);
+        let e = map_scene(&scene, "example", &project, spec, &[], dir.path())
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(e.contains("mrt_sun") && e.contains("[sun]"), "{e}");
+        let marks = [
+            Mark {
+                name: "lit".into(),
+                at: MarkAt::Scene([2.65, 1.8, 0.6]),
+            },
+            Mark {
+                name: "beside".into(),
+                at: MarkAt::Scene([2.65, 0.3, 0.6]),
+            },
+        ];
+        let mut without_project = project.clone();
+        without_project.map.quantities = vec![Quantity::Operative];
+        let without = map_scene(
+            &scene,
+            "example",
+            &without_project,
+            spec,
+            &marks,
+            dir.path(),
+        )
+        .unwrap()
+        .comfort
+        .unwrap();
+        project.sun = crate::Project::parse(
+            "[sun]\naltitude_deg = 30.0\nazimuth_deg = 0.0\ndni_w_m2 = 700\ntransmittance = 0.6\n",
+        )
+        .unwrap()
+        .sun;
+        let with = map_scene(&scene, "example", &project, spec, &marks, dir.path())
+            .unwrap()
+            .comfort
+            .unwrap();
+        assert!(dir.path().join("mrt_sun.png").exists());
+        // The sunlit patch is outlined in orange on the mrt_sun map only.
+        let svg = |q: &str| std::fs::read_to_string(dir.path().join(format!("{q}.svg"))).unwrap();
+        assert!(svg("mrt_sun").contains("#FF8C00"));
+        assert!(!svg("operative").contains("#FF8C00"));
+        let csv = std::fs::read_to_string(dir.path().join("mrt_sun.csv")).unwrap();
+        assert_eq!(csv.lines().count(), 1 + 12, "{csv}");
+        let lit = &with.summary.marks[0].1;
+        let sun = lit.sun.unwrap();
+        assert_eq!((sun.facing_deg, sun.sharp_deg), (0.0, 0.0));
+        assert!(sun.f_bes > 0.9, "{sun:?}");
+        // The example's acceptance value for this person is 16.76 K (points.rs).
+        assert!((14.0..19.0).contains(&sun.delta_mrt_k), "{sun:?}");
+        let (m, _) = lit.mrt_sun.unwrap();
+        assert!((m - sun.mrt_long_wave_c - sun.delta_mrt_k).abs() < 1e-9);
+        let beside = with.summary.marks[1].1.sun.unwrap();
+        assert_eq!(beside.f_bes, 0.0);
+        assert!(beside.delta_mrt_k < sun.delta_mrt_k / 4.0, "{beside:?}");
+        // Operative temperature with the sun: about half of ΔMRT warmer in the beam.
+        let op = |p: &crate::comfort::ComfortPoint| p.thermal.unwrap().operative_c;
+        let rise = op(lit) - op(&without.summary.marks[0].1);
+        assert!(
+            rise > 0.3 * sun.delta_mrt_k && rise < 0.7 * sun.delta_mrt_k,
+            "{rise}"
+        );
     }
 }

@@ -204,6 +204,32 @@ fn check_sun(q: &PointQuery) -> Result<()> {
     }
 }
 
+/// SolarCal for a person of `posture` facing `facing_deg` (body centre `at` in the scene's frame)
+/// in the sun `sun`: the exposure traced through the windows, SHARP and SolarCal's answer.
+pub(crate) fn solar_on(
+    tracer: &SunTracer<'_>,
+    at: &mrtmap_geometry::nalgebra::Point3<f64>,
+    posture: Posture,
+    facing_deg: f64,
+    sun: &SunQuery,
+) -> std::result::Result<(SunExposure, f64, mrtmap_physics::SolarGain), mrtmap_physics::PhysicsError>
+{
+    let exposure = tracer.exposure(at, posture, &sun.direction);
+    let sharp = sharp_deg(facing_deg, sun.direction.azimuth_deg);
+    let g = solar_gain(&SolarInputs {
+        altitude_deg: sun.direction.altitude_deg,
+        sharp_deg: sharp,
+        dni_w_m2: sun.dni_w_m2,
+        transmittance: sun.transmittance,
+        f_svv: exposure.f_svv,
+        f_bes: exposure.f_bes,
+        asw: sun.asw,
+        posture: posture.into(),
+        floor_reflectance: sun.floor_reflectance,
+    })?;
+    Ok((exposure, sharp, g))
+}
+
 /// SolarCal for the person `p` (body centre `at` in the scene's frame) in the sun `sun`.
 fn sun_on(
     tracer: &SunTracer<'_>,
@@ -215,20 +241,8 @@ fn sun_on(
         Facing::Azimuth(a) => a,
         Facing::Any => 0.0,
     };
-    let exposure = tracer.exposure(at, p.posture, &sun.direction);
-    let sharp = sharp_deg(facing, sun.direction.azimuth_deg);
-    let g = solar_gain(&SolarInputs {
-        altitude_deg: sun.direction.altitude_deg,
-        sharp_deg: sharp,
-        dni_w_m2: sun.dni_w_m2,
-        transmittance: sun.transmittance,
-        f_svv: exposure.f_svv,
-        f_bes: exposure.f_bes,
-        asw: sun.asw,
-        posture: p.posture.into(),
-        floor_reflectance: sun.floor_reflectance,
-    })
-    .map_err(solar_flag_error)?;
+    let (exposure, sharp, g) =
+        solar_on(tracer, at, p.posture, facing, sun).map_err(solar_flag_error)?;
     Ok(SunAnswer {
         sun_altitude_deg: sun.direction.altitude_deg,
         sun_azimuth_deg: sun.direction.azimuth_deg,

@@ -281,6 +281,7 @@ fn comfort_stage(
         .setting("comfort", &p.comfort)
         .setting("air", &p.air)
         .setting("mrt", &p.mrt)
+        .setting("sun", &p.sun)
         .setting("points", &p.points);
     let mut files: Vec<String> = person.iter().map(|q| format!("{}.png", q.name())).collect();
     files.push("comfort.json".into());
@@ -291,6 +292,7 @@ fn comfort_stage(
         progress.begin("mapping a person's comfort");
         progress.advance(0, 1);
         let engine = p.mrt.engine(scene)?;
+        let sun = p.sun.query()?;
         let o = make_comfort_maps(
             &engine,
             scene,
@@ -299,6 +301,7 @@ fn comfort_stage(
             &p.comfort,
             &p.air,
             &person,
+            sun.as_ref(),
             &marks,
             &dir,
         )?;

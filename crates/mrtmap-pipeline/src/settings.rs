@@ -20,8 +20,9 @@ pub const PROJECT_EXAMPLE: &str = r#"# project.toml: every key is optional (defa
 grid = [20, 20]           # nodes across and along the floor's bounding rectangle
 heights_m = [1.1]         # one map per height above the floor (1.1 m seated head, 1.7 m standing)
 margin_m = 0.1            # distance kept from the walls
-quantities = ["mrt"]      # also: mrt_seated, mrt_standing, asymmetry, operative, pmv, ppd (a person,
-                          # with [comfort]); the person's maps are at the body centre's height
+quantities = ["mrt"]      # also: mrt_seated, mrt_standing, mrt_sun, asymmetry, operative, pmv, ppd (a
+                          # person, with [comfort]; mrt_sun with [sun]); the person's maps are at
+                          # the body centre's height
 
 [[points]]                # named points (e.g. globe locations), metres, in the room frame:
 name = "A"                # x, y along the floor from the origin corner, z above the floor
@@ -86,6 +87,18 @@ std = 0.02                # the standard uncertainty of each emissivity
 # by_label = { window = 0.88, radiator = 0.2 }  # labels containing the key (longest key first)
 # by_id = { "wall-3" = 0.90 }                   # one surface or feature, by its id in scene.json
 
+[sun]                     # the sun through the windows (SolarCal), for mrt_sun and validate; unset: none
+# altitude_deg = 30.0     # the sun in the room's frame: degrees above the horizon,
+# azimuth_deg = 0.0       # and from +x towards +y
+# date_time = "2026-01-15T10:30:00Z"  # or: a UTC time and a place (NOAA's sun position)
+# latitude_deg = 52.5     # north positive
+# longitude_deg = 13.4    # east positive
+# north_deg = 0.0         # compass bearing of the room's +y axis (0: +y north, +x east)
+# dni_w_m2 = 700.0        # direct normal irradiance outside (needed with a sun)
+# transmittance = 0.6     # the windows' total solar transmittance with shades (needed with a sun)
+floor_reflectance = 0.6   # the floor's short-wave reflectance
+asw = 0.7                 # the person's short-wave absorptivity
+
 [export]
 formats = []              # also write the room to export/room.EXT: "hbjson", "gbxml", "gltf", "rad"
 # max_points = 200000     # thermal-cloud points in the glTF (evenly thinned); 0: leave the cloud out
@@ -127,6 +140,9 @@ pub enum Quantity {
     MrtSeated,
     /// The MRT of a standing person (body centre 1.0 m).
     MrtStanding,
+    /// The MRT of `[comfort]`'s person with SolarCal's ΔMRT of `[sun]` added (facing the sun
+    /// when `[comfort] facing_deg` is unset).
+    MrtSun,
     /// The worst radiant temperature asymmetry (K) at the abdomen of `[comfort]`'s posture.
     Asymmetry,
     /// Operative temperature (ISO 7726) of `[comfort]`'s person.
@@ -144,6 +160,7 @@ impl Quantity {
             Self::Mrt => "mrt",
             Self::MrtSeated => "mrt_seated",
             Self::MrtStanding => "mrt_standing",
+            Self::MrtSun => "mrt_sun",
             Self::Asymmetry => "asymmetry",
             Self::Operative => "operative",
             Self::Pmv => "pmv",
@@ -298,6 +315,14 @@ impl ComfortSection {
         }
         Ok(())
     }
+}
+
+/// The error for `mrt_sun` asked for without `[sun]`.
+pub fn no_sun_error() -> Error {
+    Error::setting(
+        "mrt_sun",
+        "needs the sun: give [sun] in project.toml (--config) with altitude_deg and azimuth_deg (or date_time, latitude_deg, longitude_deg), dni_w_m2 and transmittance",
+    )
 }
 
 /// The air temperatures accepted (°C): a room people occupy.
@@ -766,6 +791,234 @@ pub struct Project {
     pub export: crate::export::ExportSection,
     /// Emissivities.
     pub emissivity: EmissivitySection,
+    /// The sun through the windows (SolarCal), for `mrt_sun` maps and `validate`.
+    pub sun: SunSection,
+}
+
+/// `[sun]`: the sun outside and the glazing, for SolarCal's ΔMRT on a person (the `mrt_sun` map,
+/// operative temperature and PMV/PPD with the sun, and `mrtmap validate`'s globes in the beam).
+/// The sun is given either by `altitude_deg` and `azimuth_deg` in the room's frame, or by
+/// `date_time` (UTC) with `latitude_deg`, `longitude_deg` and `north_deg`; a sun below the
+/// horizon at that time is refused (no beam: leave `[sun]` out for a night-time map).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SunSection {
+    /// Solar altitude (degrees above the horizon, 0…90).
+    pub altitude_deg: Option<f64>,
+    /// Solar azimuth in the room's frame (degrees from +x towards +y).
+    pub azimuth_deg: Option<f64>,
+    /// The moment, ISO 8601 in UTC ("2026-01-15T10:30:00Z").
+    pub date_time: Option<String>,
+    /// Latitude (degrees, north positive), with `date_time`.
+    pub latitude_deg: Option<f64>,
+    /// Longitude (degrees, east positive), with `date_time`.
+    pub longitude_deg: Option<f64>,
+    /// The compass bearing of the room's +y axis (degrees; 0: +y north, +x east), with
+    /// `date_time`.
+    pub north_deg: f64,
+    /// Direct normal irradiance outside (W/m²); needed with a sun.
+    pub dni_w_m2: Option<f64>,
+    /// The windows' total solar transmittance with their shades (0…1); needed with a sun.
+    pub transmittance: Option<f64>,
+    /// The floor's short-wave reflectance (0…1).
+    pub floor_reflectance: f64,
+    /// The person's short-wave absorptivity (0…1).
+    pub asw: f64,
+}
+
+impl Default for SunSection {
+    fn default() -> Self {
+        Self {
+            altitude_deg: None,
+            azimuth_deg: None,
+            date_time: None,
+            latitude_deg: None,
+            longitude_deg: None,
+            north_deg: 0.0,
+            dni_w_m2: None,
+            transmittance: None,
+            floor_reflectance: mrtmap_physics::DEFAULT_FLOOR_REFLECTANCE,
+            asw: mrtmap_physics::DEFAULT_ASW,
+        }
+    }
+}
+
+impl SunSection {
+    /// Whether any key places a sun (so that `query` gives one or an error).
+    pub fn is_given(&self) -> bool {
+        self.altitude_deg.is_some()
+            || self.azimuth_deg.is_some()
+            || self.date_time.is_some()
+            || self.latitude_deg.is_some()
+            || self.longitude_deg.is_some()
+            || self.dni_w_m2.is_some()
+            || self.transmittance.is_some()
+    }
+
+    /// Checks every key (the same as [`SunSection::query`] without its answer).
+    pub fn check(&self) -> Result<()> {
+        self.query().map(|_| ())
+    }
+
+    /// The sun in the room's frame with the glazing and the person's absorptivity; `None` when
+    /// `[sun]` places no sun. Errors name the key.
+    pub fn query(&self) -> Result<Option<crate::points::SunQuery>> {
+        if !self.is_given() {
+            return Ok(None);
+        }
+        let bad = |key: &str, v: f64, allowed: &str| {
+            Error::setting(
+                format!("[sun] {key} = {v}"),
+                format!("is outside {allowed}"),
+            )
+        };
+        let within = |key: &str, v: f64, lo: f64, hi: f64, allowed: &str| {
+            if v.is_finite() && (lo..=hi).contains(&v) {
+                Ok(v)
+            } else {
+                Err(bad(key, v, allowed))
+            }
+        };
+        let (altitude, azimuth) = match (
+            self.altitude_deg,
+            self.azimuth_deg,
+            self.date_time.as_deref(),
+        ) {
+            (Some(alt), Some(az), None) => {
+                let alt = within(
+                    "altitude_deg",
+                    alt,
+                    0.0,
+                    90.0,
+                    "0…90° (a sun above the horizon)",
+                )?;
+                let az = within("azimuth_deg", az, -360.0, 360.0, "-360…360°")?;
+                (alt, az.rem_euclid(360.0))
+            }
+            (None, None, Some(when)) => {
+                let time = parse_utc(when).ok_or_else(|| {
+                    Error::setting(
+                        format!("[sun] date_time = \"{when}\""),
+                        "is not an ISO 8601 UTC time like \"2026-01-15T10:30:00Z\"",
+                    )
+                })?;
+                let need = |key: &str, v: Option<f64>| {
+                    v.ok_or_else(|| {
+                        Error::setting(
+                            "[sun] date_time",
+                            format!("needs [sun] {key} to place the sun"),
+                        )
+                    })
+                };
+                let lat = within(
+                    "latitude_deg",
+                    need("latitude_deg", self.latitude_deg)?,
+                    -90.0,
+                    90.0,
+                    "-90…90°",
+                )?;
+                let lon = within(
+                    "longitude_deg",
+                    need("longitude_deg", self.longitude_deg)?,
+                    -180.0,
+                    180.0,
+                    "-180…180° (east positive)",
+                )?;
+                let north = within("north_deg", self.north_deg, -360.0, 360.0, "-360…360°")?;
+                let pos = mrtmap_physics::sun_position(&time, lat, lon).map_err(|e| {
+                    Error::setting(format!("[sun] date_time = \"{when}\""), e.to_string())
+                })?;
+                if pos.altitude_deg <= 0.0 {
+                    return Err(Error::setting(
+                        format!("[sun] date_time = \"{when}\""),
+                        format!(
+                            "puts the sun {:.1}° below the horizon at {lat}°, {lon}°: no beam (leave [sun] out for a map without the sun)",
+                            -pos.altitude_deg
+                        ),
+                    ));
+                }
+                (
+                    pos.altitude_deg,
+                    mrtmap_physics::room_azimuth_deg(pos.azimuth_deg, north),
+                )
+            }
+            (_, _, Some(_)) => {
+                return Err(Error::setting(
+                    "[sun] date_time",
+                    "is given with altitude_deg or azimuth_deg: place the sun one way, not both",
+                ));
+            }
+            (None, None, None) => {
+                return Err(Error::setting(
+                    "[sun]",
+                    "places no sun: give altitude_deg and azimuth_deg, or date_time with latitude_deg and longitude_deg",
+                ));
+            }
+            (Some(_), None, None) | (None, Some(_), None) => {
+                return Err(Error::setting(
+                    "[sun] altitude_deg and azimuth_deg",
+                    "go together: give both",
+                ));
+            }
+        };
+        let dni = self.dni_w_m2.ok_or_else(|| {
+            Error::setting(
+                "[sun] dni_w_m2",
+                "is needed with a sun: the direct normal irradiance outside (W/m²)",
+            )
+        })?;
+        let dni = within(
+            "dni_w_m2",
+            dni,
+            0.0,
+            mrtmap_physics::MAX_DNI_W_M2,
+            "0…1500 W/m²",
+        )?;
+        let tau = self.transmittance.ok_or_else(|| {
+            Error::setting(
+                "[sun] transmittance",
+                "is needed with a sun: the windows' total solar transmittance (0…1)",
+            )
+        })?;
+        let tau = within("transmittance", tau, 0.0, 1.0, "0…1")?;
+        let floor = within("floor_reflectance", self.floor_reflectance, 0.0, 1.0, "0…1")?;
+        let asw = within("asw", self.asw, 0.0, 1.0, "0…1")?;
+        let mut q = crate::points::SunQuery::new(altitude, azimuth, dni, tau);
+        q.floor_reflectance = floor;
+        q.asw = asw;
+        Ok(Some(q))
+    }
+}
+
+/// An ISO 8601 time in UTC: `YYYY-MM-DDTHH:MM[:SS[.fff]]` with `Z` or `+00:00` (a space for the
+/// `T` too); ranges are checked by `sun_position`.
+fn parse_utc(s: &str) -> Option<mrtmap_physics::UtcTime> {
+    let s = s.trim();
+    let body = s
+        .strip_suffix('Z')
+        .or_else(|| s.strip_suffix('z'))
+        .or_else(|| s.strip_suffix("+00:00"))?;
+    let (date, time) = body.split_once(['T', 't', ' '])?;
+    let mut d = date.split('-');
+    let (year, month, day) = (d.next()?, d.next()?, d.next()?);
+    if d.next().is_some() || year.len() != 4 || month.len() != 2 || day.len() != 2 {
+        return None;
+    }
+    let mut t = time.split(':');
+    let (hour, minute, second) = (t.next()?, t.next()?, t.next().unwrap_or("0"));
+    if t.next().is_some() || hour.len() != 2 || minute.len() != 2 {
+        return None;
+    }
+    let second: f64 = second.parse().ok()?;
+    second.is_finite().then_some(())?;
+    Some(mrtmap_physics::UtcTime {
+        year: year.parse().ok()?,
+        month: month.parse().ok()?,
+        day: day.parse().ok()?,
+        hour: hour.parse().ok()?,
+        minute: minute.parse().ok()?,
+        second,
+    })
 }
 
 /// `[emissivity]`: the surfaces' long-wave emissivities, where the table's by label are not wanted.
@@ -885,6 +1138,10 @@ impl Project {
         self.comfort.check(&self.air, &self.map.quantities)?;
         self.mrt.check()?;
         self.emissivity.check()?;
+        self.sun.check()?;
+        if self.map.quantities.contains(&Quantity::MrtSun) && !self.sun.is_given() {
+            return Err(no_sun_error());
+        }
         Ok(())
     }
 
@@ -902,8 +1159,10 @@ mod tests {
     /// Issue 54: a ray count that cannot be answered is refused before anything runs.
     #[test]
     fn too_many_rays_are_refused_naming_the_flag() {
-        let mut m = MrtSection::default();
-        m.rays = MAX_RAYS;
+        let mut m = MrtSection {
+            rays: MAX_RAYS,
+            ..MrtSection::default()
+        };
         assert!(m.check().is_ok());
         m.rays = 1_000_000_000_000_000;
         let e = m.check().unwrap_err().to_string();
@@ -927,6 +1186,7 @@ mod tests {
         assert_eq!(p.mrt, MrtSection::default());
         assert_eq!(p.track, TrackSection::default());
         assert_eq!(p.export, crate::export::ExportSection::default());
+        assert_eq!(p.sun, SunSection::default());
         assert_eq!(p.points.len(), 1);
         assert_eq!(p.air.temperature_c, Some(21.0));
         let (line, msg) = Project::parse("[map]\n\ngird = [1, 2]\n").unwrap_err();
@@ -1009,5 +1269,121 @@ mod tests {
                 "{e}"
             );
         }
+    }
+
+    #[test]
+    fn the_sun_parses_from_an_angle_or_a_time_and_place() {
+        let p = Project::parse(
+            "[sun]\naltitude_deg = 30.0\nazimuth_deg = -90.0\ndni_w_m2 = 700\ntransmittance = 0.6\nasw = 0.5\n",
+        )
+        .unwrap();
+        p.check().unwrap();
+        let q = p.sun.query().unwrap().unwrap();
+        assert_eq!(q.direction.altitude_deg, 30.0);
+        assert_eq!(q.direction.azimuth_deg, 270.0);
+        assert_eq!((q.dni_w_m2, q.transmittance, q.asw), (700.0, 0.6, 0.5));
+        assert_eq!(
+            q.floor_reflectance,
+            mrtmap_physics::DEFAULT_FLOOR_REFLECTANCE
+        );
+        assert!(Project::default().sun.query().unwrap().is_none());
+
+        // Berlin, 15 January 2026, 11:00 UTC (about solar noon): the sun due south, about 15°
+        // high. With +y pointing north the room's azimuth of south is 270° (−y); with +y pointing
+        // east (north_deg 90) +x points south, so the sun is near 0°.
+        let text = |north: f64| {
+            format!(
+                "[sun]\ndate_time = \"2026-01-15T11:00:00Z\"\nlatitude_deg = 52.52\nlongitude_deg = 13.40\nnorth_deg = {north}\ndni_w_m2 = 600\ntransmittance = 0.5\n"
+            )
+        };
+        let q = Project::parse(&text(0.0))
+            .unwrap()
+            .sun
+            .query()
+            .unwrap()
+            .unwrap();
+        let expect = mrtmap_physics::sun_position(
+            &mrtmap_physics::UtcTime {
+                year: 2026,
+                month: 1,
+                day: 15,
+                hour: 11,
+                minute: 0,
+                second: 0.0,
+            },
+            52.52,
+            13.40,
+        )
+        .unwrap();
+        assert!((q.direction.altitude_deg - expect.altitude_deg).abs() < 1e-12);
+        assert!((10.0..20.0).contains(&q.direction.altitude_deg), "{q:?}");
+        assert!((q.direction.azimuth_deg - 270.0).abs() < 5.0, "{q:?}");
+        let east = Project::parse(&text(90.0))
+            .unwrap()
+            .sun
+            .query()
+            .unwrap()
+            .unwrap();
+        let e = east.direction.azimuth_deg;
+        assert!(!(5.0..=355.0).contains(&e), "{east:?}");
+        assert!(
+            ((e - q.direction.azimuth_deg).rem_euclid(360.0) - 90.0).abs() < 1e-9,
+            "turning the room turns the sun"
+        );
+    }
+
+    #[test]
+    fn a_bad_sun_is_refused_naming_the_key() {
+        let base = "altitude_deg = 30.0\nazimuth_deg = 0.0\ndni_w_m2 = 700\ntransmittance = 0.6\n";
+        let err = |extra: &str, body: &str| {
+            Project::parse(&format!("[sun]\n{body}{extra}"))
+                .map_err(|(_, m)| m)
+                .and_then(|p| p.check().map_err(|e| e.to_string()))
+                .unwrap_err()
+        };
+        let e = err("", &base.replace("700", "-5"));
+        assert!(e.contains("[sun] dni_w_m2 = -5"), "{e}");
+        let e = err("", &base.replace("0.6", "1.6"));
+        assert!(e.contains("[sun] transmittance = 1.6"), "{e}");
+        let e = err("", &base.replace("30.0", "-3.0"));
+        assert!(e.contains("[sun] altitude_deg = -3"), "{e}");
+        let e = err("asw = 2.0\n", base);
+        assert!(e.contains("[sun] asw = 2"), "{e}");
+        let e = err("floor_reflectance = -0.1\n", base);
+        assert!(e.contains("[sun] floor_reflectance = -0.1"), "{e}");
+        let e = err(
+            "",
+            "altitude_deg = 30.0\nazimuth_deg = 0.0\ntransmittance = 0.6\n",
+        );
+        assert!(e.contains("[sun] dni_w_m2") && e.contains("needed"), "{e}");
+        let e = err(
+            "",
+            "altitude_deg = 30.0\ndni_w_m2 = 700\ntransmittance = 0.6\n",
+        );
+        assert!(e.contains("azimuth_deg") && e.contains("both"), "{e}");
+        let when =
+            "dni_w_m2 = 700\ntransmittance = 0.6\nlatitude_deg = 52.5\nlongitude_deg = 13.4\n";
+        let e = err("date_time = \"2026-13-15T10:30:00Z\"\n", when);
+        assert!(
+            e.contains("[sun] date_time = \"2026-13-15T10:30:00Z\""),
+            "{e}"
+        );
+        let e = err("date_time = \"15.01.2026 10:30\"\n", when);
+        assert!(e.contains("ISO 8601"), "{e}");
+        // Midnight in Berlin: below the horizon, refused.
+        let e = err("date_time = \"2026-01-15T23:00:00Z\"\n", when);
+        assert!(e.contains("below the horizon"), "{e}");
+        let e = err(
+            "date_time = \"2026-01-15T11:00:00Z\"\n",
+            "dni_w_m2 = 700\ntransmittance = 0.6\n",
+        );
+        assert!(e.contains("latitude_deg"), "{e}");
+        let e = err("date_time = \"2026-01-15T11:00:00Z\"\n", base);
+        assert!(e.contains("not both"), "{e}");
+        assert!(Project::parse("[sun]\nsun_altitude = 3\n").is_err());
+        // mrt_sun without a sun is refused before anything runs.
+        let p = Project::parse("[map]\nquantities = [\"mrt_sun\"]\n").unwrap();
+        let e = p.check().unwrap_err().to_string();
+        assert!(e.contains("mrt_sun") && e.contains("[sun]"), "{e}");
     }
 }

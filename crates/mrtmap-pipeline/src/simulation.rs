@@ -5,7 +5,8 @@ use std::path::Path;
 use mrtmap_sim::preset;
 /// The simulator's rooms, settings and noise models (mrtmap-sim's types).
 pub use mrtmap_sim::{
-    Drift, NoiseLevel, PRESETS, RadiometricModel, Room, SimConfig, Surfaces, ThermalNoise, simulate,
+    Drift, NoiseLevel, PRESETS, RadiometricModel, Room, SimConfig, SimSun, Surfaces, ThermalNoise,
+    simulate,
 };
 
 use crate::error::{Error, Result};

@@ -11,7 +11,7 @@ pub use mrtmap_physics::{
 use mrtmap_radiation::{Method, MonteCarlo, MrtEngine, RadiantScene};
 use mrtmap_report::{GlobeRow, ValidationRow, parse_globe_csv, validate, validation_csv};
 /// The ISO 7726 accuracy bounds a validation judges by (mrtmap-report's).
-pub use mrtmap_report::{ISO_DESIRED_K, ISO_REQUIRED_K};
+pub use mrtmap_report::{IN_SUN_NOTE, ISO_DESIRED_K, ISO_REQUIRED_K};
 
 use serde::Serialize;
 
@@ -119,11 +119,15 @@ fn calibrate_level(
 /// Compares the MRT of the scene in `map` with the globe readings of `globe`, writing
 /// validation.csv and validation.json into `out`. Readings labelled in `calibrate_with` fix the
 /// map's temperature level first (every temperature shifted by one amount) and are not judged.
+/// With `sun` (`[sun]`), a globe whose centre the beam reaches through a window is flagged
+/// (`in_sun`) and not judged: its reading includes short-wave radiation the long-wave map does
+/// not; calibrating with it is refused.
 pub fn validate_map(
     map: &Path,
     globe: &Path,
     frame: PointFrame,
     calibrate_with: &[String],
+    sun: Option<&crate::points::SunQuery>,
     out: &Path,
 ) -> Result<Validation> {
     let scene_path = scene_of(map)?;
@@ -147,6 +151,26 @@ pub fn validate_map(
         })?;
         r.xyz = [p.x, p.y, p.z];
     }
+    let in_sun: Vec<Option<String>> = match sun {
+        Some(q) => {
+            let tracer = mrtmap_radiation::SunTracer::new(&scene);
+            readings
+                .iter()
+                .map(|r| tracer.beam_at(&Point3::from(r.xyz), &q.direction))
+                .collect()
+        }
+        None => vec![None; readings.len()],
+    };
+    if let Some((r, _)) = readings
+        .iter()
+        .zip(&in_sun)
+        .find(|(r, s)| s.is_some() && calibrate_with.contains(&r.label))
+    {
+        return Err(Error::setting(
+            format!("--calibrate-with {}", r.label),
+            "names a globe in the sun ([sun]): its reading includes short-wave radiation the long-wave map does not, so it cannot fix the map's level",
+        ));
+    }
     let level_shift_k = if calibrate_with.is_empty() {
         None
     } else {
@@ -166,9 +190,14 @@ pub fn validate_map(
             .map(|r| (r.mrt.celsius(), r.std_error_k))
     };
     let mut rows = validate(&readings, &ours);
-    for r in &mut rows {
+    for (r, sun) in rows.iter_mut().zip(in_sun) {
         if calibrate_with.contains(&r.globe.label) {
             r.calibrates = true;
+            r.meets_required = None;
+            r.meets_desired = None;
+        }
+        if sun.is_some() {
+            r.in_sun = sun;
             r.meets_required = None;
             r.meets_desired = None;
         }

@@ -213,6 +213,16 @@ impl<'a> SunTracer<'a> {
         (lit as f64 / (nu * nz) as f64, ids)
     }
 
+    /// The window (its id) through which the beam from `sun` reaches the point `p` (a globe's
+    /// centre), or `None` when the point is in shade or the sun below the horizon.
+    pub fn beam_at(&self, p: &Point3<f64>, sun: &SunDirection) -> Option<String> {
+        if sun.altitude_deg <= 0.0 {
+            return None;
+        }
+        let (si, fi) = self.window_hit(p, &sun.towards_sun())?;
+        Some(self.scene.surfaces[si].features[fi].id.clone())
+    }
+
     /// f_svv and f_bes together.
     pub fn exposure(
         &self,
@@ -245,6 +255,14 @@ mod tests {
             altitude_deg: 30.0,
             azimuth_deg: 0.0,
         };
+        // A globe's centre: in the beam in front of the window, not beside it.
+        assert!(t.beam_at(&Point3::new(2.65, 1.8, 1.1), &sun).is_some());
+        assert!(t.beam_at(&Point3::new(2.65, 0.3, 1.1), &sun).is_none());
+        let night = SunDirection {
+            altitude_deg: -5.0,
+            azimuth_deg: 0.0,
+        };
+        assert!(t.beam_at(&Point3::new(2.65, 1.8, 1.1), &night).is_none());
         // Facing the window 1.55 m away, centred on it: the whole body in the beam.
         let (f, ids) = t.f_bes(&Point3::new(2.65, 1.8, 0.6), Posture::Seated, &sun);
         assert!(f > 0.95, "{f}");

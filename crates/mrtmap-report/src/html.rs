@@ -284,7 +284,10 @@ fn validation_row(r: &ValidationRow) -> Vec<String> {
         None => "—".to_string(),
     };
     vec![
-        esc(&r.globe.label),
+        match &r.in_sun {
+            Some(_) => format!("{} ({})", esc(&r.globe.label), crate::IN_SUN_NOTE),
+            None => esc(&r.globe.label),
+        },
         format!(
             "{:.2} / {:.2} / {:.2}",
             r.globe.tg_c, r.globe.ta_c, r.globe.va_m_s

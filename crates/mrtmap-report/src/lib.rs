@@ -22,8 +22,8 @@ pub use html::{ComparisonRow, KeyValues, ReportData, ReportMap, esc, render_html
 pub use map::{MapInput, MapMark, MapQuantity, contour_step, render_png, render_svg};
 pub use tables::{MapAxes, MapSummary, coverage_svg, grid_csv, parts_line, unseen_line};
 pub use validate::{
-    GLOBE_COLUMNS, GlobeRow, ISO_DESIRED_K, ISO_REQUIRED_K, ValidationRow, parse_globe_csv,
-    validate, validation_csv,
+    GLOBE_COLUMNS, GlobeRow, IN_SUN_NOTE, ISO_DESIRED_K, ISO_REQUIRED_K, ValidationRow,
+    parse_globe_csv, validate, validation_csv,
 };
 
 /// Errors of report rendering.

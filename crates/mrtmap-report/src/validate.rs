@@ -202,7 +202,13 @@ pub struct ValidationRow {
     pub meets_desired: Option<bool>,
     /// Whether this reading fixed the map's temperature level (it is then not judged).
     pub calibrates: bool,
+    /// The window through which the sun (`[sun]`) reaches the globe's centre: its reading
+    /// includes short-wave radiation the long-wave map does not, so it is not judged.
+    pub in_sun: Option<String>,
 }
+
+/// Why a globe in the sun is not judged.
+pub const IN_SUN_NOTE: &str = "in sun: its reading includes short-wave the long-wave map does not";
 
 /// The flat JSON form of a [`ValidationRow`].
 #[derive(Serialize)]
@@ -224,6 +230,10 @@ struct ValidationJson<'a> {
     meets_required: Option<bool>,
     meets_desired: Option<bool>,
     calibrates: bool,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    in_sun: Option<&'a str>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    in_sun_note: Option<&'static str>,
 }
 
 impl Serialize for ValidationRow {
@@ -243,6 +253,8 @@ impl Serialize for ValidationRow {
             meets_required: self.meets_required,
             meets_desired: self.meets_desired,
             calibrates: self.calibrates,
+            in_sun: self.in_sun.as_deref(),
+            in_sun_note: self.in_sun.as_ref().map(|_| IN_SUN_NOTE),
         }
         .serialize(s)
     }
@@ -287,6 +299,7 @@ pub fn validate(rows: &[GlobeRow], ours: &MrtAt<'_>) -> Vec<ValidationRow> {
                 mrt_mixed_c: mixed_c,
                 ours_c: ours,
                 calibrates: false,
+                in_sun: None,
             }
         })
         .collect()
@@ -314,6 +327,7 @@ pub fn validation_csv(rows: &[ValidationRow]) -> Result<String, ReportError> {
         "meets_required_2k",
         "meets_desired_0_2k",
         "calibrates",
+        "in_sun",
     ];
     let f = |x: Option<f64>| x.map(|v| format!("{v:.3}")).unwrap_or_default();
     let b = |x: Option<bool>| x.map(|v| v.to_string()).unwrap_or_default();
@@ -339,6 +353,7 @@ pub fn validation_csv(rows: &[ValidationRow]) -> Result<String, ReportError> {
             b(r.meets_required),
             b(r.meets_desired),
             r.calibrates.to_string(),
+            r.in_sun.clone().unwrap_or_default(),
         ]);
     }
     for rec in &records {

@@ -43,7 +43,10 @@ pub use sensors::{
     render_rgb_and_mask, render_thermal,
 };
 pub use simulate::{Drift, NoiseLevel, Progress, SimConfig, SimSummary, TIME_ORIGIN_S, simulate};
-pub use truth::{TRUTH_FORMAT, Truth, TruthGrid, TruthNode, TruthPoint, compute_truth};
+pub use truth::{
+    SimSun, TRUTH_FORMAT, Truth, TruthGrid, TruthNode, TruthPoint, TruthSun, TruthSunNode,
+    compute_truth, sun_truth,
+};
 pub use walk::{Walk, WalkParams, inset_polygon};
 
 /// Why a simulation failed.

@@ -126,6 +126,10 @@ pub struct SimConfig {
     /// realistic noise: real rooms are grey, and window glass mirrors the operator; black without).
     #[serde(default)]
     pub surfaces: Option<Surfaces>,
+    /// The sun through the windows: truth.json gets SolarCal's ΔMRT on its grid (the recording
+    /// is unchanged: a long-wave camera cannot see the beam).
+    #[serde(default)]
+    pub sun: Option<crate::truth::SimSun>,
 }
 
 /// Where a realistic thermal lag is drawn from (s).
@@ -192,6 +196,7 @@ impl Default for SimConfig {
             thermal_lag_s: None,
             glass: None,
             surfaces: None,
+            sun: None,
         }
     }
 }
@@ -288,6 +293,9 @@ fn check(cfg: &SimConfig) -> Result<(), SimError> {
             value: lag,
             range: "0…1 s",
         });
+    }
+    if let Some(sun) = &cfg.sun {
+        sun.check()?;
     }
     Ok(())
 }
@@ -731,6 +739,11 @@ pub fn simulate(
     files.write("room.toml", room_toml.as_bytes())?;
     let mut truth = compute_truth(room, &world_from_room, cfg.truth_rays, cfg.seed)?;
     truth.thermal_lag_s = lag_s;
+    truth.sun = cfg
+        .sun
+        .as_ref()
+        .map(|s| crate::truth::sun_truth(room, &truth.grid, s))
+        .transpose()?;
     if cfg.noise == NoiseLevel::Realistic {
         truth.thermal_time_constant_s = cfg.thermal_noise.time_constant_s;
     }

@@ -98,6 +98,164 @@ pub struct Truth {
     /// The room as a scene in world coordinates, each surface whole at its radiant-average
     /// temperature (what segmentation should recover).
     pub scene: SceneFile,
+    /// The sun through the windows (`mrtmap simulate --sun`): SolarCal's ΔMRT of a seated person
+    /// facing the sun at each grid node. The recording does not show it (a long-wave camera
+    /// cannot see the beam).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sun: Option<TruthSun>,
+}
+
+/// The sun outside a simulated room (`mrtmap simulate --sun ALT,AZ --dni W --transmittance T`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SimSun {
+    /// Solar altitude (degrees above the horizon, 0…90).
+    pub altitude_deg: f64,
+    /// Solar azimuth in the room's frame (degrees from +x towards +y).
+    pub azimuth_deg: f64,
+    /// Direct normal irradiance outside (W/m²).
+    pub dni_w_m2: f64,
+    /// The windows' total solar transmittance (0…1).
+    pub transmittance: f64,
+}
+
+impl SimSun {
+    /// Refuses a sun below the horizon and inputs outside SolarCal's ranges, naming the flag.
+    pub fn check(&self) -> Result<(), crate::SimError> {
+        let sun = self;
+        let range = |what: &str, value: f64, lo: f64, hi: f64, range: &'static str| {
+            if value.is_finite() && (lo..=hi).contains(&value) {
+                Ok(())
+            } else {
+                Err(crate::SimError::OutOfRange {
+                    what: what.into(),
+                    value,
+                    range,
+                })
+            }
+        };
+        range("--sun altitude", sun.altitude_deg, 0.0, 90.0, "0…90°")?;
+        range("--sun azimuth", sun.azimuth_deg, -360.0, 360.0, "-360…360°")?;
+        range(
+            "--dni",
+            sun.dni_w_m2,
+            0.0,
+            mrtmap_physics::MAX_DNI_W_M2,
+            "0…1500 W/m²",
+        )?;
+        range("--transmittance", sun.transmittance, 0.0, 1.0, "0…1")?;
+        Ok(())
+    }
+}
+
+/// The sun's truth: its inputs and SolarCal on the grid.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TruthSun {
+    /// The sun and the glazing.
+    pub inputs: SimSun,
+    /// The person's short-wave absorptivity (SolarCal's default).
+    pub asw: f64,
+    /// The floor's short-wave reflectance (SolarCal's default).
+    pub floor_reflectance: f64,
+    /// The person: "seated", facing the sun (SHARP 0).
+    pub posture: String,
+    /// The body centre's height above the floor (m).
+    pub body_centre_m: f64,
+    /// One per grid node of [`Truth::grid`], in its order (the grid's x, y).
+    pub nodes: Vec<TruthSunNode>,
+}
+
+/// SolarCal at one grid node.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TruthSunNode {
+    /// Column.
+    pub i: usize,
+    /// Row.
+    pub j: usize,
+    /// The body centre in the room frame.
+    pub xyz_room: [f64; 3],
+    /// Sky-vault view fraction through the windows (traced); absent when the body centre lies
+    /// inside furniture (as the values below).
+    pub f_svv: Option<f64>,
+    /// Fraction of the body in the beam (traced).
+    pub f_bes: Option<f64>,
+    /// SolarCal's effective radiant field (W/m²).
+    pub erf_w_m2: Option<f64>,
+    /// SolarCal's ΔMRT (K).
+    pub delta_mrt_k: Option<f64>,
+    /// Why there is no value ("inside desk").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+}
+
+/// SolarCal of a seated person (body centre 0.6 m) facing `sun` at each node of `grid`, with
+/// f_svv and f_bes traced through the windows of `room`'s fine scene (room frame).
+pub fn sun_truth(room: &Room, grid: &TruthGrid, sun: &SimSun) -> Result<TruthSun, crate::SimError> {
+    use mrtmap_physics::{
+        DEFAULT_ASW, DEFAULT_FLOOR_REFLECTANCE, Posture, SolarInputs, solar_gain,
+    };
+    sun.check()?;
+    let fine = room.scene(&Isometry3::identity(), true)?;
+    let tracer = mrtmap_radiation::SunTracer::new(&fine);
+    let direction = mrtmap_radiation::SunDirection {
+        altitude_deg: sun.altitude_deg,
+        azimuth_deg: sun.azimuth_deg,
+    };
+    let posture = Posture::Seated;
+    let centre = posture.centre_height_m();
+    let nodes = grid
+        .nodes
+        .iter()
+        .map(|n| {
+            let p = Point3::new(n.xyz_room[0], n.xyz_room[1], centre);
+            if let Some(o) = fine.occluders.iter().find(|o| o.contains(&p)) {
+                return Ok(TruthSunNode {
+                    i: n.i,
+                    j: n.j,
+                    xyz_room: arr(&p),
+                    f_svv: None,
+                    f_bes: None,
+                    erf_w_m2: None,
+                    delta_mrt_k: None,
+                    note: Some(format!("inside {}", o.label)),
+                });
+            }
+            let e = tracer.exposure(&p, posture, &direction);
+            let g = solar_gain(&SolarInputs {
+                altitude_deg: sun.altitude_deg,
+                sharp_deg: 0.0,
+                dni_w_m2: sun.dni_w_m2,
+                transmittance: sun.transmittance,
+                f_svv: e.f_svv,
+                f_bes: e.f_bes,
+                asw: DEFAULT_ASW,
+                posture: posture.into(),
+                floor_reflectance: DEFAULT_FLOOR_REFLECTANCE,
+            })
+            .map_err(|err| crate::SimError::OutOfRange {
+                what: format!("SolarCal at ({:.2}, {:.2}): {err}", p.x, p.y),
+                value: f64::NAN,
+                range: "SolarCal's ranges",
+            })?;
+            Ok(TruthSunNode {
+                i: n.i,
+                j: n.j,
+                xyz_room: arr(&p),
+                f_svv: Some(e.f_svv),
+                f_bes: Some(e.f_bes),
+                erf_w_m2: Some(g.erf_w_m2),
+                delta_mrt_k: Some(g.delta_mrt_k),
+                note: None,
+            })
+        })
+        .collect::<Result<Vec<_>, crate::SimError>>()?;
+    Ok(TruthSun {
+        inputs: *sun,
+        asw: DEFAULT_ASW,
+        floor_reflectance: DEFAULT_FLOOR_REFLECTANCE,
+        posture: posture.as_str().into(),
+        body_centre_m: centre,
+        nodes,
+    })
 }
 
 fn arr(p: &Point3<f64>) -> [f64; 3] {
@@ -172,5 +330,6 @@ pub fn compute_truth(
             nodes,
         },
         scene: room.scene(world_from_room, false)?.to_file(),
+        sun: None,
     })
 }

@@ -420,6 +420,11 @@ pub struct ValidateArgs {
     /// MRT; they are then shown but not judged, and the others are compared.
     #[arg(long, value_name = "LABEL,…", value_delimiter = ',')]
     pub calibrate_with: Vec<String>,
+    /// A project.toml whose `[sun]` places the sun: a globe whose centre the beam reaches through
+    /// a window is flagged "in sun" and not judged (its reading includes short-wave radiation the
+    /// long-wave map does not).
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
     /// Where to write validation.csv and validation.json (default: the map folder).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
@@ -590,6 +595,28 @@ pub struct SimulateArgs {
     /// grey with --noise realistic, black with none.
     #[arg(long, value_enum)]
     pub surfaces: Option<Surfaces>,
+    /// The sun outside the room, for truth.json only (the recording is unchanged: a long-wave
+    /// camera cannot see the beam): its altitude and azimuth in the room's frame (degrees, 0 = the
+    /// sun beyond the +x side). truth.json gets SolarCal's ΔMRT of a seated person facing the sun
+    /// at each grid node. Needs --dni and --transmittance.
+    #[arg(long, value_name = "ALT,AZ", allow_hyphen_values = true, value_parser = parse_sun, requires_all = ["dni", "transmittance"])]
+    pub sun: Option<[f64; 2]>,
+    /// Direct normal irradiance outside (W/m²), with --sun.
+    #[arg(
+        long,
+        value_name = "W_M2",
+        allow_negative_numbers = true,
+        requires = "sun"
+    )]
+    pub dni: Option<f64>,
+    /// The windows' total solar transmittance with their shades (0…1), with --sun.
+    #[arg(
+        long,
+        value_name = "T",
+        allow_negative_numbers = true,
+        requires = "sun"
+    )]
+    pub transmittance: Option<f64>,
     /// Monte Carlo rays per truth point (rooms with furniture or not convex).
     #[arg(long, default_value_t = 100_000)]
     pub truth_rays: usize,
@@ -625,9 +652,11 @@ pub struct MapArgs {
     pub marks: Vec<(String, Vec<f64>)>,
     #[command(flatten)]
     pub method: MrtSection,
-    /// What else to map, repeatable: a person's MRT (mrt_seated, mrt_standing), radiant asymmetry,
-    /// operative temperature, PMV, PPD; the person and the air come from --config's [comfort] and
-    /// [air]. Written as QUANTITY.png/.svg/.csv and comfort.json beside the MRT map.
+    /// What else to map, repeatable: a person's MRT (mrt_seated, mrt_standing), the MRT with the
+    /// sun (mrt_sun, needs --config's [sun]), radiant asymmetry, operative temperature, PMV, PPD;
+    /// the person and the air come from --config's [comfort] and [air], and with [sun] operative,
+    /// PMV and PPD include the sun. Written as QUANTITY.png/.svg/.csv and comfort.json beside the
+    /// MRT map.
     #[arg(long = "quantity", value_enum)]
     pub quantities: Vec<Quantity>,
     /// A project.toml whose [comfort] and [air] describe the person, and whose [map] quantities

@@ -69,6 +69,9 @@ pub struct MapQuantity {
     /// scale is then symmetric about it, so a cool map is blue however narrow its range (a map
     /// from −0.8 to −0.6 was drawn from blue to red).
     pub neutral: Option<f64>,
+    /// Nodes whose cells are outlined together (the sunlit patch: where the beam reaches the
+    /// person); empty: none.
+    pub outlined: Vec<(usize, usize)>,
 }
 
 /// Colour of a value `t` in 0…1 on the map's palette (blue cold → red warm).
@@ -459,6 +462,58 @@ fn draw_contours<DB: DrawingBackend>(
         out.push((runs, format!("{level:.dec$}")));
     }
     Ok(out)
+}
+
+/// The border of the outlined cells (each side of an outlined cell whose neighbour is not), in a
+/// dashed-looking orange.
+fn draw_patch<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    field: &MrtField,
+    cells: &[(usize, usize)],
+) -> Result<(), ReportError> {
+    if cells.is_empty() {
+        return Ok(());
+    }
+    let (lo, hi) = field.frame.floor_bounds();
+    let step = |c: &[f64], span: f64| {
+        if c.len() > 1 {
+            (c[c.len() - 1] - c[0]) / (c.len() - 1) as f64
+        } else {
+            span
+        }
+    };
+    let (du, dv) = (step(&field.u, hi.x - lo.x), step(&field.v, hi.y - lo.y));
+    let has = |i: isize, j: isize| i >= 0 && j >= 0 && cells.contains(&(i as usize, j as usize));
+    let mut segments = Vec::new();
+    for &(i, j) in cells {
+        let (Some(&u), Some(&v)) = (field.u.get(i), field.v.get(j)) else {
+            continue;
+        };
+        let (u0, u1) = ((u - du / 2.0).max(lo.x), (u + du / 2.0).min(hi.x));
+        let (v0, v1) = ((v - dv / 2.0).max(lo.y), (v + dv / 2.0).min(hi.y));
+        let (ii, jj) = (i as isize, j as isize);
+        if !has(ii - 1, jj) {
+            segments.push(vec![(u0, v0), (u0, v1)]);
+        }
+        if !has(ii + 1, jj) {
+            segments.push(vec![(u1, v0), (u1, v1)]);
+        }
+        if !has(ii, jj - 1) {
+            segments.push(vec![(u0, v0), (u1, v0)]);
+        }
+        if !has(ii, jj + 1) {
+            segments.push(vec![(u0, v1), (u1, v1)]);
+        }
+    }
+    let orange = RGBColor(255, 140, 0);
+    chart
+        .draw_series(
+            segments
+                .into_iter()
+                .map(|s| PathElement::new(s, orange.stroke_width(3))),
+        )
+        .map_err(de)?;
+    Ok(())
 }
 
 /// The room's outline.
@@ -865,6 +920,9 @@ fn draw<DB: DrawingBackend>(
     let mut chart = build_chart(&map_area, input.field)?;
     draw_cells(&mut chart, input.field, &ok, scale)?;
     let contours = draw_contours(&mut chart, input, &ok, scale)?;
+    if let Some(q) = &input.quantity {
+        draw_patch(&mut chart, input.field, &q.outlined)?;
+    }
     draw_outline(&mut chart, input.field)?;
     let mut labels = draw_features(&mut chart, input, scale)?;
     labels.extend(draw_furniture(&mut chart, input)?);

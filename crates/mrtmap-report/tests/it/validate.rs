@@ -165,12 +165,12 @@ fn csv_and_json_forms_are_flat_and_quote_labels() {
     let csv = validation_csv(&v).unwrap();
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines.len(), 3);
-    assert_eq!(lines[0].split(',').count(), 18);
-    assert!(lines[0].ends_with(",calibrates"));
+    assert_eq!(lines[0].split(',').count(), 19);
+    assert!(lines[0].ends_with(",calibrates,in_sun"));
     assert!(lines[1].starts_with("\"desk, north\",0,0,1.1,25,22,0.1,0.15,0.95,"));
     // The mixed convection columns are blank for the 38 mm globe.
     let cells: Vec<&str> = lines[2].split(',').collect();
-    assert_eq!(cells.len(), 18);
+    assert_eq!(cells.len(), 19);
     assert_eq!((cells[10], cells[14]), ("", ""));
     assert_eq!(cells[11], "26.500");
     let json = serde_json::to_value(&v).unwrap();

@@ -83,6 +83,15 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
             w.worst.category.as_str()
         );
     }
+    if let Some(sun) = &s.sun {
+        outln!(
+            "  the sun (SolarCal): the beam reaches the person on {:.0} % of the floor; ΔMRT up to {:.2} K at ({}, {})",
+            100.0 * sun.sunlit_share,
+            sun.max_delta_mrt_k,
+            fixed(sun.max_at[0], 2),
+            fixed(sun.max_at[1], 2)
+        );
+    }
     for (name, p) in &s.marks {
         let cells: Vec<String> = person
             .iter()

@@ -30,6 +30,14 @@ pub fn run(a: &SimulateArgs) -> anyhow::Result<()> {
     };
     cfg.glass = a.glass.choice();
     cfg.surfaces = a.surfaces;
+    cfg.sun = a.sun.map(
+        |[altitude_deg, azimuth_deg]| mrtmap_pipeline::simulation::SimSun {
+            altitude_deg,
+            azimuth_deg,
+            dni_w_m2: a.dni.unwrap_or_default(),
+            transmittance: a.transmittance.unwrap_or_default(),
+        },
+    );
     if let Some(ms) = a.thermal_lag_ms {
         cfg.thermal_lag_s = Some(ms / 1000.0);
     }

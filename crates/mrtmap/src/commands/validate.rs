@@ -8,7 +8,21 @@ use crate::cli::ValidateArgs;
 
 pub fn run(a: &ValidateArgs) -> anyhow::Result<()> {
     let out = a.out.clone().unwrap_or_else(|| a.map.clone());
-    let v = validate_map(&a.map, &a.globe, a.frame, &a.calibrate_with, &out)?;
+    let sun = match &a.config {
+        Some(f) => {
+            let p = mrtmap_pipeline::Project::load(f)?;
+            p.sun.query()?
+        }
+        None => None,
+    };
+    let v = validate_map(
+        &a.map,
+        &a.globe,
+        a.frame,
+        &a.calibrate_with,
+        sun.as_ref(),
+        &out,
+    )?;
     let (scene_path, result) = (&v.scene, &v.rows);
     outln!("scene: {}", scene_path.display());
     outln!(
@@ -47,6 +61,9 @@ pub fn run(a: &ValidateArgs) -> anyhow::Result<()> {
             }
         };
         let class = match (r.meets_desired, r.meets_required) {
+            _ if r.in_sun.is_some() => {
+                mrtmap_pipeline::validation::IN_SUN_NOTE.to_string() + " (not judged)"
+            }
             _ if r.calibrates => "fixed the level: not judged".into(),
             (Some(true), _) => format!("meets desired ±{ISO_DESIRED_K} K"),
             (_, Some(true)) => format!("meets required ±{ISO_REQUIRED_K} K"),

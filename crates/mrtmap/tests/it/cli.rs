@@ -1164,4 +1164,113 @@ fn negative_values_are_judged_by_their_range() {
     ] {
         fails_with(args, says);
     }
+/// The example office's window is on the +x wall; `[sun]` 30° high due +x puts a globe in front
+/// of it (2.65, 1.8, 1.1) in the beam and one at y = 0.3 in the shade.
+const SUNNY_PROJECT: &str =
+    "[sun]\naltitude_deg = 30.0\nazimuth_deg = 0.0\ndni_w_m2 = 700\ntransmittance = 0.6\n";
+
+#[test]
+fn validate_flags_a_globe_in_the_sun_and_does_not_judge_it() {
+    let dir = tempfile::tempdir().unwrap();
+    edited_example(dir.path(), "scene.json", |_| {});
+    let globe = dir.path().join("globe.csv");
+    std::fs::write(
+        &globe,
+        "label,x,y,z,tg_c,ta_c,va_m_s,diameter_m,emissivity\n\
+         lit,2.65,1.8,1.1,30.0,21.0,0.1,0.15,0.95\n\
+         shade,2.65,0.3,1.1,22.0,21.0,0.1,0.15,0.95\n",
+    )
+    .unwrap();
+    let project = dir.path().join("project.toml");
+    std::fs::write(&project, SUNNY_PROJECT).unwrap();
+    let (d, g, p) = (
+        dir.path().to_str().unwrap(),
+        globe.to_str().unwrap(),
+        project.to_str().unwrap(),
+    );
+    let text = crate::ok(&["validate", "--map", d, "--globe", g, "--config", p]);
+    assert!(
+        text.contains("in sun: its reading includes short-wave the long-wave map does not"),
+        "{text}"
+    );
+    let v: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("validation.json")).unwrap())
+            .unwrap();
+    assert!(v[0]["in_sun"].is_string(), "{v}");
+    assert!(v[0]["meets_required"].is_null(), "{v}");
+    assert!(
+        v[0]["diff_iso_k"].is_number(),
+        "the difference is still shown: {v}"
+    );
+    assert!(v[1].get("in_sun").is_none(), "{v}");
+    assert!(v[1]["meets_required"].is_boolean(), "{v}");
+    let csv = std::fs::read_to_string(dir.path().join("validation.csv")).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert!(lines[0].ends_with(",in_sun"), "{csv}");
+    assert!(!lines[1].ends_with(','), "{csv}");
+    assert!(lines[2].ends_with(','), "{csv}");
+    // Without the project, the same globe is judged.
+    crate::ok(&["validate", "--map", d, "--globe", g]);
+    let v: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("validation.json")).unwrap())
+            .unwrap();
+    assert!(v[0]["meets_required"].is_boolean(), "{v}");
+    fails_with(
+        &[
+            "validate",
+            "--map",
+            d,
+            "--globe",
+            g,
+            "--config",
+            p,
+            "--calibrate-with",
+            "lit",
+        ],
+        "--calibrate-with lit names a globe in the sun",
+    );
+}
+
+#[test]
+fn map_draws_the_mrt_with_the_sun_from_the_projects_sun() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("map");
+    let o = out.to_str().unwrap();
+    fails_with(
+        &["map", "--grid", "4x3", "--quantity", "mrt_sun", "--out", o],
+        "[sun]",
+    );
+    let project = dir.path().join("project.toml");
+    std::fs::write(&project, SUNNY_PROJECT).unwrap();
+    let text = crate::ok(&[
+        "map",
+        "--grid",
+        "4x3",
+        "--quantity",
+        "mrt_sun",
+        "--config",
+        project.to_str().unwrap(),
+        "--mark",
+        "lit=2.65,1.8",
+        "--out",
+        o,
+    ]);
+    assert!(text.contains("mrt_sun"), "{text}");
+    assert!(text.contains("the beam reaches the person on"), "{text}");
+    let csv = std::fs::read_to_string(out.join("mrt_sun.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 13, "{csv}");
+    let c: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("comfort.json")).unwrap()).unwrap();
+    let lit = &c["marks"][0][1];
+    let d = lit["sun"]["delta_mrt_k"].as_f64().unwrap();
+    let share = c["sun"]["sunlit_share"].as_f64().unwrap();
+    assert!(
+        share > 0.0 && share < 1.0,
+        "part of the floor is in the beam: {share}"
+    );
+    assert!(c["sun"]["max_delta_mrt_k"].as_f64().unwrap() > 10.0, "{c}");
+    assert!(d > 10.0, "{lit}");
+    let m = lit["mrt_sun"][0].as_f64().unwrap();
+    let lw = lit["sun"]["mrt_long_wave_c"].as_f64().unwrap();
+    assert!((m - lw - d).abs() < 1e-6, "{lit}");
 }
