@@ -1164,6 +1164,8 @@ fn negative_values_are_judged_by_their_range() {
     ] {
         fails_with(args, says);
     }
+}
+
 /// The example office's window is on the +x wall; `[sun]` 30° high due +x puts a globe in front
 /// of it (2.65, 1.8, 1.1) in the beam and one at y = 0.3 in the shade.
 const SUNNY_PROJECT: &str =
