@@ -33,7 +33,8 @@ fn polygon(o: &mut String, material: &str, id: &str, p: &[Point3<f64>]) {
     o.push('\n');
 }
 
-/// The comment above an object: its id, what it is, its temperature, ± and area.
+/// The comment above an object: its id, what it is, its radiant temperature, ± and area, and its
+/// emissivity and surface temperature where the scene gives one.
 fn comment(p: &MeshPart) -> String {
     let mut what = format!("# {} ({}", p.id, p.role.as_str());
     if !p.label.is_empty() {
@@ -42,6 +43,15 @@ fn comment(p: &MeshPart) -> String {
     let _ = write!(what, "): {} °C", num(p.temperature_c, 2));
     if let Some(s) = p.temperature_std_k {
         let _ = write!(what, " ± {} K", num(s, 2));
+    }
+    if let Some((t, s)) = p.surface_temperature {
+        let _ = write!(
+            what,
+            " radiant; emissivity {}, surface {} °C ± {} K",
+            num(p.emissivity, 2),
+            num(t, 2),
+            num(s, 2)
+        );
     }
     let _ = writeln!(what, ", {} m²", num(p.area_m2, 3));
     what

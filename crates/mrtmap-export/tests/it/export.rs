@@ -446,3 +446,41 @@ fn ids_honeybee_would_refuse_are_changed_there_and_restored_on_reading() {
         h.features
     );
 }
+
+/// Issue 52: a grey scene's exports give both temperatures, each named for what it is, and a
+/// Honeybee model reads them back.
+#[test]
+fn exports_name_the_radiant_and_the_surface_temperature() {
+    let mut file = office_with_desk().to_file();
+    file.temperatures = Some(mrtmap_radiation::TemperatureKind::Radiant);
+    let w = file
+        .surfaces
+        .iter_mut()
+        .flat_map(|x| x.features.iter_mut())
+        .find(|f| f.label.contains("window"))
+        .unwrap();
+    w.emissivity = 0.84;
+    w.surface_temperature_c = Some(11.5);
+    w.surface_temperature_std_k = Some(0.25);
+    let s = RadiantScene::new(&file).unwrap();
+    let rad = radiance::write(&s, "office");
+    assert!(
+        rad.contains("radiant; emissivity 0.84, surface 11.5 °C ± 0.25 K"),
+        "{rad}"
+    );
+    let xml = gbxml::write(&s, "office");
+    assert!(xml.contains("surface_temperature_c=11.5"), "gbXML");
+    let hb = hbjson::write(&s, "office");
+    let back = read(&hb, None, None).unwrap().scene;
+    assert_eq!(
+        back.temperatures,
+        Some(mrtmap_radiation::TemperatureKind::Radiant)
+    );
+    let f = back
+        .surfaces
+        .iter()
+        .flat_map(|x| x.features.iter())
+        .find(|f| f.label.contains("window"))
+        .unwrap();
+    assert_eq!((f.surface_temperature_c, f.emissivity), (Some(11.5), 0.84));
+}
