@@ -94,6 +94,8 @@ std = 0.02                # the standard uncertainty of each emissivity
 # latitude_deg = 52.5     # north positive
 # longitude_deg = 13.4    # east positive
 # north_deg = 0.0         # compass bearing of the room's +y axis (0: +y north, +x east)
+# epw = "site.epw"        # with date_time: an EnergyPlus weather file gives the place and that
+                          # hour's direct normal irradiance (local standard time, hour ending)
 # dni_w_m2 = 700.0        # direct normal irradiance outside (needed with a sun)
 # transmittance = 0.6     # the windows' total solar transmittance with shades (needed with a sun)
 floor_reflectance = 0.6   # the floor's short-wave reflectance
@@ -816,6 +818,11 @@ pub struct SunSection {
     /// The compass bearing of the room's +y axis (degrees; 0: +y north, +x east), with
     /// `date_time`.
     pub north_deg: f64,
+    /// An EnergyPlus weather file (EPW), with `date_time`: its LOCATION gives the latitude and
+    /// longitude (unless given) and its hour holding `date_time` (local standard time, hour ending)
+    /// the direct normal irradiance (unless `dni_w_m2` is given). A relative path is from the
+    /// folder mrtmap runs in.
+    pub epw: Option<String>,
     /// Direct normal irradiance outside (W/m²); needed with a sun.
     pub dni_w_m2: Option<f64>,
     /// The windows' total solar transmittance with their shades (0…1); needed with a sun.
@@ -835,6 +842,7 @@ impl Default for SunSection {
             latitude_deg: None,
             longitude_deg: None,
             north_deg: 0.0,
+            epw: None,
             dni_w_m2: None,
             transmittance: None,
             floor_reflectance: mrtmap_physics::DEFAULT_FLOOR_REFLECTANCE,
@@ -851,6 +859,7 @@ impl SunSection {
             || self.date_time.is_some()
             || self.latitude_deg.is_some()
             || self.longitude_deg.is_some()
+            || self.epw.is_some()
             || self.dni_w_m2.is_some()
             || self.transmittance.is_some()
     }
@@ -879,6 +888,13 @@ impl SunSection {
                 Err(bad(key, v, allowed))
             }
         };
+        if self.epw.is_some() && self.date_time.is_none() {
+            return Err(Error::setting(
+                "[sun] epw",
+                "needs [sun] date_time (UTC) to pick its hour",
+            ));
+        }
+        let mut epw: Option<EpwHour> = None;
         let (altitude, azimuth) = match (
             self.altitude_deg,
             self.azimuth_deg,
@@ -902,6 +918,12 @@ impl SunSection {
                         "is not an ISO 8601 UTC time like \"2026-01-15T10:30:00Z\"",
                     )
                 })?;
+                if let Some(path) = &self.epw {
+                    let w = epw_at(Path::new(path), &time)?;
+                    epw = Some(w);
+                }
+                let lat_given = self.latitude_deg.or(epw.map(|w| w.latitude_deg));
+                let lon_given = self.longitude_deg.or(epw.map(|w| w.longitude_deg));
                 let need = |key: &str, v: Option<f64>| {
                     v.ok_or_else(|| {
                         Error::setting(
@@ -912,14 +934,14 @@ impl SunSection {
                 };
                 let lat = within(
                     "latitude_deg",
-                    need("latitude_deg", self.latitude_deg)?,
+                    need("latitude_deg", lat_given)?,
                     -90.0,
                     90.0,
                     "-90…90°",
                 )?;
                 let lon = within(
                     "longitude_deg",
-                    need("longitude_deg", self.longitude_deg)?,
+                    need("longitude_deg", lon_given)?,
                     -180.0,
                     180.0,
                     "-180…180° (east positive)",
@@ -961,7 +983,7 @@ impl SunSection {
                 ));
             }
         };
-        let dni = self.dni_w_m2.ok_or_else(|| {
+        let dni = self.dni_w_m2.or(epw.map(|w| w.dni_w_m2)).ok_or_else(|| {
             Error::setting(
                 "[sun] dni_w_m2",
                 "is needed with a sun: the direct normal irradiance outside (W/m²)",
@@ -988,6 +1010,121 @@ impl SunSection {
         q.asw = asw;
         Ok(Some(q))
     }
+}
+
+/// What an EPW weather file gives for one hour: its place and the direct normal irradiance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EpwHour {
+    /// Latitude (degrees, north positive).
+    pub latitude_deg: f64,
+    /// Longitude (degrees, east positive).
+    pub longitude_deg: f64,
+    /// Direct normal irradiance (W/m², the file's field 15).
+    pub dni_w_m2: f64,
+}
+
+/// The hour of the EnergyPlus weather file `path` that holds the instant `time` (UTC): the file's
+/// LOCATION line (latitude, longitude, time zone in hours from UTC) and the data row whose month,
+/// day and hour (local standard time, hour ending: hour h covers h − 1 to h) hold it, any year
+/// (typical-year files mix them). Errors name the file and, for a row, the line.
+pub fn epw_at(path: &Path, time: &mrtmap_physics::UtcTime) -> Result<EpwHour> {
+    let text = std::fs::read_to_string(path).map_err(|e| mrtmap_io::FileError::io(path, e))?;
+    let bad = |line: usize, message: String| Error::Config {
+        path: path.to_path_buf(),
+        line,
+        message,
+    };
+    let loc = text
+        .lines()
+        .position(|l| l.starts_with("LOCATION"))
+        .ok_or_else(|| bad(1, "no LOCATION line: is it an EPW weather file?".into()))?;
+    let cells: Vec<&str> = text.lines().nth(loc).unwrap_or("").split(',').collect();
+    let num = |k: usize, what: &str, line: usize| -> Result<f64> {
+        cells
+            .get(k)
+            .and_then(|c| c.trim().parse::<f64>().ok())
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| {
+                bad(
+                    line,
+                    format!("LOCATION's {what} (field {}) is not a number", k + 1),
+                )
+            })
+    };
+    let (lat, lon, tz) = (
+        num(6, "latitude", loc + 1)?,
+        num(7, "longitude", loc + 1)?,
+        num(8, "time zone", loc + 1)?,
+    );
+    // The local standard time, by whole days and hours from the UTC instant.
+    let days_in = |y: i32, m: u32| match m {
+        2 if (y % 4 == 0 && y % 100 != 0) || y % 400 == 0 => 29,
+        2 => 28,
+        4 | 6 | 9 | 11 => 30,
+        _ => 31,
+    };
+    let minutes = f64::from(time.hour * 60 + time.minute) + time.second / 60.0 + tz * 60.0;
+    let (mut y, mut m, mut d) = (time.year, time.month, time.day as i64);
+    let mut day_shift = (minutes / 1440.0).floor() as i64;
+    let local_min = minutes - 1440.0 * day_shift as f64;
+    while day_shift > 0 {
+        d += 1;
+        if d > i64::from(days_in(y, m)) {
+            d = 1;
+            m += 1;
+            if m > 12 {
+                m = 1;
+                y += 1;
+            }
+        }
+        day_shift -= 1;
+    }
+    while day_shift < 0 {
+        d -= 1;
+        if d < 1 {
+            m = if m == 1 { 12 } else { m - 1 };
+            if m == 12 {
+                y -= 1;
+            }
+            d = i64::from(days_in(y, m));
+        }
+        day_shift += 1;
+    }
+    let hour = (local_min / 60.0).floor() as i64 + 1;
+    for (k, line) in text.lines().enumerate().skip(loc + 1) {
+        let c: Vec<&str> = line.split(',').collect();
+        if c.len() < 15 {
+            continue;
+        }
+        let int = |i: usize| c[i].trim().parse::<i64>().ok();
+        if int(1) == Some(i64::from(m)) && int(2) == Some(d) && int(3) == Some(hour) {
+            let dni = c[14]
+                .trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite() && *v >= 0.0)
+                .ok_or_else(|| {
+                    bad(
+                        k + 1,
+                        format!(
+                            "direct normal irradiance (field 15) '{}' is not a number",
+                            c[14].trim()
+                        ),
+                    )
+                })?;
+            return Ok(EpwHour {
+                latitude_deg: lat,
+                longitude_deg: lon,
+                dni_w_m2: dni,
+            });
+        }
+    }
+    Err(bad(
+        0,
+        format!(
+            "no row for {m:02}-{d:02}, hour {hour} (local standard time, UTC{tz:+}): the file holds no such hour"
+        ),
+    ))
 }
 
 /// An ISO 8601 time in UTC: `YYYY-MM-DDTHH:MM[:SS[.fff]]` with `Z` or `+00:00` (a space for the
@@ -1157,6 +1294,62 @@ mod tests {
     use super::*;
 
     /// Issue 54: a ray count that cannot be answered is refused before anything runs.
+    /// An EPW file gives the place and the hour's direct normal irradiance: 11:00 UTC in Berlin
+    /// (UTC+1) is in the local hour ending at 13:00.
+    #[test]
+    fn an_epw_file_gives_the_place_and_the_hour_s_irradiance() {
+        let dir = tempfile::tempdir().unwrap();
+        let epw = dir.path().join("berlin.epw");
+        let row = |h: u32, dni: f64| {
+            format!("1989,1,15,{h},60,?9?9?9?9E0,1.0,-2.0,80,101000,0,0,250,150,{dni},60,0,0,0,0\n")
+        };
+        let text = format!(
+            "LOCATION,Berlin,,DEU,IWEC Data,103840,52.47,13.40,1.0,49.0\nDESIGN CONDITIONS,0\nDATA PERIODS,1,1,Data,Sunday, 1/ 1,12/31\n{}{}",
+            row(12, 100.0),
+            row(13, 345.0)
+        );
+        std::fs::write(&epw, text).unwrap();
+        let t = parse_utc("2026-01-15T11:00:00Z").unwrap();
+        let h = epw_at(&epw, &t).unwrap();
+        assert_eq!(
+            (h.latitude_deg, h.longitude_deg, h.dni_w_m2),
+            (52.47, 13.40, 345.0)
+        );
+        let sun = SunSection {
+            date_time: Some("2026-01-15T11:00:00Z".into()),
+            epw: Some(epw.display().to_string()),
+            transmittance: Some(0.6),
+            ..SunSection::default()
+        };
+        let q = sun.query().unwrap().unwrap();
+        assert_eq!(q.dni_w_m2, 345.0);
+        let direct = SunSection {
+            epw: None,
+            latitude_deg: Some(52.47),
+            longitude_deg: Some(13.40),
+            dni_w_m2: Some(345.0),
+            ..sun.clone()
+        };
+        let d = direct.query().unwrap().unwrap();
+        assert!((d.direction.altitude_deg - q.direction.altitude_deg).abs() < 1e-9);
+        // An hour the file does not hold, and an epw without a time, are refused by name.
+        let e = epw_at(&epw, &parse_utc("2026-01-16T11:00:00Z").unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("berlin.epw") && e.contains("01-16, hour 13"),
+            "{e}"
+        );
+        let e = SunSection {
+            date_time: None,
+            ..sun
+        }
+        .query()
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("[sun] epw"), "{e}");
+    }
+
     #[test]
     fn too_many_rays_are_refused_naming_the_flag() {
         let mut m = MrtSection {
