@@ -684,11 +684,46 @@ pub fn level_segmentation(
         .extend_from_slice(&seg.textured.temperature_std_k);
     seen.observations
         .extend_from_slice(&seg.textured.observations);
-    // Grey surfaces: the camera reads radiant temperatures; a contact reading is a surface
-    // temperature, compared with what the camera should read there (its emissivity, and the
-    // irradiance the scene gives the spot, at the level being fitted: three rounds settle it,
-    // since a level error moves that prediction by only 1 − ε of itself).
     level.emissivity.apply(&mut seg.scene);
+    let found = fit_grey_level(&seg.scene, &seen, &world_from_room, level);
+    apply_level(&mut seg.scene, &found);
+    // The surfaces' true temperatures, from the irradiance at the level found.
+    match grey::derive_surface_temperatures(
+        &mut seg.scene,
+        |s| level.mrt.engine(s),
+        level.emissivity.std,
+    ) {
+        Ok(unexplained) if !unexplained.is_empty() => seg.report.warnings.push(format!(
+            "level: no surface temperature explains the radiant temperature of {} with the emissivity taken (colder than what it reflects): check its emissivity in [emissivity]",
+            unexplained.join(", ")
+        )),
+        Ok(_) => {}
+        Err(e) => seg.report.warnings.push(format!(
+            "level: surface temperatures not derived: {e}"
+        )),
+    }
+    carry_to_tables(seg, &found);
+    seg.report.warnings.extend(
+        level
+            .warnings
+            .iter()
+            .chain(&found.warnings)
+            .map(|w| format!("level: {w}")),
+    );
+    found
+}
+
+/// The level of the readings of `level` seen in `seen`, on grey surfaces: the camera reads radiant
+/// temperatures and a contact reading is a surface temperature, so each reading is compared with
+/// what the camera should read there (its emissivity, and the irradiance the scene gives the spot,
+/// at the level being fitted: three rounds settle it, since a level error moves that prediction
+/// by only 1 − ε of itself).
+fn fit_grey_level(
+    scene: &RadiantScene,
+    seen: &ThermalCloud,
+    world_from_room: &Isometry3<f64>,
+    level: &LevelInputs,
+) -> Level {
     let spots: Vec<Option<Spot>> = level
         .references
         .iter()
@@ -697,11 +732,11 @@ pub fn level_segmentation(
                 PointFrame::Room => Point3::from(r.xyz),
                 PointFrame::Scan => world_from_room.inverse() * Point3::from(r.xyz),
             };
-            spot_at(&seg.scene, &p)
+            spot_at(scene, &p)
         })
         .collect();
-    let irradiance_cam: Vec<Option<Temperature>> = match level.mrt.engine(&seg.scene) {
-        Ok(engine) => spots
+    let irradiance_cam: Vec<Option<Temperature>> = match level.mrt.engine(scene) {
+        Ok(engine) if !spots.is_empty() => spots
             .iter()
             .enumerate()
             .map(|(k, s)| {
@@ -710,17 +745,20 @@ pub fn level_segmentation(
                 })
             })
             .collect(),
-        Err(_) => vec![None; spots.len()],
+        _ => vec![None; spots.len()],
     };
-    let mean_c = mean_temperature_c(&seg.scene);
-    let mut found = find_level(
-        &level.references,
-        &[],
-        &seen,
-        &world_from_room,
-        mean_c,
-        level.camera_accuracy_k,
-    );
+    let mean_c = mean_temperature_c(scene);
+    let fit = |expected: &[Expected]| {
+        find_level(
+            &level.references,
+            expected,
+            seen,
+            world_from_room,
+            mean_c,
+            level.camera_accuracy_k,
+        )
+    };
+    let mut found = fit(&[]);
     for _ in 0..3 {
         let expected: Vec<Expected> = level
             .references
@@ -733,57 +771,47 @@ pub fn level_segmentation(
                     .or(spot.as_ref().map(|s| s.emissivity))
                     .unwrap_or(1.0);
                 match irr {
-                    Some(t) if e < 1.0 => {
-                        let ts = Temperature::from_celsius(r.temperature_c);
-                        let ti = Temperature::from_celsius(found.correct(t.celsius()));
-                        let tr = grey::radiant_temperature(ts, ti, e);
-                        // ∂T_r/∂ε = (T⁴ − T_irr⁴) / 4T_r³; an emissivity the reading's column
-                        // gives is taken as known.
-                        let d_e = (ts.kelvin().powi(4) - ti.kelvin().powi(4))
-                            / (4.0 * tr.kelvin().powi(3));
-                        let sd_e = if r.emissivity.is_some() {
-                            0.0
-                        } else {
-                            level.emissivity.std
-                        };
-                        Expected {
-                            radiant_c: tr.celsius(),
-                            emissivity: e,
-                            std_k: (d_e * sd_e).abs(),
-                        }
-                    }
+                    Some(t) if e < 1.0 => expected_grey(r, e, *t, &found, level.emissivity.std),
                     _ => Expected::black(r),
                 }
             })
             .collect();
-        found = find_level(
-            &level.references,
-            &expected,
-            &seen,
-            &world_from_room,
-            mean_c,
-            level.camera_accuracy_k,
-        );
+        found = fit(&expected);
     }
-    apply_level(&mut seg.scene, &found);
-    // The surfaces' true temperatures, from the irradiance at the level found.
-    let std = level.emissivity.std;
-    match grey::derive_surface_temperatures(
-        &mut seg.scene,
-        |s| level.mrt.engine(s),
-        std,
-    ) {
-        Ok(unexplained) if !unexplained.is_empty() => seg.report.warnings.push(format!(
-            "level: no surface temperature explains the radiant temperature of {} with the emissivity taken (colder than what it reflects): check its emissivity in [emissivity]",
-            unexplained.join(", ")
-        )),
-        Ok(_) => {}
-        Err(e) => seg.report.warnings.push(format!(
-            "level: surface temperatures not derived: {e}"
-        )),
+    found
+}
+
+/// What the camera should read at reading `r` of a surface of emissivity `e` whose irradiance the
+/// camera put at `irradiance_cam` (carried to the level `found`), with the uncertainty an
+/// emissivity taken from the table (±`emissivity_std`) puts on it.
+fn expected_grey(
+    r: &Reference,
+    e: f64,
+    irradiance_cam: Temperature,
+    found: &Level,
+    emissivity_std: f64,
+) -> Expected {
+    let ts = Temperature::from_celsius(r.temperature_c);
+    let ti = Temperature::from_celsius(found.correct(irradiance_cam.celsius()));
+    let tr = grey::radiant_temperature(ts, ti, e);
+    // ∂T_r/∂ε = (T⁴ − T_irr⁴) / 4T_r³; an emissivity the reading's column gives is taken as known.
+    let d_e = (ts.kelvin().powi(4) - ti.kelvin().powi(4)) / (4.0 * tr.kelvin().powi(3));
+    let sd_e = if r.emissivity.is_some() {
+        0.0
+    } else {
+        emissivity_std
+    };
+    Expected {
+        radiant_c: tr.celsius(),
+        emissivity: e,
+        std_k: (d_e * sd_e).abs(),
     }
-    // segment.json's tables at the same level as scene.json (the report's Surfaces and Features
-    // tables showed the camera's uncorrected temperatures beside corrected maps).
+}
+
+/// segment.json's tables at the same level as scene.json (the report's Surfaces and Features tables
+/// showed the camera's uncorrected temperatures beside corrected maps), with each element's
+/// emissivity and true temperature.
+fn carry_to_tables(seg: &mut Segmentation, found: &Level) {
     for x in &mut seg.report.surfaces {
         x.temperature_c = x.temperature_c.map(|c| found.correct(c));
         x.temperature_std_k /= found.beta.abs();
@@ -795,7 +823,6 @@ pub fn level_segmentation(
     for f in &mut seg.report.furniture {
         f.temperature_c = found.correct(f.temperature_c);
     }
-    // ... and with each element's emissivity and true temperature.
     let grey_of = |id: &str| {
         seg.scene.surfaces.iter().find_map(|s| {
             if s.id == id {
@@ -821,14 +848,6 @@ pub fn level_segmentation(
             x.surface_temperature_std_k = st.map(|t| t.1);
         }
     }
-    seg.report.warnings.extend(
-        level
-            .warnings
-            .iter()
-            .chain(&found.warnings)
-            .map(|w| format!("level: {w}")),
-    );
-    found
 }
 
 #[cfg(test)]

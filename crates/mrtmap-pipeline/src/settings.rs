@@ -864,6 +864,62 @@ impl SunSection {
             || self.transmittance.is_some()
     }
 
+    /// The sun's altitude and room azimuth at `when` (`date_time`), at the place the keys (or the
+    /// EPW file) give, and the EPW file's hour when one is given.
+    fn sun_at_time(&self, when: &str) -> Result<(f64, f64, Option<EpwHour>)> {
+        let time = parse_utc(when).ok_or_else(|| {
+            Error::setting(
+                format!("[sun] date_time = \"{when}\""),
+                "is not an ISO 8601 UTC time like \"2026-01-15T10:30:00Z\"",
+            )
+        })?;
+        let epw = match &self.epw {
+            Some(path) => Some(epw_at(Path::new(path), &time)?),
+            None => None,
+        };
+        let lat_given = self.latitude_deg.or(epw.map(|w| w.latitude_deg));
+        let lon_given = self.longitude_deg.or(epw.map(|w| w.longitude_deg));
+        let need = |key: &str, v: Option<f64>| {
+            v.ok_or_else(|| {
+                Error::setting(
+                    "[sun] date_time",
+                    format!("needs [sun] {key} to place the sun"),
+                )
+            })
+        };
+        let lat = sun_within(
+            "latitude_deg",
+            need("latitude_deg", lat_given)?,
+            -90.0,
+            90.0,
+            "-90…90°",
+        )?;
+        let lon = sun_within(
+            "longitude_deg",
+            need("longitude_deg", lon_given)?,
+            -180.0,
+            180.0,
+            "-180…180° (east positive)",
+        )?;
+        let north = sun_within("north_deg", self.north_deg, -360.0, 360.0, "-360…360°")?;
+        let pos = mrtmap_physics::sun_position(&time, lat, lon)
+            .map_err(|e| Error::setting(format!("[sun] date_time = \"{when}\""), e.to_string()))?;
+        if pos.altitude_deg <= 0.0 {
+            return Err(Error::setting(
+                format!("[sun] date_time = \"{when}\""),
+                format!(
+                    "puts the sun {:.1}° below the horizon at {lat}°, {lon}°: no beam (leave [sun] out for a map without the sun)",
+                    -pos.altitude_deg
+                ),
+            ));
+        }
+        Ok((
+            pos.altitude_deg,
+            mrtmap_physics::room_azimuth_deg(pos.azimuth_deg, north),
+            epw,
+        ))
+    }
+
     /// Checks every key (the same as [`SunSection::query`] without its answer).
     pub fn check(&self) -> Result<()> {
         self.query().map(|_| ())
@@ -912,57 +968,9 @@ impl SunSection {
                 (alt, az.rem_euclid(360.0))
             }
             (None, None, Some(when)) => {
-                let time = parse_utc(when).ok_or_else(|| {
-                    Error::setting(
-                        format!("[sun] date_time = \"{when}\""),
-                        "is not an ISO 8601 UTC time like \"2026-01-15T10:30:00Z\"",
-                    )
-                })?;
-                if let Some(path) = &self.epw {
-                    let w = epw_at(Path::new(path), &time)?;
-                    epw = Some(w);
-                }
-                let lat_given = self.latitude_deg.or(epw.map(|w| w.latitude_deg));
-                let lon_given = self.longitude_deg.or(epw.map(|w| w.longitude_deg));
-                let need = |key: &str, v: Option<f64>| {
-                    v.ok_or_else(|| {
-                        Error::setting(
-                            "[sun] date_time",
-                            format!("needs [sun] {key} to place the sun"),
-                        )
-                    })
-                };
-                let lat = within(
-                    "latitude_deg",
-                    need("latitude_deg", lat_given)?,
-                    -90.0,
-                    90.0,
-                    "-90…90°",
-                )?;
-                let lon = within(
-                    "longitude_deg",
-                    need("longitude_deg", lon_given)?,
-                    -180.0,
-                    180.0,
-                    "-180…180° (east positive)",
-                )?;
-                let north = within("north_deg", self.north_deg, -360.0, 360.0, "-360…360°")?;
-                let pos = mrtmap_physics::sun_position(&time, lat, lon).map_err(|e| {
-                    Error::setting(format!("[sun] date_time = \"{when}\""), e.to_string())
-                })?;
-                if pos.altitude_deg <= 0.0 {
-                    return Err(Error::setting(
-                        format!("[sun] date_time = \"{when}\""),
-                        format!(
-                            "puts the sun {:.1}° below the horizon at {lat}°, {lon}°: no beam (leave [sun] out for a map without the sun)",
-                            -pos.altitude_deg
-                        ),
-                    ));
-                }
-                (
-                    pos.altitude_deg,
-                    mrtmap_physics::room_azimuth_deg(pos.azimuth_deg, north),
-                )
+                let (alt, az, w) = self.sun_at_time(when)?;
+                epw = w;
+                (alt, az)
             }
             (_, _, Some(_)) => {
                 return Err(Error::setting(
@@ -1009,6 +1017,18 @@ impl SunSection {
         q.floor_reflectance = floor;
         q.asw = asw;
         Ok(Some(q))
+    }
+}
+
+/// `v` when finite and within `lo…hi`, else an error naming `[sun] key` and `allowed`.
+fn sun_within(key: &str, v: f64, lo: f64, hi: f64, allowed: &str) -> Result<f64> {
+    if v.is_finite() && (lo..=hi).contains(&v) {
+        Ok(v)
+    } else {
+        Err(Error::setting(
+            format!("[sun] {key} = {v}"),
+            format!("is outside {allowed}"),
+        ))
     }
 }
 

@@ -14,9 +14,8 @@
 //! is the diffuse one above.
 
 use mrtmap_geometry::nalgebra::{Isometry3, Point2, Point3, Vector3};
-use mrtmap_geometry::sampling::DirectionSet;
 use mrtmap_physics::ZERO_CELSIUS_K;
-use mrtmap_radiation::{Method, MonteCarlo, MrtEngine};
+use mrtmap_radiation::MrtEngine;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -209,17 +208,7 @@ pub fn solve(room: &mut Room, rays: usize, seed: u64) -> Result<(), crate::SimEr
     if !g.is_grey() {
         return Ok(());
     }
-    let exact = room.convex && room.file.furniture.is_empty();
-    let method = if exact {
-        Method::Exact
-    } else {
-        Method::MonteCarlo(MonteCarlo {
-            rays,
-            seed,
-            directions: DirectionSet::Fibonacci,
-            replicates: 4,
-        })
-    };
+    let method = room.truth_method(rays, seed, 4);
     // Sample points of each element (surface backgrounds without their features; features).
     let mut elements: Vec<(Vec<Point3<f64>>, Vector3<f64>)> = Vec::new();
     for s in room.surfaces() {

@@ -605,6 +605,26 @@ impl Room {
         f
     }
 
+    /// The view factors its truth is computed with: exact solid angles when the room is convex
+    /// and has no furniture, else `rays` Fibonacci rays per point in `replicates` sets.
+    pub fn truth_method(
+        &self,
+        rays: usize,
+        seed: u64,
+        replicates: usize,
+    ) -> mrtmap_radiation::Method {
+        if self.convex && self.file.furniture.is_empty() {
+            mrtmap_radiation::Method::Exact
+        } else {
+            mrtmap_radiation::Method::MonteCarlo(mrtmap_radiation::MonteCarlo {
+                rays,
+                seed,
+                directions: mrtmap_geometry::sampling::DirectionSet::Fibonacci,
+                replicates,
+            })
+        }
+    }
+
     /// Whether any surface is grey.
     pub fn is_grey(&self) -> bool {
         self.grey.is_some()

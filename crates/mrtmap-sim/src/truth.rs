@@ -6,9 +6,8 @@
 //! with many Fibonacci rays, whose standard error is written beside each value.
 
 use mrtmap_geometry::nalgebra::{Isometry3, Point3};
-use mrtmap_geometry::sampling::DirectionSet;
 use mrtmap_io::PoseFile;
-use mrtmap_radiation::{GridSpec, MapFrame, Method, MonteCarlo, MrtEngine, MrtField, SceneFile};
+use mrtmap_radiation::{GridSpec, MapFrame, Method, MrtEngine, MrtField, SceneFile};
 use serde::{Deserialize, Serialize};
 
 use crate::room::Room;
@@ -270,17 +269,8 @@ pub fn compute_truth(
     seed: u64,
 ) -> Result<Truth, crate::SimError> {
     let fine = room.scene(&Isometry3::identity(), true)?;
-    let exact = room.convex && room.file.furniture.is_empty();
-    let method = if exact {
-        Method::Exact
-    } else {
-        Method::MonteCarlo(MonteCarlo {
-            rays,
-            seed,
-            directions: DirectionSet::Fibonacci,
-            replicates: 8,
-        })
-    };
+    let method = room.truth_method(rays, seed, 8);
+    let exact = matches!(method, Method::Exact);
     let engine = MrtEngine::new(&fine, method)?;
     let w = |p: &Point3<f64>| arr(&(world_from_room * p));
     let mut points = Vec::new();
