@@ -396,6 +396,10 @@ pub struct ComfortSummary {
     /// reaches (f_bes > 0), the largest ΔMRT and where (map x, y).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sun: Option<SunSummary>,
+    /// The sunlit patch (with `[sun]`): the floor under the nodes whose person the beam reaches,
+    /// as the report's 3D view draws it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sunlit_patch: Option<SunlitPatch>,
     /// The marked points' values.
     pub marks: Vec<(String, ComfortPoint)>,
     /// Seconds to compute.
@@ -411,6 +415,52 @@ pub struct SunSummary {
     pub max_delta_mrt_k: f64,
     /// Where (map x, y).
     pub max_at: [f64; 2],
+}
+
+/// The floor cells under the grid nodes whose person the beam reaches (f_bes > 0).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SunlitPatch {
+    /// Each cell's centre on the floor (scene frame, m).
+    pub cells: Vec<[f64; 3]>,
+    /// The map's axes along its columns and rows (unit vectors, scene frame).
+    pub u: [f64; 3],
+    /// See `u`.
+    pub v: [f64; 3],
+    /// The cells' size along u and v (m).
+    pub cell_m: [f64; 2],
+}
+
+impl SunlitPatch {
+    /// The patch of `nodes` on `field`'s floor; `None` when the sun reaches no node's person.
+    fn of(field: &MrtField, nodes: &[ComfortNode]) -> Option<Self> {
+        let cells: Vec<[f64; 3]> = nodes
+            .iter()
+            .filter(|n| {
+                n.point
+                    .as_ref()
+                    .is_ok_and(|p| p.sun.is_some_and(|s| s.f_bes > 0.0))
+            })
+            .map(|n| {
+                let p = field
+                    .frame
+                    .point(&Point2::new(field.u[n.i], field.v[n.j]), 0.0);
+                [p.x, p.y, p.z]
+            })
+            .collect();
+        let step = |xs: &[f64]| match xs {
+            [a, b, ..] => (b - a).abs(),
+            _ => 0.0,
+        };
+        let axis = |a: &mrtmap_geometry::nalgebra::Unit<
+            mrtmap_geometry::nalgebra::Vector3<f64>,
+        >| [a.x, a.y, a.z];
+        (!cells.is_empty()).then(|| Self {
+            cells,
+            u: axis(&field.frame.plane.u),
+            v: axis(&field.frame.plane.v),
+            cell_m: [step(&field.u), step(&field.v)],
+        })
+    }
 }
 
 /// The PMV/PPD variant, in words.
@@ -522,7 +572,8 @@ pub fn make_comfort_maps(
         engine.ray_settings().rays
     );
     let maps = write_maps(&field, scene, &nodes, marks, &subtitle, (&person, c), out)?;
-    let summary = summarise(&nodes, c, &person, mark_values, secs);
+    let mut summary = summarise(&nodes, c, &person, mark_values, secs);
+    summary.sunlit_patch = SunlitPatch::of(&field, &nodes);
     write_json(&out.join("comfort.json"), &summary)?;
     Ok(ComfortOutput { summary, maps })
 }
@@ -666,6 +717,7 @@ fn summarise(
         });
     ComfortSummary {
         sun,
+        sunlit_patch: None,
         comfort: c.clone(),
         pmv_model: PMV_MODEL.into(),
         quantities: quantities.to_vec(),

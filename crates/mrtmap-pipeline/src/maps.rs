@@ -585,6 +585,18 @@ mod tests {
         assert!((m - sun.mrt_long_wave_c - sun.delta_mrt_k).abs() < 1e-9);
         let beside = with.summary.marks[1].1.sun.unwrap();
         assert_eq!(beside.f_bes, 0.0);
+        // The patch the 3D view draws: on the floor, holding the cell under the lit person and
+        // not the one beside the beam.
+        let patch = with.summary.sunlit_patch.clone().unwrap();
+        assert!(patch.cells.iter().all(|c| c[2].abs() < 1e-9), "{patch:?}");
+        let near = |x: f64, y: f64| {
+            patch.cells.iter().any(|c| {
+                (c[0] - x).abs() <= 0.5 * patch.cell_m[0] + 1e-9
+                    && (c[1] - y).abs() <= 0.5 * patch.cell_m[1] + 1e-9
+            })
+        };
+        assert!(near(2.65, 1.8) && !near(2.65, 0.3), "{patch:?}");
+        assert!(without.summary.sunlit_patch.is_none());
         assert!(beside.delta_mrt_k < sun.delta_mrt_k / 4.0, "{beside:?}");
         // Operative temperature with the sun: about half of ΔMRT warmer in the beam.
         let op = |p: &crate::comfort::ComfortPoint| p.thermal.unwrap().operative_c;

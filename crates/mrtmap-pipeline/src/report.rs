@@ -702,6 +702,16 @@ pub fn view3d_for_run(
         cloud.map(|c| (c.positions.as_slice(), c.temperature_c.as_slice())),
         &grids,
         &globes_of_run(out),
+        o.comfort
+            .as_ref()
+            .and_then(|c| c.summary.sunlit_patch.as_ref())
+            .map(|p| mrtmap_report::view3d::PatchLayer {
+                cells: p.cells.clone(),
+                u: p.u,
+                v: p.v,
+                cell_m: p.cell_m,
+            })
+            .as_ref(),
     )
 }
 

@@ -176,6 +176,9 @@ fn view3d_section(o: &mut String, d: &ReportData) {
             format!("MRT at {:.2} m", m.summary.height_m),
         ));
     }
+    if view.1.sun {
+        buttons.push(("sun".into(), "Sunlit patch".into()));
+    }
     buttons.push(("marks".into(), "Points and globes".into()));
     for (layer, label) in buttons {
         o.push_str(&format!(

@@ -24,9 +24,30 @@ pub struct GridLayer {
     pub v: [f64; 3],
 }
 
+/// The sunlit patch as a layer of the 3D view: orange cells on the floor where the beam reaches a
+/// person.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PatchLayer {
+    /// Each cell's centre (scene frame, m).
+    pub cells: Vec<[f64; 3]>,
+    /// The cells' axes (unit vectors, scene frame).
+    pub u: [f64; 3],
+    /// See `u`.
+    pub v: [f64; 3],
+    /// The cells' size along u and v (m).
+    pub cell_m: [f64; 2],
+}
+
 /// The 3D view's JSON document, ready to embed.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct View3d(pub String);
+pub struct View3d(pub String, pub Layers);
+
+/// Which optional layers a [`View3d`] holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct Layers {
+    /// The sunlit patch.
+    pub sun: bool,
+}
 
 fn r3(x: f64) -> f64 {
     (x * 1000.0).round() / 1000.0
@@ -63,13 +84,14 @@ fn spacing(nodes: &[[f64; 4]], axis: &[f64; 3]) -> f64 {
 }
 
 /// The view of `scene`, with `cloud` (positions in the scene's frame, °C; thinned evenly to
-/// [`MAX_VIEW_POINTS`]), the maps' `grids` and black-globe readings (`globes`; the report adds
-/// its named points).
+/// [`MAX_VIEW_POINTS`]), the maps' `grids`, black-globe readings (`globes`; the report adds
+/// its named points) and the sunlit patch (`sun`, with `[sun]`).
 pub fn view3d(
     scene: &RadiantScene,
     cloud: Option<(&[[f32; 3]], &[f32])>,
     grids: &[GridLayer],
     globes: &[ViewMark],
+    sun: Option<&PatchLayer>,
 ) -> View3d {
     let parts = scene_mesh(scene);
     let (lo, hi) = crate::mesh::colour_range(
@@ -150,11 +172,24 @@ pub fn view3d(
         })
         .map(|(s, _)| crate::mesh::outward_normal(scene, s))
         .map(|n| [r3(n.x), r3(n.y), r3(n.z)]);
+    // 1 cm above the floor, so that the floor does not hide it.
+    let sun = sun.filter(|p| !p.cells.is_empty()).map(|p| {
+        let up = scene.up().map_or([0.0, 0.0, 1.0], |u| [u.x, u.y, u.z]);
+        json!({
+            "cells": p.cells.iter().map(|c| [0, 1, 2].map(|k| r3(c[k] + 0.01 * up[k]))).collect::<Vec<_>>(),
+            "u": p.u, "v": p.v, "cell": p.cell_m,
+        })
+    });
     let doc = json!({
         "range": [lo, hi], "bar": stops(lo, hi), "centre": centre, "size": size, "look": look,
-        "parts": json_parts, "cloud": cloud, "grids": grids, "globes": globes,
+        "parts": json_parts, "cloud": cloud, "grids": grids, "globes": globes, "sun": sun,
     });
-    View3d(serde_json::to_string(&doc).unwrap_or_default())
+    View3d(
+        serde_json::to_string(&doc).unwrap_or_default(),
+        Layers {
+            sun: !doc["sun"].is_null(),
+        },
+    )
 }
 
 /// A marked point or globe in the 3D view.

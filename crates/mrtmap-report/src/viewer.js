@@ -102,6 +102,20 @@
     }
     layers["grid" + k] = drawable(pos, col, nor, gl.TRIANGLES);
   });
+  // The sunlit patch: orange cells on the floor where the beam reaches a person.
+  if (data.sun && data.sun.cells.length) {
+    const pos = [], col = [], nor = [];
+    const hu = data.sun.cell[0] / 2, hv = data.sun.cell[1] / 2, u = data.sun.u, v = data.sun.v;
+    for (const nd of data.sun.cells) {
+      const q = (a, b) => [0, 1, 2].map((j) => nd[j] + a * u[j] + b * v[j]);
+      for (const c of [q(-hu, -hv), q(hu, -hv), q(hu, hv), q(-hu, -hv), q(hu, hv), q(-hu, hv)]) {
+        pos.push(c[0], c[1], c[2]);
+        col.push(1, 0.55, 0);
+        nor.push(0, 0, 0);
+      }
+    }
+    layers.sun = drawable(pos, col, nor, gl.TRIANGLES);
+  }
   if (marks.length) {
     const pos = [], col = [], nor = [];
     for (const mk of marks) {
@@ -114,7 +128,7 @@
   }
 
   // Which layers show: the buttons toggle them.
-  const shown = { surfaces: true, features: true, furniture: true, cloud: false, marks: true };
+  const shown = { surfaces: true, features: true, furniture: true, cloud: false, marks: true, sun: true };
   data.grids.forEach((_, k) => { shown["grid" + k] = k === 0; });
   // #3d&show=cloud,-grid0 turns layers on (or, with "-", off) from the address.
   for (const w of (hash.get("show") || "").split(",").filter(Boolean)) {
@@ -207,7 +221,8 @@
     }
     gl.disable(gl.CULL_FACE);
     gl.enable(gl.BLEND);
-    gl.blendFunc(gl.SRC_ALPHA, gl.ONE_MINUS_SRC_ALPHA);
+    // The canvas stays opaque (alpha untouched), so the page's white does not wash the colours out.
+    gl.blendFuncSeparate(gl.SRC_ALPHA, gl.ONE_MINUS_SRC_ALPHA, gl.ZERO, gl.ONE);
     gl.depthMask(false);
     gl.uniform1f(loc.a, 0.6);
     gl.uniform1f(loc.lit, 0);
@@ -215,6 +230,7 @@
       const d = layers["grid" + k];
       if (d && shown["grid" + k]) { bind(d); gl.drawArrays(d.mode, 0, d.count); }
     });
+    if (layers.sun && shown.sun) { bind(layers.sun); gl.drawArrays(layers.sun.mode, 0, layers.sun.count); }
     gl.depthMask(true);
     // Points and globes last, over everything, as their labels are.
     if (layers.marks && shown.marks) {

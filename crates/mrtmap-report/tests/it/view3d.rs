@@ -1,6 +1,6 @@
 use mrtmap_radiation::example_office;
 use mrtmap_report::mesh::{PartRole, outward_normal, scene_mesh};
-use mrtmap_report::view3d::{GridLayer, MAX_VIEW_POINTS, view3d};
+use mrtmap_report::view3d::{GridLayer, MAX_VIEW_POINTS, PatchLayer, view3d};
 use mrtmap_report::{ReportData, render_html};
 use serde_json::Value;
 
@@ -61,7 +61,8 @@ fn the_view_thins_the_cloud_and_lays_each_map_as_cells() {
         u: [1.0, 0.0, 0.0],
         v: [0.0, 1.0, 0.0],
     };
-    let v: Value = serde_json::from_str(&view3d(&s, Some((&pos, &t)), &[grid], &[]).0).unwrap();
+    let v: Value =
+        serde_json::from_str(&view3d(&s, Some((&pos, &t)), &[grid], &[], None).0).unwrap();
     assert_eq!(
         v["cloud"]["p"].as_array().unwrap().len(),
         3 * MAX_VIEW_POINTS
@@ -88,11 +89,13 @@ fn the_report_embeds_the_view_safely() {
     let s = mrtmap_radiation::RadiantScene::new(&f).unwrap();
     let d = ReportData {
         title: "t".into(),
-        view3d: Some(view3d(&s, None, &[], &[])),
+        view3d: Some(view3d(&s, None, &[], &[], None)),
         ..ReportData::default()
     };
     let html = render_html(&d);
     assert!(html.contains("<canvas id=\"view3d\">"));
+    // No sun, no sunlit-patch button.
+    assert!(!html.contains("data-layer=\"sun\""));
     assert!(html.contains("<button data-layer=\"cloud\">"));
     assert!(
         !html.contains("</script><b>"),
@@ -101,4 +104,35 @@ fn the_report_embeds_the_view_safely() {
     assert_eq!(html.matches("</script>").count(), 3);
     // Without a scene, no view.
     assert!(!render_html(&ReportData::default()).contains("<canvas"));
+}
+
+#[test]
+fn the_sunlit_patch_lies_on_the_floor_with_its_own_button() {
+    let s = example_office();
+    let patch = PatchLayer {
+        cells: vec![[2.65, 1.8, 0.0], [2.4, 1.8, 0.0]],
+        u: [1.0, 0.0, 0.0],
+        v: [0.0, 1.0, 0.0],
+        cell_m: [0.25, 0.2],
+    };
+    let view = view3d(&s, None, &[], &[], Some(&patch));
+    assert!(view.1.sun);
+    let v: Value = serde_json::from_str(&view.0).unwrap();
+    let cells: Vec<[f64; 3]> = serde_json::from_value(v["sun"]["cells"].clone()).unwrap();
+    // 1 cm above the floor (z = 0), so the floor does not hide it.
+    assert_eq!(cells, vec![[2.65, 1.8, 0.01], [2.4, 1.8, 0.01]]);
+    assert_eq!(v["sun"]["cell"], serde_json::json!([0.25, 0.2]));
+    let html = render_html(&ReportData {
+        title: "t".into(),
+        view3d: Some(view),
+        ..ReportData::default()
+    });
+    assert!(html.contains("<button data-layer=\"sun\">Sunlit patch</button>"));
+    // An empty patch is no layer.
+    let empty = PatchLayer {
+        cells: Vec::new(),
+        ..patch
+    };
+    let view = view3d(&s, None, &[], &[], Some(&empty));
+    assert!(!view.1.sun);
 }
