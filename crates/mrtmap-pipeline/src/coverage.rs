@@ -285,11 +285,7 @@ pub fn coverage_of(
             "give the map's target as a positive number of kelvin (2σ), at most 10",
         ));
     }
-    let p = match config {
-        Some(f) => Project::load(f)?,
-        None => Project::default(),
-    };
-    p.check()?;
+    let p = Project::resolve(config, &crate::Overrides::new())?;
     let temp = match out {
         Some(_) => None,
         None => Some(

@@ -11,8 +11,10 @@
 //!  calibration: image pairs ──► rig.toml + report folder
 //! ```
 //!
-//! - [`settings`]: [`Project`] (project.toml; flags are merged into it once) and the typed choices
+//! - [`settings`]: [`Project`] (project.toml) and the typed choices
 //!   shared by flags and files ([`MethodChoice`], [`DirectionChoice`]).
+//! - [`resolve`]: settings resolved once for every front end: the defaults, then project.toml,
+//!   then the flags given ([`Overrides`], [`Project::resolve`]; `[mrt]`'s flags as [`MrtFlags`]).
 //! - [`cache`]: a stage's [`Fingerprint`] and [`run_or_reuse`]; the run's stages, source
 //!   conversion and the demo's simulation all use it.
 //! - [`progress`]: the [`Progress`] trait the CLI implements with progress bars.
@@ -55,6 +57,7 @@ pub mod parse;
 pub mod points;
 pub mod progress;
 pub mod report;
+pub mod resolve;
 pub mod run;
 pub mod settings;
 pub mod simulation;
@@ -71,4 +74,5 @@ pub mod files {
 pub use cache::{Fingerprint, Stage, StageOutcome, run_or_reuse};
 pub use error::{Error, Result};
 pub use progress::{Progress, Silent};
+pub use resolve::{MrtFlags, Overrides};
 pub use settings::{DirectionChoice, MethodChoice, MrtSection, Project};

@@ -702,18 +702,7 @@ impl MrtSection {
     /// The method for `scene`: `auto` is Monte Carlo when the scene has occluders (exact solid
     /// angles cannot see them), else exact with Monte Carlo where surfaces hide each other.
     pub fn method(&self, scene: &RadiantScene) -> Result<Method> {
-        if self.rays == 0 {
-            return Err(Error::setting(
-                "--rays 0 ([mrt] rays)",
-                "is too few: at least 1 ray per point is needed",
-            ));
-        }
-        if self.method != MethodChoice::Exact && self.replicates < 2 {
-            return Err(Error::setting(
-                format!("--replicates {} ([mrt] replicates)", self.replicates),
-                "is too few: the standard error needs at least 2 independent replicates",
-            ));
-        }
+        self.check()?;
         let mc = MonteCarlo {
             rays: self.rays,
             seed: self.seed,
@@ -731,6 +720,18 @@ impl MrtSection {
     /// Settings that need no scene: the placement uncertainty and the ray count (checked before a
     /// run's fusion, not after it).
     pub fn check(&self) -> Result<()> {
+        if self.rays == 0 {
+            return Err(Error::setting(
+                "--rays 0 ([mrt] rays)",
+                "is too few: at least 1 ray per point is needed",
+            ));
+        }
+        if self.method != MethodChoice::Exact && self.replicates < 2 {
+            return Err(Error::setting(
+                format!("--replicates {} ([mrt] replicates)", self.replicates),
+                "is too few: the standard error needs at least 2 independent replicates",
+            ));
+        }
         if self.rays > MAX_RAYS {
             return Err(Error::setting(
                 format!("--rays {} ([mrt] rays)", self.rays),

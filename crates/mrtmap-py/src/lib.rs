@@ -31,7 +31,7 @@ use mrtmap_pipeline::validation::{
     Convection, Globe, GlobeFormulaChoice, GlobeInput, MIXED_CONVECTION_DIAMETERS_M, Temperature,
     convert_globe,
 };
-use mrtmap_pipeline::{MrtSection, Progress, Project};
+use mrtmap_pipeline::{MrtSection, Overrides, Progress, Project};
 use numpy::ndarray::ArrayView1;
 use numpy::{AllowTypeChange, PyArray1, PyArray2, PyArrayLike1, PyArrayLike2, PyArrayMethods};
 use pyo3::create_exception;
@@ -65,18 +65,18 @@ fn py_err(e: impl std::error::Error) -> PyErr {
     MrtmapError::new_err(message(&e))
 }
 
-/// The view-factor settings from a JSON object of `[mrt]`'s keys (the Python layer's keywords).
+/// The view-factor settings from a JSON object of `[mrt]`'s keys (the Python layer's keywords),
+/// resolved over the defaults as the CLI's flags are.
 fn mrt_settings(json: &str) -> PyResult<MrtSection> {
-    let de = &mut serde_json::Deserializer::from_str(json);
-    let s: MrtSection = serde_path_to_error::deserialize(de).map_err(|e| {
-        MrtmapError::new_err(format!(
-            "view-factor setting {}: {}",
-            e.path(),
-            json_words(e.inner())
-        ))
-    })?;
-    s.check().map_err(py_err)?;
-    Ok(s)
+    let keys: serde_json::Map<String, serde_json::Value> = serde_json::from_str(json)
+        .map_err(|e| MrtmapError::new_err(format!("view-factor settings: {}", json_words(&e))))?;
+    let mut o = Overrides::new();
+    for (k, v) in &keys {
+        o.set(&format!("mrt.{k}"), &format!("{k}="), v);
+    }
+    Ok(Project::resolve_over(Project::default(), &o)
+        .map_err(py_err)?
+        .mrt)
 }
 
 /// A serde_json error without its position in the JSON the Python layer wrote (the path names
@@ -380,16 +380,17 @@ fn project_of(config: Option<&Bound<'_, PyAny>>) -> PyResult<Project> {
     if let Ok(json) = c.getattr("__mrtmap_json__").and_then(|f| f.call0()) {
         let text: String = json.extract()?;
         let de = &mut serde_json::Deserializer::from_str(&text);
-        return serde_path_to_error::deserialize(de).map_err(|e| {
+        let p: Project = serde_path_to_error::deserialize(de).map_err(|e| {
             MrtmapError::new_err(format!("config [{}]: {}", e.path(), json_words(e.inner())))
-        });
+        })?;
+        return Project::resolve_over(p, &Overrides::new()).map_err(py_err);
     }
     let path: PathBuf = c.extract().map_err(|_| {
         MrtmapError::new_err(
             "config must be None, a path to project.toml, or a dict of its sections",
         )
     })?;
-    Project::load(&path).map_err(py_err)
+    Project::resolve(Some(&path), &Overrides::new()).map_err(py_err)
 }
 
 /// `mrtmap run` on `recording` into `out`: (the run's lines, run.json's path, seconds, the

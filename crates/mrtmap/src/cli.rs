@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use mrtmap_pipeline::MrtSection;
+use mrtmap_pipeline::MrtFlags;
 use mrtmap_pipeline::export::{DEFAULT_MAX_POINTS, ExportFormat, ExportSource};
 use mrtmap_pipeline::maps::SceneSource;
 use mrtmap_pipeline::parse::{
@@ -638,20 +638,22 @@ pub struct MapArgs {
     #[command(flatten)]
     pub scene: SceneSource,
     /// Height of the map above the floor (m); 1.1 m is seated head height, 1.7 m standing.
-    #[arg(long, default_value_t = 1.1)]
-    pub height: f64,
-    /// Grid nodes as COLSxROWS over the floor's bounding rectangle (nodes outside the floor are left out).
-    #[arg(long, default_value = "20x20", value_parser = parse_grid)]
-    pub grid: (usize, usize),
-    /// Distance kept from the floor outline (m).
-    #[arg(long = "margin-m", default_value_t = 0.1)]
-    pub margin_m: f64,
+    /// Default: --config's first [map] heights_m, else 1.1.
+    #[arg(long)]
+    pub height: Option<f64>,
+    /// Grid nodes as COLSxROWS over the floor's bounding rectangle (nodes outside the floor are
+    /// left out). Default: --config's [map] grid, else 20x20.
+    #[arg(long, value_parser = parse_grid)]
+    pub grid: Option<(usize, usize)>,
+    /// Distance kept from the floor outline (m). Default: --config's [map] margin_m, else 0.1.
+    #[arg(long = "margin-m")]
+    pub margin_m: Option<f64>,
     /// A point to mark and report, NAME=U,V in map coordinates (x,y for a z-up scene) or
     /// NAME=X,Y,Z in scene coordinates. Repeatable.
     #[arg(long = "mark", value_name = "NAME=U,V", allow_hyphen_values = true, value_parser = parse_mark)]
     pub marks: Vec<(String, Vec<f64>)>,
     #[command(flatten)]
-    pub method: MrtSection,
+    pub method: MrtFlags,
     /// What else to map, repeatable: a person's MRT (mrt_seated, mrt_standing), the MRT with the
     /// sun (mrt_sun, needs --config's [sun]), radiant asymmetry, operative temperature, PMV, PPD;
     /// the person and the air come from --config's [comfort] and [air], and with [sun] operative,
@@ -659,8 +661,8 @@ pub struct MapArgs {
     /// MRT map.
     #[arg(long = "quantity", value_enum)]
     pub quantities: Vec<Quantity>,
-    /// A project.toml whose [comfort] and [air] describe the person, and whose [map] quantities
-    /// are mapped unless --quantity is given.
+    /// A project.toml: its [map], [mrt], [comfort], [air] and [sun] apply, each flag given
+    /// overriding its key.
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
     /// Air temperature (°C) for operative temperature, PMV and PPD ([air] temperature_c).
@@ -686,7 +688,7 @@ pub struct MrtArgs {
     #[arg(long, value_enum, default_value_t = PointFrame::Room)]
     pub frame: PointFrame,
     #[command(flatten)]
-    pub method: MrtSection,
+    pub method: MrtFlags,
     /// The MRT of a person instead of a small sphere: --at is the body centre (0.6 m above the
     /// floor seated, 1.0 m standing); angle factors from the projected-area factors of a seated or
     /// standing body.

@@ -1,34 +1,40 @@
 //! `mrtmap map`: MRT over a grid, written as CSV, PNG, SVG and JSON; with `--quantity`, a
 //! person's comfort maps beside it.
 
-use mrtmap_pipeline::Project;
 use mrtmap_pipeline::comfort::value_of;
 use mrtmap_pipeline::maps::GridSpec;
 use mrtmap_pipeline::maps::{Mark, MarkAt, load_scene, map_scene};
 use mrtmap_pipeline::report::numbers::{fixed, uncertainty};
 use mrtmap_pipeline::settings::Quantity;
+use mrtmap_pipeline::{Overrides, Project};
 
 use crate::cli::MapArgs;
 use crate::output::print_lines;
 
 pub fn run(a: &MapArgs) -> anyhow::Result<()> {
-    let mut project = match &a.config {
-        Some(f) => Project::load(f)?,
-        None => Project::default(),
-    };
-    if !a.quantities.is_empty() {
-        project.map.quantities = a.quantities.clone();
-    }
-    if a.air_c.is_some() {
-        project.air.temperature_c = a.air_c;
-    }
+    let mut o = Overrides::new();
+    o.set_some("map.grid", "--grid", a.grid.map(|(x, y)| [x, y]).as_ref())
+        .set_some(
+            "map.heights_m",
+            "--height",
+            a.height.map(|h| vec![h]).as_ref(),
+        )
+        .set_some("map.margin_m", "--margin-m", a.margin_m.as_ref())
+        .set_some(
+            "map.quantities",
+            "--quantity",
+            (!a.quantities.is_empty()).then_some(&a.quantities),
+        )
+        .set_some("air.temperature_c", "--air-c", a.air_c.as_ref());
+    a.method.add_to(&mut o);
+    let project = Project::resolve(a.config.as_deref(), &o)?;
     let (scene, source) = load_scene(&a.scene)?;
-    project.mrt = a.method;
+    // One map: at --height, else at [map] heights_m's first.
     let spec = GridSpec {
-        nx: a.grid.0,
-        ny: a.grid.1,
-        height_m: a.height,
-        margin_m: a.margin_m,
+        nx: project.map.grid[0],
+        ny: project.map.grid[1],
+        height_m: project.map.heights_m[0],
+        margin_m: project.map.margin_m,
     };
     let marks: Vec<Mark> = a
         .marks

@@ -24,7 +24,7 @@ pub fn run(a: &MrtArgs) -> anyhow::Result<()> {
             )
         }),
     };
-    let answers = mrt_at_points(&scene, &source, &a.method, &query)?;
+    let answers = mrt_at_points(&scene, &source, &a.method.section()?, &query)?;
     if a.json {
         out!("{}", json(&answers)?);
     } else {

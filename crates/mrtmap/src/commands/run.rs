@@ -1,64 +1,55 @@
 //! `mrtmap run`: the whole pipeline on a recording.
 
 use anyhow::bail;
-use mrtmap_pipeline::Project;
 use mrtmap_pipeline::report::run_recording;
 use mrtmap_pipeline::settings::PointEntry;
+use mrtmap_pipeline::{Overrides, Project};
 
 use crate::cli::RunArgs;
 use crate::output::{Bar, print_lines};
 
-/// The project from the file and the flags.
+/// The project: the defaults, then the file, then the flags given.
 fn settings(a: &RunArgs) -> anyhow::Result<Project> {
-    let mut p = match &a.config {
-        Some(f) => Project::load(f)?,
-        None => Project::default(),
-    };
-    if let Some((x, y)) = a.grid {
-        p.map.grid = [x, y];
-    }
-    if !a.heights.is_empty() {
-        p.map.heights_m = a.heights.clone();
-    }
-    if let Some(m) = a.margin_m {
-        p.map.margin_m = m;
-    }
-    if !a.quantities.is_empty() {
-        p.map.quantities = a.quantities.clone();
-    }
+    let mut o = Overrides::new();
+    o.set_some("map.grid", "--grid", a.grid.map(|(x, y)| [x, y]).as_ref())
+        .set_some(
+            "map.heights_m",
+            "--height",
+            (!a.heights.is_empty()).then_some(&a.heights),
+        )
+        .set_some("map.margin_m", "--margin-m", a.margin_m.as_ref())
+        .set_some(
+            "map.quantities",
+            "--quantity",
+            (!a.quantities.is_empty()).then_some(&a.quantities),
+        )
+        .set_some("fuse.voxel_m", "--voxel-m", a.voxel_m.as_ref())
+        .set_some("fuse.icp", "--icp", a.icp.as_ref())
+        .set_some(
+            "fuse.self_calibrate",
+            "--self-calibrate",
+            a.self_calibrate.as_ref(),
+        )
+        .set_some("segment.masks", "--no-masks", a.no_masks.then_some(&false))
+        .set_some(
+            "room.origin_corner",
+            "--origin-corner",
+            a.origin_corner.as_ref(),
+        )
+        .set_some("air.temperature_c", "--air-c", a.air_c.as_ref());
     for (name, c) in &a.marks {
         let &[x, y, z] = c.as_slice() else {
             bail!(
                 "--mark {name}: give X,Y,Z (metres; the room frame, or the scan's with --frame scan)"
             );
         };
-        p.points.retain(|q| &q.name != name);
-        p.points.push(PointEntry {
+        o.point(PointEntry {
             name: name.clone(),
             xyz: [x, y, z],
             frame: a.frame,
         });
     }
-    if let Some(v) = a.voxel_m {
-        p.fuse.voxel_m = v;
-    }
-    if let Some(i) = a.icp {
-        p.fuse.icp = i;
-    }
-    if let Some(s) = a.self_calibrate {
-        p.fuse.self_calibrate = s;
-    }
-    if a.no_masks {
-        p.segment.masks = false;
-    }
-    if let Some(c) = a.origin_corner {
-        p.room.origin_corner = Some(c);
-    }
-    if let Some(t) = a.air_c {
-        p.air.temperature_c = Some(t);
-    }
-    p.check()?;
-    Ok(p)
+    Ok(Project::resolve(a.config.as_deref(), &o)?)
 }
 
 pub fn run(a: &RunArgs) -> anyhow::Result<()> {

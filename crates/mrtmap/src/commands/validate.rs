@@ -10,7 +10,7 @@ pub fn run(a: &ValidateArgs) -> anyhow::Result<()> {
     let out = a.out.clone().unwrap_or_else(|| a.map.clone());
     let sun = match &a.config {
         Some(f) => {
-            let p = mrtmap_pipeline::Project::load(f)?;
+            let p = mrtmap_pipeline::Project::resolve(Some(f), &mrtmap_pipeline::Overrides::new())?;
             p.sun.query()?
         }
         None => None,

@@ -336,6 +336,63 @@ fn example_scene_round_trips_through_map() {
     );
 }
 
+#[test]
+fn map_takes_the_configs_sections_and_each_flag_over_its_key() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("p.toml");
+    std::fs::write(
+        &cfg,
+        "[mrt]\nmethod = \"montecarlo\"\nrays = 2000\nreplicates = 4\n[map]\ngrid = [6, 5]\nheights_m = [1.7]\n",
+    )
+    .unwrap();
+    let summary = |args: &[&str], name: &str| {
+        let out = dir.path().join(name);
+        let mut all = vec![
+            "map",
+            "--config",
+            cfg.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        all.extend_from_slice(args);
+        let o = mrtmap(&all);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let s: Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        (
+            s["method"].clone(),
+            s["rays"].clone(),
+            s["nodes"].clone(),
+            s["height_m"].clone(),
+        )
+    };
+    // The file's [mrt] and [map] (the map once replaced [mrt] with the flags' defaults).
+    let (m, r, n, h) = summary(&[], "file");
+    assert_eq!(
+        (m.as_str(), r.as_u64(), n.as_u64(), h.as_f64()),
+        (Some("montecarlo"), Some(2000), Some(30), Some(1.7))
+    );
+    // Each flag given overrides its key only.
+    let (m, r, n, h) = summary(&["--rays", "3000", "--grid", "4x4"], "flags");
+    assert_eq!(
+        (m.as_str(), r.as_u64(), n.as_u64(), h.as_f64()),
+        (Some("montecarlo"), Some(3000), Some(16), Some(1.7))
+    );
+    fails_with(
+        &[
+            "map",
+            "--config",
+            cfg.to_str().unwrap(),
+            "--rays",
+            "0",
+            "--out",
+            dir.path().join("x").to_str().unwrap(),
+        ],
+        "--rays 0",
+    );
+}
+
 /// The example office as JSON, changed by `edit`, written to `dir/name`.
 fn edited_example(dir: &Path, name: &str, edit: impl FnOnce(&mut Value)) -> String {
     let mut v: Value = serde_json::from_str(mrtmap_pipeline::points::EXAMPLE_OFFICE_JSON).unwrap();
