@@ -1,0 +1,81 @@
+//! `[emissivity]`: the surfaces' long-wave emissivities, overriding the table's by label or id.
+
+use mrtmap_radiation::RadiantScene;
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
+
+/// `[emissivity]`: the surfaces' long-wave emissivities, where the table's by label are not wanted.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct EmissivitySection {
+    /// The standard uncertainty of each emissivity.
+    pub std: f64,
+    /// Emissivity of elements whose label contains the key (case-insensitive; the longest key
+    /// that matches wins).
+    pub by_label: std::collections::BTreeMap<String, f64>,
+    /// Emissivity of one surface or feature, by id.
+    pub by_id: std::collections::BTreeMap<String, f64>,
+}
+
+impl Default for EmissivitySection {
+    fn default() -> Self {
+        Self {
+            std: mrtmap_radiation::grey::EMISSIVITY_STD,
+            by_label: Default::default(),
+            by_id: Default::default(),
+        }
+    }
+}
+
+impl EmissivitySection {
+    /// Every value is an emissivity (0 < ε ≤ 1), the standard uncertainty within 0…0.5.
+    pub fn check(&self) -> Result<()> {
+        if !(self.std.is_finite() && (0.0..=0.5).contains(&self.std)) {
+            return Err(Error::setting(
+                format!("[emissivity] std = {}", self.std),
+                "must be between 0 and 0.5",
+            ));
+        }
+        for (table, map) in [("by_label", &self.by_label), ("by_id", &self.by_id)] {
+            if let Some((k, v)) = map.iter().find(|(_, v)| !(**v > 0.0 && **v <= 1.0)) {
+                return Err(Error::setting(
+                    format!("[emissivity] {table}.{k} = {v}"),
+                    "is not an emissivity: give a value above 0 and at most 1",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The emissivity of the element `id` labelled `label` (of kind `kind` for a surface).
+    pub fn of(&self, id: &str, label: &str, kind: Option<mrtmap_radiation::SurfaceKind>) -> f64 {
+        if let Some(e) = self.by_id.get(id) {
+            return *e;
+        }
+        let l = label.to_lowercase();
+        self.by_label
+            .iter()
+            .filter(|(k, _)| l.contains(&k.to_lowercase()))
+            .max_by_key(|(k, _)| k.len())
+            .map_or_else(
+                || mrtmap_radiation::grey::default_emissivity(label, kind),
+                |(_, e)| *e,
+            )
+    }
+
+    /// Sets every surface's, feature's and occluder's emissivity in `scene` and marks its
+    /// temperatures as radiant (what the camera read).
+    pub fn apply(&self, scene: &mut RadiantScene) {
+        for s in &mut scene.surfaces {
+            s.emissivity = self.of(&s.id, &s.label, Some(s.kind));
+            for f in &mut s.features {
+                f.emissivity = self.of(&f.id, &f.label, None);
+            }
+        }
+        for o in &mut scene.occluders {
+            o.emissivity = self.of(&o.id, &o.label, None);
+        }
+        scene.temperatures = Some(mrtmap_radiation::TemperatureKind::Radiant);
+    }
+}
