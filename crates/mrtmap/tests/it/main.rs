@@ -5,6 +5,7 @@ mod architecture;
 mod calibrate;
 mod cli;
 mod pipeline;
+mod readme;
 mod sources;
 
 /// Runs the built binary.
