@@ -42,8 +42,8 @@ pub use image16::{Image16, encode_png_rgb8, encode_png16, gaussian_blur, read_im
 pub use layout::masks;
 pub use layout::{
     ImuSample, InterpolationLimits, LayoutWriter, PoseFile, QUATERNION_NORM_TOLERANCE, Recording,
-    RgbCamera, Rig, StreamEntry, ThermalEncoding, Trajectory, imu_text, parse_imu,
-    parse_stream_list, quaternion_xyzw, read_imu, stream_list_text, unit_quaternion,
+    RecordingWarning, RgbCamera, Rig, StreamEntry, ThermalEncoding, Trajectory, imu_text,
+    parse_imu, parse_stream_list, quaternion_xyzw, read_imu, stream_list_text, unit_quaternion,
 };
 pub use ply::{ReadCloud, ThermalCloud, cloud_ply_bytes, iron, read_cloud_ply, write_cloud_ply};
 pub use thermal::{

@@ -139,7 +139,7 @@ pub fn judge(o: &RunOutcome, target_k: f64) -> Coverage {
     let max_unseen_k = field.map_or(0.0, |f| f.max_std_error_parts.unseen_k);
     let (level_basis, level_std_k) = o.level.as_ref().map_or_else(
         || ("camera".to_string(), o.scene.temperature_level_std_k),
-        |l| (l.basis.clone(), l.std_k),
+        |l| (l.basis.to_string(), l.std_k),
     );
     let mut reasons = Vec::new();
     let mut look_at = Vec::new();

@@ -184,11 +184,35 @@ pub struct ReferenceUse {
     pub note: Option<String>,
 }
 
+/// What the temperatures' level rests on (in level.json by its phrase).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum LevelBasis {
+    /// Readings at two or more temperatures: the camera's offset and gain.
+    #[serde(rename = "references (offset and gain)")]
+    OffsetAndGain,
+    /// Readings that fix the offset alone.
+    #[serde(rename = "references (offset)")]
+    Offset,
+    /// No readings: the camera as it is, its stated accuracy in every ±.
+    #[serde(rename = "camera")]
+    Camera,
+}
+
+impl std::fmt::Display for LevelBasis {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::OffsetAndGain => "references (offset and gain)",
+            Self::Offset => "references (offset)",
+            Self::Camera => "camera",
+        })
+    }
+}
+
 /// The temperatures' level: what the fit found and what it rests on (`level.json`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Level {
-    /// "references (offset and gain)", "reference (offset)" or "camera".
-    pub basis: String,
+    /// What it rests on.
+    pub basis: LevelBasis,
     /// α: the camera's reading of a 0 °C surface… in the fit camera = α + β·true (°C).
     pub alpha_c: f64,
     /// β: the camera's gain relative to the truth.
@@ -425,7 +449,7 @@ pub fn find_level(
         .collect();
     if pts.is_empty() {
         return Level {
-            basis: "camera".into(),
+            basis: LevelBasis::Camera,
             alpha_c: 0.0,
             beta: 1.0,
             offset_at_mean_k: 0.0,
@@ -465,9 +489,9 @@ pub fn find_level(
     }
     Level {
         basis: if gain {
-            "references (offset and gain)".into()
+            LevelBasis::OffsetAndGain
         } else {
-            "references (offset)".into()
+            LevelBasis::Offset
         },
         alpha_c: alpha,
         beta,
@@ -889,14 +913,14 @@ mod tests {
         let c = cloud([10.0, 20.0, 30.0], 1.5, 1.02);
         let id = Isometry3::identity();
         let one = find_level(&[reading("a", 5.0, 20.0)], &[], &c, &id, 20.0, 5.0);
-        assert_eq!(one.basis, "references (offset)");
+        assert_eq!(one.basis, LevelBasis::Offset);
         assert!((one.correct(1.5 + 1.02 * 20.0) - 20.0).abs() < 1e-3);
         assert!((one.std_k - 0.1).abs() < 0.01, "{}", one.std_k);
         // One reading of the window (10 °C) for a room at 20 °C: the camera's 2 % gain error is
         // 0.2 K there, which the ± must hold (a 20 s walk whose wall reading the scan missed
         // stated 0.10 K and was 0.28-0.34 K off).
         let window = find_level(&[reading("w", 0.0, 10.0)], &[], &c, &id, 20.0, 5.0);
-        assert_eq!(window.basis, "references (offset)");
+        assert_eq!(window.basis, LevelBasis::Offset);
         let err = window.correct(1.5 + 1.02 * 20.0) - 20.0;
         assert!((err - 0.2).abs() < 0.01, "{err}");
         assert!(2.0 * window.std_k > err.abs(), "{}", window.std_k);
@@ -913,7 +937,7 @@ mod tests {
             20.0,
             5.0,
         );
-        assert_eq!(two.basis, "references (offset and gain)");
+        assert_eq!(two.basis, LevelBasis::OffsetAndGain);
         assert!((two.beta - 1.02).abs() < 1e-3 && (two.alpha_c - 1.5).abs() < 1e-2);
         assert!((two.correct(1.5 + 1.02 * 20.0) - 20.0).abs() < 1e-3);
     }
@@ -948,7 +972,7 @@ mod tests {
             "{l:?}"
         );
         let none = find_level(&[], &[], &c, &id, 20.0, 5.0);
-        assert_eq!((none.basis.as_str(), none.std_k), ("camera", 5.0));
+        assert_eq!((none.basis, none.std_k), (LevelBasis::Camera, 5.0));
     }
 
     /// Issue 41: a wall read 40 instead of 20.9 gave a gain of 0.34 and a map 17 K warm, without a
@@ -968,7 +992,7 @@ mod tests {
         );
         let wall = l.references.iter().find(|r| r.label == "wall").unwrap();
         assert!(!wall.used, "{wall:?}");
-        assert_eq!(l.basis, "references (offset)");
+        assert_eq!(l.basis, LevelBasis::Offset);
         assert!((l.correct(21.0) - 20.0).abs() < 1e-3, "{l:?}");
         assert!(
             l.warnings
@@ -986,7 +1010,7 @@ mod tests {
             20.0,
             5.0,
         );
-        assert_eq!(l.basis, "references (offset)", "{l:?}");
+        assert_eq!(l.basis, LevelBasis::Offset, "{l:?}");
         assert!((l.beta - 1.0).abs() < 1e-12);
         assert!(
             l.warnings.iter().any(|w| w.contains("gain of 2.00")),
@@ -1011,7 +1035,7 @@ mod tests {
         let id = Isometry3::identity();
         let refs = [reading("window", 0.0, 10.0), reading("wall", 5.0, 20.0)];
         let black = find_level(&refs, &[], &c, &id, 20.0, 5.0);
-        assert_eq!(black.basis, "references (offset)", "{black:?}");
+        assert_eq!(black.basis, LevelBasis::Offset, "{black:?}");
         assert!((black.correct(20.0) - 20.0).abs() > 0.5, "{black:?}");
         let expected = [
             Expected {
@@ -1022,7 +1046,7 @@ mod tests {
             Expected::black(&refs[1]),
         ];
         let grey = find_level(&refs, &expected, &c, &id, 20.0, 5.0);
-        assert_eq!(grey.basis, "references (offset and gain)", "{grey:?}");
+        assert_eq!(grey.basis, LevelBasis::OffsetAndGain, "{grey:?}");
         assert!(
             (grey.beta - 1.0).abs() < 1e-3 && grey.alpha_c.abs() < 1e-2,
             "{grey:?}"

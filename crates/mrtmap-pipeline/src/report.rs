@@ -384,7 +384,7 @@ fn asymmetry_words(k: mrtmap_physics::AsymmetryKind) -> &'static str {
 /// Without two readings at different temperatures the camera's gain is not known, and it
 /// stretches every difference between places: how much, for the first map's range of MRT.
 fn gain_row(l: &crate::level::Level, o: &RunOutcome) -> Option<(String, String)> {
-    if l.basis.contains("gain") {
+    if l.basis == crate::level::LevelBasis::OffsetAndGain {
         return None;
     }
     let m = o.maps.first()?;
@@ -406,7 +406,7 @@ fn level_rows(o: &RunOutcome) -> (KeyValues, Vec<[String; 7]>) {
     let mut rows: KeyValues = Vec::new();
     let mut refs = Vec::new();
     if let Some(l) = &o.level {
-        let text = if l.basis == "camera" {
+        let text = if l.basis == crate::level::LevelBasis::Camera {
             format!(
                 "the thermal camera's own level: no usable reference reading, so its stated absolute accuracy (±{:.1} K) is part of every ± (add references.csv or [[references]] to fix it)",
                 l.std_k

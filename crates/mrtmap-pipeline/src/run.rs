@@ -13,13 +13,15 @@
 use std::path::Path;
 
 use mrtmap_geometry::nalgebra::Point3;
-use mrtmap_io::{Recording, Trajectory, read_cloud_ply, write_atomic, write_cloud_ply};
+use mrtmap_io::{
+    Recording, RecordingWarning, Trajectory, read_cloud_ply, write_atomic, write_cloud_ply,
+};
 use mrtmap_radiation::{GridSpec, RadiantScene};
 use mrtmap_scan::FusedFrame;
 use mrtmap_scan::segment::{MaskInput, SegmentParams, TextureInput, segment_textured};
 /// What segmentation reports, and the label votes (mrtmap-scan's).
 pub use mrtmap_scan::segment::{SegmentReport, Votes};
-use mrtmap_scan::{FuseParams, FusionReport, fuse, refined_poses};
+use mrtmap_scan::{FuseParams, FusionReport, SkipReason, fuse, refined_poses};
 use mrtmap_track::{TrackParams, TrackReport, track};
 
 use crate::cache::{Fingerprint, Stage, StageOutcome, read_json, run_or_reuse, write_json};
@@ -629,20 +631,28 @@ pub fn run(
     check_out_dir(out)?;
     check_out_apart(recording, out)?;
     let mut rec = Recording::open(recording)?;
-    let mut warnings: Vec<String> = rec
+    let on_depth_clock = |w: &RecordingWarning| {
+        // The recording's count was of the stamps as recorded; on the depth clock they may have
+        // poses (fusion says).
+        matches!(w, RecordingWarning::ThermalWithoutPose { .. })
+    };
+    let mut recording_warnings: Vec<RecordingWarning> = rec
         .warnings
         .iter()
-        .filter(|w| !w.starts_with("no trajectory.txt"))
-        .map(|w| format!("recording: {w}"))
+        .copied()
+        .filter(|w| *w != RecordingWarning::NoTrajectory)
         .collect();
     let tracked = track_stage(&mut rec, out, p, force, progress)?;
+    let (fused, fusion) = fuse_stage(&rec, out, p, force, progress)?;
+    if fusion.clock.offset_s != 0.0 && !fusion.skipped.contains_key(&SkipReason::NoPose) {
+        recording_warnings.retain(|w| !on_depth_clock(w));
+    }
+    let mut warnings: Vec<String> = recording_warnings
+        .iter()
+        .map(|w| format!("recording: {w}"))
+        .collect();
     if let Some((_, t)) = &tracked {
         warnings.extend(t.warnings());
-    }
-    let (fused, fusion) = fuse_stage(&rec, out, p, force, progress)?;
-    if fusion.clock.offset_s != 0.0 && !fusion.skipped.keys().any(|k| k.contains("pose")) {
-        // The recording's count was of the stamps as recorded; on the depth clock they have poses.
-        warnings.retain(|w| !w.contains("thermal frames have no pose"));
     }
     for (why, n) in &fusion.skipped {
         warnings.push(format!("fusion skipped {n} thermal frames: {why}"));

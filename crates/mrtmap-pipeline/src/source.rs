@@ -365,7 +365,7 @@ pub fn inspect(source: &Path, o: &SourceOptions) -> Result<Inspection> {
                     poses,
                 ],
                 rig: rec.rig,
-                warnings: rec.warnings,
+                warnings: rec.warnings.iter().map(ToString::to_string).collect(),
             }))
         }
         SourceKind::RtabMap => {

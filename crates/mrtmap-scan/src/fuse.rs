@@ -264,7 +264,7 @@ pub struct FusionReport {
     #[serde(default)]
     pub pose_check: PoseCheck,
     /// Frames skipped, by reason.
-    pub skipped: BTreeMap<String, usize>,
+    pub skipped: BTreeMap<SkipReason, usize>,
     /// The first few problems, with file names.
     pub problems: Vec<String>,
     /// What happened to the depth points.
@@ -502,11 +502,7 @@ impl<'a> Fuser<'a> {
 
     /// Counts a frame skipped for `r`.
     fn skip(&mut self, r: SkipReason) {
-        *self
-            .report
-            .skipped
-            .entry(r.describe().to_string())
-            .or_default() += 1;
+        *self.report.skipped.entry(r).or_default() += 1;
     }
 
     /// Counts a frame skipped for `r` before it reaches the map: it is done.

@@ -5,20 +5,30 @@ use mrtmap_geometry::nalgebra::Isometry3;
 use mrtmap_io::{InterpolationLimits, Recording};
 use serde::{Deserialize, Serialize};
 
-/// Why a thermal frame was not used.
+/// Why a thermal frame was not used (in fusion.json by its phrase, [`SkipReason::describe`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
 pub enum SkipReason {
     /// No depth frame within the sync tolerance.
+    #[serde(rename = "no depth frame within the sync tolerance")]
     NoDepthWithinTolerance,
     /// No pose at the thermal or the depth frame's time.
+    #[serde(rename = "no pose at the frame time")]
     NoPose,
     /// An image could not be read.
+    #[serde(rename = "an image could not be read")]
     UnreadableImage,
     /// Too few valid depth points.
+    #[serde(rename = "too few valid depth points")]
     TooFewDepthPoints,
     /// Nothing of the depth frame is visible in the thermal camera.
+    #[serde(rename = "no depth point visible in the thermal image")]
     NothingVisible,
+}
+
+impl std::fmt::Display for SkipReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.describe())
+    }
 }
 
 impl SkipReason {

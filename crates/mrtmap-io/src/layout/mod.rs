@@ -10,7 +10,7 @@ mod trajectory;
 mod writer;
 
 pub use imu::{ImuSample, imu_text, parse_imu, read_imu};
-pub use recording::Recording;
+pub use recording::{Recording, RecordingWarning};
 pub use rig::{PoseFile, RgbCamera, Rig, ThermalEncoding};
 pub use streams::{StreamEntry, parse_stream_list, stream_list_text};
 pub use trajectory::{

@@ -31,7 +31,46 @@ pub struct Recording {
     /// Inertial samples (`imu.txt`, optional), in the depth camera's frame.
     pub imu: Vec<super::ImuSample>,
     /// Things worth knowing that do not stop a scan from being used.
-    pub warnings: Vec<String>,
+    pub warnings: Vec<RecordingWarning>,
+}
+
+/// Something worth knowing about a recording that does not stop it from being used.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum RecordingWarning {
+    /// No trajectory.txt: the poses must come from the built-in tracker (the recording has colour).
+    NoTrajectory,
+    /// depth.txt lists no frames.
+    NoDepthFrames,
+    /// thermal.txt lists no frames.
+    NoThermalFrames,
+    /// trajectory.txt has no poses.
+    NoPoses,
+    /// Thermal frames whose stamps lie outside the trajectory (as recorded: another clock's
+    /// offset may cover them).
+    ThermalWithoutPose {
+        /// Frames without a pose.
+        uncovered: usize,
+        /// Thermal frames.
+        total: usize,
+    },
+}
+
+impl std::fmt::Display for RecordingWarning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::NoTrajectory => {
+                f.write_str("no trajectory.txt: the poses must come from the built-in tracker")
+            }
+            Self::NoDepthFrames => f.write_str("depth.txt lists no frames"),
+            Self::NoThermalFrames => f.write_str("thermal.txt lists no frames"),
+            Self::NoPoses => f.write_str("trajectory.txt has no poses"),
+            Self::ThermalWithoutPose { uncovered, total } => write!(
+                f,
+                "{uncovered} of {total} thermal frames have no pose within the trajectory"
+            ),
+        }
+    }
 }
 
 fn list(dir: &Path, name: &str, required: bool) -> Result<Vec<StreamEntry>, FileError> {
@@ -93,9 +132,7 @@ impl Recording {
         let trajectory = if traj_path.exists() {
             Trajectory::read(&traj_path)?
         } else if !rgb.is_empty() {
-            warnings.push(
-                "no trajectory.txt: the poses must come from the built-in tracker".to_string(),
-            );
+            warnings.push(RecordingWarning::NoTrajectory);
             Trajectory::default()
         } else {
             return Err(FileError::new(
@@ -120,13 +157,13 @@ impl Recording {
             Vec::new()
         };
         if depth.is_empty() {
-            warnings.push("depth.txt lists no frames".to_string());
+            warnings.push(RecordingWarning::NoDepthFrames);
         }
         if thermal.is_empty() {
-            warnings.push("thermal.txt lists no frames".to_string());
+            warnings.push(RecordingWarning::NoThermalFrames);
         }
         if trajectory.is_empty() && traj_path.exists() {
-            warnings.push("trajectory.txt has no poses".to_string());
+            warnings.push(RecordingWarning::NoPoses);
         }
         let limits = InterpolationLimits::default();
         let uncovered = thermal
@@ -134,10 +171,10 @@ impl Recording {
             .filter(|e| trajectory.interpolate(e.t, &limits).is_none())
             .count();
         if uncovered > 0 && !trajectory.is_empty() {
-            warnings.push(format!(
-                "{uncovered} of {} thermal frames have no pose within the trajectory",
-                thermal.len()
-            ));
+            warnings.push(RecordingWarning::ThermalWithoutPose {
+                uncovered,
+                total: thermal.len(),
+            });
         }
         Ok(Self {
             dir: dir.to_path_buf(),

@@ -98,6 +98,9 @@ fn missing_and_mismatched_files_are_named() {
     let r = Recording::open(dir.path()).unwrap();
     assert_eq!(
         r.warnings,
-        vec!["1 of 1 thermal frames have no pose within the trajectory".to_string()]
+        vec![mrtmap_io::RecordingWarning::ThermalWithoutPose {
+            uncovered: 1,
+            total: 1
+        }]
     );
 }

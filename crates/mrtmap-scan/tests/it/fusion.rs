@@ -144,10 +144,15 @@ fn corrupt_frames_are_skipped_and_reported() {
     let fused = fuse_dir(&rec, &params(false));
     let r = &fused.report;
     assert_eq!(
-        r.skipped.get("an image could not be read"),
+        r.skipped.get(&mrtmap_scan::SkipReason::UnreadableImage),
         Some(&1),
         "{:?}",
         r.skipped
+    );
+    // fusion.json names each reason by its phrase, as before the reasons were typed.
+    assert_eq!(
+        serde_json::to_string(&r.skipped).unwrap(),
+        r#"{"an image could not be read":1}"#
     );
     assert!(
         r.problems[0].contains("thermal/000003.png"),

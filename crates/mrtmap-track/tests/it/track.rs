@@ -30,7 +30,10 @@ fn a_walk_without_poses_is_tracked_to_within_centimetres_and_the_same_every_time
     assert!(!rec_dir.join("trajectory.txt").exists());
     let rec = Recording::open(&rec_dir).unwrap();
     assert!(rec.trajectory.is_empty());
-    assert!(rec.warnings.iter().any(|w| w.contains("no trajectory.txt")));
+    assert!(
+        rec.warnings
+            .contains(&mrtmap_io::RecordingWarning::NoTrajectory)
+    );
     let (traj, report) = track(&rec, &TrackParams::default(), &|_, _| {}).unwrap();
     assert_eq!(report.frames, rec.rgb.len());
     assert!(
