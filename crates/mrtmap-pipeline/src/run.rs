@@ -639,8 +639,8 @@ pub fn run(
     let mut recording_warnings: Vec<RecordingWarning> = rec
         .warnings
         .iter()
-        .copied()
-        .filter(|w| *w != RecordingWarning::NoTrajectory)
+        .filter(|w| **w != RecordingWarning::NoTrajectory)
+        .cloned()
         .collect();
     let tracked = track_stage(&mut rec, out, p, force, progress)?;
     let (fused, fusion) = fuse_stage(&rec, out, p, force, progress)?;

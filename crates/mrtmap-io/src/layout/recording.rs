@@ -35,9 +35,12 @@ pub struct Recording {
 }
 
 /// Something worth knowing about a recording that does not stop it from being used.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum RecordingWarning {
+    /// rig.toml has keys or sections mrtmap does not read (`[section] key`): a misspelt optional
+    /// key would otherwise be read past without a word.
+    UnknownRigKeys(Vec<String>),
     /// No trajectory.txt: the poses must come from the built-in tracker (the recording has colour).
     NoTrajectory,
     /// depth.txt lists no frames.
@@ -59,6 +62,11 @@ pub enum RecordingWarning {
 impl std::fmt::Display for RecordingWarning {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
+            Self::UnknownRigKeys(keys) => write!(
+                f,
+                "rig.toml has {}, which mrtmap does not read (a misspelt key? the keys are in docs/recording.md)",
+                keys.join(", ")
+            ),
             Self::NoTrajectory => {
                 f.write_str("no trajectory.txt: the poses must come from the built-in tracker")
             }
@@ -122,12 +130,18 @@ impl Recording {
             ));
         }
         let rig = Rig::read(&rig_path)?;
+        let mut warnings = Vec::new();
+        let unknown = std::fs::read_to_string(&rig_path)
+            .map(|t| super::rig::unknown_rig_keys(&t))
+            .unwrap_or_default();
+        if !unknown.is_empty() {
+            warnings.push(RecordingWarning::UnknownRigKeys(unknown));
+        }
         let depth = list(dir, "depth.txt", true)?;
         let thermal = list(dir, "thermal.txt", true)?;
         let rgb = list(dir, "rgb.txt", false)?;
         let masks = list(dir, "masks.txt", false)?;
         let traj_path = dir.join("trajectory.txt");
-        let mut warnings = Vec::new();
         // Without poses, a recording with colour can still be tracked (`mrtmap track`).
         let trajectory = if traj_path.exists() {
             Trajectory::read(&traj_path)?

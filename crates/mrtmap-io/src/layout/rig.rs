@@ -182,6 +182,80 @@ fn pose(section: &str, p: &PoseFile) -> Result<Isometry3<f64>, String> {
     ))
 }
 
+/// The keys rig.toml's sections hold (others are read past: the layout may carry more, such as
+/// `mrtmap calibrate`'s `[calibration]`).
+const KNOWN_KEYS: [(&str, &[&str]); 4] = [
+    (
+        "depth",
+        &[
+            "width",
+            "height",
+            "fx",
+            "fy",
+            "cx",
+            "cy",
+            "depth_scale",
+            "distortion",
+        ],
+    ),
+    (
+        "thermal",
+        &[
+            "width",
+            "height",
+            "fx",
+            "fy",
+            "cx",
+            "cy",
+            "distortion",
+            "encoding",
+            "depth_from_thermal",
+            "absolute_accuracy_k",
+            "time_offset_s",
+        ],
+    ),
+    (
+        "rgb",
+        &[
+            "width",
+            "height",
+            "fx",
+            "fy",
+            "cx",
+            "cy",
+            "distortion",
+            "depth_from_rgb",
+        ],
+    ),
+    ("calibration", &[]),
+];
+
+/// The keys of rig.toml `text` that mrtmap does not read, as `[section] key` (or `[section]` for
+/// a section it does not know): likely typos, since a misspelt optional key is otherwise read
+/// past without a word.
+pub fn unknown_rig_keys(text: &str) -> Vec<String> {
+    let Ok(table) = text.parse::<toml::Table>() else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for (section, value) in &table {
+        match KNOWN_KEYS.iter().find(|(s, _)| s == section) {
+            None => out.push(format!("[{section}]")),
+            Some((_, keys)) if !keys.is_empty() => {
+                if let Some(t) = value.as_table() {
+                    out.extend(
+                        t.keys()
+                            .filter(|k| !keys.contains(&k.as_str()))
+                            .map(|k| format!("[{section}] {k}")),
+                    );
+                }
+            }
+            Some(_) => {}
+        }
+    }
+    out
+}
+
 impl Rig {
     /// Parses rig.toml text.
     pub fn parse(text: &str, path: &Path) -> Result<Self, FileError> {
@@ -189,7 +263,15 @@ impl Rig {
             let line = e
                 .span()
                 .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
-            FileError::new(path, line, FileErrorKind::Syntax(e.message().to_string()))
+            let unknown = unknown_rig_keys(text);
+            let mut message = e.message().trim().to_string();
+            if !unknown.is_empty() {
+                message.push_str(&format!(
+                    " (rig.toml also has {}, which mrtmap does not read: a misspelt key or section? The sections are [depth], [thermal] and [rgb])",
+                    unknown.join(", ")
+                ));
+            }
+            FileError::new(path, line, FileErrorKind::Syntax(message))
         })?;
         let bad = |m: String| FileError::new(path, None, FileErrorKind::Syntax(m));
         let d = &f.depth;

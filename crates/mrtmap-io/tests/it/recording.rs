@@ -104,3 +104,34 @@ fn missing_and_mismatched_files_are_named() {
         }]
     );
 }
+
+/// Issue 54: a misspelt key was reported as the missing one alone ("missing field `fy`"), and a
+/// misspelt optional key was read past without a word.
+#[test]
+fn a_misspelt_rig_key_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    tiny(dir.path());
+    let typo = RIG.replace(
+        "[thermal]\nwidth = 2\nheight = 2\nfx = 2.0\nfy = 2.0",
+        "[thermal]\nwidth = 2\nheight = 2\nfx = 2.0\nfyy = 2.0",
+    );
+    std::fs::write(dir.path().join("rig.toml"), &typo).unwrap();
+    let e = Recording::open(dir.path()).unwrap_err().to_string();
+    assert!(e.contains("`fy`") && e.contains("[thermal] fyy"), "{e}");
+    // An optional key misspelt, and a section misnamed: the recording opens, with a warning.
+    let extra = format!("{RIG}time_ofset_s = -0.05\n\n[colour]\nwidth = 4\n");
+    std::fs::write(dir.path().join("rig.toml"), extra).unwrap();
+    let r = Recording::open(dir.path()).unwrap();
+    assert_eq!(
+        r.warnings,
+        vec![mrtmap_io::RecordingWarning::UnknownRigKeys(vec![
+            "[colour]".to_string(),
+            "[thermal] time_ofset_s".to_string()
+        ])]
+    );
+    assert!(
+        r.warnings[0]
+            .to_string()
+            .contains("[colour], [thermal] time_ofset_s")
+    );
+}
