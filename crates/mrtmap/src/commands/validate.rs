@@ -96,5 +96,16 @@ pub fn run(a: &ValidateArgs) -> anyhow::Result<()> {
         "wrote validation.csv and validation.json in {}",
         out.display()
     );
+    let judged = result
+        .iter()
+        .filter(|r| r.meets_required.is_some() && r.in_sun.is_none() && !r.calibrates)
+        .count();
+    if judged == 0 {
+        anyhow::bail!(
+            "{}: none of its {} globe readings could be judged against the map (the table above says why); validate needs at least one reading that is neither missing a value, in the sun, nor used to fix the level",
+            a.globe.display(),
+            result.len()
+        );
+    }
     Ok(())
 }

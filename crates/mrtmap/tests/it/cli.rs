@@ -596,6 +596,19 @@ fn validate_refuses_globes_outside_the_room_and_says_why_a_value_is_missing() {
         text.contains("(1) big: no mixed-convection MRT: "),
         "{text}"
     );
+    // Issue 54: no row judged is a failure, not a pass (exit 0 said nothing was wrong).
+    fails_with(
+        &[
+            "validate",
+            "--map",
+            d,
+            "--globe",
+            g,
+            "--calibrate-with",
+            "big",
+        ],
+        "none of its 1 globe readings could be judged",
+    );
 }
 
 #[test]
