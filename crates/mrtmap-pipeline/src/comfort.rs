@@ -396,6 +396,10 @@ pub struct ComfortSummary {
     /// reaches (f_bes > 0), the largest ΔMRT and where (map x, y).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sun: Option<SunSummary>,
+    /// The share of the computed nodes whose PMV inputs lie outside ISO 7730's ranges (their PMV
+    /// and PPD are indicative only), when PMV was computed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub outside_iso_ranges_share: Option<f64>,
     /// The sunlit patch (with `[sun]`): the floor under the nodes whose person the beam reaches,
     /// as the report's 3D view draws it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -606,11 +610,20 @@ fn write_maps(
                 Some((n.i, n.j, v.0))
             })
             .collect();
+        let outside = nodes.iter().filter(|n| indicative_only(n, q)).count();
+        let subtitle = if outside > 0 {
+            format!(
+                "{subtitle}; inputs outside ISO 7730's ranges at {outside} of {} nodes: indicative only",
+                values.len()
+            )
+        } else {
+            subtitle.to_string()
+        };
         let input = MapInput {
             field,
             scene,
             marks: &map_marks,
-            subtitle: subtitle.to_string(),
+            subtitle,
             quantity: Some(MapQuantity {
                 title: title.clone(),
                 unit: unit.into(),
@@ -646,13 +659,28 @@ fn write_maps(
     Ok(maps)
 }
 
+/// Whether node `n`'s value of `q` is a PMV or PPD whose inputs lie outside ISO 7730's ranges.
+fn indicative_only(n: &ComfortNode, q: Quantity) -> bool {
+    matches!(q, Quantity::Pmv | Quantity::Ppd)
+        && n.point
+            .as_ref()
+            .is_ok_and(|p| p.thermal.is_some_and(|t| !t.within_iso_ranges))
+}
+
 /// One quantity over the grid as CSV: x, y, value, standard error, i, j, note.
 fn quantity_csv(field: &MrtField, nodes: &[ComfortNode], q: Quantity) -> String {
     let mut s = format!("x,y,{},std_error,i,j,note\n", q.name());
     for n in nodes {
         let (x, y) = (field.u[n.i], field.v[n.j]);
         let line = match n.point.as_ref().map(|p| value_of(p, q)) {
-            Ok(Some((v, e))) => format!("{x:.4},{y:.4},{v:.4},{e:.4},{},{},\n", n.i, n.j),
+            Ok(Some((v, e))) => {
+                let note = if indicative_only(n, q) {
+                    "\"outside ISO 7730's ranges: indicative only\""
+                } else {
+                    ""
+                };
+                format!("{x:.4},{y:.4},{v:.4},{e:.4},{},{},{note}\n", n.i, n.j)
+            }
             Ok(None) => format!("{x:.4},{y:.4},,,{},{},\"not computed\"\n", n.i, n.j),
             Err(e) => format!(
                 "{x:.4},{y:.4},,,{},{},\"{}\"\n",
@@ -715,8 +743,13 @@ fn summarise(
             max_delta_mrt_k: s.delta_mrt_k,
             max_at: *xy,
         });
+    let thermals: Vec<&Thermal> = ok.iter().filter_map(|p| p.thermal.as_ref()).collect();
+    let outside_iso_ranges_share = (!thermals.is_empty()).then(|| {
+        thermals.iter().filter(|t| !t.within_iso_ranges).count() as f64 / thermals.len() as f64
+    });
     ComfortSummary {
         sun,
+        outside_iso_ranges_share,
         sunlit_patch: None,
         comfort: c.clone(),
         pmv_model: PMV_MODEL.into(),

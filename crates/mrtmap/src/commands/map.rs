@@ -79,6 +79,12 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
             100.0 * sh[3]
         );
     }
+    if let Some(share) = s.outside_iso_ranges_share.filter(|x| *x > 0.0) {
+        outln!(
+            "  PMV inputs outside ISO 7730's ranges on {:.0} % of the floor: PMV and PPD there are indicative only",
+            100.0 * share
+        );
+    }
     if let Some((w, xy)) = &s.worst_asymmetry {
         outln!(
             "  worst radiant asymmetry {:.2} K at ({}, {}): PD {:.1} %, category {}",

@@ -393,6 +393,54 @@ fn map_takes_the_configs_sections_and_each_flag_over_its_key() {
     );
 }
 
+/// Issue 54: PMV maps at 55 °C air were filled without the caveat `comfort` prints.
+#[test]
+fn pmv_maps_outside_iso_ranges_say_they_are_indicative_only() {
+    let dir = tempfile::tempdir().unwrap();
+    let hot = dir.path().join("hot");
+    let text = crate::ok(&[
+        "map",
+        "--quantity",
+        "pmv",
+        "--air-c",
+        "55",
+        "--grid",
+        "4x3",
+        "--out",
+        hot.to_str().unwrap(),
+    ]);
+    assert!(
+        text.contains("outside ISO 7730's ranges on 100 % of the floor"),
+        "{text}"
+    );
+    let csv = std::fs::read_to_string(hot.join("pmv.csv")).unwrap();
+    assert!(
+        csv.lines()
+            .skip(1)
+            .all(|l| l.ends_with("\"outside ISO 7730's ranges: indicative only\"")),
+        "{csv}"
+    );
+    let c: Value =
+        serde_json::from_str(&std::fs::read_to_string(hot.join("comfort.json")).unwrap()).unwrap();
+    assert_eq!(c["outside_iso_ranges_share"], 1.0);
+    let mild = dir.path().join("mild");
+    let text = crate::ok(&[
+        "map",
+        "--quantity",
+        "pmv",
+        "--air-c",
+        "22",
+        "--grid",
+        "4x3",
+        "--out",
+        mild.to_str().unwrap(),
+    ]);
+    assert!(!text.contains("indicative only"), "{text}");
+    let c: Value =
+        serde_json::from_str(&std::fs::read_to_string(mild.join("comfort.json")).unwrap()).unwrap();
+    assert_eq!(c["outside_iso_ranges_share"], 0.0);
+}
+
 /// The example office as JSON, changed by `edit`, written to `dir/name`.
 fn edited_example(dir: &Path, name: &str, edit: impl FnOnce(&mut Value)) -> String {
     let mut v: Value = serde_json::from_str(mrtmap_pipeline::points::EXAMPLE_OFFICE_JSON).unwrap();
