@@ -259,6 +259,26 @@ pub enum MrtError {
         /// What was asked.
         what: &'static str,
     },
+    /// A person centred at the point would pass through furniture (a seated person's legs
+    /// through a desk).
+    #[error(
+        "a {posture} person centred at ({:.2}, {:.2}, {:.2}) would pass through the furniture '{id}' at {at_m:.2} m above their feet: a {posture} person's body reaches from {centre_m:.2} m below the centre to {head_m:.2} m above it; place the centre clear of it",
+        point[0], point[1], point[2]
+    )]
+    PersonThroughOccluder {
+        /// The body centre.
+        point: [f64; 3],
+        /// "seated" or "standing".
+        posture: &'static str,
+        /// The occluder.
+        id: String,
+        /// Where the body meets it, above the floor (m).
+        at_m: f64,
+        /// Body centre above the feet (m).
+        centre_m: f64,
+        /// Crown above the body centre (m).
+        head_m: f64,
+    },
     /// The point lies inside an occluder.
     #[error("point ({:.2}, {:.2}, {:.2}) lies inside the furniture '{id}'", point[0], point[1], point[2])]
     InsideOccluder {

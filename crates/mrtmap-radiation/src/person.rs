@@ -142,6 +142,9 @@ fn axes(engine: &MrtEngine<'_>) -> Result<[Vector3<f64>; 3], MrtError> {
     Ok([f.normal.into_inner(), f.u.into_inner(), f.v.into_inner()])
 }
 
+/// The spacing of the points along a person's vertical axis checked against furniture (m).
+pub const BODY_STEP_M: f64 = 0.05;
+
 impl MrtEngine<'_> {
     /// Refuses a point outside the room or inside furniture.
     fn check_place(&self, p: &Point3<f64>) -> Result<(), MrtError> {
@@ -155,7 +158,8 @@ impl MrtEngine<'_> {
         Ok(())
     }
 
-    /// Refuses a person whose feet (2 cm above them) or crown would lie outside the room.
+    /// Refuses a person whose feet (2 cm above them) or crown would lie outside the room, or whose
+    /// body (its vertical axis, every [`BODY_STEP_M`]) would pass through furniture.
     fn check_body(
         &self,
         centre: &Point3<f64>,
@@ -166,6 +170,10 @@ impl MrtEngine<'_> {
             posture.centre_height_m(),
             posture.head_height_m() - posture.centre_height_m(),
         );
+        let posture_name = match posture {
+            Posture::Seated => "seated",
+            Posture::Standing => "standing",
+        };
         for (part, q) in [
             ("feet", centre - up * (below - 0.02)),
             ("head", centre + up * above),
@@ -173,12 +181,24 @@ impl MrtEngine<'_> {
             if let Err(MrtError::OutsideRoom { where_, .. }) = self.check_inside(&q) {
                 return Err(MrtError::PersonDoesNotFit {
                     point: [centre.x, centre.y, centre.z],
-                    posture: match posture {
-                        Posture::Seated => "seated",
-                        Posture::Standing => "standing",
-                    },
+                    posture: posture_name,
                     part,
                     where_,
+                    centre_m: below,
+                    head_m: above,
+                });
+            }
+        }
+        let steps = ((below - 0.02 + above) / BODY_STEP_M).ceil() as usize;
+        for k in 0..=steps {
+            let h = (-(below - 0.02) + k as f64 * BODY_STEP_M).min(above);
+            let q = centre + up * h;
+            if let Some(o) = self.scene().occluders.iter().find(|o| o.contains(&q)) {
+                return Err(MrtError::PersonThroughOccluder {
+                    point: [centre.x, centre.y, centre.z],
+                    posture: posture_name,
+                    id: o.id.clone(),
+                    at_m: below + h,
                     centre_m: below,
                     head_m: above,
                 });

@@ -157,6 +157,36 @@ fn scene_with_desk(dir: &Path) -> String {
     p.display().to_string()
 }
 
+/// Issue 54: a seated person centred 5 cm above a desk (legs through it) was answered.
+#[test]
+fn a_person_through_furniture_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_with_desk(dir.path());
+    fails_with(
+        &[
+            "mrt",
+            "--scene",
+            &scene,
+            "--person",
+            "seated",
+            "--at",
+            "1.6,1.4,0.8",
+        ],
+        "would pass through the furniture 'desk-1'",
+    );
+    // Beside the desk the same person is answered.
+    let text = crate::ok(&[
+        "mrt",
+        "--scene",
+        &scene,
+        "--person",
+        "seated",
+        "--at",
+        "1.6,2.4,0.6",
+    ]);
+    assert!(text.contains("MRT"), "{text}");
+}
+
 #[test]
 fn occluders_need_montecarlo_and_auto_picks_it() {
     let dir = tempfile::tempdir().unwrap();
