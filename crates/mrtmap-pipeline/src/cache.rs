@@ -19,7 +19,8 @@ use crate::error::{Error, Result};
 /// One input file as last seen: missing files stamp as such.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FileStamp {
-    /// The path as given.
+    /// The path, absolute (canonical where it exists, so that `rec` and `/abs/…/rec` are one
+    /// input).
     pub path: String,
     /// Its size, or `None` when it did not exist.
     pub bytes: Option<u64>,
@@ -31,8 +32,11 @@ impl FileStamp {
     /// Stamps `p` now.
     pub fn of(p: &Path) -> Self {
         let m = std::fs::metadata(p).ok();
+        let path = std::fs::canonicalize(p)
+            .or_else(|_| std::path::absolute(p))
+            .unwrap_or_else(|_| p.to_path_buf());
         Self {
-            path: p.display().to_string(),
+            path: path.display().to_string(),
             bytes: m.as_ref().map(std::fs::Metadata::len),
             modified_ns: m
                 .and_then(|m| m.modified().ok())
@@ -247,6 +251,32 @@ mod tests {
         assert!(!stage.stamp.exists());
         let again = run_or_reuse(&stage, Fingerprint::new(), false, || Ok(())).unwrap();
         assert!(!again.skipped);
+    }
+
+    /// Issue 54: `rec15` then `/abs/…/rec15` fused again: an input is one input however its path
+    /// is written.
+    #[test]
+    fn a_relative_and_an_absolute_path_are_one_input() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("a"), "1").unwrap();
+        let absolute = Fingerprint::new().file(&dir.path().join("a"));
+        let dotted = Fingerprint::new().file(&dir.path().join(".").join("a"));
+        assert_eq!(absolute, dotted);
+        let here = std::env::current_dir().unwrap();
+        let relative = pathdiff(dir.path(), &here);
+        assert_eq!(
+            absolute,
+            Fingerprint::new().file(&here.join(relative).join("a"))
+        );
+    }
+
+    /// `to` relative to `from` by `..` steps (both absolute).
+    fn pathdiff(to: &Path, from: &Path) -> PathBuf {
+        let mut up = PathBuf::new();
+        for _ in from.components().skip(1) {
+            up.push("..");
+        }
+        up.join(to.strip_prefix("/").unwrap())
     }
 
     #[test]
