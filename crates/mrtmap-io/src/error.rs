@@ -30,6 +30,9 @@ pub enum FileErrorKind {
     /// The file could not be read or written (said in words, without the OS's error number).
     #[error("{}", io_words(.0))]
     Io(#[from] std::io::Error),
+    /// A file stands where a folder is needed, for the path named.
+    #[error("is a file where a folder is needed (for {})", .0.display())]
+    NotAFolder(PathBuf),
     /// A line or value that does not parse.
     #[error("{0}")]
     Syntax(String),
@@ -137,6 +140,20 @@ impl FileError {
 
     /// A read or write failure.
     pub fn io(path: &Path, e: std::io::Error) -> Self {
+        // Making a folder under a file says "already exists" (EEXIST): name the file that stands
+        // where a folder is needed instead.
+        if matches!(
+            e.kind(),
+            std::io::ErrorKind::AlreadyExists | std::io::ErrorKind::NotADirectory
+        ) && let Some(file) = path.ancestors().find(|a| a.is_file())
+        {
+            let needed_for = if file == path {
+                path.join("…")
+            } else {
+                path.to_path_buf()
+            };
+            return Self::new(file, None, FileErrorKind::NotAFolder(needed_for));
+        }
         Self::new(path, None, FileErrorKind::Io(e))
     }
 }

@@ -471,6 +471,22 @@ fn pmv_maps_outside_iso_ranges_say_they_are_indicative_only() {
     assert_eq!(c["outside_iso_ranges_share"], 0.0);
 }
 
+/// Issue 54: a file where a folder is needed was reported as "already exists: remove it".
+#[test]
+fn a_file_where_a_folder_is_needed_is_named_as_such() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("file.txt");
+    std::fs::write(&file, "x").unwrap();
+    fails_with(
+        &[
+            "export",
+            "--out",
+            file.join("room.hbjson").to_str().unwrap(),
+        ],
+        &format!("{}: is a file where a folder is needed", file.display()),
+    );
+}
+
 /// The example office as JSON, changed by `edit`, written to `dir/name`.
 fn edited_example(dir: &Path, name: &str, edit: impl FnOnce(&mut Value)) -> String {
     let mut v: Value = serde_json::from_str(mrtmap_pipeline::points::EXAMPLE_OFFICE_JSON).unwrap();
