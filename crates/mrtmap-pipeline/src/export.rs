@@ -175,11 +175,33 @@ fn thin(cloud: &CloudPoints, max_points: usize) -> CloudPoints {
 /// A run's thermal cloud (`out/fuse/cloud.ply`) in its scene's frame, read once for the report's
 /// 3D view and the exports; `None` when it cannot be read (they then go without it).
 pub fn run_cloud(out: &Path, scene: &RadiantScene) -> Option<CloudPoints> {
-    cloud_in_scene(&out.join("fuse").join("cloud.ply"), scene).ok()
+    cloud_in_scene(
+        &out.join("fuse").join("cloud.ply"),
+        scene,
+        level_of(out).as_ref(),
+    )
+    .ok()
 }
 
-/// The thermal cloud at `ply` in `scene`'s frame (through its `world_from_room`).
-fn cloud_in_scene(ply: &Path, scene: &RadiantScene) -> Result<CloudPoints> {
+/// The temperatures' level a run or segmentation folder found (`segment/level.json` or
+/// `level.json`), when there is one.
+fn level_of(dir: &Path) -> Option<crate::level::Level> {
+    [
+        dir.join("segment").join("level.json"),
+        dir.join("level.json"),
+    ]
+    .iter()
+    .find_map(|p| crate::cache::read_json(p).ok())
+}
+
+/// The thermal cloud at `ply` in `scene`'s frame (through its `world_from_room`), its
+/// temperatures at `level` (the camera's raw level corrected as the scene's surfaces are: the
+/// cloud and the surfaces then share one scale).
+fn cloud_in_scene(
+    ply: &Path,
+    scene: &RadiantScene,
+    level: Option<&crate::level::Level>,
+) -> Result<CloudPoints> {
     let c = read_cloud_ply(ply)?.cloud;
     let room_from_world = scene.world_from_room.map(|w| w.inverse());
     let positions = c
@@ -195,7 +217,14 @@ fn cloud_in_scene(ply: &Path, scene: &RadiantScene) -> Result<CloudPoints> {
             [r.x as f32, r.y as f32, r.z as f32]
         })
         .collect();
-    let temperature_c = c.temperature_k.iter().map(|t| t - 273.15).collect();
+    let temperature_c = c
+        .temperature_k
+        .iter()
+        .map(|t| {
+            let camera_c = f64::from(t - 273.15);
+            level.map_or(camera_c, |l| l.correct(camera_c)) as f32
+        })
+        .collect();
     Ok(CloudPoints {
         positions,
         temperature_c,
@@ -261,7 +290,10 @@ pub fn open_for_export(path: &Path, src: &ExportSource, max_points: usize) -> Re
             .into_iter()
             .find(|p| p.is_file());
         let cloud = match ply {
-            Some(p) => Some(thin(&cloud_in_scene(&p, &scene)?, max_points)),
+            Some(p) => Some(thin(
+                &cloud_in_scene(&p, &scene, level_of(path).as_ref())?,
+                max_points,
+            )),
             None => None,
         };
         let dir_name = path
@@ -412,4 +444,43 @@ pub fn export_run(
         .iter()
         .map(|f| export(&input, *f, &dir.join(format!("room.{}", f.extension()))))
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    /// Issue 54: the report's thermal cloud and the glTF's carried the camera's raw level (floor
+    /// points 22.28 °C beside the floor surface's 20.36 °C on one colour scale): they are drawn
+    /// and exported at the level the readings set, as the surfaces are.
+    #[test]
+    fn the_runs_cloud_is_at_the_corrected_level() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut cloud = mrtmap_io::ThermalCloud::default();
+        cloud.push([1.0, 1.0, 0.0], [0.0, 0.0, 1.0], 273.15 + 22.28, 0.1, 3);
+        mrtmap_io::write_cloud_ply(&dir.path().join("fuse/cloud.ply"), &cloud, "t", &[]).unwrap();
+        let scene = mrtmap_radiation::example_office();
+        let raw = run_cloud(dir.path(), &scene).unwrap();
+        assert!(
+            (raw.temperature_c[0] - 22.28).abs() < 1e-3,
+            "no level: as read"
+        );
+        let level = crate::level::Level {
+            basis: crate::level::LevelBasis::Offset,
+            alpha_c: 1.92,
+            beta: 1.0,
+            offset_at_mean_k: 1.92,
+            std_k: 0.1,
+            references: Vec::new(),
+            warnings: Vec::new(),
+        };
+        crate::cache::write_json(&dir.path().join("segment/level.json"), &level).unwrap();
+        let fixed = run_cloud(dir.path(), &scene).unwrap();
+        assert!(
+            (fixed.temperature_c[0] - 20.36).abs() < 1e-3,
+            "{:?}",
+            fixed.temperature_c
+        );
+    }
 }

@@ -193,7 +193,8 @@ fn view3d_section(o: &mut String, d: &ReportData) {
          <p id=\"view3d-info\">Hover or click a surface to name it.</p>\
          <p><small>Left drag turns the room, right drag (or shift and drag) moves it, the wheel zooms. \
          Walls and ceiling facing you are left out, so you look in. The buttons show and hide each \
-         layer; the thermal cloud is thinned for the report. Open <code>report.html#3d</code> for \
+         layer; the thermal cloud is thinned for the report and drawn at the temperatures' corrected \
+         level (level.json), on the surfaces' colour scale. Open <code>report.html#3d</code> for \
          the view alone.</small></p>",
     );
     o.push_str(&format!(

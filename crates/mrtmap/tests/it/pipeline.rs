@@ -657,6 +657,28 @@ fn camera_errors_are_self_calibrated_and_anchored_by_references() {
         (a - b).abs() < 1e-6,
         "segment.json floor {a} °C, scene.json {b} °C"
     );
+    // The thermal cloud the report draws and the glTF carries is at the same level (issue 54: it
+    // carried the camera's raw level, ~2 K above the floor surface on one colour scale).
+    let (scene, _) = mrtmap_pipeline::maps::load_scene(&mrtmap_pipeline::maps::SceneSource {
+        scene: Some(run.join("segment/scene.json")),
+        ..Default::default()
+    })
+    .unwrap();
+    let cloud = mrtmap_pipeline::export::run_cloud(&run, &scene).unwrap();
+    let mut on_floor: Vec<f32> = cloud
+        .positions
+        .iter()
+        .zip(&cloud.temperature_c)
+        .filter(|(p, _)| p[2].abs() < 0.03 && p[0] > 0.5 && p[1] > 0.5)
+        .map(|(_, t)| *t)
+        .collect();
+    on_floor.sort_by(f32::total_cmp);
+    let median = f64::from(on_floor[on_floor.len() / 2]);
+    assert!(
+        (median - b).abs() < 0.3,
+        "cloud on the floor {median:.2} °C, floor surface {b:.2} °C ({} points)",
+        on_floor.len()
+    );
     // The same readings in the room's frame (references.csv's default: what a tape measures),
     // placed after segmentation: the camera's readings there are the same.
     use mrtmap_geometry::nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion};
