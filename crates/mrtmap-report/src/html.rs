@@ -132,7 +132,7 @@ img{max-width:100%;border:1px solid #ddd}table.kv td{text-align:left}pre{backgro
 #view3d-labels{position:absolute;left:0;top:0;right:0;bottom:0;pointer-events:none;overflow:hidden}\
 .view3d-label{position:absolute;font-size:12px;background:rgba(255,255,255,.85);padding:0 3px;border:1px solid #999;white-space:nowrap}\
 #view3d-buttons button{margin:0 .3em .4em 0;padding:.25em .7em;border:1px solid #888;background:#fff;border-radius:3px;cursor:pointer}\
-#view3d-buttons button.on{background:#2b5d8a;color:#fff}#view3d-bars{display:flex;gap:2.5em;margin:.5em 0;font-size:.9em}\
+#view3d-buttons button.on{background:#2b5d8a;color:#fff}#view3d-bars{position:absolute;left:8px;top:8px;display:flex;flex-direction:column;gap:.4em;padding:.3em .6em;background:rgba(255,255,255,.85);border:1px solid #ccc;font-size:.9em;pointer-events:none}\
 .view3d-gradient{height:12px;width:260px;border:1px solid #999}.view3d-ticks{display:flex;justify-content:space-between;width:260px;font-size:12px}\
 body.view3d-full{max-width:none;margin:.5em}body.view3d-full>*:not(#view3d-section){display:none}body.view3d-full #view3d{height:calc(100vh - 150px)}";
 
@@ -188,8 +188,8 @@ fn view3d_section(o: &mut String, d: &ReportData) {
     }
     o.push_str(
         "<button id=\"view3d-fullscreen\">Full window</button></div>\
-         <div id=\"view3d-stage\"><canvas id=\"view3d\"></canvas><div id=\"view3d-labels\"></div></div>\
-         <div id=\"view3d-bars\"><div id=\"view3d-bar\"></div><div id=\"view3d-gridbar\"></div></div>\
+         <div id=\"view3d-stage\"><canvas id=\"view3d\"></canvas><div id=\"view3d-labels\"></div>\
+         <div id=\"view3d-bars\"><div id=\"view3d-bar\"></div><div id=\"view3d-gridbar\"></div></div></div>\
          <p id=\"view3d-info\">Hover or click a surface to name it.</p>\
          <p><small>Left drag turns the room, right drag (or shift and drag) moves it, the wheel zooms. \
          Walls and ceiling facing you are left out, so you look in. The buttons show and hide each \

@@ -262,6 +262,16 @@ pub fn colour_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
 }
 
 /// The colour of `t_c` on the maps' palette (blue cold → red warm) over `lo…hi` (°C).
+/// Colour of an MRT grid cell at `t_c` on `lo…hi`: viridis, a palette of its own, so that a
+/// grid cell is never read on the surfaces' scale (issue 54: a 20.6 °C MRT cell drawn pink-red
+/// beside a 20.9 °C wall drawn pale yellow, one palette on two scales).
+pub fn grid_rgb(t_c: f64, lo: f64, hi: f64) -> [u8; 3] {
+    let t = if hi > lo { (t_c - lo) / (hi - lo) } else { 0.5 };
+    let g = colorgrad::preset::viridis();
+    let c = colorgrad::Gradient::at(&g, t.clamp(0.0, 1.0) as f32).to_rgba8();
+    [c[0], c[1], c[2]]
+}
+
 pub fn temperature_rgb(t_c: f64, lo: f64, hi: f64) -> [u8; 3] {
     let t = if hi > lo { (t_c - lo) / (hi - lo) } else { 0.5 };
     let c = crate::map::palette(t);

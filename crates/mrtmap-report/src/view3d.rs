@@ -6,7 +6,7 @@ use mrtmap_radiation::RadiantScene;
 use serde::Serialize;
 use serde_json::{Value, json};
 
-use crate::mesh::{scene_mesh, temperature_rgb};
+use crate::mesh::{grid_rgb, scene_mesh, temperature_rgb};
 
 /// Most cloud points the report carries (about 1.5 MB of the file).
 pub const MAX_VIEW_POINTS: usize = 40_000;
@@ -53,10 +53,10 @@ fn r3(x: f64) -> f64 {
     (x * 1000.0).round() / 1000.0
 }
 
-fn stops(lo: f64, hi: f64) -> Vec<String> {
+fn stops(lo: f64, hi: f64, rgb: fn(f64, f64, f64) -> [u8; 3]) -> Vec<String> {
     (0..=8)
         .map(|k| {
-            let c = temperature_rgb(lo + (hi - lo) * f64::from(k) / 8.0, lo, hi);
+            let c = rgb(lo + (hi - lo) * f64::from(k) / 8.0, lo, hi);
             format!("#{:02x}{:02x}{:02x}", c[0], c[1], c[2])
         })
         .collect()
@@ -147,11 +147,11 @@ pub fn view3d(
         .map(|g| {
             let (glo, ghi) = crate::mesh::colour_range(g.nodes.iter().map(|n| n[3]));
             json!({
-                "height": g.height_m, "range": [glo, ghi], "bar": stops(glo, ghi),
+                "height": g.height_m, "range": [glo, ghi], "bar": stops(glo, ghi, grid_rgb),
                 "cell": [spacing(&g.nodes, &g.u), spacing(&g.nodes, &g.v)],
                 "u": g.u, "v": g.v,
                 "n": g.nodes.iter().map(|n| {
-                    let c = temperature_rgb(n[3], glo, ghi);
+                    let c = grid_rgb(n[3], glo, ghi);
                     [r3(n[0]), r3(n[1]), r3(n[2]), r3(n[3]), f64::from(c[0]), f64::from(c[1]), f64::from(c[2])]
                 }).collect::<Vec<_>>(),
             })
@@ -181,7 +181,7 @@ pub fn view3d(
         })
     });
     let doc = json!({
-        "range": [lo, hi], "bar": stops(lo, hi), "centre": centre, "size": size, "look": look,
+        "range": [lo, hi], "bar": stops(lo, hi, temperature_rgb), "centre": centre, "size": size, "look": look,
         "parts": json_parts, "cloud": cloud, "grids": grids, "globes": globes, "sun": sun,
     });
     View3d(

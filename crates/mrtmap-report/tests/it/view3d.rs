@@ -78,6 +78,13 @@ fn the_view_thins_the_cloud_and_lays_each_map_as_cells() {
         (range[0] - 11.5).abs() < 1e-9 && (range[1] - 29.0).abs() < 1e-9,
         "{range:?}"
     );
+    // The MRT grid has a palette of its own (viridis), not the surfaces' on another scale.
+    assert_eq!(
+        v["grids"][0]["bar"][0], "#440154",
+        "{}",
+        v["grids"][0]["bar"]
+    );
+    assert_ne!(v["grids"][0]["bar"][0], v["bar"][0]);
     // The camera starts facing the window's wall (outward normal +x).
     assert_eq!(v["look"], serde_json::json!([1.0, 0.0, 0.0]));
 }
@@ -94,6 +101,11 @@ fn the_report_embeds_the_view_safely() {
     };
     let html = render_html(&d);
     assert!(html.contains("<canvas id=\"view3d\">"));
+    // The colour bars lie over the view, not below the fold.
+    let stage = html.find("<div id=\"view3d-stage\">").unwrap();
+    let bars = html.find("<div id=\"view3d-bars\">").unwrap();
+    let info = html.find("<p id=\"view3d-info\">").unwrap();
+    assert!(stage < bars && bars < info);
     // No sun, no sunlit-patch button.
     assert!(!html.contains("data-layer=\"sun\""));
     assert!(html.contains("<button data-layer=\"cloud\">"));
