@@ -660,6 +660,9 @@ pub fn run(
     if fusion.clock.weak && fusion.clock.source == mrtmap_scan::clock::OffsetSource::Estimated {
         warnings.push(format!("fusion: {}", fusion.clock.describe()));
     }
+    for line in fusion.pose_check.jump_lines() {
+        warnings.push(format!("fusion: {line}"));
+    }
     if fusion.pose_check.dropped > 0 {
         warnings.push(format!(
             "fusion dropped {} of {} poses that jumped away from their neighbours' motion and back (the pose source relocalising or losing track); the trajectory is interpolated across them",

@@ -916,7 +916,7 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
     // thermal clock is set.
     let (checked, pose_check) = drop_outlier_poses(&rec.trajectory);
     let cleaned;
-    let rec = if pose_check.dropped > 0 {
+    let rec = if pose_check.dropped > 0 || pose_check.left_out > 0 {
         let mut r = rec.clone();
         r.trajectory = checked;
         cleaned = r;

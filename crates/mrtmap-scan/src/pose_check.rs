@@ -8,8 +8,16 @@
 //! poses in a row do not hide each other; it is dropped when it lies farther from that line than a
 //! hand can move the camera off a straight line in that time (5 cm plus 20 m/s² · Δt²/2 over the
 //! window's span Δt; 8° plus 300°/s² · Δt²/2 for the rotation). The trajectory is then
-//! interpolated across the gap. A jump that stays (a relocalisation that moves every later pose)
-//! is not there-and-back and is not dropped: it is the pose source's frame changing.
+//! interpolated across the gap. A small jump that stays (a relocalisation or loop closure that
+//! moves every later pose by centimetres) is not there-and-back and is not dropped: it is the pose
+//! source's frame correcting itself.
+//!
+//! A jump that stays and is larger than a correction ([`JUMP_MIN_M`] beyond what a hand moves the
+//! camera in that interval, or [`JUMP_MIN_DEG`]) is a relocalisation into another frame: the poses
+//! either side of it are in two frames that no longer agree. The trajectory is cut there first;
+//! the piece with the most poses is kept and the others are left out (their frames are not fused),
+//! each jump listed with its time and size so that a run says which part of the scan it lost.
+//! Re-registering a piece to the map is not attempted.
 
 use mrtmap_geometry::nalgebra::{Isometry3, Vector3};
 use mrtmap_io::Trajectory;
@@ -17,6 +25,24 @@ use serde::{Deserialize, Serialize};
 
 /// Poses either side of a pose in its fit.
 const HALF_WINDOW: usize = 3;
+
+/// The smallest jump that stays which cuts the trajectory (m, beyond 3 m/s times the interval):
+/// a pose source's corrections move its poses by centimetres, a relocalisation into another frame
+/// by metres (issue 54: a 50 m jump mapped 1.8 K off).
+pub const JUMP_MIN_M: f64 = 1.0;
+/// The same for the rotation (degrees, beyond 400°/s times the interval).
+pub const JUMP_MIN_DEG: f64 = 45.0;
+
+/// A jump that stayed: the trajectory was cut there.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PoseJump {
+    /// The time of the first pose after it (s).
+    pub t: f64,
+    /// How far the camera jumped (m).
+    pub jump_m: f64,
+    /// How far it turned (degrees).
+    pub jump_deg: f64,
+}
 
 /// A pose dropped.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -38,6 +64,98 @@ pub struct PoseCheck {
     pub dropped: usize,
     /// The first few dropped.
     pub examples: Vec<DroppedPose>,
+    /// Jumps that stayed (relocalisations), where the trajectory was cut.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub jumps: Vec<PoseJump>,
+    /// Poses left out with the pieces not kept.
+    #[serde(default)]
+    pub left_out: usize,
+    /// The trajectory's first stamp (s): the jumps' and the kept span's times are said from it.
+    #[serde(default)]
+    pub start_s: f64,
+    /// The time span of the piece kept (s), when the trajectory was cut.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kept_span_s: Option<[f64; 2]>,
+}
+
+impl PoseCheck {
+    /// A sentence per jump that cut the trajectory: when, how far, and what was left out.
+    pub fn jump_lines(&self) -> Vec<String> {
+        let t0 = self.start_s;
+        let kept = self.kept_span_s.map_or(String::new(), |[a, b]| {
+            format!("only {:.2}–{:.2} s of it kept", a - t0, b - t0)
+        });
+        self.jumps
+            .iter()
+            .map(|j| {
+                format!(
+                    "the poses jumped {:.2} m ({:.0}°) {:.2} s into the trajectory and stayed there (the pose source relocalising into another frame): the trajectory was cut there, {kept}; {} poses and the frames in their time left out",
+                    j.jump_m,
+                    j.jump_deg,
+                    j.t - t0,
+                    self.left_out
+                )
+            })
+            .collect()
+    }
+}
+
+/// Whether pose `b` is farther from pose `a` than a hand moves a camera in `dt` by more than
+/// [`JUMP_MIN_M`] or [`JUMP_MIN_DEG`]; (metres, degrees).
+fn jumped(a: &Isometry3<f64>, b: &Isometry3<f64>, dt: f64) -> Option<(f64, f64)> {
+    let m = (b.translation.vector - a.translation.vector).norm();
+    let deg = a.rotation.angle_to(&b.rotation).to_degrees();
+    (m > JUMP_MIN_M + 3.0 * dt.abs() || deg > JUMP_MIN_DEG + 400.0 * dt.abs()).then_some((m, deg))
+}
+
+/// Cuts `traj` at the jumps that stay (the next [`HALF_WINDOW`] poses do not come back) and keeps
+/// the piece with the most poses: (that piece, the jumps, the poses left out).
+fn keep_largest_piece(traj: &Trajectory) -> (Trajectory, Vec<PoseJump>, usize) {
+    let n = traj.stamps.len();
+    let mut cuts = Vec::new();
+    let mut jumps = Vec::new();
+    for k in 0..n.saturating_sub(1) {
+        let Some((m, deg)) = jumped(
+            &traj.poses[k],
+            &traj.poses[k + 1],
+            traj.stamps[k + 1] - traj.stamps[k],
+        ) else {
+            continue;
+        };
+        let stays = (k + 2..n.min(k + 2 + HALF_WINDOW)).all(|j| {
+            jumped(
+                &traj.poses[k],
+                &traj.poses[j],
+                traj.stamps[j] - traj.stamps[k],
+            )
+            .is_some()
+        });
+        if stays {
+            cuts.push(k + 1);
+            jumps.push(PoseJump {
+                t: traj.stamps[k + 1],
+                jump_m: m,
+                jump_deg: deg,
+            });
+        }
+    }
+    if cuts.is_empty() {
+        return (traj.clone(), jumps, 0);
+    }
+    let bounds: Vec<usize> = std::iter::once(0)
+        .chain(cuts)
+        .chain(std::iter::once(n))
+        .collect();
+    let (a, b) = bounds
+        .windows(2)
+        .map(|w| (w[0], w[1]))
+        .max_by_key(|(a, b)| (b - a, std::cmp::Reverse(*a)))
+        .unwrap_or((0, n));
+    let piece = Trajectory {
+        stamps: traj.stamps[a..b].to_vec(),
+        poses: traj.poses[a..b].to_vec(),
+    };
+    (piece, jumps, n - (b - a))
 }
 
 fn median(v: &mut [f64]) -> f64 {
@@ -122,9 +240,24 @@ fn limits(span_s: f64) -> (f64, f64) {
     )
 }
 
-/// Drops the poses that jump away from their neighbours' motion and back; returns the trajectory
-/// without them and what was dropped.
+/// Cuts the trajectory at relocalisation jumps (keeping its largest piece), then drops the poses
+/// that jump away from their neighbours' motion and back; returns the trajectory without them and
+/// what was found.
 pub fn drop_outlier_poses(traj: &Trajectory) -> (Trajectory, PoseCheck) {
+    let (piece, jumps, left_out) = keep_largest_piece(traj);
+    let kept_span_s =
+        (left_out > 0).then(|| [piece.stamps[0], piece.stamps[piece.stamps.len() - 1]]);
+    let (out, mut check) = drop_outliers(&piece);
+    check.poses = traj.stamps.len();
+    check.jumps = jumps;
+    check.left_out = left_out;
+    check.kept_span_s = kept_span_s;
+    check.start_s = traj.stamps.first().copied().unwrap_or(0.0);
+    (out, check)
+}
+
+/// The there-and-back check over one piece of trajectory.
+fn drop_outliers(traj: &Trajectory) -> (Trajectory, PoseCheck) {
     let n = traj.stamps.len();
     let mut check = PoseCheck {
         poses: n,
@@ -226,5 +359,37 @@ mod tests {
         }
         let (_, check) = drop_outlier_poses(&step);
         assert_eq!(check.dropped, 0, "{check:?}");
+        assert!(check.jumps.is_empty(), "{check:?}");
+    }
+
+    /// Issue 54: a trajectory that jumps 50 m and stays there (a relocalisation) mapped 1.8 K off,
+    /// and the poses beside the jump were reported as jumping "away and back".
+    #[test]
+    fn a_jump_that_stays_cuts_the_trajectory_and_the_larger_piece_is_kept() {
+        let mut t = walk(300);
+        for p in &mut t.poses[200..] {
+            p.translation.vector.x += 50.0;
+        }
+        let (out, check) = drop_outlier_poses(&t);
+        assert_eq!(check.jumps.len(), 1, "{check:?}");
+        assert!((check.jumps[0].t - 200.0 / 30.0).abs() < 1e-9);
+        assert!((check.jumps[0].jump_m - 50.0).abs() < 0.1, "{check:?}");
+        assert_eq!((check.left_out, check.dropped), (100, 0), "{check:?}");
+        assert_eq!(out.stamps.len(), 200);
+        assert_eq!(check.kept_span_s, Some([0.0, 199.0 / 30.0]));
+        let said = check.jump_lines();
+        assert!(
+            said[0].contains("jumped 50.02 m (1°) 6.67 s into the trajectory")
+                && said[0].contains("only 0.00–6.63 s of it kept; 100 poses"),
+            "{said:?}"
+        );
+        // The later piece kept when it is the larger.
+        let mut early = walk(300);
+        for p in &mut early.poses[..60] {
+            p.translation.vector.x -= 50.0;
+        }
+        let (out, check) = drop_outlier_poses(&early);
+        assert_eq!((check.left_out, out.stamps.len()), (60, 240), "{check:?}");
+        assert!((out.stamps[0] - 2.0).abs() < 1e-9);
     }
 }

@@ -37,6 +37,9 @@ pub fn run(a: &FuseArgs) -> anyhow::Result<()> {
         r.frames_per_second
     );
     outln!("  {}", r.clock.describe());
+    for line in r.pose_check.jump_lines() {
+        outln!("  warning: {line}");
+    }
     if r.pose_check.dropped > 0 {
         outln!(
             "  dropped {} of {} poses that jumped away from their neighbours' motion and back (the largest {:.2} m)",
