@@ -52,6 +52,7 @@ pub mod demo;
 mod error;
 pub mod export;
 pub mod level;
+pub mod lock;
 pub mod maps;
 pub mod parse;
 pub mod points;

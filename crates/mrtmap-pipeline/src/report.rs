@@ -770,6 +770,7 @@ pub fn run_recording(
 ) -> Result<RunDone> {
     project.check()?;
     crate::run::check_out_dir(out)?;
+    let _lock = crate::lock::OutLock::take(out)?;
     let t0 = std::time::Instant::now();
     let prepared = crate::source::prepare(recording, out, source)?;
     let outcome = crate::run::run(&prepared.dir, out, project, force, progress)?;
