@@ -279,13 +279,25 @@ pub fn coverage_of(
     target_k: f64,
     progress: &dyn Progress,
 ) -> Result<Coverage> {
+    let p = Project::resolve(config, &crate::Overrides::new())?;
+    coverage_with(recording, out, &p, source, target_k, progress)
+}
+
+/// [`coverage_of`] with the settings resolved.
+pub(crate) fn coverage_with(
+    recording: &Path,
+    out: Option<&Path>,
+    p: &Project,
+    source: &crate::source::SourceOptions,
+    target_k: f64,
+    progress: &dyn Progress,
+) -> Result<Coverage> {
     if !(target_k.is_finite() && target_k > 0.0 && target_k <= 10.0) {
         return Err(Error::setting(
             format!("--target-k {target_k}"),
             "give the map's target as a positive number of kelvin (2σ), at most 10",
         ));
     }
-    let p = Project::resolve(config, &crate::Overrides::new())?;
     let temp = match out {
         Some(_) => None,
         None => Some(
@@ -300,5 +312,5 @@ pub fn coverage_of(
     };
     crate::run::check_out_dir(&out)?;
     let prepared = crate::source::prepare(recording, &out, source)?;
-    coverage(&prepared.dir, &out, &p, target_k, progress)
+    coverage(&prepared.dir, &out, p, target_k, progress)
 }

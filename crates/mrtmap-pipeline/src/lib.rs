@@ -51,6 +51,7 @@ pub mod coverage;
 pub mod demo;
 mod error;
 pub mod export;
+pub mod front;
 pub mod level;
 pub mod lock;
 pub mod maps;
@@ -74,6 +75,7 @@ pub mod files {
 
 pub use cache::{Fingerprint, Stage, StageOutcome, run_or_reuse};
 pub use error::{Error, Result};
+pub use front::{FuseDone, Pipeline, TrackDone};
 pub use progress::{Progress, Silent};
 pub use resolve::{MrtFlags, Overrides};
 pub use settings::{DirectionChoice, MethodChoice, MrtSection, Project};

@@ -24,14 +24,12 @@ use mrtmap_pipeline::comfort::{
 use mrtmap_pipeline::export::{ExportFormat, export_scene};
 use mrtmap_pipeline::maps::{GridSpec, RadiantScene, SceneSource, load_scene, map_arrays};
 use mrtmap_pipeline::points::{Facing, PointQuery, Posture, mrt_at_points};
-use mrtmap_pipeline::report::run_recording;
 use mrtmap_pipeline::settings::PointFrame;
-use mrtmap_pipeline::source::SourceOptions;
 use mrtmap_pipeline::validation::{
     Convection, Globe, GlobeFormulaChoice, GlobeInput, MIXED_CONVECTION_DIAMETERS_M, Temperature,
     convert_globe,
 };
-use mrtmap_pipeline::{MrtSection, Overrides, Progress, Project};
+use mrtmap_pipeline::{MrtSection, Overrides, Pipeline, Progress, Project};
 use numpy::ndarray::ArrayView1;
 use numpy::{AllowTypeChange, PyArray1, PyArray2, PyArrayLike1, PyArrayLike2, PyArrayMethods};
 use pyo3::create_exception;
@@ -415,14 +413,10 @@ fn run(
     };
     let done = py
         .detach(|| {
-            run_recording(
-                &recording,
-                &out,
-                &project,
-                force,
-                &SourceOptions::default(),
-                progress.as_ref(),
-            )
+            Pipeline::new(project)
+                .force(force)
+                .progress(progress.as_ref())
+                .run(&recording, &out)
         })
         .map_err(py_err)?;
     let figures = outcome_json(&done.outcome).map_err(py_err)?;

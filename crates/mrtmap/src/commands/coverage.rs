@@ -2,7 +2,7 @@
 
 use std::time::Instant;
 
-use mrtmap_pipeline::coverage::coverage_of;
+use mrtmap_pipeline::{Overrides, Pipeline, Project};
 
 use crate::cli::CoverageArgs;
 use crate::output::{Bar, print_lines};
@@ -10,14 +10,10 @@ use crate::output::{Bar, print_lines};
 pub fn run(a: &CoverageArgs) -> anyhow::Result<()> {
     let t0 = Instant::now();
     let bar = Bar::new("");
-    let c = coverage_of(
-        &a.recording,
-        a.out.as_deref(),
-        a.config.as_deref(),
-        &a.src,
-        a.target_k,
-        &bar,
-    )?;
+    let c = Pipeline::new(Project::resolve(a.config.as_deref(), &Overrides::new())?)
+        .source(a.src.clone())
+        .progress(&bar)
+        .coverage(&a.recording, a.out.as_deref(), a.target_k)?;
     bar.finish();
     if a.json {
         outln!("{}", serde_json::to_string_pretty(&c)?);

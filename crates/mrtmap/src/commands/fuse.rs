@@ -1,32 +1,37 @@
 //! `mrtmap fuse`: recording → thermal point cloud.
 
-use mrtmap_pipeline::files::Recording;
-use mrtmap_pipeline::run::fuse_into;
-use mrtmap_pipeline::source::prepare;
+use mrtmap_pipeline::{Overrides, Pipeline, Project};
 
 use crate::cli::FuseArgs;
 use crate::output::{Bar, print_lines};
 
 pub fn run(a: &FuseArgs) -> anyhow::Result<()> {
-    let params = a.fuse.params()?;
-    mrtmap_pipeline::run::check_out_apart(&a.recording, &a.out)?;
-    let prepared = prepare(&a.recording, &a.out, &a.src)?;
-    if let Some(c) = &prepared.conversion {
+    let project = Project::resolve_over(
+        Project {
+            fuse: a.fuse.clone(),
+            ..Project::default()
+        },
+        &Overrides::new(),
+    )?;
+    let bar = Bar::new("");
+    let done = Pipeline::new(project)
+        .source(a.src.clone())
+        .progress(&bar)
+        .fuse(&a.recording, &a.out)?;
+    bar.finish();
+    if let Some(c) = &done.prepared.conversion {
         print_lines(c.lines());
-    } else if prepared.reused {
+    } else if done.prepared.reused {
         outln!(
             "using {} (converted earlier from {})",
-            prepared.dir.display(),
+            done.prepared.dir.display(),
             a.recording.display()
         );
     }
-    let rec = Recording::open(&prepared.dir)?;
-    for w in &rec.warnings {
+    for w in &done.warnings {
         eprintln!("warning: {w}");
     }
-    let bar = Bar::new("");
-    let r = fuse_into(&rec, &params, &a.out, &bar)?;
-    bar.finish();
+    let r = &done.report;
     outln!(
         "fused {} of {} thermal frames into {} voxels of {} m in {:.1} s ({:.0} frames/s)",
         r.used_frames,

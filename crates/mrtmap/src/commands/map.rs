@@ -2,11 +2,10 @@
 //! person's comfort maps beside it.
 
 use mrtmap_pipeline::comfort::value_of;
-use mrtmap_pipeline::maps::GridSpec;
-use mrtmap_pipeline::maps::{Mark, MarkAt, load_scene, map_scene};
+use mrtmap_pipeline::maps::{Mark, MarkAt, load_scene};
 use mrtmap_pipeline::report::numbers::{fixed, uncertainty};
 use mrtmap_pipeline::settings::Quantity;
-use mrtmap_pipeline::{Overrides, Project};
+use mrtmap_pipeline::{Overrides, Pipeline, Project};
 
 use crate::cli::MapArgs;
 use crate::output::print_lines;
@@ -29,13 +28,6 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
     a.method.add_to(&mut o);
     let project = Project::resolve(a.config.as_deref(), &o)?;
     let (scene, source) = load_scene(&a.scene)?;
-    // One map: at --height, else at [map] heights_m's first.
-    let spec = GridSpec {
-        nx: project.map.grid[0],
-        ny: project.map.grid[1],
-        height_m: project.map.heights_m[0],
-        margin_m: project.map.margin_m,
-    };
     let marks: Vec<Mark> = a
         .marks
         .iter()
@@ -47,7 +39,9 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
             },
         })
         .collect();
-    let maps = map_scene(&scene, &source, &project, spec, &marks, &a.out)?;
+    let front = Pipeline::new(project);
+    let maps = front.map(&scene, &source, &marks, &a.out)?;
+    let project = front.project();
     let m = &maps.map;
     outln!("scene: {source}");
     outln!("method: {}", m.method);

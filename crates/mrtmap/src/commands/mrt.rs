@@ -1,7 +1,8 @@
 //! `mrtmap mrt`: MRT at points with view-factor tables.
 
 use mrtmap_pipeline::maps::load_scene;
-use mrtmap_pipeline::points::{Facing, PointQuery, SunQuery, mrt_at_points};
+use mrtmap_pipeline::points::{Facing, PointQuery, SunQuery};
+use mrtmap_pipeline::{Overrides, Pipeline, Project};
 
 use crate::cli::MrtArgs;
 use crate::output::{json, print_lines};
@@ -24,7 +25,9 @@ pub fn run(a: &MrtArgs) -> anyhow::Result<()> {
             )
         }),
     };
-    let answers = mrt_at_points(&scene, &source, &a.method.section()?, &query)?;
+    let mut flags = Overrides::new();
+    a.method.add_to(&mut flags);
+    let answers = Pipeline::new(Project::resolve(None, &flags)?).mrt(&scene, &source, &query)?;
     if a.json {
         out!("{}", json(&answers)?);
     } else {

@@ -1,9 +1,8 @@
 //! `mrtmap run`: the whole pipeline on a recording.
 
 use anyhow::bail;
-use mrtmap_pipeline::report::run_recording;
 use mrtmap_pipeline::settings::PointEntry;
-use mrtmap_pipeline::{Overrides, Project};
+use mrtmap_pipeline::{Overrides, Pipeline, Project};
 
 use crate::cli::RunArgs;
 use crate::output::{Bar, print_lines};
@@ -55,7 +54,11 @@ fn settings(a: &RunArgs) -> anyhow::Result<Project> {
 pub fn run(a: &RunArgs) -> anyhow::Result<()> {
     let p = settings(a)?;
     let bar = Bar::new("");
-    let done = run_recording(&a.recording, &a.out, &p, a.force, &a.src, &bar)?;
+    let done = Pipeline::new(p)
+        .force(a.force)
+        .source(a.src.clone())
+        .progress(&bar)
+        .run(&a.recording, &a.out)?;
     bar.finish();
     print_lines(done.lines(&a.recording, &a.out));
     Ok(())

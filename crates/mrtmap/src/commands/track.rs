@@ -1,28 +1,30 @@
 //! `mrtmap track`: poses for a recording without a pose source.
 
-use mrtmap_pipeline::files::Recording;
-use mrtmap_pipeline::run::track_into;
 use mrtmap_pipeline::settings::TrackSection;
+use mrtmap_pipeline::{Overrides, Pipeline, Project};
 
 use crate::cli::TrackArgs;
 use crate::output::Bar;
 
 pub fn run(a: &TrackArgs) -> anyhow::Result<()> {
-    mrtmap_pipeline::run::check_out_apart(&a.recording, &a.out)?;
-    let rec = Recording::open(&a.recording)?;
-    for w in &rec.warnings {
+    let project = Project {
+        track: TrackSection {
+            loop_closure: !a.no_loops,
+            use_imu: !a.no_imu,
+            fast_threshold: a.fast_threshold,
+            ..TrackSection::default()
+        },
+        ..Project::default()
+    };
+    let bar = Bar::new(" frames");
+    let done = Pipeline::new(Project::resolve_over(project, &Overrides::new())?)
+        .progress(&bar)
+        .track(&a.recording, &a.out)?;
+    bar.finish();
+    for w in &done.warnings {
         eprintln!("warning: {w}");
     }
-    let params = TrackSection {
-        loop_closure: !a.no_loops,
-        use_imu: !a.no_imu,
-        fast_threshold: a.fast_threshold,
-        ..TrackSection::default()
-    }
-    .params();
-    let bar = Bar::new(" frames");
-    let (traj, r) = track_into(&rec, &params, &a.out, &bar)?;
-    bar.finish();
+    let (traj, r) = (&done.trajectory, &done.report);
     for w in r.warnings() {
         eprintln!("warning: {w}");
     }
