@@ -144,6 +144,30 @@ pub struct GridSpec {
     pub margin_m: f64,
 }
 
+/// The most nodes a grid may have (a 2000 × 2000 map).
+pub const MAX_GRID_NODES: usize = 4_000_000;
+
+impl GridSpec {
+    /// Refuses a grid without nodes or with more than [`MAX_GRID_NODES`], and a height or margin
+    /// that is not a number or a negative margin: what can be checked before the room is known.
+    pub fn check(&self) -> Result<(), FieldError> {
+        let nodes = self.nx.saturating_mul(self.ny);
+        if self.nx == 0 || self.ny == 0 || nodes > MAX_GRID_NODES {
+            return Err(FieldError::BadGrid(format!(
+                "{}×{} nodes (at least 1×1, at most {MAX_GRID_NODES} in all)",
+                self.nx, self.ny
+            )));
+        }
+        if !(self.height_m.is_finite() && self.margin_m.is_finite() && self.margin_m >= 0.0) {
+            return Err(FieldError::BadGrid(format!(
+                "height {} m, margin {} m (the margin is a distance from the walls: 0 or more)",
+                self.height_m, self.margin_m
+            )));
+        }
+        Ok(())
+    }
+}
+
 impl Default for GridSpec {
     fn default() -> Self {
         Self {
@@ -322,18 +346,7 @@ impl MrtField {
         spec: &GridSpec,
         bounds: Option<&RoomBounds>,
     ) -> Result<GridLayout, FieldError> {
-        if spec.nx == 0 || spec.ny == 0 || spec.nx * spec.ny > 4_000_000 {
-            return Err(FieldError::BadGrid(format!(
-                "{}×{} nodes",
-                spec.nx, spec.ny
-            )));
-        }
-        if !(spec.height_m.is_finite() && spec.margin_m.is_finite() && spec.margin_m >= 0.0) {
-            return Err(FieldError::BadGrid(format!(
-                "height {} m, margin {} m",
-                spec.height_m, spec.margin_m
-            )));
-        }
+        spec.check()?;
         if let Some(b) = bounds {
             b.check_height(spec.height_m)?;
         }

@@ -182,6 +182,24 @@ impl Project {
                 "must be positive numbers",
             ));
         }
+        for &h in &self.map.heights_m {
+            mrtmap_radiation::GridSpec {
+                nx: self.map.grid[0],
+                ny: self.map.grid[1],
+                height_m: h,
+                margin_m: self.map.margin_m,
+            }
+            .check()
+            .map_err(|e| {
+                Error::setting(
+                    format!(
+                        "[map] grid = {:?}, margin_m = {} (--grid, --margin-m)",
+                        self.map.grid, self.map.margin_m
+                    ),
+                    format!("is refused: {e}"),
+                )
+            })?;
+        }
         self.fuse.params()?;
         self.segment.check()?;
         self.room.check()?;
@@ -244,6 +262,28 @@ mod tests {
         assert_eq!(line, 3, "unknown keys are refused with their line");
         assert!(msg.contains("gird"), "{msg}");
         assert!(Project::parse("[mrt]\nmethod = \"fast\"\n").is_err());
+    }
+
+    /// Issue 54: a grid without nodes or a negative margin was refused only after fusion and
+    /// segmentation (7 s into a 20 s scan's run).
+    #[test]
+    fn a_bad_grid_is_refused_before_any_stage_runs() {
+        for (toml, says) in [
+            ("[map]\ngrid = [0, 5]\n", "0×5 nodes"),
+            ("[map]\ngrid = [100000, 100000]\n", "at most 4000000"),
+            ("[map]\nmargin_m = -1.0\n", "margin -1 m"),
+        ] {
+            let e = Project::parse(toml)
+                .unwrap()
+                .check()
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains("[map] grid") && e.contains(says), "{e}");
+        }
+        let huge = Project::parse("[map]\ngrid = [18446744073709551615, 2]\n");
+        if let Ok(p) = huge {
+            assert!(p.check().is_err());
+        }
     }
 
     #[test]
