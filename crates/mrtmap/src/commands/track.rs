@@ -1,6 +1,7 @@
 //! `mrtmap track`: poses for a recording without a pose source.
 
 use mrtmap_pipeline::files::Recording;
+use mrtmap_pipeline::layout::TrackDir;
 use mrtmap_pipeline::run::track_into;
 use mrtmap_pipeline::settings::TrackSection;
 
@@ -70,7 +71,7 @@ pub fn run(a: &TrackArgs) -> anyhow::Result<()> {
     outln!(
         "wrote {} poses to {}",
         traj.len(),
-        a.out.join("trajectory.txt").display()
+        TrackDir::new(&a.out).trajectory_txt().display()
     );
     Ok(())
 }
