@@ -6,7 +6,8 @@ arrays in and out:
 - :class:`Scene` — a radiant scene (``scene.json``, or the built-in example office): MRT at
   points (:meth:`Scene.mrt`), a person's MRT (:meth:`Scene.person`), plane radiant temperatures
   (:meth:`Scene.plane_radiant`) and maps (:meth:`Scene.map`).
-- :func:`run` — the whole pipeline on a recording, as ``mrtmap run``.
+- :func:`run` — the whole pipeline on a recording, as ``mrtmap run``; :class:`RunLayout` — where
+  each file of its output folder is (``RunLayout(out).scene_json()``; docs/run-folder.md).
 - :func:`survey` — many recordings as independent tasks on a Dask cluster, one table.
 - :func:`pmv_ppd_iso`, :func:`operative_tmp`, :func:`mean_radiant_tmp`, :func:`v_relative`,
   :func:`solar_gain` (the sun on a person, SolarCal) and :func:`f_svv` — vectorised with numpy
@@ -27,7 +28,7 @@ from typing import Any, Callable, Optional, Sequence, Union
 import numpy as np
 
 from . import _mrtmap
-from ._mrtmap import MrtmapError
+from ._mrtmap import MrtmapError, RunLayout
 
 __version__ = _mrtmap.__version__
 
@@ -38,6 +39,7 @@ __all__ = [
     "PlaneRadiant",
     "MrtMap",
     "RunResult",
+    "RunLayout",
     "run",
     "survey",
     "pmv_ppd_iso",
@@ -347,6 +349,7 @@ def run(
     lines, secs, figures = _mrtmap.run(str(recording), str(out), cfg, force, progress)
     f = json.loads(figures)
     o = Path(out)
+    layout = RunLayout(str(o))
     maps = []
     for m in f["maps"]:
         s = m["summary"]
@@ -367,9 +370,9 @@ def run(
         maps=maps, comfort=f["comfort"], level=f["level"], warnings=f["warnings"],
         surfaces=f["scene"]["surfaces"], features=f["scene"]["features"],
         paths={
-            "report": str(o / "report.html"),
-            "run_json": str(o / "run.json"),
-            "scene": str(o / "segment" / "scene.json"),
+            "report": str(Path(layout.report_html())),
+            "run_json": str(Path(layout.run_json())),
+            "scene": str(Path(layout.scene_json())),
         },
     )
 

@@ -2,6 +2,7 @@
 
 import csv
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -90,6 +91,29 @@ def test_run_equals_the_cli_on_a_short_scan(scans, tmp_path):
     a = scene.mrt([[1.5, 1.5, 1.1]])
     ref = cli_points("--scene", r.paths["scene"], "--at", "1.5,1.5,1.1")["points"][0]
     assert a.mrt[0] == pytest.approx(ref["mrt_c"], abs=1e-9)
+    # The paths it gives are the run folder's layout's, and the layout's files are there.
+    layout = mrtmap.RunLayout(tmp_path / "py")
+    assert r.paths == {"report": layout.report_html(), "run_json": layout.run_json(),
+                       "scene": layout.scene_json()}
+    assert r.maps[0]["csv"] == layout.mrt_grid_csv(1.1)
+    for f in (layout.cloud_ply(), layout.fusion_json(), layout.poses_txt(), layout.frames_json(),
+              layout.scene_json(), layout.segment_json(), layout.segments_ply(),
+              layout.level_json(), layout.mrt_grid_csv(1.1), layout.mrt_map_png(1.1),
+              layout.mrt_map_svg(1.1), layout.summary_json(1.1)):
+        assert Path(f).is_file(), f
+
+
+def test_run_layout_names_the_documented_files():
+    layout = mrtmap.RunLayout("out")
+    assert mrtmap.RunLayout.map_dir_name(1.1) == "map-1.10m"
+    assert Path(layout.mrt_grid_csv(1.7)) == Path("out/map-1.70m/mrt_grid.csv")
+    assert Path(layout.scene_json()) == Path("out/segment/scene.json")
+    assert Path(layout.comfort_csv("mrt_seated")) == Path("out/comfort/mrt_seated.csv")
+    assert Path(layout.export_file("gltf")) == Path("out/export/room.glb")
+    with pytest.raises(mrtmap.MrtmapError, match="pmvv"):
+        layout.comfort_png("pmvv")
+    with pytest.raises(mrtmap.MrtmapError, match="the formats are"):
+        layout.export_file("obj")
 
 
 def test_map_goes_into_xarray():

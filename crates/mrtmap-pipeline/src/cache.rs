@@ -108,7 +108,7 @@ impl Stage {
     pub fn in_dir(name: impl Into<String>, dir: &Path, outputs: &[&str]) -> Self {
         Self {
             name: name.into(),
-            stamp: dir.join("stage.json"),
+            stamp: crate::layout::stage_json_in(dir),
             outputs: outputs.iter().map(|o| dir.join(o)).collect(),
         }
     }

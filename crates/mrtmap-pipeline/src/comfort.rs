@@ -36,6 +36,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::cache::write_json;
 use crate::error::{Error, Result};
+use crate::layout::ComfortDir;
 use crate::points::SunQuery;
 use crate::settings::{AirSection, ComfortSection, Quantity};
 
@@ -578,7 +579,7 @@ pub fn make_comfort_maps(
     let maps = write_maps(&field, scene, &nodes, marks, &subtitle, (&person, c), out)?;
     let mut summary = summarise(&nodes, c, &person, mark_values, secs);
     summary.sunlit_patch = SunlitPatch::of(&field, &nodes);
-    write_json(&out.join("comfort.json"), &summary)?;
+    write_json(&ComfortDir::new(out).comfort_json(), &summary)?;
     Ok(ComfortOutput { summary, maps })
 }
 
@@ -600,6 +601,7 @@ fn write_maps(
             uv: Point2::new(xy[0], xy[1]),
         })
         .collect();
+    let dir = ComfortDir::new(out);
     let mut maps = Vec::new();
     for &q in person {
         let (title, unit) = title_of(q, c);
@@ -645,15 +647,9 @@ fn write_maps(
             }),
         };
         let png = render_png(&input)?;
-        mrtmap_io::write_atomic(&out.join(format!("{}.png", q.name())), &png)?;
-        mrtmap_io::write_atomic(
-            &out.join(format!("{}.svg", q.name())),
-            render_svg(&input)?.as_bytes(),
-        )?;
-        mrtmap_io::write_atomic(
-            &out.join(format!("{}.csv", q.name())),
-            quantity_csv(field, nodes, q).as_bytes(),
-        )?;
+        mrtmap_io::write_atomic(&dir.png(q), &png)?;
+        mrtmap_io::write_atomic(&dir.svg(q), render_svg(&input)?.as_bytes())?;
+        mrtmap_io::write_atomic(&dir.csv(q), quantity_csv(field, nodes, q).as_bytes())?;
         maps.push((q, title, png));
     }
     Ok(maps)

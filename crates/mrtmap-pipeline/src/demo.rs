@@ -14,6 +14,7 @@ use serde::Serialize;
 
 use crate::cache::{Fingerprint, Stage, StageOutcome, read_json, run_or_reuse, write_json};
 use crate::error::{Error, Result};
+use crate::layout::{DemoLayout, RunLayout};
 use crate::progress::Progress;
 use crate::report::report_data;
 use crate::run::{RunOutcome, run};
@@ -142,7 +143,8 @@ fn simulate_stage(
             ));
         }
     };
-    let rec_dir = out.join("recording");
+    let layout = DemoLayout::new(out);
+    let rec_dir = layout.recording_dir();
     let mut cfg = SimConfig {
         seconds: s.seconds,
         seed: s.seed,
@@ -168,8 +170,8 @@ fn simulate_stage(
         .setting("references", &s.references);
     let stage = Stage {
         name: "simulate".into(),
-        stamp: out.join("simulate.json"),
-        outputs: vec![rec_dir.join("truth.json")],
+        stamp: layout.simulate_json(),
+        outputs: vec![layout.truth_json()],
     };
     let outcome = run_or_reuse(&stage, fingerprint, s.force, || {
         progress.begin(&format!(
@@ -328,11 +330,11 @@ fn write_demo_outputs(
         ("simulate".into(), format!("{:.1}{reused}", d.simulate.secs)),
     );
     mrtmap_io::write_atomic(
-        &d.run_dir.join("report.html"),
+        &RunLayout::new(&d.run_dir).report_html(),
         mrtmap_report::render_html(&data).as_bytes(),
     )?;
     write_json(
-        &out.join("demo.json"),
+        &DemoLayout::new(out).demo_json(),
         &DemoFile {
             points: &d.rows,
             grid: d.grid,
@@ -348,10 +350,11 @@ fn write_demo_outputs(
 pub fn demo(out: &Path, s: &DemoSettings, progress: &dyn Progress) -> Result<DemoOutcome> {
     let t0 = std::time::Instant::now();
     let (simulated, room) = simulate_stage(out, s, progress)?;
-    let recording = out.join("recording");
-    let truth: Truth = read_json(&recording.join("truth.json"))?;
+    let layout = DemoLayout::new(out);
+    let recording = layout.recording_dir();
+    let truth: Truth = read_json(&layout.truth_json())?;
     let project = demo_project(&truth, s);
-    let run_dir = out.join("run");
+    let run_dir = layout.run().root().to_path_buf();
     let outcome = run(&recording, &run_dir, &project, s.force, progress)?;
     progress.begin("comparing with the truth");
     let rows = compare_points(&outcome, &truth, s.air_speed_m_s)?;

@@ -12,6 +12,7 @@ pub use mrtmap_export::hbjson::Temperatures;
 use mrtmap_export::{ImportError, gbxml, gltf, hbjson, radiance};
 use mrtmap_radiation::RadiantScene;
 
+use crate::layout::{FuseDir, RunLayout, SegmentDir};
 use crate::{Error, Result};
 
 /// The formats a room is exported to.
@@ -175,23 +176,16 @@ fn thin(cloud: &CloudPoints, max_points: usize) -> CloudPoints {
 /// A run's thermal cloud (`out/fuse/cloud.ply`) in its scene's frame, read once for the report's
 /// 3D view and the exports; `None` when it cannot be read (they then go without it).
 pub fn run_cloud(out: &Path, scene: &RadiantScene) -> Option<CloudPoints> {
-    cloud_in_scene(
-        &out.join("fuse").join("cloud.ply"),
-        scene,
-        level_of(out).as_ref(),
-    )
-    .ok()
+    let run = RunLayout::new(out);
+    cloud_in_scene(&run.cloud_ply(), scene, level_of(out).as_ref()).ok()
 }
 
 /// The temperatures' level a run or segmentation folder found (`segment/level.json` or
 /// `level.json`), when there is one.
 fn level_of(dir: &Path) -> Option<crate::level::Level> {
-    [
-        dir.join("segment").join("level.json"),
-        dir.join("level.json"),
-    ]
-    .iter()
-    .find_map(|p| crate::cache::read_json(p).ok())
+    [RunLayout::new(dir).level_json(), dir.join("level.json")]
+        .iter()
+        .find_map(|p| crate::cache::read_json(p).ok())
 }
 
 /// The thermal cloud at `ply` in `scene`'s frame (through its `world_from_room`), its
@@ -276,7 +270,8 @@ pub fn open_for_export(path: &Path, src: &ExportSource, max_points: usize) -> Re
             .to_string()
     };
     if path.is_dir() {
-        let scene_path = [path.join("segment").join("scene.json"), path.join("scene.json")]
+        let run = RunLayout::new(path);
+        let scene_path = [run.scene_json(), SegmentDir::new(path).scene_json()]
             .into_iter()
             .find(|p| p.is_file())
             .ok_or_else(|| {
@@ -286,7 +281,7 @@ pub fn open_for_export(path: &Path, src: &ExportSource, max_points: usize) -> Re
                 )
             })?;
         let scene = RadiantScene::load(&scene_path)?;
-        let ply = [path.join("fuse").join("cloud.ply"), path.join("cloud.ply")]
+        let ply = [run.cloud_ply(), FuseDir::new(path).cloud_ply()]
             .into_iter()
             .find(|p| p.is_file());
         let cloud = match ply {
@@ -437,12 +432,13 @@ pub fn export_run(
         cloud,
         name: "room".into(),
     };
-    let dir = out.join("export");
+    let run = RunLayout::new(out);
+    let dir = run.export_dir();
     std::fs::create_dir_all(&dir).map_err(|e| mrtmap_io::FileError::io(&dir, e))?;
     section
         .formats
         .iter()
-        .map(|f| export(&input, *f, &dir.join(format!("room.{}", f.extension()))))
+        .map(|f| export(&input, *f, &run.export_file(*f)))
         .collect()
 }
 

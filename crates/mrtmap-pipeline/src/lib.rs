@@ -18,6 +18,8 @@
 //! - [`cache`]: a stage's [`Fingerprint`] and [`run_or_reuse`]; the run's stages, source
 //!   conversion and the demo's simulation all use it.
 //! - [`progress`]: the [`Progress`] trait the CLI implements with progress bars.
+//! - [`layout`]: where a run's files go, [`RunLayout`] (and each stage's folder, the demo's
+//!   [`DemoLayout`]); no other module spells a file name of the run folder.
 //! - [`source`], [`run`], [`maps`], [`report`], [`demo`], [`calibration`]: one job each.
 //! - [`points`]: MRT at points of a scene (a sphere's, a person's, the plane radiant
 //!   temperatures) from one call, [`points::mrt_at_points`].
@@ -52,6 +54,7 @@ pub mod demo;
 mod error;
 pub mod export;
 pub mod front;
+pub mod layout;
 pub mod level;
 pub mod lock;
 pub mod maps;
@@ -76,6 +79,7 @@ pub mod files {
 pub use cache::{Fingerprint, Stage, StageOutcome, run_or_reuse};
 pub use error::{Error, Result};
 pub use front::{FuseDone, Pipeline, TrackDone};
+pub use layout::{DemoLayout, RunLayout};
 pub use progress::{Progress, Silent};
 pub use resolve::{MrtFlags, Overrides};
 pub use settings::{DirectionChoice, MethodChoice, MrtSection, Project};

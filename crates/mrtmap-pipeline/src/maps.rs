@@ -18,6 +18,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::cache::write_json;
 use crate::error::{Error, Result};
+use crate::layout::MapDir;
 use crate::settings::MrtSection;
 
 /// A point to mark on a map: map coordinates U,V at the map's height, or scene coordinates X,Y,Z.
@@ -327,10 +328,11 @@ pub fn make_map(
         marks: records,
     };
     let png = render_png(&input)?;
-    write_atomic(&out.join("mrt_grid.csv"), grid_csv(&field).as_bytes())?;
-    write_atomic(&out.join("mrt_map.png"), &png)?;
-    write_atomic(&out.join("mrt_map.svg"), render_svg(&input)?.as_bytes())?;
-    write_json(&out.join("summary.json"), &summary)?;
+    let dir = MapDir::new(out);
+    write_atomic(&dir.mrt_grid_csv(), grid_csv(&field).as_bytes())?;
+    write_atomic(&dir.mrt_map_png(), &png)?;
+    write_atomic(&dir.mrt_map_svg(), render_svg(&input)?.as_bytes())?;
+    write_json(&dir.summary_json(), &summary)?;
     Ok(MapOutput {
         summary,
         method: how,

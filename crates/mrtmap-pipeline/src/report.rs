@@ -14,6 +14,7 @@ use serde::Serialize;
 use crate::cache::{StageOutcome, write_json};
 use crate::comfort::value_of;
 use crate::error::Result;
+use crate::layout::RunLayout;
 use crate::run::{ComfortResult, RunOutcome};
 use crate::settings::Project;
 
@@ -364,7 +365,7 @@ fn comfort_rows(
             (
                 title.clone(),
                 png.clone(),
-                format!("comfort/{}.csv", q.name()),
+                RunLayout::name_in_run(|r| r.comfort_csv(*q)),
             )
         })
         .collect();
@@ -592,13 +593,14 @@ pub fn write_run_outputs(
     seconds: f64,
     cloud: Option<&crate::export::CloudPoints>,
 ) -> Result<Vec<crate::export::ExportDone>> {
+    let layout = RunLayout::new(out);
     mrtmap_io::write_atomic(
-        &out.join("report.html"),
+        &layout.report_html(),
         mrtmap_report::render_html(data).as_bytes(),
     )?;
     let exports = crate::export::export_run(out, &o.scene, &p.export, cloud)?;
     write_json(
-        &out.join("run.json"),
+        &layout.run_json(),
         &RunFile {
             recording: recording.display().to_string(),
             stages: &o.stages,
@@ -718,12 +720,10 @@ pub fn view3d_for_run(
 /// The black-globe readings `mrtmap validate` wrote into the run's folder (validation.json), when
 /// they are newer than its scene (older ones compared another scene and are left out).
 fn globes_of_run(out: &Path) -> Vec<mrtmap_report::view3d::ViewMark> {
-    let file = out.join("validation.json");
+    let layout = RunLayout::new(out);
+    let file = layout.validation_json();
     let modified = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
-    let fresh = match (
-        modified(&file),
-        modified(&out.join("segment").join("scene.json")),
-    ) {
+    let fresh = match (modified(&file), modified(&layout.scene_json())) {
         (Some(v), Some(s)) => v >= s,
         _ => false,
     };
@@ -769,6 +769,7 @@ pub fn run_recording(
     progress: &dyn crate::Progress,
 ) -> Result<RunDone> {
     project.check()?;
+    project.check_heights_above_floor()?;
     crate::run::check_out_dir(out)?;
     let _lock = crate::lock::OutLock::take(out)?;
     let t0 = std::time::Instant::now();

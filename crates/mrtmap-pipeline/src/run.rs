@@ -7,6 +7,8 @@
 //!            ──map──► map-H.HHm/ per height (mrt_grid.csv, mrt_map.png/.svg, summary.json)
 //! ```
 //!
+//! Every file's path comes from [`crate::layout`] ([`RunLayout`] and its stage folders).
+//!
 //! A new stage goes here: a `*_stage` function taking what it needs and returning its outcome,
 //! called in order by [`run`], with its files in its own folder.
 
@@ -27,6 +29,7 @@ use mrtmap_track::{TrackParams, TrackReport, track};
 use crate::cache::{Fingerprint, Stage, StageOutcome, read_json, run_or_reuse, write_json};
 use crate::comfort::{ComfortSummary, comfort_title, make_comfort_maps};
 use crate::error::{Error, Result};
+use crate::layout::{FuseDir, RunLayout, SegmentDir, TrackDir};
 use crate::level::{DEFAULT_CAMERA_ACCURACY_K, Level, LevelInputs, read_references};
 use crate::maps::{Mark, MarkAt, Summary, make_map};
 use crate::progress::Progress;
@@ -46,15 +49,16 @@ pub fn track_into(
     let (traj, report) = track(rec, params, &|d, t| progress.advance(d as u64, t as u64))
         .map_err(|e| Error::source(&rec.dir, e.to_string()))?;
     std::fs::create_dir_all(out).map_err(|e| mrtmap_io::FileError::io(out, e))?;
+    let dir = TrackDir::new(out);
     write_atomic(
-        &out.join("trajectory.txt"),
+        &dir.trajectory_txt(),
         traj.to_tum(&format!(
             "mrtmap track of {}: world_from_depth at the colour frames' times (the first frame's depth camera is the world)",
             rec.dir.display()
         ))
         .as_bytes(),
     )?;
-    write_json(&out.join("track.json"), &report)?;
+    write_json(&dir.track_json(), &report)?;
     Ok((traj, report))
 }
 
@@ -73,15 +77,16 @@ pub fn fuse_into(
         params.voxel_m,
         if params.icp.enabled { "on" } else { "off" }
     );
-    write_cloud_ply(&out.join("cloud.ply"), &fused.cloud, &comment, &[])?;
-    write_json(&out.join("fusion.json"), &fused.report)?;
+    let dir = FuseDir::new(out);
+    write_cloud_ply(&dir.cloud_ply(), &fused.cloud, &comment, &[])?;
+    write_json(&dir.fusion_json(), &fused.report)?;
     let traj = fused.trajectory();
     write_atomic(
-        &out.join("poses.txt"),
+        &dir.poses_txt(),
         traj.to_tum("world_from_depth of each fused thermal frame's depth frame, after ICP")
             .as_bytes(),
     )?;
-    write_json(&out.join("frames.json"), &fused.frames)?;
+    write_json(&dir.frames_json(), &fused.frames)?;
     Ok(fused.report)
 }
 
@@ -110,7 +115,7 @@ pub struct SegmentJob<'a> {
 /// Segments a fusion's folder as [`SegmentJob`] says, after checking its inputs; one call for
 /// `mrtmap segment`.
 pub fn segment_folder(job: &SegmentJob<'_>) -> Result<SegmentReport> {
-    if !job.fused.join("cloud.ply").exists() {
+    if !FuseDir::new(job.fused).cloud_ply().exists() {
         return Err(Error::source(
             job.fused,
             "no cloud.ply here: give the output folder of `mrtmap fuse`",
@@ -168,19 +173,20 @@ pub fn segment_into(
     level: &LevelInputs,
     out: &Path,
 ) -> Result<SegmentReport> {
-    let cloud_path = fused.join("cloud.ply");
+    let fused = FuseDir::new(fused);
+    let cloud_path = fused.cloud_ply();
     let cloud = read_cloud_ply(&cloud_path)?.cloud;
-    let poses = Trajectory::read(&fused.join("poses.txt"))?;
+    let poses = Trajectory::read(&fused.poses_txt())?;
     let masks = inputs.recording.filter(|_| inputs.masks);
     let pose_fn = masks.map(|r| refined_poses(r, &poses));
     let mask_input = masks.zip(pose_fn.as_ref()).map(|(r, f)| MaskInput {
         recording: r,
         world_from_depth: f,
     });
-    let frames_path = fused.join("frames.json");
+    let frames_path = fused.frames_json();
     let texture_frames: Option<(Vec<FusedFrame>, f64)> = match inputs.recording {
         Some(_) if inputs.texture && frames_path.exists() => {
-            let report: FusionReport = read_json(&fused.join("fusion.json"))?;
+            let report: FusionReport = read_json(&fused.fusion_json())?;
             Some((read_json(&frames_path)?, report.radiometric.vignetting_k))
         }
         _ => None,
@@ -205,13 +211,11 @@ pub fn segment_into(
         source,
     })?;
     let found = crate::level::level_segmentation(&mut seg, &cloud, level);
-    write_json(&out.join("level.json"), &found)?;
-    write_atomic(
-        &out.join("scene.json"),
-        (seg.scene.to_json() + "\n").as_bytes(),
-    )?;
+    let dir = SegmentDir::new(out);
+    write_json(&dir.level_json(), &found)?;
+    write_atomic(&dir.scene_json(), (seg.scene.to_json() + "\n").as_bytes())?;
     write_cloud_ply(
-        &out.join("segments.ply"),
+        &dir.segments_ply(),
         &cloud,
         "mrtmap segments: surface_id indexes segment.json's surfaces, feature_id its features (-1: none)",
         &[
@@ -219,7 +223,7 @@ pub fn segment_into(
             ("feature_id", &seg.feature_id),
         ],
     )?;
-    write_json(&out.join("segment.json"), &seg.report)?;
+    write_json(&dir.segment_json(), &seg.report)?;
     Ok(seg.report)
 }
 
@@ -257,7 +261,7 @@ pub struct ComfortResult {
 /// The comfort stage: `out/comfort`, when `[map] quantities` ask for a person's quantities.
 fn comfort_stage(
     scene: &RadiantScene,
-    out: &Path,
+    run: &RunLayout,
     p: &Project,
     force: bool,
     progress: &dyn Progress,
@@ -266,8 +270,8 @@ fn comfort_stage(
     if person.is_empty() {
         return Ok(None);
     }
-    let dir = out.join("comfort");
-    let scene_path = out.join("segment").join("scene.json");
+    let dir = run.comfort();
+    let scene_path = run.scene_json();
     let marks: Vec<(String, [f64; 2])> = points_in_room(&p.points, scene, &scene_path)?
         .into_iter()
         .filter_map(|m| match m.at {
@@ -285,10 +289,11 @@ fn comfort_stage(
         .setting("mrt", &p.mrt)
         .setting("sun", &p.sun)
         .setting("points", &p.points);
-    let mut files: Vec<String> = person.iter().map(|q| format!("{}.png", q.name())).collect();
-    files.push("comfort.json".into());
-    let files: Vec<&str> = files.iter().map(String::as_str).collect();
-    let stage = Stage::in_dir("comfort maps", &dir, &files);
+    let stage = Stage {
+        name: "comfort maps".into(),
+        stamp: dir.stage_json(),
+        outputs: dir.outputs(&person),
+    };
     let mut made = None;
     let outcome = run_or_reuse(&stage, fingerprint, force, || {
         progress.begin("mapping a person's comfort");
@@ -305,7 +310,7 @@ fn comfort_stage(
             &person,
             sun.as_ref(),
             &marks,
-            &dir,
+            dir.dir(),
         )?;
         made = Some(ComfortResult {
             summary: o.summary,
@@ -316,11 +321,11 @@ fn comfort_stage(
     let result = match made {
         Some(r) => r,
         None => {
-            let summary: ComfortSummary = read_json(&dir.join("comfort.json"))?;
+            let summary: ComfortSummary = read_json(&dir.comfort_json())?;
             let maps = person
                 .iter()
                 .map(|q| {
-                    let f = dir.join(format!("{}.png", q.name()));
+                    let f = dir.png(*q);
                     let png = std::fs::read(&f).map_err(|e| mrtmap_io::FileError::io(&f, e))?;
                     Ok((*q, comfort_title(*q, &p.comfort), png))
                 })
@@ -359,7 +364,7 @@ pub struct RunOutcome {
 /// the recording's trajectory becomes the tracked one (re-tracked: aligned to the recording's own).
 fn track_stage(
     rec: &mut Recording,
-    out: &Path,
+    run: &RunLayout,
     p: &Project,
     force: bool,
     progress: &dyn Progress,
@@ -381,17 +386,21 @@ fn track_stage(
     if !needed {
         return Ok(None);
     }
-    let dir = out.join("track");
+    let dir = run.track();
     let fingerprint = ["rig.toml", "depth.txt", "rgb.txt", "imu.txt"]
         .iter()
         .fold(Fingerprint::new(), |f, n| f.file(&rec.dir.join(n)))
         .setting("track", &p.track);
-    let stage = Stage::in_dir("track", &dir, &["trajectory.txt", "track.json"]);
+    let stage = Stage {
+        name: "track".into(),
+        stamp: dir.stage_json(),
+        outputs: dir.outputs(),
+    };
     let params = p.track.params();
     let outcome = run_or_reuse(&stage, fingerprint, force, || {
-        track_into(rec, &params, &dir, progress).map(|_| ())
+        track_into(rec, &params, dir.dir(), progress).map(|_| ())
     })?;
-    let tracked = Trajectory::read(&dir.join("trajectory.txt"))?;
+    let tracked = Trajectory::read(&dir.trajectory_txt())?;
     // Re-tracked (mode = "always"): in the recording's own world frame, the frame of its
     // references.csv and of the project's scan-frame points.
     rec.trajectory = if has_poses {
@@ -399,52 +408,52 @@ fn track_stage(
     } else {
         tracked
     };
-    Ok(Some((outcome, read_json(&dir.join("track.json"))?)))
+    Ok(Some((outcome, read_json(&dir.track_json())?)))
 }
 
 /// The fuse stage: `out/fuse`.
 fn fuse_stage(
     rec: &Recording,
-    out: &Path,
+    run: &RunLayout,
     p: &Project,
     force: bool,
     progress: &dyn Progress,
 ) -> Result<(StageOutcome, FusionReport)> {
-    let dir = out.join("fuse");
+    let dir = run.fuse();
     let params = p.fuse.params()?;
-    let tracked = out.join("track").join("trajectory.txt");
+    let tracked = run.trajectory_txt();
     let fingerprint = ["rig.toml", "depth.txt", "thermal.txt", "trajectory.txt"]
         .iter()
         .fold(Fingerprint::new(), |f, n| f.file(&rec.dir.join(n)))
         .maybe_file(tracked.exists().then_some(tracked.as_path()))
         .setting("fuse", &p.fuse);
-    let stage = Stage::in_dir(
-        "fuse",
-        &dir,
-        &["cloud.ply", "fusion.json", "poses.txt", "frames.json"],
-    );
+    let stage = Stage {
+        name: "fuse".into(),
+        stamp: dir.stage_json(),
+        outputs: dir.outputs(),
+    };
     let outcome = run_or_reuse(&stage, fingerprint, force, || {
-        fuse_into(rec, &params, &dir, progress).map(|_| ())
+        fuse_into(rec, &params, dir.dir(), progress).map(|_| ())
     })?;
-    Ok((outcome, read_json(&dir.join("fusion.json"))?))
+    Ok((outcome, read_json(&dir.fusion_json())?))
 }
 
 /// The segment stage: `out/segment`.
 fn segment_stage(
     rec: &Recording,
-    out: &Path,
+    run: &RunLayout,
     p: &Project,
     force: bool,
     progress: &dyn Progress,
 ) -> Result<(StageOutcome, SegmentReport)> {
-    let fused = out.join("fuse");
-    let dir = out.join("segment");
+    let fused = run.fuse();
+    let dir = run.segment();
     let use_masks = p.segment.masks && !rec.masks.is_empty();
     let fingerprint = Fingerprint::new()
-        .file(&fused.join("cloud.ply"))
-        .file(&fused.join("poses.txt"))
+        .file(&fused.cloud_ply())
+        .file(&fused.poses_txt())
         .maybe_file(
-            Some(fused.join("frames.json"))
+            Some(fused.frames_json())
                 .filter(|f| p.segment.texture && f.exists())
                 .as_deref(),
         )
@@ -460,11 +469,11 @@ fn segment_stage(
         .setting("emissivity", &p.emissivity)
         .setting("mrt", &p.mrt)
         .setting("camera_accuracy_k", &rec.rig.thermal_accuracy_k);
-    let stage = Stage::in_dir(
-        "segment",
-        &dir,
-        &["scene.json", "segment.json", "segments.ply", "level.json"],
-    );
+    let stage = Stage {
+        name: "segment".into(),
+        stamp: dir.stage_json(),
+        outputs: dir.outputs(),
+    };
     let outcome = run_or_reuse(&stage, fingerprint, force, || {
         progress.begin("segmenting surfaces and features");
         progress.advance(0, 1);
@@ -474,9 +483,16 @@ fn segment_stage(
             texture: p.segment.texture,
         };
         let level = LevelInputs::of(rec, p)?;
-        segment_into(&fused, &inputs, &p.segment.params(&p.room), &level, &dir).map(|_| ())
+        segment_into(
+            fused.dir(),
+            &inputs,
+            &p.segment.params(&p.room),
+            &level,
+            dir.dir(),
+        )
+        .map(|_| ())
     })?;
-    Ok((outcome, read_json(&dir.join("segment.json"))?))
+    Ok((outcome, read_json(&dir.segment_json())?))
 }
 
 /// The project's points in the scene's (room) frame: points given in the scan's frame are carried
@@ -516,15 +532,14 @@ pub fn points_in_room(
 /// The map stage at one height: `out/map-H.HHm`.
 fn map_stage(
     scene: &RadiantScene,
-    out: &Path,
+    run: &RunLayout,
     p: &Project,
     height_m: f64,
     force: bool,
     progress: &dyn Progress,
 ) -> Result<(StageOutcome, MapResult)> {
-    let name = format!("map-{height_m:.2}m");
-    let dir = out.join(&name);
-    let scene_path = out.join("segment").join("scene.json");
+    let dir = run.map(height_m);
+    let scene_path = run.scene_json();
     let spec = GridSpec {
         nx: p.map.grid[0],
         ny: p.map.grid[1],
@@ -540,11 +555,11 @@ fn map_stage(
         .setting("mrt", &p.mrt)
         .setting("points", &p.points)
         .setting("height", &height_m);
-    let stage = Stage::in_dir(
-        format!("map at {height_m:.2} m"),
-        &dir,
-        &["summary.json", "mrt_map.png", "mrt_grid.csv"],
-    );
+    let stage = Stage {
+        name: format!("map at {height_m:.2} m"),
+        stamp: dir.stage_json(),
+        outputs: dir.outputs(),
+    };
     let mut made = None;
     let outcome = run_or_reuse(&stage, fingerprint, force, || {
         progress.begin(&format!("mapping MRT at {height_m:.2} m"));
@@ -555,19 +570,19 @@ fn map_stage(
             &p.mrt,
             spec,
             &marks,
-            &dir,
+            dir.dir(),
         )?);
         Ok(())
     })?;
     let (summary, png) = match made {
         Some(m) => (m.summary, m.png),
         None => (
-            read_json(&dir.join("summary.json"))?,
-            std::fs::read(dir.join("mrt_map.png"))
-                .map_err(|e| mrtmap_io::FileError::io(&dir.join("mrt_map.png"), e))?,
+            read_json(&dir.summary_json())?,
+            std::fs::read(dir.mrt_map_png())
+                .map_err(|e| mrtmap_io::FileError::io(&dir.mrt_map_png(), e))?,
         ),
     };
-    let csv = format!("{name}/mrt_grid.csv");
+    let csv = RunLayout::name_in_run(|r| r.mrt_grid_csv(height_m));
     Ok((outcome, MapResult { summary, png, csv }))
 }
 
@@ -631,6 +646,7 @@ pub fn run(
     check_out_dir(out)?;
     check_out_apart(recording, out)?;
     let mut rec = Recording::open(recording)?;
+    let layout = RunLayout::new(out);
     let on_depth_clock = |w: &RecordingWarning| {
         // The recording's count was of the stamps as recorded; on the depth clock they may have
         // poses (fusion says).
@@ -642,8 +658,8 @@ pub fn run(
         .filter(|w| **w != RecordingWarning::NoTrajectory)
         .cloned()
         .collect();
-    let tracked = track_stage(&mut rec, out, p, force, progress)?;
-    let (fused, fusion) = fuse_stage(&rec, out, p, force, progress)?;
+    let tracked = track_stage(&mut rec, &layout, p, force, progress)?;
+    let (fused, fusion) = fuse_stage(&rec, &layout, p, force, progress)?;
     if fusion.clock.offset_s != 0.0 && !fusion.skipped.contains_key(&SkipReason::NoPose) {
         recording_warnings.retain(|w| !on_depth_clock(w));
     }
@@ -669,14 +685,14 @@ pub fn run(
             fusion.pose_check.dropped, fusion.pose_check.poses
         ));
     }
-    let (segmented, segment) = segment_stage(&rec, out, p, force, progress)?;
+    let (segmented, segment) = segment_stage(&rec, &layout, p, force, progress)?;
     warnings.extend(
         segment
             .warnings
             .iter()
             .map(|w| format!("segmentation: {w}")),
     );
-    let scene_path = out.join("segment").join("scene.json");
+    let scene_path = layout.scene_json();
     let scene = RadiantScene::load(&scene_path)?;
     check_requests(&scene, &scene_path, p)?;
     let (track_outcome, track) = tracked.unzip();
@@ -684,12 +700,12 @@ pub fn run(
     stages.extend([fused, segmented]);
     let mut maps = Vec::new();
     for &h in &p.map.heights_m {
-        let (st, m) = map_stage(&scene, out, p, h, force, progress)?;
+        let (st, m) = map_stage(&scene, &layout, p, h, force, progress)?;
         stages.push(st);
         maps.push(m);
     }
-    let level: Option<Level> = read_json(&out.join("segment").join("level.json")).ok();
-    let comfort = match comfort_stage(&scene, out, p, force, progress)? {
+    let level: Option<Level> = read_json(&layout.level_json()).ok();
+    let comfort = match comfort_stage(&scene, &layout, p, force, progress)? {
         Some((st, c)) => {
             stages.push(st);
             Some(c)
@@ -747,7 +763,7 @@ impl RunOutcome {
         }
         lines.push(format!(
             "done in {secs:.1} s; report: {}",
-            out.join("report.html").display()
+            RunLayout::new(out).report_html().display()
         ));
         lines
     }

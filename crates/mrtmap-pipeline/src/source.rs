@@ -19,6 +19,7 @@ use serde::Serialize;
 use crate::cache::{Fingerprint, Stage, run_or_reuse};
 pub use crate::conversion::{Conversion, SourceOptions};
 use crate::error::{Error, Result};
+use crate::layout::RunLayout;
 
 /// One stream of a recording folder.
 #[derive(Clone, Debug, Serialize)]
@@ -519,10 +520,12 @@ pub fn prepare(source: &Path, out: &Path, o: &SourceOptions) -> Result<Prepared>
             reused: false,
         });
     }
-    let dir = out.join("recording");
+    // `mrtmap fuse`'s folder takes the conversion where a run's folder does.
+    let layout = RunLayout::new(out);
+    let dir = layout.recording_dir();
     let stage = Stage {
         name: "convert".into(),
-        stamp: out.join("recording.stage.json"),
+        stamp: layout.recording_stage_json(),
         outputs: vec![dir.join("rig.toml")],
     };
     let fingerprint = Fingerprint::new()

@@ -17,6 +17,7 @@ use serde::Serialize;
 
 use crate::cache::write_json;
 use crate::error::{Error, Result};
+use crate::layout::{RunLayout, SegmentDir};
 use crate::maps::to_scene_frame;
 use crate::settings::PointFrame;
 
@@ -36,7 +37,10 @@ pub struct Validation {
 
 /// The scene of a `run` output folder or of a folder holding scene.json.
 fn scene_of(map: &Path) -> Result<PathBuf> {
-    [map.join("scene.json"), map.join("segment").join("scene.json")]
+    [
+        SegmentDir::new(map).scene_json(),
+        RunLayout::new(map).scene_json(),
+    ]
         .into_iter()
         .find(|p| p.exists())
         .ok_or_else(|| {
@@ -202,11 +206,9 @@ pub fn validate_map(
             r.meets_desired = None;
         }
     }
-    mrtmap_io::write_atomic(
-        &out.join("validation.csv"),
-        validation_csv(&rows)?.as_bytes(),
-    )?;
-    write_json(&out.join("validation.json"), &rows)?;
+    let layout = RunLayout::new(out);
+    mrtmap_io::write_atomic(&layout.validation_csv(), validation_csv(&rows)?.as_bytes())?;
+    write_json(&layout.validation_json(), &rows)?;
     Ok(Validation {
         scene: scene_path,
         rows,

@@ -3,13 +3,16 @@
 //! The native module (`mrtmap._mrtmap`) of the Python package in `python/`: mrtmap-pipeline's
 //! public API and nothing below it, with numpy arrays in and out. The Python layer
 //! (`python/mrtmap/__init__.py`) broadcasts, names and documents; this module converts, checks,
-//! releases the GIL and runs the pipeline's calls (rayon inside).
+//! releases the GIL and runs the pipeline's calls (rayon inside). `RunLayout` (`layout.rs`) gives
+//! the run folder's paths, so that the Python layer spells no file name of it.
 //!
 //! Every error is a `mrtmap.MrtmapError` (a `ValueError`) carrying the message the CLI prints.
 // PyO3's macros expand to unsafe FFI glue; this crate itself writes none.
 #![allow(unsafe_code)]
 // Python hands owned values (strings, lists) to the functions PyO3 wraps.
 #![allow(clippy::needless_pass_by_value)]
+
+mod layout;
 
 /// Two float arrays (values and their standard errors).
 type Pair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
@@ -748,6 +751,7 @@ fn _mrtmap(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MrtmapError", m.py().get_type::<MrtmapError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_class::<PyScene>()?;
+    m.add_class::<layout::PyRunLayout>()?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(pmv_ppd, m)?)?;
     m.add_function(wrap_pyfunction!(operative, m)?)?;

@@ -168,18 +168,24 @@ impl Project {
         })
     }
 
+    /// Refuses map heights at or below the floor before a run, when the room and its ceiling are
+    /// not known yet (`map` and `mrt` check heights against the room itself, naming its ceiling).
+    pub fn check_heights_above_floor(&self) -> Result<()> {
+        if let Some(h) = self.map.heights_m.iter().find(|h| **h <= 0.0) {
+            return Err(Error::setting(
+                format!("a map {h:.2} m above the floor ([map] heights_m, --height)"),
+                "is not in the room: give a height above the floor (1.1 m is seated head height, 1.7 m standing)",
+            ));
+        }
+        Ok(())
+    }
+
     /// Checks what can be checked before any stage runs.
     pub fn check(&self) -> Result<()> {
-        if self.map.heights_m.is_empty()
-            || self
-                .map
-                .heights_m
-                .iter()
-                .any(|h| !(h.is_finite() && *h > 0.0))
-        {
+        if self.map.heights_m.is_empty() || self.map.heights_m.iter().any(|h| !h.is_finite()) {
             return Err(Error::setting(
                 format!("map heights {:?} m", self.map.heights_m),
-                "must be positive numbers",
+                "must be numbers (metres above the floor)",
             ));
         }
         for &h in &self.map.heights_m {

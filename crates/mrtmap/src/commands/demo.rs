@@ -1,5 +1,6 @@
 //! `mrtmap demo`: simulate the office scan, run the pipeline, compare with the exact truth.
 
+use mrtmap_pipeline::RunLayout;
 use mrtmap_pipeline::demo::{DemoSettings, demo};
 
 use crate::cli::DemoArgs;
@@ -74,7 +75,10 @@ pub fn run(a: &DemoArgs) -> anyhow::Result<()> {
         d.grid.max_abs_error_k,
         d.grid.rmse_k
     );
-    outln!("report: {}", d.run_dir.join("report.html").display());
+    outln!(
+        "report: {}",
+        RunLayout::new(&d.run_dir).report_html().display()
+    );
     outln!(
         "{} holds {:.0} MB (recording, fused cloud, maps, report)",
         a.out.display(),

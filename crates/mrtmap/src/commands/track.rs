@@ -1,5 +1,6 @@
 //! `mrtmap track`: poses for a recording without a pose source.
 
+use mrtmap_pipeline::layout::TrackDir;
 use mrtmap_pipeline::settings::TrackSection;
 use mrtmap_pipeline::{Overrides, Pipeline, Project};
 
@@ -72,7 +73,7 @@ pub fn run(a: &TrackArgs) -> anyhow::Result<()> {
     outln!(
         "wrote {} poses to {}",
         traj.len(),
-        a.out.join("trajectory.txt").display()
+        TrackDir::new(&a.out).trajectory_txt().display()
     );
     Ok(())
 }

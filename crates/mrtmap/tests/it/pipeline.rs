@@ -5,6 +5,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::OnceLock;
 
+use mrtmap_pipeline::export::ExportFormat;
+use mrtmap_pipeline::settings::Quantity;
+use mrtmap_pipeline::{DemoLayout, RunLayout};
 use serde_json::Value;
 
 use crate::{mrtmap, ok};
@@ -40,6 +43,25 @@ fn read_json(p: &Path) -> Value {
         &std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display())),
     )
     .unwrap()
+}
+
+/// Each of `paths` (a layout's) is there.
+fn assert_exist(paths: &[PathBuf]) {
+    for p in paths {
+        assert!(p.exists(), "{} missing", p.display());
+    }
+}
+
+/// `dir` holds nothing but `known` (a layout's paths).
+fn assert_only(dir: &Path, known: &[PathBuf]) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        assert!(
+            known.contains(&p),
+            "{} is not a RunLayout path",
+            p.display()
+        );
+    }
 }
 
 fn stages_skipped(out: &Path) -> Vec<(String, bool)> {
@@ -89,6 +111,33 @@ fn run_produces_every_output_and_reuses_unchanged_stages() {
     ] {
         assert!(out.join(f).exists(), "{f} missing");
     }
+    // RunLayout names each file the run wrote, and nothing else is there.
+    let l = RunLayout::new(&out);
+    let (fuse, segment, map) = (l.fuse(), l.segment(), l.map(1.1));
+    let fuse_files = [fuse.outputs(), vec![fuse.stage_json()]].concat();
+    let segment_files = [segment.outputs(), vec![segment.stage_json()]].concat();
+    let map_files = [map.outputs(), vec![map.stage_json(), map.mrt_map_svg()]].concat();
+    for (dir, files) in [
+        (fuse.dir(), &fuse_files),
+        (segment.dir(), &segment_files),
+        (map.dir(), &map_files),
+    ] {
+        assert_exist(files);
+        assert_only(dir, files);
+    }
+    let top = [
+        l.fuse_dir(),
+        l.segment_dir(),
+        l.map_dir(1.1),
+        l.report_html(),
+        l.run_json(),
+    ];
+    assert_exist(&top);
+    assert_only(&out, &top);
+    assert_eq!(
+        (l.cloud_ply(), l.scene_json(), l.mrt_grid_csv(1.1)),
+        (fuse.cloud_ply(), segment.scene_json(), map.mrt_grid_csv())
+    );
     assert!(stages_skipped(&out).iter().all(|s| !s.1));
     // Unchanged: everything reused.
     ok(&[
@@ -121,6 +170,7 @@ fn run_produces_every_output_and_reuses_unchanged_stages() {
         "--height",
         "1.7",
     ]);
+    assert_exist(&RunLayout::new(&out).map(1.7).outputs());
     let st = stages_skipped(&out);
     assert_eq!(
         st,
@@ -184,6 +234,11 @@ fn run_produces_every_output_and_reuses_unchanged_stages() {
     let glb = std::fs::read(out.join("export/room.glb")).unwrap();
     assert_eq!(&glb[..4], b"glTF");
     assert!(!out.join("export/room.xml").exists());
+    assert_exist(&[
+        l.export_file(ExportFormat::Hbjson),
+        l.export_file(ExportFormat::Gltf),
+    ]);
+    assert!(!l.export_file(ExportFormat::Gbxml).exists());
 }
 
 /// The report is self-contained, its numbers match the CSV, and it renders in headless Chromium.
@@ -214,6 +269,14 @@ fn report_numbers_match_the_csv_and_it_renders() {
     assert!(html.contains("floor by ISO 7730 PMV category"));
     assert!(html.contains("<h3>PMV (ISO 7730) of a seated person"));
     assert!(out.join("comfort/pmv.csv").exists() && out.join("comfort/comfort.json").exists());
+    let l = RunLayout::new(&out);
+    let comfort = l.comfort();
+    let mut comfort_files = vec![comfort.stage_json(), comfort.comfort_json()];
+    for q in [Quantity::MrtSeated, Quantity::Pmv] {
+        comfort_files.extend([l.comfort_png(q), l.comfort_svg(q), l.comfort_csv(q)]);
+    }
+    assert_exist(&comfort_files);
+    assert_only(&l.comfort_dir(), &comfort_files);
     assert!(
         html.contains("data:image/png;base64,") && !html.contains("src=\"map-"),
         "images are embedded"
@@ -501,6 +564,8 @@ fn validate_compares_globes_with_the_map() {
     assert_eq!(v[1]["meets_desired"], false);
     let vcsv = std::fs::read_to_string(out.join("validation.csv")).unwrap();
     assert_eq!(vcsv.lines().count(), 3);
+    let l = RunLayout::new(&out);
+    assert_exist(&[l.validation_csv(), l.validation_json()]);
     // Run again (every stage reused): the report's 3D view shows the globes with their values.
     ok(&[
         "run",
@@ -555,6 +620,16 @@ fn demo_prints_the_papers_table_and_grid_error() {
     }
     assert!(d["grid"]["nodes"].as_u64().unwrap() > 300);
     assert!(out.join("run/report.html").exists());
+    let l = DemoLayout::new(&out);
+    assert_exist(&[l.simulate_json(), l.truth_json(), l.demo_json()]);
+    assert_exist(&[l.run().report_html(), l.run().scene_json()]);
+    let top = [
+        l.simulate_json(),
+        l.recording_dir(),
+        l.run().root().to_path_buf(),
+        l.demo_json(),
+    ];
+    assert_only(&out, &top);
     let html = std::fs::read_to_string(out.join("run/report.html")).unwrap();
     assert!(html.contains("Against the truth") && html.contains("id=\"grid-rmse\""));
 }
