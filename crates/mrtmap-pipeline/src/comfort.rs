@@ -900,90 +900,6 @@ pub struct SolarAnswer {
     pub delta_mrt_k: f64,
 }
 
-/// The command line's flag for each SolarCal input, by the name mrtmap-physics gives it, and
-/// what the flag is.
-const SOLAR_FLAGS: [(&str, &str, &str); 8] = [
-    (
-        "solar altitude (°)",
-        "--altitude",
-        "the solar altitude in degrees",
-    ),
-    (
-        "SHARP (°)",
-        "--sharp",
-        "the sun's angle from the person's front in degrees",
-    ),
-    (
-        "direct normal irradiance (W/m²)",
-        "--dni",
-        "the direct normal irradiance in W/m²",
-    ),
-    (
-        "solar transmittance",
-        "--transmittance",
-        "the glazing's solar transmittance",
-    ),
-    (
-        "sky-vault view fraction f_svv",
-        "--f-svv",
-        "the sky-vault view fraction",
-    ),
-    (
-        "fraction of the body in the beam f_bes",
-        "--f-bes",
-        "the fraction of the body in the beam",
-    ),
-    (
-        "short-wave absorptivity",
-        "--asw",
-        "the person's short-wave absorptivity",
-    ),
-    (
-        "floor reflectance",
-        "--floor-reflectance",
-        "the floor's reflectance",
-    ),
-];
-
-/// SolarCal for one person ([`solar_gain`]); an input out of its range is refused naming its
-/// `mrtmap solar-gain` flag.
-pub fn solar_gain_of(inputs: SolarInputs) -> Result<SolarAnswer> {
-    let g = solar_gain(&inputs).map_err(solar_flag_error)?;
-    Ok(SolarAnswer {
-        model: SOLAR_MODEL,
-        inputs,
-        erf_w_m2: g.erf_w_m2,
-        delta_mrt_k: g.delta_mrt_k,
-    })
-}
-
-/// A SolarCal input refused, as its flag with the value given.
-pub(crate) fn solar_flag_error(e: PhysicsError) -> Error {
-    let flag = |name: &str| SOLAR_FLAGS.iter().find(|f| f.0 == name).map(|f| (f.1, f.2));
-    match e {
-        PhysicsError::OutOfRange {
-            name,
-            value,
-            min,
-            max,
-        } => match flag(name) {
-            Some((f, what)) => Error::setting(
-                format!("{f} {value}"),
-                format!("is outside {min}…{max} ({what})"),
-            ),
-            None => e.into(),
-        },
-        PhysicsError::NotFinite { name, value } => match flag(name) {
-            Some((f, what)) => Error::setting(
-                format!("{f} {value}"),
-                format!("is not a finite number ({what})"),
-            ),
-            None => e.into(),
-        },
-        e => e.into(),
-    }
-}
-
 impl SolarAnswer {
     /// The answer in lines.
     pub fn lines(&self) -> Vec<String> {
@@ -1009,4 +925,16 @@ impl SolarAnswer {
             ),
         ]
     }
+}
+
+/// SolarCal for one person ([`solar_gain`]); an input out of its range is refused naming its
+/// `mrtmap solar-gain` flag.
+pub fn solar_gain_of(inputs: SolarInputs) -> Result<SolarAnswer> {
+    let g = solar_gain(&inputs).map_err(crate::points::solar_flag_error)?;
+    Ok(SolarAnswer {
+        model: SOLAR_MODEL,
+        inputs,
+        erf_w_m2: g.erf_w_m2,
+        delta_mrt_k: g.delta_mrt_k,
+    })
 }

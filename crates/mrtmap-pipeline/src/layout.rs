@@ -53,7 +53,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::export::ExportFormat;
+use crate::settings::ExportFormat;
 use crate::settings::Quantity;
 
 /// Each stage folder's fingerprint (see [`crate::cache::Stage`]).

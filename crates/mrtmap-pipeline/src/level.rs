@@ -33,37 +33,12 @@ use mrtmap_scan::segment::Segmentation;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
+pub use crate::settings::Reference;
 use crate::settings::{EmissivitySection, MrtSection, PointFrame, Project};
 
 /// A thermal camera's absolute accuracy when the rig does not state one (K): the Lepton 3.5's
 /// datasheet (high gain).
 pub const DEFAULT_CAMERA_ACCURACY_K: f64 = 5.0;
-
-/// A contact (or spot) thermometer's reading of a surface point.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Reference {
-    /// Label.
-    pub label: String,
-    /// The point (m).
-    pub xyz: [f64; 3],
-    /// The reading (°C).
-    pub temperature_c: f64,
-    /// Its standard uncertainty (K).
-    #[serde(default = "default_std")]
-    pub std_k: f64,
-    /// The frame of `xyz`: room (project.toml's default) or scan (references.csv's).
-    #[serde(default)]
-    pub frame: PointFrame,
-    /// The emissivity of the surface read; unset: the emissivity of the scene's surface or
-    /// feature under the point.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub emissivity: Option<f64>,
-}
-
-fn default_std() -> f64 {
-    0.2
-}
 
 fn one() -> f64 {
     1.0
@@ -115,7 +90,7 @@ pub fn parse_references(text: &str, path: &Path) -> Result<Vec<Reference>> {
         };
         let std_k = match col("std_k") {
             Some(s) if !s.is_empty() => num("std_k")?,
-            _ => default_std(),
+            _ => crate::settings::default_std(),
         };
         if !(std_k > 0.0 && std_k < 50.0) {
             return Err(bad(k + 1, format!("std_k {std_k} is outside 0…50 K")));

@@ -417,27 +417,6 @@ pub fn load_scene(src: &SceneSource) -> Result<(RadiantScene, String)> {
     Ok((RadiantScene::load(p)?, p.display().to_string()))
 }
 
-/// A point of `frame` in the scene's own frame: a scan-frame point is carried through the scene's
-/// `world_from_room` (`source` names the scene for the error when it has none).
-pub fn to_scene_frame(
-    xyz: [f64; 3],
-    frame: crate::settings::PointFrame,
-    scene: &RadiantScene,
-    source: &str,
-) -> Result<Point3<f64>> {
-    let p = Point3::from(xyz);
-    match frame {
-        crate::settings::PointFrame::Room => Ok(p),
-        crate::settings::PointFrame::Scan => match scene.world_from_room {
-            Some(w) => Ok(w.inverse() * p),
-            None => Err(Error::source(
-                Path::new(source),
-                "has no world_from_room (it was not written by segmentation), so points in the scan's frame cannot be placed in it: give them in its own frame",
-            )),
-        },
-    }
-}
-
 impl Summary {
     /// A map's extremes, the parts of its largest ±, the unseen patches that matter most and its
     /// marks, in lines (what `map` and `run` print).
@@ -466,10 +445,10 @@ impl Summary {
                 }
                 lines.push(format!(
                     "  its parts, the largest of each: {}",
-                    crate::report::parts_line(&f.max_std_error_parts, 3)
+                    mrtmap_report::parts_line(&f.max_std_error_parts, 3)
                 ));
                 for u in f.unseen_patches.iter().take(3) {
-                    lines.push(format!("  not seen: {}", crate::report::unseen_line(u)));
+                    lines.push(format!("  not seen: {}", mrtmap_report::unseen_line(u)));
                 }
             }
             None => lines.push("no grid node could be computed".to_string()),

@@ -4,7 +4,11 @@
 
 /// A person's posture and the asymmetry kinds (mrtmap-physics' types).
 pub use mrtmap_physics::{AsymmetryKind, Posture};
-use mrtmap_physics::{DEFAULT_ASW, DEFAULT_FLOOR_REFLECTANCE, SolarInputs, sharp_deg, solar_gain};
+use std::path::Path;
+
+use mrtmap_geometry::nalgebra::Point3;
+use mrtmap_physics::PhysicsError;
+use mrtmap_physics::{SolarInputs, sharp_deg, solar_gain};
 /// A sphere's MRT at a point with its view-factor table (mrtmap-radiation's).
 pub use mrtmap_radiation::PointRecord;
 /// Which way a person faces, an asymmetry's verdict, the enclosure tolerance and the built-in
@@ -17,9 +21,8 @@ use mrtmap_report::numbers::{fixed, uncertainty};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::comfort::solar_flag_error;
 use crate::error::{Error, Result};
-use crate::maps::to_scene_frame;
+pub use crate::settings::SunQuery;
 use crate::settings::{MrtSection, PointFrame};
 
 /// What to compute at the points.
@@ -37,38 +40,6 @@ pub struct PointQuery {
     /// The sun through the scene's windows on the person (SolarCal), which needs `person` with a
     /// facing.
     pub sun: Option<SunQuery>,
-}
-
-/// The sun outside and the glazing, for SolarCal at each person.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct SunQuery {
-    /// Where the sun is in the room's frame (altitude, and azimuth from +x towards +y).
-    pub direction: SunDirection,
-    /// Direct normal irradiance outside (W/m²).
-    pub dni_w_m2: f64,
-    /// The windows' total solar transmittance (0…1).
-    pub transmittance: f64,
-    /// The person's short-wave absorptivity.
-    pub asw: f64,
-    /// The floor's short-wave reflectance.
-    pub floor_reflectance: f64,
-}
-
-impl SunQuery {
-    /// The sun at `altitude_deg` and `azimuth_deg` (room frame) with SolarCal's default
-    /// absorptivity (0.7) and floor reflectance (0.6).
-    pub fn new(altitude_deg: f64, azimuth_deg: f64, dni_w_m2: f64, transmittance: f64) -> Self {
-        Self {
-            direction: SunDirection {
-                altitude_deg,
-                azimuth_deg,
-            },
-            dni_w_m2,
-            transmittance,
-            asw: DEFAULT_ASW,
-            floor_reflectance: DEFAULT_FLOOR_REFLECTANCE,
-        }
-    }
 }
 
 /// The sun on a person: the exposure traced in the scene and SolarCal's answer.
@@ -208,12 +179,11 @@ fn check_sun(q: &PointQuery) -> Result<()> {
 /// in the sun `sun`: the exposure traced through the windows, SHARP and SolarCal's answer.
 pub(crate) fn solar_on(
     tracer: &SunTracer<'_>,
-    at: &mrtmap_geometry::nalgebra::Point3<f64>,
+    at: &Point3<f64>,
     posture: Posture,
     facing_deg: f64,
     sun: &SunQuery,
-) -> std::result::Result<(SunExposure, f64, mrtmap_physics::SolarGain), mrtmap_physics::PhysicsError>
-{
+) -> std::result::Result<(SunExposure, f64, mrtmap_physics::SolarGain), PhysicsError> {
     let exposure = tracer.exposure(at, posture, &sun.direction);
     let sharp = sharp_deg(facing_deg, sun.direction.azimuth_deg);
     let g = solar_gain(&SolarInputs {
@@ -233,7 +203,7 @@ pub(crate) fn solar_on(
 /// SolarCal for the person `p` (body centre `at` in the scene's frame) in the sun `sun`.
 fn sun_on(
     tracer: &SunTracer<'_>,
-    at: &mrtmap_geometry::nalgebra::Point3<f64>,
+    at: &Point3<f64>,
     p: &PersonAnswer,
     sun: &SunQuery,
 ) -> Result<SunAnswer> {
@@ -378,7 +348,7 @@ impl PointAnswers {
             ));
             lines.push(format!(
                 "  ± in parts: {}",
-                crate::report::parts_line(&p.parts(), 2)
+                mrtmap_report::parts_line(&p.parts(), 2)
             ));
             if (p.view_factor_sum - 1.0).abs() > ENCLOSURE_TOLERANCE {
                 lines.push(format!(
@@ -477,6 +447,99 @@ fn person_and_plane_lines(persons: &[PersonAnswer], planes: &[PlaneAnswer]) -> V
         ));
     }
     lines
+}
+
+/// A point of `frame` in the scene's own frame: a scan-frame point is carried through the scene's
+/// `world_from_room` (`source` names the scene for the error when it has none).
+pub fn to_scene_frame(
+    xyz: [f64; 3],
+    frame: PointFrame,
+    scene: &RadiantScene,
+    source: &str,
+) -> Result<Point3<f64>> {
+    let p = Point3::from(xyz);
+    match frame {
+        PointFrame::Room => Ok(p),
+        PointFrame::Scan => match scene.world_from_room {
+            Some(w) => Ok(w.inverse() * p),
+            None => Err(Error::source(
+                Path::new(source),
+                "has no world_from_room (it was not written by segmentation), so points in the scan's frame cannot be placed in it: give them in its own frame",
+            )),
+        },
+    }
+}
+
+/// The command line's flag for each SolarCal input, by the name mrtmap-physics gives it, and
+/// what the flag is.
+const SOLAR_FLAGS: [(&str, &str, &str); 8] = [
+    (
+        "solar altitude (°)",
+        "--altitude",
+        "the solar altitude in degrees",
+    ),
+    (
+        "SHARP (°)",
+        "--sharp",
+        "the sun's angle from the person's front in degrees",
+    ),
+    (
+        "direct normal irradiance (W/m²)",
+        "--dni",
+        "the direct normal irradiance in W/m²",
+    ),
+    (
+        "solar transmittance",
+        "--transmittance",
+        "the glazing's solar transmittance",
+    ),
+    (
+        "sky-vault view fraction f_svv",
+        "--f-svv",
+        "the sky-vault view fraction",
+    ),
+    (
+        "fraction of the body in the beam f_bes",
+        "--f-bes",
+        "the fraction of the body in the beam",
+    ),
+    (
+        "short-wave absorptivity",
+        "--asw",
+        "the person's short-wave absorptivity",
+    ),
+    (
+        "floor reflectance",
+        "--floor-reflectance",
+        "the floor's reflectance",
+    ),
+];
+
+/// A SolarCal input refused, as its flag with the value given.
+pub(crate) fn solar_flag_error(e: PhysicsError) -> Error {
+    let flag = |name: &str| SOLAR_FLAGS.iter().find(|f| f.0 == name).map(|f| (f.1, f.2));
+    match e {
+        PhysicsError::OutOfRange {
+            name,
+            value,
+            min,
+            max,
+        } => match flag(name) {
+            Some((f, what)) => Error::setting(
+                format!("{f} {value}"),
+                format!("is outside {min}…{max} ({what})"),
+            ),
+            None => e.into(),
+        },
+        PhysicsError::NotFinite { name, value } => match flag(name) {
+            Some((f, what)) => Error::setting(
+                format!("{f} {value}"),
+                format!("is not a finite number ({what})"),
+            ),
+            None => e.into(),
+        },
+        e => e.into(),
+    }
 }
 
 #[cfg(test)]

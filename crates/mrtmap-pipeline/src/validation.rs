@@ -18,7 +18,7 @@ use serde::Serialize;
 use crate::cache::write_json;
 use crate::error::{Error, Result};
 use crate::layout::{RunLayout, SegmentDir};
-use crate::maps::to_scene_frame;
+use crate::points::to_scene_frame;
 use crate::settings::PointFrame;
 
 /// Rays per globe location: a standard error well below the globes' own.

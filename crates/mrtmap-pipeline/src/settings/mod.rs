@@ -10,15 +10,20 @@ use crate::error::{Error, Result};
 
 mod comfort;
 mod emissivity;
+mod export;
 mod map;
 mod mrt;
+mod references;
 mod scan;
 mod sun;
 
 pub use comfort::*;
 pub use emissivity::*;
+pub use export::*;
 pub use map::*;
 pub use mrt::*;
+pub(crate) use references::default_std;
+pub use references::*;
 pub use scan::*;
 pub use sun::*;
 
@@ -135,11 +140,11 @@ pub struct Project {
     /// The person for comfort maps and points.
     pub comfort: ComfortSection,
     /// Contact-thermometer readings of surface points (besides the recording's references.csv).
-    pub references: Vec<crate::level::Reference>,
+    pub references: Vec<Reference>,
     /// View factors.
     pub mrt: MrtSection,
     /// Exports of the measured room (`export/` of the run's output).
-    pub export: crate::export::ExportSection,
+    pub export: ExportSection,
     /// Emissivities.
     pub emissivity: EmissivitySection,
     /// The sun through the windows (SolarCal), for `mrt_sun` maps and `validate`.
@@ -260,7 +265,7 @@ mod tests {
         assert_eq!(p.segment, SegmentSection::default());
         assert_eq!(p.mrt, MrtSection::default());
         assert_eq!(p.track, TrackSection::default());
-        assert_eq!(p.export, crate::export::ExportSection::default());
+        assert_eq!(p.export, ExportSection::default());
         assert_eq!(p.sun, SunSection::default());
         assert_eq!(p.points.len(), 1);
         assert_eq!(p.air.temperature_c, Some(21.0));

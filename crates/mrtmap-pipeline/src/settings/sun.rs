@@ -3,6 +3,8 @@
 
 use std::path::Path;
 
+use mrtmap_physics::{DEFAULT_ASW, DEFAULT_FLOOR_REFLECTANCE};
+use mrtmap_radiation::SunDirection;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
@@ -55,8 +57,8 @@ impl Default for SunSection {
             epw: None,
             dni_w_m2: None,
             transmittance: None,
-            floor_reflectance: mrtmap_physics::DEFAULT_FLOOR_REFLECTANCE,
-            asw: mrtmap_physics::DEFAULT_ASW,
+            floor_reflectance: DEFAULT_FLOOR_REFLECTANCE,
+            asw: DEFAULT_ASW,
         }
     }
 }
@@ -137,7 +139,7 @@ impl SunSection {
 
     /// The sun in the room's frame with the glazing and the person's absorptivity; `None` when
     /// `[sun]` places no sun. Errors name the key.
-    pub fn query(&self) -> Result<Option<crate::points::SunQuery>> {
+    pub fn query(&self) -> Result<Option<SunQuery>> {
         if !self.is_given() {
             return Ok(None);
         }
@@ -223,7 +225,7 @@ impl SunSection {
         let tau = within("transmittance", tau, 0.0, 1.0, "0…1")?;
         let floor = within("floor_reflectance", self.floor_reflectance, 0.0, 1.0, "0…1")?;
         let asw = within("asw", self.asw, 0.0, 1.0, "0…1")?;
-        let mut q = crate::points::SunQuery::new(altitude, azimuth, dni, tau);
+        let mut q = SunQuery::new(altitude, azimuth, dni, tau);
         q.floor_reflectance = floor;
         q.asw = asw;
         Ok(Some(q))
@@ -388,6 +390,38 @@ fn parse_utc(s: &str) -> Option<mrtmap_physics::UtcTime> {
     })
 }
 
+/// The sun outside and the glazing, for SolarCal at each person.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct SunQuery {
+    /// Where the sun is in the room's frame (altitude, and azimuth from +x towards +y).
+    pub direction: SunDirection,
+    /// Direct normal irradiance outside (W/m²).
+    pub dni_w_m2: f64,
+    /// The windows' total solar transmittance (0…1).
+    pub transmittance: f64,
+    /// The person's short-wave absorptivity.
+    pub asw: f64,
+    /// The floor's short-wave reflectance.
+    pub floor_reflectance: f64,
+}
+
+impl SunQuery {
+    /// The sun at `altitude_deg` and `azimuth_deg` (room frame) with SolarCal's default
+    /// absorptivity (0.7) and floor reflectance (0.6).
+    pub fn new(altitude_deg: f64, azimuth_deg: f64, dni_w_m2: f64, transmittance: f64) -> Self {
+        Self {
+            direction: SunDirection {
+                altitude_deg,
+                azimuth_deg,
+            },
+            dni_w_m2,
+            transmittance,
+            asw: DEFAULT_ASW,
+            floor_reflectance: DEFAULT_FLOOR_REFLECTANCE,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used)]
@@ -463,7 +497,7 @@ mod tests {
         assert_eq!((q.dni_w_m2, q.transmittance, q.asw), (700.0, 0.6, 0.5));
         assert_eq!(
             q.floor_reflectance,
-            mrtmap_physics::DEFAULT_FLOOR_REFLECTANCE
+            DEFAULT_FLOOR_REFLECTANCE
         );
         assert!(Project::default().sun.query().unwrap().is_none());
 
