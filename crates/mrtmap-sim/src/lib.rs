@@ -15,7 +15,6 @@
 
 mod evaluate;
 mod evaluate_scene;
-mod grey;
 mod radiometric;
 mod render;
 mod room;
@@ -26,14 +25,15 @@ mod walk;
 
 pub use evaluate::{CloudScore, score_cloud, truth_at};
 pub use evaluate_scene::{FeatureScore, PointScore, SceneScore, SurfaceScore, score_scene};
-pub use grey::{
-    GLASS_EMISSIVITY, GREY_EMISSIVITY, Grey, IRRADIANCE_RAYS, OPERATOR_C, Operator, Surfaces,
-    radiant_c, room_as_simulated,
-};
 pub use radiometric::{
     CameraErrors, FfcPeriod, RadiometricModel, ReferenceReading, reference_readings,
 };
-pub use render::{Element, Hit, RoomRenderer, is_glass, temperature_at};
+pub use render::{Element, Hit, RoomRenderer, temperature_at};
+pub use room::grey::{
+    GLASS_EMISSIVITY, GREY_EMISSIVITY, Grey, IRRADIANCE_RAYS, OPERATOR_C, Operator, Surfaces,
+    radiant_c, room_as_simulated,
+};
+pub use room::is_glass;
 pub use room::{
     EmissivitiesFile, FeatureSpec, FurnitureSpec, GRADIENT_STRIP_M, PRESETS, PlacedFeature,
     PointSpec, Room, RoomError, RoomFile, SurfaceRef, TemperaturesFile, WallFile, preset,

@@ -102,7 +102,7 @@ impl RoomRenderer {
                         let (lo, hi) = bounds(&f.polygon_2d);
                         PlaneFeature {
                             index: k,
-                            glass: is_glass(&f.label),
+                            glass: crate::room::is_glass(&f.label),
                             poly: f.polygon_2d.clone(),
                             lo,
                             hi,
@@ -343,16 +343,6 @@ impl PlaneFeature {
     }
 }
 
-/// Whether a feature's label names glass: windows, glazing, glass doors, mirrors. Near-infrared
-/// light passes through (or is mirrored by) them, so an active-stereo depth camera gets no depth
-/// there; a thermal camera sees the pane itself, which is opaque at 8–14 µm.
-pub fn is_glass(label: &str) -> bool {
-    let l = label.to_lowercase();
-    ["window", "glass", "glazing", "mirror", "skylight"]
-        .iter()
-        .any(|w| l.contains(w))
-}
-
 fn polygon_area(p: &[Point2<f64>]) -> f64 {
     mrtmap_geometry::polygon::signed_area(p).abs()
 }
@@ -370,4 +360,32 @@ pub fn temperature_at(room: &Room, hit: &Hit, point: &Point3<f64>) -> f64 {
         } => room.background_radiant_c(RoomRenderer::surface_ref(room, surface), point.z),
         Element::Furniture(b) => room.file.furniture[b].temperature_c,
     }
+}
+
+#[allow(clippy::too_many_arguments)]
+/// What the thermal camera sees of glass feature `k` at `p` looking along `d` (unit): its emission
+/// and what the mirrored ray meets (the operator, a surface's radiosity, or the air), as T⁴ (K⁴).
+pub fn specular_t4(
+    room: &Room,
+    renderer: &RoomRenderer,
+    k: usize,
+    e: f64,
+    p: &Point3<f64>,
+    d: &Vector3<f64>,
+    normal: &Vector3<f64>,
+    operator: &crate::room::grey::Operator,
+) -> f64 {
+    let r = d - normal * (2.0 * d.dot(normal));
+    let start = p + r * 1e-6;
+    let hit = renderer.cast(&start, &r);
+    let by_operator = operator
+        .hit(&start, &r)
+        .filter(|t| hit.is_none_or(|h| *t < h.t));
+    let reflected_c = match (by_operator, hit) {
+        (Some(_), _) => crate::room::grey::OPERATOR_C,
+        (None, Some(h)) => temperature_at(room, &h, &(start + r * h.t)),
+        (None, None) => room.file.air_temperature_c,
+    };
+    let t = room.features[k].temperature_c + mrtmap_physics::ZERO_CELSIUS_K;
+    e * t.powi(4) + (1.0 - e) * (reflected_c + mrtmap_physics::ZERO_CELSIUS_K).powi(4)
 }

@@ -314,7 +314,7 @@ pub fn render_thermal<R: Rng>(
                 o,
                 renderer.view(p),
                 p.rotation.to_rotation_matrix(),
-                crate::grey::Operator::behind(p),
+                crate::room::grey::Operator::behind(p),
             )
         })
         .collect();
@@ -322,7 +322,7 @@ pub fn render_thermal<R: Rng>(
     let mirrors: Vec<Option<f64>> = (0..room.features.len())
         .map(|k| {
             let e = room.feature_emissivity(k);
-            (e < 1.0 && crate::render::is_glass(&room.features[k].label)).then_some(e)
+            (e < 1.0 && crate::room::is_glass(&room.features[k].label)).then_some(e)
         })
         .collect();
     let n_views = views.len().max(1);
@@ -344,7 +344,7 @@ pub fn render_thermal<R: Rng>(
                         _ => None,
                     };
                     let t4 = match mirror {
-                        Some((k, e)) => crate::grey::specular_t4(
+                        Some((k, e)) => crate::render::specular_t4(
                             room,
                             renderer,
                             k,

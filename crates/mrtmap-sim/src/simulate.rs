@@ -18,10 +18,10 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::SimError;
-use crate::grey::Surfaces;
 use crate::radiometric::{CameraErrors, RadiometricModel, ReferenceReading, reference_readings};
 use crate::render::RoomRenderer;
 use crate::room::Room;
+use crate::room::grey::Surfaces;
 use crate::sensors::{
     DepthNoise, ThermalNoise, camera_rays, render_depth, render_rgb_and_mask, render_thermal,
 };

@@ -495,10 +495,7 @@ mod tests {
         assert_eq!(q.direction.altitude_deg, 30.0);
         assert_eq!(q.direction.azimuth_deg, 270.0);
         assert_eq!((q.dni_w_m2, q.transmittance, q.asw), (700.0, 0.6, 0.5));
-        assert_eq!(
-            q.floor_reflectance,
-            DEFAULT_FLOOR_REFLECTANCE
-        );
+        assert_eq!(q.floor_reflectance, DEFAULT_FLOOR_REFLECTANCE);
         assert!(Project::default().sun.query().unwrap().is_none());
 
         // Berlin, 15 January 2026, 11:00 UTC (about solar noon): the sun due south, about 15°

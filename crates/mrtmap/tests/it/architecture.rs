@@ -1,8 +1,8 @@
 //! ARCHITECTURE.md's crate table is the map of the code: it must list every workspace crate, and
 //! each row's "uses" column must name exactly the crates that crate depends on.
 
-use std::collections::BTreeSet;
-use std::path::Path;
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
 
 /// The mrtmap crates named in a "uses" cell (`—` for none; words in parentheses are remarks).
 fn named(cell: &str) -> BTreeSet<String> {
@@ -151,4 +151,139 @@ fn the_method_table_names_files_that_exist() {
         }
     }
     assert!(checked >= 40, "only {checked} paths in the method table");
+}
+
+/// The code of a module file that is not test code, comments dropped.
+fn code_of(path: &Path) -> String {
+    let text = std::fs::read_to_string(path).unwrap();
+    let text = text.split("#[cfg(test)]").next().unwrap_or_default();
+    text.lines()
+        .map(|l| l.split("//").next().unwrap_or_default())
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// The crate's modules (files and folders directly in `src/`) and the others each one names as
+/// `crate::x`, in a `use crate::{…}` group, or (from a file directly in `src/`) as `super::x`.
+fn module_graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
+    let mut files: BTreeMap<String, Vec<PathBuf>> = BTreeMap::new();
+    for e in std::fs::read_dir(src).unwrap().map(Result::unwrap) {
+        let p = e.path();
+        let name = p.file_stem().unwrap().to_string_lossy().to_string();
+        if p.is_dir() {
+            let mut all = Vec::new();
+            let mut stack = vec![p];
+            while let Some(d) = stack.pop() {
+                for f in std::fs::read_dir(d).unwrap().map(|e| e.unwrap().path()) {
+                    if f.is_dir() {
+                        stack.push(f);
+                    } else if f.extension().is_some_and(|x| x == "rs") {
+                        all.push(f);
+                    }
+                }
+            }
+            files.entry(name).or_default().extend(all);
+        } else if p.extension().is_some_and(|x| x == "rs") && name != "lib" && name != "main" {
+            files.entry(name).or_default().push(p);
+        }
+    }
+    let names: BTreeSet<String> = files.keys().cloned().collect();
+    let word = |s: &str| -> String {
+        s.chars()
+            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+            .collect()
+    };
+    files
+        .iter()
+        .map(|(m, fs)| {
+            let mut uses = BTreeSet::new();
+            for f in fs {
+                let code = code_of(f);
+                let top = f.parent() == Some(src);
+                let mut names_after = |prefix: &str| {
+                    for part in code.split(prefix).skip(1) {
+                        if let Some(group) = part.strip_prefix('{') {
+                            let group = group.split('}').next().unwrap_or_default();
+                            uses.extend(group.split(',').map(|g| word(g.trim())));
+                        } else {
+                            uses.insert(word(part));
+                        }
+                    }
+                };
+                names_after("crate::");
+                if top {
+                    names_after("super::");
+                }
+            }
+            uses.retain(|u| u != m && names.contains(u));
+            (m.clone(), uses)
+        })
+        .collect()
+}
+
+/// A cycle in `g`, if there is one.
+fn a_cycle(g: &BTreeMap<String, BTreeSet<String>>) -> Option<Vec<String>> {
+    fn visit(
+        g: &BTreeMap<String, BTreeSet<String>>,
+        m: &str,
+        path: &mut Vec<String>,
+        done: &mut BTreeSet<String>,
+    ) -> Option<Vec<String>> {
+        if let Some(k) = path.iter().position(|p| p == m) {
+            let mut c = path[k..].to_vec();
+            c.push(m.to_string());
+            return Some(c);
+        }
+        if done.contains(m) {
+            return None;
+        }
+        path.push(m.to_string());
+        for n in g.get(m).into_iter().flatten() {
+            if let Some(c) = visit(g, n, path, done) {
+                return Some(c);
+            }
+        }
+        path.pop();
+        done.insert(m.to_string());
+        None
+    }
+    let mut done = BTreeSet::new();
+    g.keys()
+        .find_map(|m| visit(g, m, &mut Vec::new(), &mut done))
+}
+
+/// Issue 53: ARCHITECTURE.md said no crate's modules form a cycle while four did.
+#[test]
+fn no_crates_modules_form_a_cycle() {
+    let crates = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let mut found = Vec::new();
+    for e in std::fs::read_dir(&crates).unwrap().map(Result::unwrap) {
+        let src = e.path().join("src");
+        if src.is_dir()
+            && let Some(c) = a_cycle(&module_graph(&src))
+        {
+            found.push(format!(
+                "{}: {}",
+                e.file_name().to_string_lossy(),
+                c.join(" → ")
+            ));
+        }
+    }
+    found.sort();
+    assert!(found.is_empty(), "module cycles:\n{}", found.join("\n"));
+}
+
+#[test]
+fn the_cycle_check_sees_a_cycle() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path();
+    std::fs::write(src.join("lib.rs"), "mod a;\nmod b;\n").unwrap();
+    std::fs::write(src.join("a.rs"), "use crate::b::X;\n// crate::c\n").unwrap();
+    std::fs::create_dir(src.join("b")).unwrap();
+    std::fs::write(src.join("b/mod.rs"), "mod inner;\n").unwrap();
+    std::fs::write(src.join("b/inner.rs"), "use crate::{a::Y, b};\n").unwrap();
+    let g = module_graph(src);
+    assert_eq!(a_cycle(&g), Some(vec!["a".into(), "b".into(), "a".into()]));
+    std::fs::write(src.join("b/inner.rs"), "#[cfg(test)]\nuse crate::a::Y;\n").unwrap();
+    assert_eq!(a_cycle(&module_graph(src)), None);
 }

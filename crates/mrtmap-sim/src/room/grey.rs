@@ -20,7 +20,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::render::is_glass;
+use crate::room::is_glass;
 use crate::room::{Room, SurfaceRef};
 
 /// `room` with its surfaces as `cfg` asks (see [`crate::SimConfig::surfaces`]): what
@@ -248,34 +248,6 @@ pub fn solve(room: &mut Room, rays: usize, seed: u64) -> Result<(), crate::SimEr
         }
     }
     Ok(())
-}
-
-#[allow(clippy::too_many_arguments)]
-/// What the thermal camera sees of glass feature `k` at `p` looking along `d` (unit): its emission
-/// and what the mirrored ray meets (the operator, a surface's radiosity, or the air), as T⁴ (K⁴).
-pub fn specular_t4(
-    room: &Room,
-    renderer: &crate::render::RoomRenderer,
-    k: usize,
-    e: f64,
-    p: &Point3<f64>,
-    d: &Vector3<f64>,
-    normal: &Vector3<f64>,
-    operator: &Operator,
-) -> f64 {
-    let r = d - normal * (2.0 * d.dot(normal));
-    let start = p + r * 1e-6;
-    let hit = renderer.cast(&start, &r);
-    let by_operator = operator
-        .hit(&start, &r)
-        .filter(|t| hit.is_none_or(|h| *t < h.t));
-    let reflected_c = match (by_operator, hit) {
-        (Some(_), _) => OPERATOR_C,
-        (None, Some(h)) => crate::render::temperature_at(room, &h, &(start + r * h.t)),
-        (None, None) => room.file.air_temperature_c,
-    };
-    let t = room.features[k].temperature_c + ZERO_CELSIUS_K;
-    e * t.powi(4) + (1.0 - e) * (reflected_c + ZERO_CELSIUS_K).powi(4)
 }
 
 #[cfg(test)]

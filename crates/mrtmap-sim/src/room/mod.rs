@@ -5,6 +5,8 @@
 //! furniture boxes, the air temperature and named validation points. Coordinates are the room
 //! frame: z up, the floor at z = 0. Wall `i` runs from `floor_plan[i]` to `floor_plan[i + 1]`.
 
+pub mod grey;
+
 use mrtmap_geometry::nalgebra::{Isometry3, Point2, Point3, Vector3};
 use mrtmap_geometry::polygon::{self, Containment};
 use mrtmap_radiation::{
@@ -207,7 +209,7 @@ pub struct Room {
     /// Each wall's emissivity as the file gives it, by wall index.
     pub wall_emissivity: Vec<Option<f64>>,
     /// Emissivities and irradiances, once [`Room::with_surfaces`] has set them (none: black).
-    pub grey: Option<crate::grey::Grey>,
+    pub grey: Option<grey::Grey>,
 }
 
 fn finite(name: &str, v: f64) -> Result<f64, RoomError> {
@@ -580,16 +582,16 @@ impl Room {
     }
 
     /// The room with its surfaces black or grey (the room file's emissivities where it gives them;
-    /// see [`crate::grey::Grey::emissivities`]) and, grey, its radiosities solved.
+    /// see [`grey::Grey::emissivities`]) and, grey, its radiosities solved.
     pub fn with_surfaces(
         mut self,
-        surfaces: crate::grey::Surfaces,
+        surfaces: grey::Surfaces,
         seed: u64,
         rays: usize,
     ) -> Result<Self, crate::SimError> {
-        let g = crate::grey::Grey::emissivities(&self, surfaces, seed);
+        let g = grey::Grey::emissivities(&self, surfaces, seed);
         self.grey = g.is_grey().then_some(g);
-        crate::grey::solve(&mut self, rays, seed)?;
+        grey::solve(&mut self, rays, seed)?;
         Ok(self)
     }
 
@@ -666,7 +668,7 @@ impl Room {
     /// The radiant temperature (°C: what the camera reads, what the MRT uses) of a surface's
     /// background at height `z`: its own temperature in a black room.
     pub fn background_radiant_c(&self, s: SurfaceRef, z: f64) -> f64 {
-        crate::grey::radiant_c(
+        grey::radiant_c(
             self.background_temperature_c(s, z),
             self.emissivity(s),
             self.surface_irradiance_k(s),
@@ -675,7 +677,7 @@ impl Room {
 
     /// Feature `k`'s radiant temperature (°C).
     pub fn feature_radiant_c(&self, k: usize) -> f64 {
-        crate::grey::radiant_c(
+        grey::radiant_c(
             self.features[k].temperature_c,
             self.feature_emissivity(k),
             self.feature_irradiance_k(k),
@@ -685,7 +687,7 @@ impl Room {
     /// The radiant (T⁴ area-average) temperature of a surface's background as the camera reads
     /// it (°C): [`Room::surface_radiant_temperature_c`] in a black room.
     pub fn surface_apparent_c(&self, s: SurfaceRef) -> f64 {
-        crate::grey::radiant_c(
+        grey::radiant_c(
             self.surface_radiant_temperature_c(s),
             self.emissivity(s),
             self.surface_irradiance_k(s),
@@ -934,11 +936,11 @@ fn clip_band(poly: &[Point2<f64>], y0: f64, y1: f64) -> Vec<Point2<f64>> {
 
 /// The documented presets: (name, TOML text).
 pub const PRESETS: [(&str, &str); 3] = [
-    ("office", include_str!("../rooms/office.toml")),
-    ("l-shaped", include_str!("../rooms/l-shaped.toml")),
+    ("office", include_str!("../../rooms/office.toml")),
+    ("l-shaped", include_str!("../../rooms/l-shaped.toml")),
     (
         "radiant-ceiling",
-        include_str!("../rooms/radiant-ceiling.toml"),
+        include_str!("../../rooms/radiant-ceiling.toml"),
     ),
 ];
 
@@ -948,4 +950,14 @@ pub fn preset(name: &str) -> Option<Result<Room, RoomError>> {
         .iter()
         .find(|(n, _)| *n == name)
         .map(|(_, t)| Room::from_toml(t))
+}
+
+/// Whether a feature's label names glass: windows, glazing, glass doors, mirrors. Near-infrared
+/// light passes through (or is mirrored by) them, so an active-stereo depth camera gets no depth
+/// there; a thermal camera sees the pane itself, which is opaque at 8–14 µm.
+pub fn is_glass(label: &str) -> bool {
+    let l = label.to_lowercase();
+    ["window", "glass", "glazing", "mirror", "skylight"]
+        .iter()
+        .any(|w| l.contains(w))
 }
