@@ -7,7 +7,7 @@
 //! 3. A pose with enough inliers is a loop: an edge from the candidate to the new keyframe,
 //!    weighted by its information.
 
-use crate::pose_graph::Edge;
+use mrtmap_geometry::pose_graph::Edge;
 
 use super::matching::match_features;
 use super::pose::{Seen, estimate};

@@ -45,10 +45,10 @@ mod pose;
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-use crate::pose_graph::{Edge, optimise};
 use mrtmap_geometry::camera::PinholeCamera;
 use mrtmap_geometry::icp::IcpTarget;
 use mrtmap_geometry::nalgebra::{Isometry3, Point3, UnitQuaternion};
+use mrtmap_geometry::pose_graph::{Edge, optimise};
 use mrtmap_io::{Recording, Trajectory};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
