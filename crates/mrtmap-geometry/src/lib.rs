@@ -1,8 +1,9 @@
 //! # mrtmap-geometry
 //!
 //! Space for mrtmap: solid angles (Van Oosterom–Strackee), planar polygons in 3D with a 2D frame
-//! and the 2D tests a radiant scene needs, direction sets on the sphere, and ray casting against
-//! triangle soups through a BVH.
+//! and the 2D tests a radiant scene needs, direction sets on the sphere, ray casting against
+//! triangle soups through a BVH, and pose-graph optimisation ([`pose_graph`], shared by the tracker
+//! and RTAB-Map conversion).
 //!
 //! Conventions: metres, radians, `f64` points and vectors from `nalgebra`; transforms are named
 //! `a_from_b` (`p_in_a = a_from_b * p_in_b`).
@@ -23,6 +24,7 @@ pub mod cloud;
 pub mod icp;
 pub mod plane;
 pub mod polygon;
+pub mod pose_graph;
 pub mod ray;
 pub mod sampling;
 pub mod shape2d;

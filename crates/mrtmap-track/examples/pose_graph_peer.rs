@@ -1,9 +1,9 @@
 //! The Rust side of `bench/run posegraph`: reads a g2o pose graph (`VERTEX_SE3:QUAT`,
 //! `EDGE_SE3:QUAT` with its 6×6 upper-triangular information over x y z qx qy qz), optimises it
-//! with `mrtmap_track::pose_graph` (as `convert` does for an RTAB-Map database), writes the poses
+//! with `mrtmap_geometry::pose_graph` (as `convert` does for an RTAB-Map database), writes the poses
 //! as g2o vertices and prints JSON with the median time of 3 runs.
 //!
-//! `cargo run --release -p mrtmap-scan --example pose_graph_peer -- IN.g2o OUT.g2o`
+//! `cargo run --release -p mrtmap-track --example pose_graph_peer -- IN.g2o OUT.g2o`
 #![allow(clippy::unwrap_used, clippy::print_stdout, clippy::expect_used)]
 
 use std::collections::BTreeMap;
@@ -11,7 +11,7 @@ use std::fmt::Write as _;
 use std::time::Instant;
 
 use mrtmap_geometry::nalgebra::{Isometry3, Matrix6, Quaternion, Translation3, UnitQuaternion};
-use mrtmap_track::pose_graph::{Edge, optimise};
+use mrtmap_geometry::pose_graph::{Edge, optimise};
 
 fn pose(v: &[f64]) -> Isometry3<f64> {
     Isometry3::from_parts(

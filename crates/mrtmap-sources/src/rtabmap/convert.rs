@@ -7,8 +7,8 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use mrtmap_geometry::nalgebra::{Isometry3, Matrix6};
+use mrtmap_geometry::pose_graph::{Edge, optimise};
 use mrtmap_io::{Image16, LayoutWriter, Recording, RgbCamera, Rig, read_image16};
-use mrtmap_track::pose_graph::{Edge, optimise};
 
 use crate::convert::{Conversion, ConvertError as Error, Result, SourceOptions};
 use crate::ros::{self, Container};

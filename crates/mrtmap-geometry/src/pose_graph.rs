@@ -1,6 +1,7 @@
 //! Pose-graph optimisation: node poses from odometry and loop-closure constraints, as RTAB-Map
 //! keeps them in its `Link` table, solved with tiny-solver (Levenberg–Marquardt on SE(3), sparse
-//! Cholesky, automatic derivatives). Used when a database did not save its optimised graph.
+//! Cholesky, automatic derivatives). Used by the tracker's loop closure (mrtmap-track) and for
+//! RTAB-Map databases that did not save their optimised graph (mrtmap-sources).
 //!
 //! Each edge says where node `to` sits in node `from`'s frame, with a 6×6 information matrix over
 //! (x, y, z, roll, pitch, yaw) — RTAB-Map's order. The residual of an edge is
@@ -10,7 +11,7 @@
 use std::collections::{BTreeMap, HashMap};
 use std::sync::Arc;
 
-use mrtmap_geometry::nalgebra::{Isometry3, Matrix6, Quaternion, Translation3, UnitQuaternion};
+use nalgebra::{Isometry3, Matrix6, Quaternion, Translation3, UnitQuaternion};
 use tiny_solver::factors::Factor;
 use tiny_solver::manifold::se3::{SE3, SE3Manifold};
 use tiny_solver::na::{DVector, RealField};
@@ -298,7 +299,7 @@ pub fn optimise(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use mrtmap_geometry::nalgebra::Vector3;
+    use nalgebra::Vector3;
 
     /// A loop around a 4 m × 3 m room: 40 nodes, turning as it goes.
     fn truth() -> BTreeMap<i64, Isometry3<f64>> {
@@ -317,7 +318,7 @@ mod tests {
     }
 
     fn info(sigma_t: f64, sigma_r: f64) -> Matrix6<f64> {
-        Matrix6::from_diagonal(&mrtmap_geometry::nalgebra::Vector6::new(
+        Matrix6::from_diagonal(&nalgebra::Vector6::new(
             1.0 / sigma_t.powi(2),
             1.0 / sigma_t.powi(2),
             1.0 / sigma_t.powi(2),
