@@ -24,6 +24,7 @@ mod bounds;
 mod engine;
 mod field;
 pub mod grey;
+mod map_frame;
 mod person;
 mod scene;
 mod sun;
@@ -34,9 +35,10 @@ pub use engine::{
     PatchKind, PointMrt, UnseenPart, patches,
 };
 pub use field::{
-    Extreme, FieldError, FieldSummary, GridLayout, GridNode, GridSpec, MapFrame, MrtField,
-    StdErrorParts, UNSEEN_LISTED, UnseenImpact,
+    Extreme, FieldSummary, GridLayout, GridNode, GridSpec, MrtField, StdErrorParts, UNSEEN_LISTED,
+    UnseenImpact,
 };
+pub use map_frame::{FieldError, MapFrame};
 pub use person::{AsymmetryVerdict, Facing, PersonMrt, PlaneRadiant, RadiantAsymmetry};
 pub use scene::{
     BoxFile, FEATURE_PLANE_TOLERANCE_M, Feature, FeatureFile, FramePose, MAX_COORDINATE_M,
