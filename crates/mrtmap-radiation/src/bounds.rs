@@ -4,7 +4,7 @@
 use mrtmap_geometry::nalgebra::{Point2, Point3};
 use mrtmap_geometry::polygon::{Containment, point_in_polygon};
 
-use crate::field::{FieldError, MapFrame};
+use crate::map_frame::{FieldError, MapFrame};
 use crate::scene::RadiantScene;
 
 /// Points this far outside the outline, below the floor or above the ceiling still count as in

@@ -23,8 +23,7 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 use crate::bounds::RoomBounds;
-use crate::raster::UnseenShare;
-use crate::scene::{RadiantScene, SurfaceKind};
+use crate::scene::{RadiantScene, SurfaceKind, UnseenShare};
 
 /// Tolerance on Σ F above 1 before the exact engine declares that surfaces hide each other.
 pub const EXACT_OVERLAP_TOLERANCE: f64 = 1e-6;

@@ -24,8 +24,8 @@ mod bounds;
 mod engine;
 mod field;
 pub mod grey;
+mod map_frame;
 mod person;
-mod raster;
 mod scene;
 mod sun;
 
@@ -35,16 +35,17 @@ pub use engine::{
     PatchKind, PointMrt, UnseenPart, patches,
 };
 pub use field::{
-    Extreme, FieldError, FieldSummary, GridLayout, GridNode, GridSpec, MapFrame, MrtField,
-    StdErrorParts, UNSEEN_LISTED, UnseenImpact,
+    Extreme, FieldSummary, GridLayout, GridNode, GridSpec, MrtField, StdErrorParts, UNSEEN_LISTED,
+    UnseenImpact,
 };
+pub use map_frame::{FieldError, MapFrame};
 pub use person::{AsymmetryVerdict, Facing, PersonMrt, PlaneRadiant, RadiantAsymmetry};
-pub use raster::{MAX_TEXELS, Raster, RasterFile, Texel, UnseenPatch, UnseenShare};
 pub use scene::{
     BoxFile, FEATURE_PLANE_TOLERANCE_M, Feature, FeatureFile, FramePose, MAX_COORDINATE_M,
-    Occluder, OccluderFile, OccluderShape, PLANARITY_TOLERANCE_M, RadiantScene, SCENE_FORMAT,
-    SceneError, SceneFile, SceneLoadError, SceneLoadErrorKind, Surface, SurfaceFile, SurfaceKind,
-    TEMPERATURE_RANGE_C, TemperatureKind, slug,
+    MAX_TEXELS, Occluder, OccluderFile, OccluderShape, PLANARITY_TOLERANCE_M, RadiantScene, Raster,
+    RasterFile, SCENE_FORMAT, SceneError, SceneFile, SceneLoadError, SceneLoadErrorKind, Surface,
+    SurfaceFile, SurfaceKind, TEMPERATURE_RANGE_C, TemperatureKind, Texel, UnseenPatch,
+    UnseenShare, slug,
 };
 pub use sun::{BODY_WIDTH_M, SunDirection, SunExposure, SunTracer, is_window_label};
 

@@ -7,55 +7,34 @@
 //! clipped to the surface's outline, dₜ the direction to the texel's centre and w the receiver's
 //! directional weight (1 for a sphere). The surface's view factor itself is unchanged (exact or
 //! by rays), so occlusion by furniture acts on the surface as a whole.
+//!
+//! The raster as scene.json writes it is a [`RasterFile`]; here it is checked against its surface
+//! ([`Raster::check`]: texel size and count, axes in the surface's plane, temperatures and unseen
+//! patches within the scene's limits) and its texels clipped to the surface's outline.
 
 use mrtmap_geometry::nalgebra::{Point3, Unit, Vector3};
 use mrtmap_geometry::{clip_polygon_to_halfspace, polygon_solid_angle};
 use mrtmap_physics::Temperature;
-use serde::{Deserialize, Serialize};
 
-use crate::scene::{SceneError, TEMPERATURE_RANGE_C};
+use super::error::SceneError;
+use super::file::RasterFile;
+use super::limits::TEMPERATURE_RANGE_C;
 
 /// Largest number of texels of one raster.
 pub const MAX_TEXELS: usize = 1_000_000;
 
-/// A surface's raster in `scene.json`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct RasterFile {
-    /// Texel edge (m).
-    pub texel_m: f64,
-    /// Corner of texel (0, 0), in the surface's plane (m).
-    pub origin: [f64; 3],
-    /// Unit direction along a row (columns increase along it), in the surface's plane.
-    pub u: [f64; 3],
-    /// Unit direction from row to row, in the plane, perpendicular to `u`.
-    pub v: [f64; 3],
-    /// Texels per row.
-    pub cols: usize,
-    /// Rows.
-    pub rows: usize,
-    /// Radiant temperature of each texel (°C), row after row (index = row · cols + col); `null`
-    /// for a texel off the surface.
-    pub temperature_c: Vec<Option<f64>>,
-    /// Texels not observed, whose temperature was filled in from the texels seen around them
-    /// (indices).
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub filled: Vec<usize>,
-    /// Patches of texels the scan never saw, each with the temperatures its seen surroundings
-    /// allow: they enter every MRT's standard error as its unseen-areas part.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub unseen: Vec<UnseenPatch>,
-}
+/// The smallest texel (m).
+const MIN_TEXEL_M: f64 = 0.005;
 
-/// Texels of a raster the scan never saw: their temperatures in the raster are filled in, and the
-/// truth may lie anywhere in `range_c`, the temperatures seen around them.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct UnseenPatch {
-    /// The texels (indices, as in `filled`).
-    pub texels: Vec<usize>,
-    /// The lowest and highest temperature the patch may have (°C).
-    pub range_c: [f64; 2],
-}
+/// The largest texel (m).
+const MAX_TEXEL_M: f64 = 10.0;
+
+/// `u` and `v` must be unit length, perpendicular to each other and lie in the surface's plane
+/// to within this (as a length, or a cosine).
+const AXIS_TOLERANCE: f64 = 1e-3;
+
+/// The raster's origin must lie within this of the surface's plane (m).
+const ORIGIN_OFF_PLANE_M: f64 = 0.01;
 
 /// How much of a surface, as seen from a point, is one unseen patch.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -160,10 +139,13 @@ impl Raster {
         polygon: &[Point3<f64>],
         normal: &Unit<Vector3<f64>>,
     ) -> Result<Self, SceneError> {
-        if !(r.texel_m.is_finite() && r.texel_m >= 0.005 && r.texel_m <= 10.0) {
+        if !(r.texel_m.is_finite() && r.texel_m >= MIN_TEXEL_M && r.texel_m <= MAX_TEXEL_M) {
             return Err(bad(
                 id,
-                format!("texel_m {} is outside 0.005…10 m", r.texel_m),
+                format!(
+                    "texel_m {} is outside {MIN_TEXEL_M}…{MAX_TEXEL_M} m",
+                    r.texel_m
+                ),
             ));
         }
         let n = r.cols.saturating_mul(r.rows);
@@ -198,20 +180,20 @@ impl Raster {
             Point3::from(r.origin),
         );
         if !o.coords.iter().all(|c| c.is_finite())
-            || (u.norm() - 1.0).abs() > 1e-3
-            || (v.norm() - 1.0).abs() > 1e-3
-            || u.dot(&v).abs() > 1e-3
+            || (u.norm() - 1.0).abs() > AXIS_TOLERANCE
+            || (v.norm() - 1.0).abs() > AXIS_TOLERANCE
+            || u.dot(&v).abs() > AXIS_TOLERANCE
         {
             return Err(bad(
                 id,
                 "u and v must be perpendicular unit vectors and origin a finite point".into(),
             ));
         }
-        if u.dot(normal).abs() > 1e-3 || v.dot(normal).abs() > 1e-3 {
+        if u.dot(normal).abs() > AXIS_TOLERANCE || v.dot(normal).abs() > AXIS_TOLERANCE {
             return Err(bad(id, "u and v must lie in the surface's plane".into()));
         }
         let off = normal.dot(&(o - polygon[0]));
-        if off.abs() > 0.01 {
+        if off.abs() > ORIGIN_OFF_PLANE_M {
             return Err(bad(
                 id,
                 format!("origin lies {:.3} m off the surface's plane", off),
