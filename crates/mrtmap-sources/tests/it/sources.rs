@@ -783,8 +783,7 @@ fn a_source_without_poses_converts_with_its_imu_in_the_depth_cameras_axes() {
         let conv = Recording::open(&out).unwrap();
         assert!(
             conv.warnings
-                .iter()
-                .any(|w| w.contains("no trajectory.txt"))
+                .contains(&mrtmap_io::RecordingWarning::NoTrajectory)
         );
         assert_eq!(conv.imu.len(), 200);
         for (a, b) in orig.imu.iter().zip(&conv.imu) {

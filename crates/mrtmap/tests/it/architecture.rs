@@ -51,7 +51,7 @@ fn dependencies(manifest: &Path) -> BTreeSet<String> {
 fn the_crate_table_lists_every_crate_and_what_it_uses() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let doc = std::fs::read_to_string(root.join("ARCHITECTURE.md")).unwrap();
-    let mut rows = std::collections::BTreeMap::new();
+    let mut rows = BTreeMap::new();
     for line in doc.lines().filter(|l| l.starts_with("| `mrtmap")) {
         let cells: Vec<&str> = line.split(" | ").collect();
         let name = cells[0]
@@ -117,7 +117,7 @@ fn the_method_table_names_files_that_exist() {
             continue;
         };
         let paths = paths_in(cell);
-        let full: Vec<std::path::PathBuf> = paths
+        let full: Vec<PathBuf> = paths
             .iter()
             .filter_map(|p| {
                 if p.starts_with("mrtmap-") {
