@@ -8,6 +8,18 @@ use super::limits::MAX_COORDINATE_M;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum SceneError {
+    /// Surfaces spanning more than any room (a scene in millimetres).
+    #[error(
+        "the surfaces span {extent_m:.0} m, more than any room ({max_m:.0} m at most): scene.json is in metres{hint}"
+    )]
+    TooLarge {
+        /// The largest extent of the surfaces' bounding box (m).
+        extent_m: f64,
+        /// The limit (m).
+        max_m: f64,
+        /// What the unit likely was.
+        hint: String,
+    },
     /// Not JSON, or JSON not of the scene's shape.
     #[error("not a valid scene file: {message} (line {line}, column {column})")]
     Json {

@@ -24,8 +24,8 @@ use mrtmap_physics::Temperature;
 use super::error::SceneError;
 use super::file::{FeatureFile, OccluderFile, SCENE_FORMAT, SceneFile, SurfaceFile, point};
 use super::limits::{
-    FEATURE_PLANE_TOLERANCE_M, MAX_COORDINATE_M, MAX_LEVEL_STD_K, PLANARITY_TOLERANCE_M,
-    TEMPERATURE_RANGE_C,
+    FEATURE_PLANE_TOLERANCE_M, MAX_COORDINATE_M, MAX_LEVEL_STD_K, MAX_ROOM_EXTENT_M,
+    PLANARITY_TOLERANCE_M, TEMPERATURE_RANGE_C,
 };
 use super::model::{Feature, Occluder, OccluderShape, RadiantScene, Surface, SurfaceKind};
 use super::raster::Raster;
@@ -369,6 +369,36 @@ fn check_shape(o: &OccluderFile) -> Result<OccluderShape, SceneError> {
     }
 }
 
+/// Refuses surfaces spanning more than [`MAX_ROOM_EXTENT_M`], naming the unit they were likely
+/// written in (issue 54: a scene in millimetres mapped a 4.2 km room without a word).
+fn check_extent(surfaces: &[Surface]) -> Result<(), SceneError> {
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for p in surfaces.iter().flat_map(|s| s.polygon.iter()) {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let extent_m = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
+    if extent_m <= MAX_ROOM_EXTENT_M {
+        return Ok(());
+    }
+    let hint = [(1000.0, "millimetres"), (100.0, "centimetres")]
+        .iter()
+        .find(|(per_m, _)| (1.0..=MAX_ROOM_EXTENT_M).contains(&(extent_m / per_m)))
+        .map_or(String::new(), |(per_m, unit)| {
+            format!(
+                "; in {unit} it would span {:.2} m: were its coordinates written in {unit}? Divide them by {per_m:.0}",
+                extent_m / per_m
+            )
+        });
+    Err(SceneError::TooLarge {
+        extent_m,
+        max_m: MAX_ROOM_EXTENT_M,
+        hint,
+    })
+}
+
 impl RadiantScene {
     /// Validates a scene file against every rule of the spec.
     pub fn new(file: &SceneFile) -> Result<Self, SceneError> {
@@ -395,6 +425,7 @@ impl RadiantScene {
             .enumerate()
             .map(|(si, s)| check_surface(s, si, &mut ids))
             .collect::<Result<Vec<_>, _>>()?;
+        check_extent(&surfaces)?;
         let mut occluders = Vec::with_capacity(file.occluders.len());
         for (oi, o) in file.occluders.iter().enumerate() {
             ids.claim(&o.id, format!("occluder {}", oi + 1))?;

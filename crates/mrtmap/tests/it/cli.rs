@@ -487,6 +487,33 @@ fn a_file_where_a_folder_is_needed_is_named_as_such() {
     );
 }
 
+/// Issue 54: a scene.json written in millimetres mapped a 4.2 km room without a word.
+#[test]
+fn a_scene_in_millimetres_is_refused_naming_the_unit() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = edited_example(dir.path(), "mm.json", |v| {
+        for s in v["surfaces"].as_array_mut().unwrap() {
+            for p in s["polygon"].as_array_mut().unwrap() {
+                for c in p.as_array_mut().unwrap() {
+                    *c = serde_json::json!(c.as_f64().unwrap() * 1000.0);
+                }
+            }
+            let features = s.get_mut("features").and_then(Value::as_array_mut);
+            for f in features.into_iter().flatten() {
+                for p in f["polygon"].as_array_mut().unwrap() {
+                    for c in p.as_array_mut().unwrap() {
+                        *c = serde_json::json!(c.as_f64().unwrap() * 1000.0);
+                    }
+                }
+            }
+        }
+    });
+    fails_with(
+        &["mrt", "--scene", &path, "--at", "2000,1500,1100"],
+        "the surfaces span 4200 m, more than any room (500 m at most): scene.json is in metres; in millimetres it would span 4.20 m",
+    );
+}
+
 /// The example office as JSON, changed by `edit`, written to `dir/name`.
 fn edited_example(dir: &Path, name: &str, edit: impl FnOnce(&mut Value)) -> String {
     let mut v: Value = serde_json::from_str(mrtmap_pipeline::points::EXAMPLE_OFFICE_JSON).unwrap();
