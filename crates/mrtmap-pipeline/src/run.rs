@@ -336,6 +336,26 @@ fn comfort_stage(
     Ok(Some((outcome, result)))
 }
 
+/// A warning per reason fusion skipped thermal frames; an unreadable frame's first problem, which
+/// names the file and what is wrong with it (another size, a broken image, a depth or a thermal
+/// frame), is said with its count.
+fn skip_warnings(fusion: &FusionReport) -> Vec<String> {
+    fusion
+        .skipped
+        .iter()
+        .map(|(why, n)| {
+            let first = match why {
+                SkipReason::UnreadableImage => fusion
+                    .problems
+                    .first()
+                    .map_or(String::new(), |p| format!(" (the first: {p})")),
+                _ => String::new(),
+            };
+            format!("fusion skipped {n} thermal frames: {why}{first}")
+        })
+        .collect()
+}
+
 /// The outcome of a run.
 #[derive(Clone, Debug)]
 pub struct RunOutcome {
@@ -670,9 +690,7 @@ pub fn run(
     if let Some((_, t)) = &tracked {
         warnings.extend(t.warnings());
     }
-    for (why, n) in &fusion.skipped {
-        warnings.push(format!("fusion skipped {n} thermal frames: {why}"));
-    }
+    warnings.extend(skip_warnings(&fusion));
     if fusion.clock.weak && fusion.clock.source == mrtmap_scan::clock::OffsetSource::Estimated {
         warnings.push(format!("fusion: {}", fusion.clock.describe()));
     }
@@ -831,4 +849,28 @@ pub fn segment_lines(r: &SegmentReport) -> Vec<String> {
     }
     lines.extend(r.warnings.iter().map(|w| format!("  warning: {w}")));
     lines
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    /// Issue 54: "fusion skipped 1 thermal frames: an image could not be read" named no file.
+    #[test]
+    fn an_unreadable_frame_is_named_in_the_runs_warning() {
+        let mut f = FusionReport::default();
+        f.skipped.insert(SkipReason::UnreadableImage, 1);
+        f.skipped.insert(SkipReason::NoPose, 2);
+        f.problems
+            .push("scan/thermal/000003.png: image is 5×3 pixels but the rig says 4×3".into());
+        let w = skip_warnings(&f);
+        assert_eq!(
+            w,
+            vec![
+                "fusion skipped 2 thermal frames: no pose at the frame time".to_string(),
+                "fusion skipped 1 thermal frames: an image could not be read (the first: scan/thermal/000003.png: image is 5×3 pixels but the rig says 4×3)".to_string(),
+            ]
+        );
+    }
 }
