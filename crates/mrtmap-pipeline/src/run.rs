@@ -37,6 +37,25 @@ use crate::settings::{
     PointEntry, PointFrame, Project, Quantity, RoomSection, SegmentSection, TrackMode,
 };
 
+/// The tracked trajectory without the poses that jump away from their neighbours' motion and
+/// back (issue 54: the frame after a lost one was written 54 cm off); the report counts them and
+/// its accuracy is of the trajectory written.
+fn without_outliers(
+    traj: Trajectory,
+    mut report: TrackReport,
+    truth: Option<&Trajectory>,
+) -> (Trajectory, TrackReport) {
+    let (clean, check) = mrtmap_scan::pose_check::drop_outlier_poses(&traj);
+    if check.dropped == 0 && check.left_out == 0 {
+        return (traj, report);
+    }
+    report.outliers_dropped = check.dropped + check.left_out;
+    if let Some(t) = truth {
+        report.accuracy = mrtmap_track::trajectory_error(&clean, t);
+    }
+    (clean, report)
+}
+
 /// Tracks `rec`'s colour and depth frames into `out`: trajectory.txt (world_from_depth, TUM) and
 /// track.json (what was done; with the recording's groundtruth.txt, the trajectory error).
 pub fn track_into(
@@ -48,6 +67,7 @@ pub fn track_into(
     progress.begin("tracking the camera (colour + depth)");
     let (traj, report) = track(rec, params, &|d, t| progress.advance(d as u64, t as u64))
         .map_err(|e| Error::source(&rec.dir, e.to_string()))?;
+    let (traj, report) = without_outliers(traj, report, rec.groundtruth.as_ref());
     std::fs::create_dir_all(out).map_err(|e| mrtmap_io::FileError::io(out, e))?;
     let dir = TrackDir::new(out);
     write_atomic(
@@ -855,6 +875,37 @@ pub fn segment_lines(r: &SegmentReport) -> Vec<String> {
 mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
+
+    /// Issue 54: the built-in tracker wrote a pose 54 cm off its neighbours (the frame after a
+    /// lost one); it is left out of trajectory.txt and counted.
+    #[test]
+    fn a_tracked_pose_that_jumps_and_comes_back_is_not_written() {
+        use mrtmap_geometry::nalgebra::{Isometry3, Translation3, UnitQuaternion};
+        let stamps: Vec<f64> = (0..90).map(|k| f64::from(k) / 30.0).collect();
+        let poses: Vec<Isometry3<f64>> = stamps
+            .iter()
+            .map(|&t| {
+                Isometry3::from_parts(
+                    Translation3::new(0.5 * t, 0.0, 1.4),
+                    UnitQuaternion::from_euler_angles(0.0, 0.0, 0.5 * t),
+                )
+            })
+            .collect();
+        let truth = Trajectory {
+            stamps: stamps.clone(),
+            poses: poses.clone(),
+        };
+        let mut tracked = truth.clone();
+        tracked.poses[40].translation.vector.y += 0.54;
+        let (out, report) = without_outliers(tracked, TrackReport::default(), Some(&truth));
+        assert_eq!((out.stamps.len(), report.outliers_dropped), (89, 1));
+        assert!(!out.stamps.contains(&stamps[40]));
+        assert!(report.accuracy.unwrap().ate_rmse_m < 1e-9);
+        assert!(report.warnings()[0].contains("1 tracked pose(s) left out"));
+        // A clean track is written as it is.
+        let (out, report) = without_outliers(truth.clone(), TrackReport::default(), None);
+        assert_eq!((out.stamps.len(), report.outliers_dropped), (90, 0));
+    }
 
     /// Issue 54: "fusion skipped 1 thermal frames: an image could not be read" named no file.
     #[test]

@@ -183,6 +183,10 @@ pub struct TrackReport {
     /// The first wrong-size frame: its file and its width and height.
     #[serde(default)]
     pub wrong_size_first: Option<(String, u32, u32)>,
+    /// Poses left out of the trajectory written because they jumped away from their neighbours'
+    /// motion and back (the frame after a lost one placed wrongly; set by the pipeline's check).
+    #[serde(default)]
+    pub outliers_dropped: usize,
 }
 
 impl TrackReport {
@@ -193,6 +197,12 @@ impl TrackReport {
             out.push(format!(
                 "tracking lost {} of {} colour frames",
                 self.lost, self.frames
+            ));
+        }
+        if self.outliers_dropped > 0 {
+            out.push(format!(
+                "{} tracked pose(s) left out of trajectory.txt: they jumped away from their neighbours' motion and back",
+                self.outliers_dropped
             ));
         }
         if let Some((path, w, h)) = &self.wrong_size_first {
