@@ -292,6 +292,7 @@ pub(crate) fn coverage_with(
     target_k: f64,
     progress: &dyn Progress,
 ) -> Result<Coverage> {
+    p.check_heights_above_floor()?;
     if !(target_k.is_finite() && target_k > 0.0 && target_k <= 10.0) {
         return Err(Error::setting(
             format!("--target-k {target_k}"),

@@ -514,6 +514,23 @@ fn a_scene_in_millimetres_is_refused_naming_the_unit() {
     );
 }
 
+/// A map height below the floor is refused by coverage before it reads the scan, as by run.
+#[test]
+fn coverage_refuses_a_height_below_the_floor_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("p.toml");
+    std::fs::write(&cfg, "[map]\nheights_m = [-1.0]\n").unwrap();
+    fails_with(
+        &[
+            "coverage",
+            "/nonexistent",
+            "--config",
+            cfg.to_str().unwrap(),
+        ],
+        "a map -1.00 m above the floor ([map] heights_m, --height) is not in the room",
+    );
+}
+
 /// The example office as JSON, changed by `edit`, written to `dir/name`.
 fn edited_example(dir: &Path, name: &str, edit: impl FnOnce(&mut Value)) -> String {
     let mut v: Value = serde_json::from_str(mrtmap_pipeline::points::EXAMPLE_OFFICE_JSON).unwrap();
