@@ -401,12 +401,11 @@ fn prepare(
 type Posed = (Prepared, Isometry3<f64>, Isometry3<f64>);
 
 /// The state carried through a fusion, chunk after chunk.
-struct Fuser<'a> {
-    rec: &'a Recording,
-    params: &'a FuseParams,
+pub(crate) struct Fuser {
+    pub(crate) params: FuseParams,
     limits: InterpolationLimits,
-    report: FusionReport,
-    map: VoxelMap,
+    pub(crate) report: FusionReport,
+    pub(crate) map: VoxelMap,
     target: Option<IcpTarget>,
     since_rebuild: usize,
     /// The ICP correction carried from frame to frame.
@@ -416,13 +415,13 @@ struct Fuser<'a> {
     fit_sum: f64,
     rmse_sum: f64,
     iterations_sum: usize,
-    poses: Vec<(f64, Isometry3<f64>)>,
-    frames: Vec<FusedFrame>,
+    pub(crate) poses: Vec<(f64, Isometry3<f64>)>,
+    pub(crate) frames: Vec<FusedFrame>,
     /// A few of each frame's depth points, placed by its refined and by its given pose.
     anchor: Vec<(Point3<f64>, Point3<f64>)>,
     timing: Timing,
     done: u64,
-    calibrator: Calibrator,
+    pub(crate) calibrator: Calibrator,
 }
 
 /// A first pass for the vignetting fuses at most this share of the scan's chunks (one in …).
@@ -432,18 +431,16 @@ const WARM_UP_SHARE: usize = 4;
 /// estimate needs.
 const WARM_UP_SPREAD: f64 = 4.0;
 
-impl<'a> Fuser<'a> {
+impl Fuser {
     /// A fuser with an empty map.
-    fn new(
-        rec: &'a Recording,
-        params: &'a FuseParams,
+    pub(crate) fn new(
+        params: &FuseParams,
         limits: InterpolationLimits,
         report: FusionReport,
         calibrator: Calibrator,
     ) -> Self {
         Fuser {
-            rec,
-            params,
+            params: *params,
             limits,
             report,
             map: VoxelMap::new(params.voxel_m),
@@ -466,15 +463,16 @@ impl<'a> Fuser<'a> {
     /// Fuses `chunks` in order, until `enough` says so after a chunk; the next chunk is read
     /// while the current one is registered, observed and merged (ICP and merging are partly
     /// sequential, reading is not). Returns the chunks fused.
-    fn run(
+    pub(crate) fn run(
         &mut self,
+        rec: &Recording,
         rays: &RayTable,
         chunks: &[&[(usize, usize)]],
         total: u64,
         progress: &(dyn Fn(u64, u64) + Sync),
         enough: &(dyn Fn(&Self) -> bool + Sync),
     ) -> usize {
-        let (rec, params) = (self.rec, self.params);
+        let params = &{ self.params };
         let mut next = chunks.first().map(|c| prepare(rec, rays, params, c));
         for i in 0..chunks.len() {
             let Some((prepared, cpu)) = next.take() else {
@@ -484,9 +482,9 @@ impl<'a> Fuser<'a> {
             let (following, stop) = rayon::join(
                 || chunks.get(i + 1).map(|c| prepare(rec, rays, params, c)),
                 || {
-                    let ready = self.posed(prepared);
-                    let work = self.register(ready);
-                    let results = self.observe(&work);
+                    let ready = self.posed(rec, prepared);
+                    let work = self.register(rec, ready);
+                    let results = self.observe(rec, &work);
                     self.record_frames(&work, &results);
                     self.merge(results, total, progress);
                     enough(self)
@@ -506,13 +504,13 @@ impl<'a> Fuser<'a> {
     }
 
     /// Counts a frame skipped for `r` before it reaches the map: it is done.
-    fn drop_frame(&mut self, r: SkipReason) {
+    pub(crate) fn drop_frame(&mut self, r: SkipReason) {
         self.skip(r);
         self.done += 1;
     }
 
     /// The frames that can be used, with their poses; the others skipped and counted.
-    fn posed(&mut self, prepared: Vec<Result<Prepared, String>>) -> Vec<Posed> {
+    fn posed(&mut self, rec: &Recording, prepared: Vec<Result<Prepared, String>>) -> Vec<Posed> {
         let mut ready = Vec::with_capacity(prepared.len());
         for pr in prepared {
             let pr = match pr {
@@ -529,7 +527,7 @@ impl<'a> Fuser<'a> {
                 self.drop_frame(SkipReason::TooFewDepthPoints);
                 continue;
             }
-            let traj = &self.rec.trajectory;
+            let traj = &rec.trajectory;
             let (Some(wd), Some(wt)) = (
                 traj.interpolate(pr.depth_t, &self.limits),
                 traj.interpolate(pr.thermal_t, &self.limits),
@@ -549,7 +547,7 @@ impl<'a> Fuser<'a> {
         wd: &Isometry3<f64>,
         start: &Isometry3<f64>,
     ) -> Option<(usize, Result<Refinement, &'static str>)> {
-        let params = self.params;
+        let params = &self.params;
         let tgt = self.target.as_ref().filter(|_| params.icp.enabled)?;
         let init = start * wd;
         let step = (pr.points.points.len() / params.icp.source_points.max(1)).max(1);
@@ -584,7 +582,7 @@ impl<'a> Fuser<'a> {
     /// ICP: every frame of the chunk is refined in parallel from the correction at the chunk's
     /// start; the carried correction is then updated in frame order. Returns the frames with
     /// their refined world_from_depth and world_from_thermal.
-    fn register(&mut self, ready: Vec<Posed>) -> Vec<Posed> {
+    fn register(&mut self, rec: &Recording, ready: Vec<Posed>) -> Vec<Posed> {
         let t1 = Instant::now();
         let start = self.correction;
         let refinements: Vec<_> = ready
@@ -619,7 +617,7 @@ impl<'a> Fuser<'a> {
                 }
             }
             let world_from_depth = frame_correction * wd;
-            let world_from_thermal = frame_correction * wt * self.rec.rig.depth_from_thermal;
+            let world_from_thermal = frame_correction * wt * rec.rig.depth_from_thermal;
             if self.params.icp.enabled {
                 let pts = &pr.points.points;
                 for p in pts.iter().step_by((pts.len() / ANCHOR_POINTS).max(1)) {
@@ -639,8 +637,8 @@ impl<'a> Fuser<'a> {
 
     /// Observes the frames' temperatures on their points, in parallel; with self-calibration,
     /// each frame is compared with the map as it stood at the chunk's start and corrected.
-    fn observe(&mut self, work: &[Posed]) -> Vec<Observed> {
-        let (rec, params) = (self.rec, self.params);
+    fn observe(&mut self, rec: &Recording, work: &[Posed]) -> Vec<Observed> {
+        let params = &{ self.params };
         let cal = params.radiometric;
         let (map, a, carried) = (
             &self.map,
@@ -870,7 +868,7 @@ struct Observed {
 
 /// The sync tolerance used: the setting, or 0.55 of the depth frames' median interval where that
 /// is longer (15 Hz depth: 37 ms), so that every thermal frame has a depth frame.
-fn sync_tolerance(rec: &Recording, setting_s: f64) -> f64 {
+pub(crate) fn sync_tolerance(rec: &Recording, setting_s: f64) -> f64 {
     let mut gaps: Vec<f64> = rec.depth.windows(2).map(|w| w[1].t - w[0].t).collect();
     if gaps.is_empty() {
         return setting_s;
@@ -969,9 +967,9 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
     // applies it from the first frame on.
     let t_warm = Instant::now();
     let calibrator = if params.radiometric.enabled && params.radiometric.warm_up {
-        let mut warm = Fuser::new(rec, params, limits, report.clone(), Calibrator::default());
+        let mut warm = Fuser::new(params, limits, report.clone(), Calibrator::default());
         let most = chunks.len().div_ceil(WARM_UP_SHARE);
-        let done = warm.run(&rays, &chunks[..most], total, &|_, _| {}, &|f| {
+        let done = warm.run(rec, &rays, &chunks[..most], total, &|_, _| {}, &|f| {
             f.calibrator.vignetting_ready(WARM_UP_SPREAD)
         });
         if warm.calibrator.vignetting_ready(1.0) && done < chunks.len() {
@@ -983,13 +981,13 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
     } else {
         Calibrator::default()
     };
-    let mut fuser = Fuser::new(rec, params, limits, report, calibrator);
+    let mut fuser = Fuser::new(params, limits, report, calibrator);
     fuser.timing.clock = clock_s;
     fuser.timing.vignetting_warm_up = t_warm.elapsed().as_secs_f64();
     for r in dropped {
         fuser.drop_frame(r);
     }
-    fuser.run(&rays, &chunks, total, progress, &|_| false);
+    fuser.run(rec, &rays, &chunks, total, progress, &|_| false);
     fuser.finish(t_start)
 }
 

@@ -12,6 +12,7 @@
 pub mod clock;
 pub mod frame;
 mod fuse;
+mod fuse_live;
 pub mod observe;
 pub mod pose_check;
 pub mod radiometric;
@@ -23,4 +24,5 @@ pub use fuse::{
     FuseParams, Fused, FusedFrame, FusionReport, IcpReport, IcpSettings, Timing, from_pose7, fuse,
     pose7,
 };
+pub use fuse_live::{Advance, LiveFusion};
 pub use sync::{Pairing, SkipReason, pair_frames, refined_poses};

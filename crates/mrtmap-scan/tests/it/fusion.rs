@@ -183,3 +183,71 @@ fn fusion_gives_the_same_cloud_on_one_thread_as_on_several() {
     assert!(one.cloud == three.cloud, "the clouds differ");
     assert_eq!(one.poses, three.poses);
 }
+
+/// Fusion fed while the recording grows (a prefix of each list at a time, as `mrtmap live` sees
+/// it) makes the cloud batch fusion makes of the whole recording, once the steps that need the
+/// scan's end are off in both (the clock's estimate, the vignetting warm-up, ICP) and no pose
+/// jumps; a frame is taken only once the depth list and the trajectory have passed it.
+#[test]
+fn fusion_fed_as_the_recording_grows_makes_the_batch_cloud() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scan");
+    scan("office", NoiseLevel::Realistic, Drift::NONE, 3.0, &path);
+    let mut p = params(false);
+    p.clock = mrtmap_scan::clock::ClockOffset::Off;
+    p.radiometric.warm_up = false;
+    p.chunk = 4;
+    let whole = mrtmap_io::Recording::open(&path).unwrap();
+    let batch = mrtmap_scan::fuse(&whole, &p, &|_, _| {});
+    let mut live = mrtmap_scan::LiveFusion::new(&p);
+    let mut grown = whole.clone();
+    let (t0, t1) = (whole.depth[0].t, whole.depth.last().unwrap().t);
+    let mut taken = 0;
+    for k in 1..=6 {
+        let until = t0 + (t1 - t0) * f64::from(k) / 6.0;
+        grown.depth = whole.depth.iter().filter(|e| e.t <= until).cloned().collect();
+        grown.thermal = whole.thermal.iter().filter(|e| e.t <= until).cloned().collect();
+        let n = whole.trajectory.stamps.partition_point(|&t| t <= until);
+        grown.trajectory.stamps = whole.trajectory.stamps[..n].to_vec();
+        grown.trajectory.poses = whole.trajectory.poses[..n].to_vec();
+        let a = live.advance(&grown);
+        // Nothing is taken before the depth list has passed it by the tolerance.
+        if let Some(&last) = a.taken.last() {
+            assert!(grown.thermal[last].t < grown.depth.last().unwrap().t);
+        }
+        taken += a.taken.len();
+        assert_eq!(live.taken(), taken);
+    }
+    assert!(taken < whole.thermal.len() + 1);
+    // The last frames wait for depth beyond the scan's end; batch fusion takes them.
+    let snap = live.snapshot();
+    assert!(snap.report.used_frames > 20, "{}", snap.report.used_frames);
+    let common: Vec<_> = batch
+        .frames
+        .iter()
+        .take_while(|f| f.thermal < taken)
+        .collect();
+    assert_eq!(common.len(), snap.frames.len());
+    for (a, b) in common.iter().zip(&snap.frames) {
+        assert_eq!(a.thermal, b.thermal);
+        assert_eq!(a.world_from_depth, b.world_from_depth);
+    }
+    // The clouds agree wherever both saw: the live one lacks only the last frames' voxels.
+    let at: std::collections::HashMap<[i64; 3], f32> = batch
+        .cloud
+        .positions
+        .iter()
+        .zip(&batch.cloud.temperature_k)
+        .map(|(p, t)| ([0, 1, 2].map(|i| (f64::from(p[i]) * 1e4).round() as i64), *t))
+        .collect();
+    let (mut matched, mut worst) = (0, 0.0f32);
+    for (p, t) in snap.cloud.positions.iter().zip(&snap.cloud.temperature_k) {
+        if let Some(b) = at.get(&[0, 1, 2].map(|i| (f64::from(p[i]) * 1e4).round() as i64)) {
+            matched += 1;
+            worst = worst.max((b - t).abs());
+        }
+    }
+    eprintln!("matched {matched} of {}, worst {worst} K", snap.cloud.len());
+    assert!(matched * 10 > snap.cloud.len() * 8, "{matched} of {}", snap.cloud.len());
+    assert!(worst < 0.05, "{worst} K");
+}
