@@ -10,7 +10,10 @@
 
 use std::path::Path;
 
+use mrtmap_geometry::nalgebra::Isometry3;
 use mrtmap_radiation::UnseenImpact;
+
+use crate::advice::{Advice, Namer, Target, advise};
 use serde::Serialize;
 
 use crate::error::{Error, Result};
@@ -47,8 +50,10 @@ pub struct Coverage {
     pub good_enough: bool,
     /// Why not (empty when good enough), most important first.
     pub reasons: Vec<String>,
-    /// Where to point the camera, most important first.
+    /// Where to point the camera, most important first (the advice's sentences).
     pub look_at: Vec<String>,
+    /// The same, each with the point it is about (room frame).
+    pub advice: Vec<Advice>,
     /// What the verdict does not rest on but the map does (the readings' level).
     pub notes: Vec<String>,
     /// Each surface's coverage.
@@ -90,13 +95,18 @@ pub fn coverage(
     progress: &dyn Progress,
 ) -> Result<Coverage> {
     match run(recording, out, &coarse(base), false, progress) {
-        Ok(o) => Ok(judge(&o, target_k)),
+        Ok(o) => {
+            let poses = mrtmap_io::Trajectory::read(&crate::RunLayout::new(out).fuse().poses_txt()).ok();
+            let start = poses.and_then(|t| t.poses.first().copied());
+            Ok(judge(&o, target_k, start.as_ref(), None))
+        }
         // A room segmentation cannot close is the clearest "not good enough": say why and where.
         Err(Error::Segment { source, .. }) => Ok(Coverage {
             target_k,
             good_enough: false,
             reasons: vec![format!("the room could not be put together: {source}")],
             look_at: Vec::new(),
+            advice: Vec::new(),
             notes: Vec::new(),
             surfaces: Vec::new(),
             unseen_patches: Vec::new(),
@@ -109,8 +119,14 @@ pub fn coverage(
     }
 }
 
-/// The verdict on a run's outcome.
-pub fn judge(o: &RunOutcome, target_k: f64) -> Coverage {
+/// The verdict on a run's outcome; the advice names walls from where the scan started (`start`,
+/// world_from_camera), and starts with the turn to make from `camera` when given.
+pub(crate) fn judge(
+    o: &RunOutcome,
+    target_k: f64,
+    start: Option<&Isometry3<f64>>,
+    camera: Option<&Isometry3<f64>>,
+) -> Coverage {
     let s = &o.segment;
     let surfaces: Vec<SurfaceCoverage> = s
         .surfaces
@@ -141,14 +157,15 @@ pub fn judge(o: &RunOutcome, target_k: f64) -> Coverage {
         || ("camera".to_string(), o.scene.temperature_level_std_k),
         |l| (l.basis.to_string(), l.std_k),
     );
+    let namer = Namer::new(&o.scene, start.copied());
     let mut reasons = Vec::new();
-    let mut look_at = Vec::new();
+    let mut targets = Vec::new();
     for w in surfaces.iter().filter(|x| x.inferred) {
         reasons.push(format!(
             "{} was never seen: it is placed at the floor's edge",
-            w.id
+            namer.wall(&w.id)
         ));
-        look_at.push(format!("{}: the whole wall", w.id));
+        targets.push(Target::Wall(&w.id));
     }
     if 2.0 * max_unseen_k > target_k {
         reasons.push(format!(
@@ -161,8 +178,10 @@ pub fn judge(o: &RunOutcome, target_k: f64) -> Coverage {
         .filter(|u| 2.0 * u.max_std_error_k > 0.25 * target_k)
         .take(5)
     {
-        look_at.push(mrtmap_report::unseen_line(u));
+        targets.push(Target::Patch(u));
     }
+    let advice = advise(&namer, &targets, camera);
+    let look_at = advice.iter().map(|a| a.text.clone()).collect();
     // The level is the readings', not the scan's: two readings at σ 0.1 K leave about ±0.2 K
     // (2σ) however well the room was scanned. It is a reason only when no reading was usable or
     // the readings leave over twice the target (one reading, far from the room's temperature).
@@ -194,6 +213,7 @@ pub fn judge(o: &RunOutcome, target_k: f64) -> Coverage {
         good_enough: reasons.is_empty(),
         reasons,
         look_at,
+        advice,
         notes,
         surfaces,
         unseen_patches,

@@ -45,6 +45,7 @@
 //! # }
 //! ```
 
+mod advice;
 pub mod cache;
 pub mod calibration;
 pub mod comfort;
@@ -76,6 +77,7 @@ pub mod files {
     pub use mrtmap_io::{FileError, InterpolationLimits, Recording, Rig, io_words, write_atomic};
 }
 
+pub use advice::Advice;
 pub use cache::{Fingerprint, Stage, StageOutcome, run_or_reuse};
 pub use error::{Error, Result};
 pub use front::{FuseDone, Pipeline, TrackDone};
