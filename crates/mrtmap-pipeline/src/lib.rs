@@ -56,6 +56,7 @@ mod error;
 pub mod export;
 pub mod front;
 pub mod layout;
+pub mod live;
 pub mod level;
 pub mod lock;
 pub mod maps;

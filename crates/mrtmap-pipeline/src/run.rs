@@ -91,6 +91,17 @@ pub fn fuse_into(
 ) -> Result<FusionReport> {
     progress.begin("fusing thermal frames");
     let fused = fuse(rec, params, &|d, t| progress.advance(d, t));
+    write_fused(rec, params, &fused, out)?;
+    Ok(fused.report)
+}
+
+/// Writes a fusion into `out`: cloud.ply, fusion.json, poses.txt and frames.json.
+pub(crate) fn write_fused(
+    rec: &Recording,
+    params: &FuseParams,
+    fused: &mrtmap_scan::Fused,
+    out: &Path,
+) -> Result<()> {
     let comment = format!(
         "mrtmap thermal cloud of {}\ntemperature_c: radiant (T^4) weighted average of the observations; temperature_std in K\nvoxel {} m, ICP {}",
         rec.dir.display(),
@@ -107,7 +118,7 @@ pub fn fuse_into(
             .as_bytes(),
     )?;
     write_json(&dir.frames_json(), &fused.frames)?;
-    Ok(fused.report)
+    Ok(())
 }
 
 /// What `mrtmap segment` is given: a fusion's folder and where to write, with the recording to

@@ -162,6 +162,18 @@ fn view3d_section(o: &mut String, d: &ReportData) {
         xyz: v.globe.xyz,
         kind: "globe",
     }));
+    let heights: Vec<f64> = d.maps.iter().map(|m| m.summary.height_m).collect();
+    view3d_block(o, view, &marks, &heights);
+}
+
+/// The 3D view's section: buttons, canvas, colour bars, the data and the viewer (`heights`: the
+/// maps' heights, a layer each).
+fn view3d_block(
+    o: &mut String,
+    view: &crate::view3d::View3d,
+    marks: &[crate::view3d::ViewMark],
+    heights: &[f64],
+) {
     let safe = |s: &str| s.replace("</", "<\\/");
     o.push_str("<section id=\"view3d-section\"><h2>The room in 3D</h2><div id=\"view3d-buttons\">");
     let mut buttons: Vec<(String, String)> = vec![
@@ -170,11 +182,8 @@ fn view3d_section(o: &mut String, d: &ReportData) {
         ("furniture".into(), "Furniture".into()),
         ("cloud".into(), "Thermal cloud".into()),
     ];
-    for (k, m) in d.maps.iter().enumerate() {
-        buttons.push((
-            format!("grid{k}"),
-            format!("MRT at {:.2} m", m.summary.height_m),
-        ));
+    for (k, h) in heights.iter().enumerate() {
+        buttons.push((format!("grid{k}"), format!("MRT at {h:.2} m")));
     }
     if view.1.sun {
         buttons.push(("sun".into(), "Sunlit patch".into()));
@@ -204,6 +213,21 @@ fn view3d_section(o: &mut String, d: &ReportData) {
         safe(&serde_json::to_string(&marks).unwrap_or_else(|_| "[]".into())),
         crate::view3d::VIEWER_JS
     ));
+}
+
+/// A page with the 3D view alone (the live page shows it in a frame): `marks` are drawn and named
+/// as the report's points are; `heights` are the maps' heights.
+pub fn view3d_page(
+    view: &crate::view3d::View3d,
+    marks: &[crate::view3d::ViewMark],
+    heights: &[f64],
+) -> String {
+    let mut o = format!(
+        "<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\"><title>mrtmap: the room in 3D</title><style>{STYLE}</style></head><body class=\"view3d-full\">"
+    );
+    view3d_block(&mut o, view, marks, heights);
+    o.push_str("</body></html>");
+    o
 }
 
 fn map_section(o: &mut String, m: &ReportMap) {

@@ -18,7 +18,7 @@ mod tables;
 mod validate;
 pub mod view3d;
 
-pub use html::{ComparisonRow, KeyValues, ReportData, ReportMap, esc, render_html};
+pub use html::{ComparisonRow, KeyValues, ReportData, ReportMap, esc, render_html, view3d_page};
 pub use map::{MapInput, MapMark, MapQuantity, contour_step, render_png, render_svg};
 pub use tables::{MapAxes, MapSummary, coverage_svg, grid_csv, parts_line, unseen_line};
 pub use validate::{

@@ -131,6 +131,11 @@ impl LiveFusion {
         self.next
     }
 
+    /// What could not be read (the first few frames', in words).
+    pub fn problems(&self) -> &[String] {
+        &self.fuser.report.problems
+    }
+
     /// The thermal frames fused so far.
     pub fn fused(&self) -> usize {
         self.fuser.report.used_frames

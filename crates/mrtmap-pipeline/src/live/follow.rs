@@ -1,0 +1,335 @@
+//! Following a recording folder while a recorder writes it.
+//!
+//! The recorder's contract (docs/recording-format.md, "Recording live"): rig.toml (and
+//! references.csv, if any) exist from the start; the lists grow by appended lines; each line's
+//! file is written before the line. So, at each poll:
+//!
+//! 1. Each list is read from where the last poll stopped, up to its last complete line: a line
+//!    still being written is left for the next poll.
+//! 2. A frame line is taken once its file is whole (a PNG up to its end chunk, another format
+//!    when its size has not changed since the last poll). A file that has not appeared after
+//!    [`MISSING_WAIT_S`] is skipped with a warning naming the list, the line and the file; the
+//!    lines after it wait meanwhile, so the stream stays in order.
+//! 3. A line that goes back in time, or that cannot be read, is skipped with a warning naming the
+//!    list and the line; the stream goes on.
+//!
+//! The thermal stamps are moved onto the depth clock by the rig's offset (or the project's given
+//! one) as they are taken; the finished recording is read again from disk by the final run.
+
+use std::collections::VecDeque;
+use std::fs::File;
+use std::io::{Read, Seek, SeekFrom};
+use std::path::{Path, PathBuf};
+use std::time::{Instant, SystemTime};
+
+use mrtmap_io::{Recording, StreamEntry, Trajectory};
+
+/// How long a listed file may take to appear before its line is skipped (s).
+pub(crate) const MISSING_WAIT_S: f64 = 2.0;
+
+/// Warnings kept (the first ones; the count goes on).
+const MAX_WARNINGS: usize = 50;
+
+/// Which list.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum List {
+    Depth,
+    Thermal,
+    Rgb,
+    Masks,
+    Trajectory,
+}
+
+impl List {
+    fn file(self) -> &'static str {
+        match self {
+            List::Depth => "depth.txt",
+            List::Thermal => "thermal.txt",
+            List::Rgb => "rgb.txt",
+            List::Masks => "masks.txt",
+            List::Trajectory => "trajectory.txt",
+        }
+    }
+}
+
+/// A line waiting for its file.
+struct Pending {
+    line: usize,
+    t: f64,
+    path: PathBuf,
+    since: Instant,
+    size: Option<u64>,
+}
+
+/// One list being followed.
+struct Tail {
+    list: List,
+    /// Bytes read so far.
+    offset: u64,
+    /// Lines read so far.
+    lines: usize,
+    pending: VecDeque<Pending>,
+    last_t: f64,
+}
+
+/// A thermal frame taken: its index in the recording and when its file was written.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Taken {
+    pub(crate) index: usize,
+    pub(crate) written: SystemTime,
+}
+
+/// A recording folder followed as it grows.
+pub(crate) struct Follower {
+    /// The recording as taken so far (thermal stamps on the depth clock).
+    pub(crate) rec: Recording,
+    tails: Vec<Tail>,
+    thermal_offset_s: f64,
+    /// What was skipped and why, in words (the first [`MAX_WARNINGS`]).
+    pub(crate) warnings: Vec<String>,
+    /// How many warnings there were in all.
+    pub(crate) warning_count: usize,
+    /// When a list last grew.
+    pub(crate) last_growth: Instant,
+    /// The thermal frames taken at the last poll, with when each was written.
+    pub(crate) taken: Vec<Taken>,
+}
+
+/// Whether a file is whole: a PNG up to its end chunk; another format once its size stands.
+fn whole(path: &Path, size_before: Option<u64>) -> (bool, Option<u64>) {
+    let Ok(meta) = std::fs::metadata(path) else {
+        return (false, None);
+    };
+    let size = meta.len();
+    let is_png = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if is_png {
+        let ok = size >= 12
+            && File::open(path)
+                .and_then(|mut f| {
+                    f.seek(SeekFrom::End(-12))?;
+                    let mut b = [0u8; 12];
+                    f.read_exact(&mut b)?;
+                    Ok(&b[4..8] == b"IEND")
+                })
+                .unwrap_or(false);
+        return (ok, Some(size));
+    }
+    (size > 0 && size_before == Some(size), Some(size))
+}
+
+impl Follower {
+    /// Starts following `dir`, whose rig.toml must be readable.
+    pub(crate) fn new(dir: &Path, thermal_offset_s: Option<f64>) -> crate::Result<Self> {
+        let rig = mrtmap_io::Rig::read(&dir.join("rig.toml"))?;
+        let offset = thermal_offset_s
+            .or(rig.thermal_time_offset_s)
+            .unwrap_or(0.0);
+        let tails = [
+            List::Depth,
+            List::Thermal,
+            List::Rgb,
+            List::Masks,
+            List::Trajectory,
+        ]
+        .into_iter()
+        .map(|list| Tail {
+            list,
+            offset: 0,
+            lines: 0,
+            pending: VecDeque::new(),
+            last_t: f64::NEG_INFINITY,
+        })
+        .collect();
+        Ok(Follower {
+            rec: Recording {
+                dir: dir.to_path_buf(),
+                rig,
+                depth: Vec::new(),
+                thermal: Vec::new(),
+                rgb: Vec::new(),
+                masks: Vec::new(),
+                trajectory: Trajectory::default(),
+                groundtruth: None,
+                imu: Vec::new(),
+                warnings: Vec::new(),
+            },
+            tails,
+            thermal_offset_s: offset,
+            warnings: Vec::new(),
+            warning_count: 0,
+            last_growth: Instant::now(),
+            taken: Vec::new(),
+        })
+    }
+
+    /// Thermal frames listed so far (taken, or waiting for their file).
+    pub(crate) fn thermal_received(&self) -> usize {
+        self.rec.thermal.len()
+            + self
+                .tails
+                .iter()
+                .find(|t| t.list == List::Thermal)
+                .map_or(0, |t| t.pending.len())
+    }
+
+    fn warn(&mut self, w: String) {
+        self.warning_count += 1;
+        if self.warnings.len() < MAX_WARNINGS {
+            self.warnings.push(w);
+        }
+    }
+
+    /// Reads what the lists gained since the last poll; returns whether anything was taken.
+    pub(crate) fn poll(&mut self) -> bool {
+        self.taken.clear();
+        let mut grew = false;
+        for k in 0..self.tails.len() {
+            grew |= self.read_new_lines(k);
+            self.take_pending(k);
+        }
+        if grew {
+            self.last_growth = Instant::now();
+        }
+        grew
+    }
+
+    /// Reads the complete lines appended to list `k` since the last poll.
+    fn read_new_lines(&mut self, k: usize) -> bool {
+        let list = self.tails[k].list;
+        let path = self.rec.dir.join(list.file());
+        let Ok(mut f) = File::open(&path) else {
+            return false;
+        };
+        let mut bytes = Vec::new();
+        if f.seek(SeekFrom::Start(self.tails[k].offset)).is_err() || f.read_to_end(&mut bytes).is_err() {
+            return false;
+        }
+        let Some(end) = bytes.iter().rposition(|&b| b == b'\n') else {
+            return false;
+        };
+        self.tails[k].offset += end as u64 + 1;
+        let text = String::from_utf8_lossy(&bytes[..=end]).into_owned();
+        for raw in text.lines() {
+            self.tails[k].lines += 1;
+            let n = self.tails[k].lines;
+            let s = raw.trim();
+            if s.is_empty() || s.starts_with('#') {
+                continue;
+            }
+            if list == List::Trajectory {
+                self.take_pose(k, n, s, &path);
+                continue;
+            }
+            let mut it = s.split_whitespace();
+            let parsed = match (it.next().map(str::parse::<f64>), it.next()) {
+                (Some(Ok(t)), Some(p)) if t.is_finite() => Some((t, p)),
+                _ => None,
+            };
+            let Some((t, p)) = parsed else {
+                self.warn(format!(
+                    "{} line {n}: expected 'timestamp path', got '{s}': skipped",
+                    list.file()
+                ));
+                continue;
+            };
+            let tail = &mut self.tails[k];
+            let last = tail.pending.back().map_or(tail.last_t, |q| q.t);
+            if t < last {
+                self.warn(format!(
+                    "{} line {n}: its time {t:.6} goes back before the line above ({last:.6}): skipped; the recorder's clock or its lists are out of order",
+                    list.file()
+                ));
+                continue;
+            }
+            tail.pending.push_back(Pending {
+                line: n,
+                t,
+                path: PathBuf::from(p),
+                since: Instant::now(),
+                size: None,
+            });
+        }
+        true
+    }
+
+    /// One trajectory line.
+    fn take_pose(&mut self, k: usize, n: usize, s: &str, path: &Path) {
+        match Trajectory::parse(s, path) {
+            Ok(one) if one.stamps.len() == 1 => {
+                let t = one.stamps[0];
+                let traj = &mut self.rec.trajectory;
+                match traj.stamps.last() {
+                    Some(&last) if t < last => self.warn(format!(
+                        "trajectory.txt line {n}: its time {t:.6} goes back before the line above ({last:.6}): skipped"
+                    )),
+                    Some(&last) if t == last => {}
+                    _ => {
+                        traj.stamps.push(t);
+                        traj.poses.push(one.poses[0]);
+                        self.tails[k].last_t = t;
+                    }
+                }
+            }
+            Ok(_) => {}
+            Err(e) => self.warn(format!(
+                "trajectory.txt line {n}: {}: skipped",
+                e.to_string().rsplit(": ").next().unwrap_or("cannot be read")
+            )),
+        }
+    }
+
+    /// Takes the lines of list `k` whose files are whole, in order.
+    fn take_pending(&mut self, k: usize) {
+        let list = self.tails[k].list;
+        while let Some(head) = self.tails[k].pending.front_mut() {
+            let file = self.rec.dir.join(&head.path);
+            let (ok, size) = whole(&file, head.size);
+            head.size = size;
+            if !ok {
+                if head.since.elapsed().as_secs_f64() < MISSING_WAIT_S {
+                    return;
+                }
+                let (line, p) = (head.line, head.path.display().to_string());
+                self.tails[k].pending.pop_front();
+                let what = if size.is_some() {
+                    "is still incomplete"
+                } else {
+                    "has not appeared"
+                };
+                self.warn(format!(
+                    "{} line {line} points to {p}, which {what} after {MISSING_WAIT_S} s: skipped",
+                    list.file()
+                ));
+                continue;
+            }
+            let Some(head) = self.tails[k].pending.pop_front() else {
+                return;
+            };
+            self.tails[k].last_t = head.t;
+            let mut entry = StreamEntry {
+                t: head.t,
+                path: head.path,
+                line: head.line,
+            };
+            match list {
+                List::Depth => self.rec.depth.push(entry),
+                List::Thermal => {
+                    entry.t += self.thermal_offset_s;
+                    let written = std::fs::metadata(&file)
+                        .and_then(|m| m.modified())
+                        .unwrap_or_else(|_| SystemTime::now());
+                    self.taken.push(Taken {
+                        index: self.rec.thermal.len(),
+                        written,
+                    });
+                    self.rec.thermal.push(entry);
+                }
+                List::Rgb => self.rec.rgb.push(entry),
+                List::Masks => self.rec.masks.push(entry),
+                List::Trajectory => {}
+            }
+        }
+    }
+}

@@ -1,0 +1,451 @@
+//! `mrtmap live`: the room filling in while the scan is recorded, and when it is enough.
+//!
+//! 1. A [`follow::Follower`] reads the recording folder as the recorder appends to it.
+//! 2. [`mrtmap_scan::LiveFusion`] fuses each thermal frame once the depth list and the
+//!    trajectory have passed it (the coverage check's coarse settings: 5 cm voxels, no ICP), so a
+//!    frame is fused within a poll of being written.
+//! 3. Every [`LiveOptions::refresh_s`] a snapshot of the fusion goes to a second thread that runs
+//!    the coverage check's coarse pipeline on it (segmentation with texturing, the temperatures'
+//!    level, a 10 × 10 map at 1.1 m with its ±) and judges it as `mrtmap coverage` does.
+//! 4. [`LiveState`] (`/state.json`) is sent out at least every [`STATE_EVERY_S`]; the advice is
+//!    worded from the camera's pose at that moment. A new 3D view page follows each refresh.
+//! 5. When the recording has not grown for `exit_when_idle_s`, or on a stop request, the whole run
+//!    is made into `out` by [`crate::Pipeline::run`], exactly as `mrtmap run` makes it.
+
+mod follow;
+pub mod replay;
+
+use std::collections::VecDeque;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant, SystemTime};
+
+use mrtmap_geometry::nalgebra::Isometry3;
+use mrtmap_io::{Recording, Trajectory};
+use mrtmap_radiation::RadiantScene;
+use mrtmap_scan::{Fused, LiveFusion};
+use serde::Serialize;
+
+use crate::advice::Advice;
+use crate::coverage::{Coverage, coarse, judge};
+use crate::error::{Error, Result};
+use crate::layout::RunLayout;
+use crate::maps::{GridSpec, make_map};
+use crate::run::{MapResult, RunOutcome, SegmentInputs, segment_into, write_fused};
+use crate::settings::Project;
+
+/// How often the folder is read (s).
+const POLL_S: f64 = 0.1;
+
+/// The state is sent at least this often (s).
+pub const STATE_EVERY_S: f64 = 1.0;
+
+/// Thermal frames a refresh textures the room model from at most (evenly spread over the scan):
+/// texturing reads each, and the scan grows.
+const TEXTURE_FRAMES: usize = 60;
+
+/// Frame latencies kept for the state's median.
+const LATENCIES_KEPT: usize = 300;
+
+/// What `mrtmap live` is asked.
+#[derive(Clone, Debug)]
+pub struct LiveOptions {
+    /// The map's target (K, 2σ).
+    pub target_k: f64,
+    /// Stop following once the recording has not grown for this long (s).
+    pub exit_when_idle_s: Option<f64>,
+    /// The room model and the map are refreshed this often at most (s).
+    pub refresh_s: f64,
+}
+
+impl Default for LiveOptions {
+    fn default() -> Self {
+        LiveOptions {
+            target_k: crate::coverage::DEFAULT_TARGET_K,
+            exit_when_idle_s: None,
+            refresh_s: 2.0,
+        }
+    }
+}
+
+/// One surface's share seen so far.
+#[derive(Clone, Debug, Serialize)]
+pub struct SurfaceSeen {
+    /// Its id (segment.json's).
+    pub id: String,
+    /// Its name for people in the room.
+    pub name: String,
+    /// Share seen (with depth or by texturing).
+    pub seen: f64,
+    /// Never seen: placed at the floor's edge.
+    pub inferred: bool,
+}
+
+/// The camera's pose now (the trajectory's last pose).
+#[derive(Clone, Debug, Serialize)]
+pub struct CameraNow {
+    /// Its time (s).
+    pub t: f64,
+    /// Its position in the scan's frame (m).
+    pub position: [f64; 3],
+    /// Its orientation in the scan's frame (x, y, z, w).
+    pub rotation_xyzw: [f64; 4],
+    /// Its position in the room's frame (m), once the room is put together.
+    pub position_room: Option<[f64; 3]>,
+}
+
+/// What `mrtmap live` knows now (`GET /state.json`).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct LiveState {
+    /// "following", "final run", "done" or "failed".
+    pub phase: String,
+    /// Thermal frames listed (taken or waiting for their file).
+    pub frames_received: usize,
+    /// Thermal frames fused.
+    pub frames_fused: usize,
+    /// Thermal frames taken (fused or skipped).
+    pub frames_taken: usize,
+    /// Scan time between the newest thermal frame listed and the newest taken (s).
+    pub behind_s: f64,
+    /// Each surface's share seen, at the last refresh.
+    pub surfaces: Vec<SurfaceSeen>,
+    /// "keep scanning" or "enough for ±0.2 K" (with the target).
+    pub verdict: String,
+    /// Whether the scan is enough for the target.
+    pub good_enough: bool,
+    /// Why not, most important first.
+    pub reasons: Vec<String>,
+    /// The largest standard error of the coarse map (K, 1σ; its ± is twice that), at the last
+    /// refresh.
+    pub map_max_std_error_k: Option<f64>,
+    /// The coarse map's nodes at the last refresh: x, y, z (room frame, m) and MRT (°C).
+    pub map_nodes: Vec<[f64; 4]>,
+    /// Where to point the camera, from where it is now.
+    pub advice: Vec<Advice>,
+    /// The camera's pose now.
+    pub camera: Option<CameraNow>,
+    /// What was skipped and why (lines, frames, files), the first ones.
+    pub warnings: Vec<String>,
+    /// How many warnings in all.
+    pub warning_count: usize,
+    /// Seconds from a thermal file written to its frame fused: median of the recent frames.
+    pub latency_median_s: Option<f64>,
+    /// … and the largest of them.
+    pub latency_max_s: Option<f64>,
+    /// Refreshes of the room model done.
+    pub refreshes: usize,
+    /// Seconds the last refresh took.
+    pub refresh_took_s: Option<f64>,
+    /// Longest time between two refreshes while frames were being fused (s).
+    pub refresh_gap_max_s: Option<f64>,
+    /// The view page's version (it changes with each refresh).
+    pub view_version: usize,
+    /// Seconds since following began.
+    pub elapsed_s: f64,
+    /// The process's resident memory (MB; Linux).
+    pub rss_mb: Option<f64>,
+}
+
+/// Where `mrtmap live` sends what it knows.
+pub trait LiveSink: Sync {
+    /// The state now.
+    fn state(&self, state: &LiveState);
+    /// A new 3D view page (after a refresh).
+    fn view(&self, html: String);
+}
+
+/// What a refresh made.
+struct Refreshed {
+    outcome: RunOutcome,
+    nodes: Vec<[f64; 4]>,
+    view: String,
+    secs: f64,
+}
+
+/// The resident memory of this process (MB), where /proc says it.
+fn rss_mb() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/self/status").ok()?;
+    let kb: f64 = s
+        .lines()
+        .find(|l| l.starts_with("VmRSS:"))?
+        .split_whitespace()
+        .nth(1)?
+        .parse()
+        .ok()?;
+    Some(kb / 1024.0)
+}
+
+/// The coarse pipeline on a snapshot: the fusion written into `work` as a run's fuse folder,
+/// segmented, levelled and mapped; and the 3D view page of it.
+fn refresh(rec: &Recording, mut fused: Fused, p: &Project, work: &Path) -> Result<Refreshed> {
+    let t0 = Instant::now();
+    let run = RunLayout::new(work);
+    let keep = mrtmap_report::view3d::evenly_spaced(fused.frames.len(), TEXTURE_FRAMES);
+    fused.frames = keep.iter().map(|&i| fused.frames[i].clone()).collect();
+    write_fused(rec, &p.fuse.params()?, &fused, run.fuse().dir())?;
+    let inputs = SegmentInputs {
+        recording: Some(rec),
+        masks: false,
+        texture: p.segment.texture,
+    };
+    let level = crate::level::LevelInputs::of(rec, p)?;
+    let segment = segment_into(
+        run.fuse().dir(),
+        &inputs,
+        &p.segment.params(&p.room),
+        &level,
+        run.segment().dir(),
+    )?;
+    let scene = RadiantScene::load(&run.scene_json())?;
+    let h = p.map.heights_m.first().copied().unwrap_or(1.1);
+    let spec = GridSpec {
+        nx: p.map.grid[0],
+        ny: p.map.grid[1],
+        height_m: h,
+        margin_m: p.map.margin_m,
+    };
+    let m = make_map(&scene, "the scan so far", &p.mrt, spec, &[], run.map(h).dir())?;
+    let outcome = RunOutcome {
+        stages: Vec::new(),
+        track: None,
+        scene,
+        fusion: fused.report,
+        segment,
+        maps: vec![MapResult {
+            summary: m.summary,
+            png: m.png,
+            csv: RunLayout::name_in_run(|r| r.mrt_grid_csv(h)),
+        }],
+        comfort: None,
+        level: crate::cache::read_json(&run.level_json()).ok(),
+        warnings: Vec::new(),
+    };
+    let cloud = crate::export::run_cloud(work, &outcome.scene);
+    let view = crate::report::view3d_for_run(work, &outcome, cloud.as_ref());
+    Ok(Refreshed {
+        nodes: crate::maps::read_grid_nodes(&work.join(&outcome.maps[0].csv))?,
+        view: mrtmap_report::view3d_page(&view, &[], &[h]),
+        outcome,
+        secs: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// The state's part that comes from the last refresh, with the advice from the camera now.
+fn judged(
+    state: &mut LiveState,
+    o: &RunOutcome,
+    target_k: f64,
+    start: Option<&Isometry3<f64>>,
+    camera: Option<&Isometry3<f64>>,
+) {
+    let c: Coverage = judge(o, target_k, start, camera);
+    let namer = crate::advice::Namer::new(&o.scene, start.copied());
+    state.surfaces = c
+        .surfaces
+        .iter()
+        .map(|s| SurfaceSeen {
+            id: s.id.clone(),
+            name: match o.scene.surfaces.iter().find(|x| x.id == s.id) {
+                Some(x) if x.kind == mrtmap_radiation::SurfaceKind::Wall => namer.wall(&s.id),
+                _ => s.id.clone(),
+            },
+            seen: 1.0 - s.unseen,
+            inferred: s.inferred,
+        })
+        .collect();
+    state.good_enough = c.good_enough;
+    state.verdict = if c.good_enough {
+        format!("enough for ±{} K", target_k)
+    } else {
+        "keep scanning".to_string()
+    };
+    state.reasons = c.reasons;
+    state.advice = c.advice;
+    let field = o.maps.first().and_then(|m| m.summary.map.field.as_ref());
+    state.map_max_std_error_k = field.map(|f| f.max_std_error_k);
+}
+
+/// The camera's pose now, in the state's words.
+fn camera_now(traj: &Trajectory, scene: Option<&RadiantScene>) -> Option<CameraNow> {
+    let (t, p) = (traj.stamps.last()?, traj.poses.last()?);
+    let q = p.rotation.coords;
+    let room = scene
+        .and_then(|s| s.world_from_room)
+        .map(|w| (w.inverse() * p).translation.vector.into());
+    Some(CameraNow {
+        t: *t,
+        position: p.translation.vector.into(),
+        rotation_xyzw: [q.x, q.y, q.z, q.w],
+        position_room: room,
+    })
+}
+
+/// Follows `recording` as it is written, sending what is known to `sink`, until it stops growing
+/// for `opts.exit_when_idle_s` or `stop` is set; then makes the whole run into `out` with
+/// `pipeline` (as `mrtmap run`) and returns it.
+pub fn live(
+    pipeline: &crate::Pipeline<'_>,
+    recording: &Path,
+    out: &Path,
+    opts: &LiveOptions,
+    stop: &AtomicBool,
+    sink: &dyn LiveSink,
+) -> Result<crate::report::RunDone> {
+    let p = coarse(pipeline.project());
+    crate::run::check_out_dir(out)?;
+    let params = p.fuse.params()?;
+    let fixed_offset = match params.clock {
+        mrtmap_scan::clock::ClockOffset::Fixed(o) => Some(o),
+        mrtmap_scan::clock::ClockOffset::Off => Some(0.0),
+        _ => None,
+    };
+    let mut follower = follow::Follower::new(recording, fixed_offset)?;
+    let work = tempfile::tempdir().map_err(|e| mrtmap_io::FileError::io(Path::new("a temporary folder"), e))?;
+    let mut fusion = LiveFusion::new(&params);
+    let t0 = Instant::now();
+    let mut state = LiveState {
+        phase: "following".into(),
+        verdict: "keep scanning".into(),
+        ..LiveState::default()
+    };
+    let mut written: VecDeque<(usize, SystemTime)> = VecDeque::new();
+    let mut latencies: VecDeque<f64> = VecDeque::new();
+    let mut job: Option<JoinHandle<Result<Refreshed>>> = None;
+    let mut last: Option<RunOutcome> = None;
+    let (mut last_refresh, mut last_state) = (Instant::now(), Instant::now() - Duration::from_secs(10));
+    let mut fused_at_refresh = 0;
+    let mut refresh_problem: Option<String> = None;
+    loop {
+        let round = Instant::now();
+        follower.poll();
+        written.extend(follower.taken.iter().map(|t| (t.index, t.written)));
+        let adv = fusion.advance(&follower.rec);
+        let now = SystemTime::now();
+        for i in &adv.taken {
+            while let Some(&(k, w)) = written.front() {
+                if k > *i {
+                    break;
+                }
+                written.pop_front();
+                if k == *i {
+                    latencies.push_back(now.duration_since(w).map_or(0.0, |d| d.as_secs_f64()));
+                    if latencies.len() > LATENCIES_KEPT {
+                        latencies.pop_front();
+                    }
+                }
+            }
+        }
+        if job.as_ref().is_some_and(|j| j.is_finished()) {
+            match job.take().map(|j| j.join()) {
+                Some(Ok(Ok(r))) => {
+                    state.refreshes += 1;
+                    state.refresh_took_s = Some(r.secs);
+                    state.view_version += 1;
+                    sink.view(r.view);
+                    state.map_nodes = r.nodes;
+                    last = Some(r.outcome);
+                    refresh_problem = None;
+                }
+                Some(Ok(Err(e))) => refresh_problem = Some(e.to_string()),
+                Some(Err(_)) | None => refresh_problem = Some("the refresh stopped unexpectedly".into()),
+            }
+        }
+        let due = last_refresh.elapsed().as_secs_f64() >= opts.refresh_s;
+        if job.is_none() && due && fusion.fused() > fused_at_refresh && fusion.fused() >= 10 {
+            let gap = last_refresh.elapsed().as_secs_f64();
+            if state.refreshes > 0 {
+                state.refresh_gap_max_s = Some(state.refresh_gap_max_s.unwrap_or(0.0).max(gap));
+            }
+            last_refresh = Instant::now();
+            fused_at_refresh = fusion.fused();
+            let (rec, snap, p2, dir) = (follower.rec.clone(), fusion.snapshot(), p.clone(), work.path().to_path_buf());
+            job = Some(std::thread::spawn(move || refresh(&rec, snap, &p2, &dir)));
+        }
+        let idle = opts
+            .exit_when_idle_s
+            .is_some_and(|s| follower.last_growth.elapsed().as_secs_f64() > s);
+        let stopping = idle || stop.load(Ordering::Relaxed);
+        if stopping || last_state.elapsed().as_secs_f64() >= STATE_EVERY_S - POLL_S / 2.0 {
+            last_state = Instant::now();
+            update_state(&mut state, &follower, &fusion, &latencies, last.as_ref(), opts, &refresh_problem);
+            state.elapsed_s = t0.elapsed().as_secs_f64();
+            state.rss_mb = rss_mb();
+            sink.state(&state);
+        }
+        if stopping {
+            break;
+        }
+        let spent = round.elapsed().as_secs_f64();
+        std::thread::sleep(Duration::from_secs_f64((POLL_S - spent).max(0.005)));
+    }
+    if let Some(j) = job.take() {
+        let _ = j.join();
+    }
+    state.phase = "final run".into();
+    sink.state(&state);
+    let done = pipeline.run(recording, out);
+    state.phase = if done.is_ok() { "done" } else { "failed" }.into();
+    sink.state(&state);
+    done
+}
+
+/// The state from the follower, the fusion and the last refresh.
+fn update_state(
+    state: &mut LiveState,
+    follower: &follow::Follower,
+    fusion: &LiveFusion,
+    latencies: &VecDeque<f64>,
+    last: Option<&RunOutcome>,
+    opts: &LiveOptions,
+    refresh_problem: &Option<String>,
+) {
+    let rec = &follower.rec;
+    state.frames_received = follower.thermal_received();
+    state.frames_fused = fusion.fused();
+    state.frames_taken = fusion.taken();
+    state.behind_s = match (rec.thermal.last(), fusion.taken().checked_sub(1)) {
+        (Some(newest), Some(k)) => (newest.t - rec.thermal[k].t).max(0.0),
+        (Some(newest), None) => newest.t - rec.thermal[0].t,
+        _ => 0.0,
+    };
+    let mut l: Vec<f64> = latencies.iter().copied().collect();
+    l.sort_by(f64::total_cmp);
+    state.latency_median_s = l.get(l.len() / 2).copied();
+    state.latency_max_s = l.last().copied();
+    let camera = rec.trajectory.poses.last();
+    let start = rec.trajectory.poses.first();
+    state.camera = camera_now(&rec.trajectory, last.map(|o| &o.scene));
+    if let Some(o) = last {
+        judged(state, o, opts.target_k, start, camera);
+    }
+    state.warnings = follower.warnings.clone();
+    let problems = &fusion_problems(fusion);
+    state.warnings.extend(problems.iter().cloned());
+    state.warning_count = follower.warning_count + problems.len();
+    if let Some(why) = refresh_problem {
+        state.good_enough = false;
+        state.verdict = "keep scanning".into();
+        state.reasons = vec![format!("the room could not be put together yet: {why}")];
+    } else if last.is_none() {
+        state.reasons = vec!["the room is not put together yet: keep scanning".into()];
+    }
+}
+
+/// The frames fusion could not read, in words.
+fn fusion_problems(fusion: &LiveFusion) -> Vec<String> {
+    fusion.problems().iter().map(|p| format!("fusion skipped a frame: {p}")).collect()
+}
+
+/// The folder a live run's final outputs go to, checked before following begins.
+pub fn check_live_out(recording: &Path, out: &Path) -> Result<PathBuf> {
+    crate::run::check_out_dir(out)?;
+    crate::run::check_out_apart(recording, out)?;
+    if !recording.join("rig.toml").is_file() {
+        return Err(Error::source(
+            &recording.join("rig.toml"),
+            "is missing: a recording followed live must have its rig.toml from the start (the recorder writes it first)",
+        ));
+    }
+    Ok(out.to_path_buf())
+}
