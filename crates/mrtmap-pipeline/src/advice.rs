@@ -154,12 +154,8 @@ impl<'a> Namer<'a> {
                 .filter(|w| w.kind == SurfaceKind::Wall)
         };
         let feature = Self::main_feature(s);
-        let unique = feature.is_some_and(|f| {
-            walls()
-                .filter(|w| Self::main_feature(w) == Some(f))
-                .count()
-                == 1
-        });
+        let unique = feature
+            .is_some_and(|f| walls().filter(|w| Self::main_feature(w) == Some(f)).count() == 1);
         let place = self.from_start(&centroid(&s.polygon));
         match (feature, unique, place) {
             (Some(f), true, _) => format!("the wall with the {f} ({id})"),
@@ -326,13 +322,22 @@ mod tests {
     #[test]
     fn the_turn_is_read_from_the_camera_heading_and_pitch() {
         let c = camera_along_x();
-        assert_eq!(turn_towards(&c, &Point3::new(5.0, 2.0, 1.5)), "straight ahead");
-        assert_eq!(turn_towards(&c, &Point3::new(2.0, 5.0, 1.5)), "turn left about 90°");
+        assert_eq!(
+            turn_towards(&c, &Point3::new(5.0, 2.0, 1.5)),
+            "straight ahead"
+        );
+        assert_eq!(
+            turn_towards(&c, &Point3::new(2.0, 5.0, 1.5)),
+            "turn left about 90°"
+        );
         assert_eq!(
             turn_towards(&c, &Point3::new(2.0, -1.0, 1.5)),
             "turn right about 90°"
         );
-        assert_eq!(turn_towards(&c, &Point3::new(-2.0, 2.1, 1.5)), "turn around");
+        assert_eq!(
+            turn_towards(&c, &Point3::new(-2.0, 2.1, 1.5)),
+            "turn around"
+        );
         assert_eq!(turn_towards(&c, &Point3::new(3.0, 2.0, 2.8)), "look up");
         assert_eq!(
             turn_towards(&c, &Point3::new(2.0, 4.0, 3.5)),

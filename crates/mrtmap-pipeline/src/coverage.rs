@@ -96,7 +96,8 @@ pub fn coverage(
 ) -> Result<Coverage> {
     match run(recording, out, &coarse(base), false, progress) {
         Ok(o) => {
-            let poses = mrtmap_io::Trajectory::read(&crate::RunLayout::new(out).fuse().poses_txt()).ok();
+            let poses =
+                mrtmap_io::Trajectory::read(&crate::RunLayout::new(out).fuse().poses_txt()).ok();
             let start = poses.and_then(|t| t.poses.first().copied());
             Ok(judge(&o, target_k, start.as_ref(), None))
         }

@@ -73,7 +73,8 @@ impl LiveFusion {
     pub fn advance(&mut self, rec: &Recording) -> Advance {
         if self.rays.is_none() {
             if self.params.depth.stride == 0 {
-                self.params.depth.stride = DepthSampling::auto_stride(&rec.rig.depth, &rec.rig.thermal);
+                self.params.depth.stride =
+                    DepthSampling::auto_stride(&rec.rig.depth, &rec.rig.thermal);
                 self.fuser.params = self.params;
                 self.fuser.report.parameters = self.params;
             }
@@ -116,7 +117,8 @@ impl LiveFusion {
             let rays = self.rays.as_ref().expect("set above");
             let chunks: Vec<&[(usize, usize)]> = usable.chunks(self.params.chunk.max(1)).collect();
             let total = rec.thermal.len() as u64;
-            self.fuser.run(rec, rays, &chunks, total, &|_, _| {}, &|_| false);
+            self.fuser
+                .run(rec, rays, &chunks, total, &|_, _| {}, &|_| false);
         }
         self.fuser.report.thermal_frames = rec.thermal.len();
         self.fuser.report.depth_frames = rec.depth.len();

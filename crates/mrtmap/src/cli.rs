@@ -63,6 +63,12 @@ pub enum Command {
     /// On site: is a scan good enough for a ±0.2 K map, and if not, where to point the camera (a
     /// coarse run: walls never seen, each surface's coverage, the unseen areas that matter most).
     Coverage(CoverageArgs),
+    /// On site, live: follow a recording as it is written, serve a page showing the room filling
+    /// in, what is missing and when it is enough; then make the full run.
+    Live(LiveArgs),
+    /// Write a finished recording into a new folder at its own pace, as a recorder would (to try
+    /// `mrtmap live` without a rig).
+    Replay(ReplayArgs),
     /// Simulate the office scan, run the pipeline and compare with the truth (the seed paper's table).
     Demo(DemoArgs),
     /// Compare a map with black-globe readings (ISO 7726 and mixed convection).
@@ -358,6 +364,51 @@ pub struct CoverageArgs {
     /// Print JSON instead of text.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `mrtmap live`.
+#[derive(Debug, Args)]
+pub struct LiveArgs {
+    /// The recording folder a recorder is writing: rig.toml from the start, the lists growing by
+    /// appended lines, each line's file written before the line.
+    pub recording: PathBuf,
+    /// Where to serve the page (ADDRESS:PORT; port 0 picks a free port, printed at the start).
+    #[arg(long, value_name = "ADDR", default_value = "127.0.0.1:8080")]
+    pub serve: String,
+    /// Output folder of the full run made when following ends (what `mrtmap run` makes).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// A project file (TOML): the full run's settings (the live preview makes them coarse).
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// The map's target (K, 2σ) the verdict is given against.
+    #[arg(
+        long = "target-k",
+        default_value_t = 0.2,
+        allow_negative_numbers = true
+    )]
+    pub target_k: f64,
+    /// Stop following once the recording has not grown for this many seconds (default: follow
+    /// until Ctrl-C); then make the full run and exit.
+    #[arg(
+        long = "exit-when-idle",
+        value_name = "SECONDS",
+        allow_negative_numbers = true
+    )]
+    pub exit_when_idle: Option<f64>,
+}
+
+/// `mrtmap replay`.
+#[derive(Debug, Args)]
+pub struct ReplayArgs {
+    /// The finished recording folder.
+    pub recording: PathBuf,
+    /// The new folder to write it into (must not exist yet, or be empty).
+    #[arg(long, value_name = "DIR")]
+    pub into: PathBuf,
+    /// How many times the scan's own pace (1: as recorded).
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    pub speed: f64,
 }
 
 /// `mrtmap demo`.

@@ -10,6 +10,7 @@ mod cli;
 mod commands;
 
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use clap::Parser;
 
@@ -48,10 +49,23 @@ pub fn report_error(e: &anyhow::Error) -> ExitCode {
     ExitCode::FAILURE
 }
 
+/// Set by a command that stops gracefully on a first Ctrl-C (`live`: the full run is still made).
+pub(crate) static STOP_GRACEFULLY: AtomicBool = AtomicBool::new(false);
+
+/// Set by the first Ctrl-C when [`STOP_GRACEFULLY`] is.
+pub(crate) static STOP: AtomicBool = AtomicBool::new(false);
+
 /// Ctrl-C: says what is left (outputs are written whole or not at all, and finished stages are
-/// reused), then exits as a shell expects of an interrupted program (130).
+/// reused), then exits as a shell expects of an interrupted program (130). Under `live` the first
+/// Ctrl-C asks it to stop following and make the full run; a second one exits at once.
 pub fn on_interrupt_say_what_is_left() {
     let _ = ctrlc::set_handler(|| {
+        if STOP_GRACEFULLY.load(Ordering::SeqCst) && !STOP.swap(true, Ordering::SeqCst) {
+            eprintln!(
+                "\nstopping: following ends and the full run is made; press Ctrl-C again to stop at once (every file already written stays complete)"
+            );
+            return;
+        }
         eprintln!(
             "\ninterrupted: every file already written is complete (outputs are written whole or not at all); run the same command again and the stages that finished are reused"
         );

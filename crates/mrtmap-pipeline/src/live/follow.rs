@@ -203,7 +203,9 @@ impl Follower {
             return false;
         };
         let mut bytes = Vec::new();
-        if f.seek(SeekFrom::Start(self.tails[k].offset)).is_err() || f.read_to_end(&mut bytes).is_err() {
+        if f.seek(SeekFrom::Start(self.tails[k].offset)).is_err()
+            || f.read_to_end(&mut bytes).is_err()
+        {
             return false;
         }
         let Some(end) = bytes.iter().rposition(|&b| b == b'\n') else {
@@ -275,7 +277,10 @@ impl Follower {
             Ok(_) => {}
             Err(e) => self.warn(format!(
                 "trajectory.txt line {n}: {}: skipped",
-                e.to_string().rsplit(": ").next().unwrap_or("cannot be read")
+                e.to_string()
+                    .rsplit(": ")
+                    .next()
+                    .unwrap_or("cannot be read")
             )),
         }
     }

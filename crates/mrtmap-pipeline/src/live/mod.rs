@@ -159,7 +159,8 @@ pub trait LiveSink: Sync {
 struct Refreshed {
     outcome: RunOutcome,
     nodes: Vec<[f64; 4]>,
-    view: String,
+    view: mrtmap_report::view3d::View3d,
+    height_m: f64,
     secs: f64,
 }
 
@@ -205,7 +206,14 @@ fn refresh(rec: &Recording, mut fused: Fused, p: &Project, work: &Path) -> Resul
         height_m: h,
         margin_m: p.map.margin_m,
     };
-    let m = make_map(&scene, "the scan so far", &p.mrt, spec, &[], run.map(h).dir())?;
+    let m = make_map(
+        &scene,
+        "the scan so far",
+        &p.mrt,
+        spec,
+        &[],
+        run.map(h).dir(),
+    )?;
     let outcome = RunOutcome {
         stages: Vec::new(),
         track: None,
@@ -225,7 +233,8 @@ fn refresh(rec: &Recording, mut fused: Fused, p: &Project, work: &Path) -> Resul
     let view = crate::report::view3d_for_run(work, &outcome, cloud.as_ref());
     Ok(Refreshed {
         nodes: crate::maps::read_grid_nodes(&work.join(&outcome.maps[0].csv))?,
-        view: mrtmap_report::view3d_page(&view, &[], &[h]),
+        view,
+        height_m: h,
         outcome,
         secs: t0.elapsed().as_secs_f64(),
     })
@@ -266,6 +275,31 @@ fn judged(
     state.map_max_std_error_k = field.map(|f| f.max_std_error_k);
 }
 
+/// The 3D view page of a refresh: the advice's points numbered as the page lists them, and the
+/// camera.
+fn view_page(r: &Refreshed, traj: &Trajectory, target_k: f64) -> String {
+    use mrtmap_report::view3d::ViewMark;
+    let c = judge(&r.outcome, target_k, traj.poses.first(), traj.poses.last());
+    let mut marks: Vec<ViewMark> = c
+        .advice
+        .iter()
+        .enumerate()
+        .map(|(k, a)| ViewMark {
+            text: format!("{}", k + 1),
+            xyz: a.point,
+            kind: "point",
+        })
+        .collect();
+    if let Some(at) = camera_now(traj, Some(&r.outcome.scene)).and_then(|c| c.position_room) {
+        marks.push(ViewMark {
+            text: "camera".into(),
+            xyz: at,
+            kind: "globe",
+        });
+    }
+    mrtmap_report::view3d_page(&r.view, &marks, &[r.height_m])
+}
+
 /// The camera's pose now, in the state's words.
 fn camera_now(traj: &Trajectory, scene: Option<&RadiantScene>) -> Option<CameraNow> {
     let (t, p) = (traj.stamps.last()?, traj.poses.last()?);
@@ -301,7 +335,8 @@ pub fn live(
         _ => None,
     };
     let mut follower = follow::Follower::new(recording, fixed_offset)?;
-    let work = tempfile::tempdir().map_err(|e| mrtmap_io::FileError::io(Path::new("a temporary folder"), e))?;
+    let work = tempfile::tempdir()
+        .map_err(|e| mrtmap_io::FileError::io(Path::new("a temporary folder"), e))?;
     let mut fusion = LiveFusion::new(&params);
     let t0 = Instant::now();
     let mut state = LiveState {
@@ -313,7 +348,8 @@ pub fn live(
     let mut latencies: VecDeque<f64> = VecDeque::new();
     let mut job: Option<JoinHandle<Result<Refreshed>>> = None;
     let mut last: Option<RunOutcome> = None;
-    let (mut last_refresh, mut last_state) = (Instant::now(), Instant::now() - Duration::from_secs(10));
+    let (mut last_refresh, mut last_state) =
+        (Instant::now(), Instant::now() - Duration::from_secs(10));
     let mut fused_at_refresh = 0;
     let mut refresh_problem: Option<String> = None;
     loop {
@@ -342,13 +378,15 @@ pub fn live(
                     state.refreshes += 1;
                     state.refresh_took_s = Some(r.secs);
                     state.view_version += 1;
-                    sink.view(r.view);
+                    sink.view(view_page(&r, &follower.rec.trajectory, opts.target_k));
                     state.map_nodes = r.nodes;
                     last = Some(r.outcome);
                     refresh_problem = None;
                 }
                 Some(Ok(Err(e))) => refresh_problem = Some(e.to_string()),
-                Some(Err(_)) | None => refresh_problem = Some("the refresh stopped unexpectedly".into()),
+                Some(Err(_)) | None => {
+                    refresh_problem = Some("the refresh stopped unexpectedly".into())
+                }
             }
         }
         let due = last_refresh.elapsed().as_secs_f64() >= opts.refresh_s;
@@ -359,7 +397,12 @@ pub fn live(
             }
             last_refresh = Instant::now();
             fused_at_refresh = fusion.fused();
-            let (rec, snap, p2, dir) = (follower.rec.clone(), fusion.snapshot(), p.clone(), work.path().to_path_buf());
+            let (rec, snap, p2, dir) = (
+                follower.rec.clone(),
+                fusion.snapshot(),
+                p.clone(),
+                work.path().to_path_buf(),
+            );
             job = Some(std::thread::spawn(move || refresh(&rec, snap, &p2, &dir)));
         }
         let idle = opts
@@ -368,7 +411,15 @@ pub fn live(
         let stopping = idle || stop.load(Ordering::Relaxed);
         if stopping || last_state.elapsed().as_secs_f64() >= STATE_EVERY_S - POLL_S / 2.0 {
             last_state = Instant::now();
-            update_state(&mut state, &follower, &fusion, &latencies, last.as_ref(), opts, &refresh_problem);
+            update_state(
+                &mut state,
+                &follower,
+                &fusion,
+                &latencies,
+                last.as_ref(),
+                opts,
+                &refresh_problem,
+            );
             state.elapsed_s = t0.elapsed().as_secs_f64();
             state.rss_mb = rss_mb();
             sink.state(&state);
@@ -434,7 +485,11 @@ fn update_state(
 
 /// The frames fusion could not read, in words.
 fn fusion_problems(fusion: &LiveFusion) -> Vec<String> {
-    fusion.problems().iter().map(|p| format!("fusion skipped a frame: {p}")).collect()
+    fusion
+        .problems()
+        .iter()
+        .map(|p| format!("fusion skipped a frame: {p}"))
+        .collect()
 }
 
 /// The folder a live run's final outputs go to, checked before following begins.

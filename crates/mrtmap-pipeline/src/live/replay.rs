@@ -70,7 +70,11 @@ fn events(rec: &Recording) -> Vec<Event> {
     }
     for s in &rec.imu {
         let text = mrtmap_io::imu_text(std::slice::from_ref(s), "");
-        let line = text.lines().find(|l| !l.starts_with('#')).unwrap_or("").to_string();
+        let line = text
+            .lines()
+            .find(|l| !l.starts_with('#'))
+            .unwrap_or("")
+            .to_string();
         ev.push(Event {
             t: s.t,
             list: "imu.txt",
@@ -106,7 +110,11 @@ pub fn replay(
         ));
     }
     let rec = Recording::open(from)?;
-    if into.exists() && std::fs::read_dir(into).map(|mut d| d.next().is_some()).unwrap_or(true) {
+    if into.exists()
+        && std::fs::read_dir(into)
+            .map(|mut d| d.next().is_some())
+            .unwrap_or(true)
+    {
         return Err(Error::source(
             into,
             "is not empty: a replay writes a new recording, so give a folder that does not exist yet",
@@ -124,8 +132,11 @@ pub fn replay(
         _ => (0.0, 0.0),
     };
     for list in ["depth.txt", "thermal.txt"] {
-        std::fs::write(into.join(list), format!("# replayed from {}\n", from.display()))
-            .map_err(|e| FileError::io(&into.join(list), e))?;
+        std::fs::write(
+            into.join(list),
+            format!("# replayed from {}\n", from.display()),
+        )
+        .map_err(|e| FileError::io(&into.join(list), e))?;
     }
     let start = Instant::now();
     let mut done = ReplayDone {

@@ -205,8 +205,18 @@ fn fusion_fed_as_the_recording_grows_makes_the_batch_cloud() {
     let mut taken = 0;
     for k in 1..=6 {
         let until = t0 + (t1 - t0) * f64::from(k) / 6.0;
-        grown.depth = whole.depth.iter().filter(|e| e.t <= until).cloned().collect();
-        grown.thermal = whole.thermal.iter().filter(|e| e.t <= until).cloned().collect();
+        grown.depth = whole
+            .depth
+            .iter()
+            .filter(|e| e.t <= until)
+            .cloned()
+            .collect();
+        grown.thermal = whole
+            .thermal
+            .iter()
+            .filter(|e| e.t <= until)
+            .cloned()
+            .collect();
         let n = whole.trajectory.stamps.partition_point(|&t| t <= until);
         grown.trajectory.stamps = whole.trajectory.stamps[..n].to_vec();
         grown.trajectory.poses = whole.trajectory.poses[..n].to_vec();
@@ -238,7 +248,12 @@ fn fusion_fed_as_the_recording_grows_makes_the_batch_cloud() {
         .positions
         .iter()
         .zip(&batch.cloud.temperature_k)
-        .map(|(p, t)| ([0, 1, 2].map(|i| (f64::from(p[i]) * 1e4).round() as i64), *t))
+        .map(|(p, t)| {
+            (
+                [0, 1, 2].map(|i| (f64::from(p[i]) * 1e4).round() as i64),
+                *t,
+            )
+        })
         .collect();
     let (mut matched, mut worst) = (0, 0.0f32);
     for (p, t) in snap.cloud.positions.iter().zip(&snap.cloud.temperature_k) {
@@ -248,6 +263,10 @@ fn fusion_fed_as_the_recording_grows_makes_the_batch_cloud() {
         }
     }
     eprintln!("matched {matched} of {}, worst {worst} K", snap.cloud.len());
-    assert!(matched * 10 > snap.cloud.len() * 8, "{matched} of {}", snap.cloud.len());
+    assert!(
+        matched * 10 > snap.cloud.len() * 8,
+        "{matched} of {}",
+        snap.cloud.len()
+    );
     assert!(worst < 0.05, "{worst} K");
 }

@@ -11,6 +11,7 @@ mod export;
 mod fuse;
 mod globe;
 mod inspect;
+mod live;
 mod map;
 mod mrt;
 mod rooms;
@@ -41,6 +42,8 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Segment(a) => segment::run(&a),
         Command::Run(a) => run::run(&a),
         Command::Coverage(a) => coverage::run(&a),
+        Command::Live(a) => live::run(&a),
+        Command::Replay(a) => live::replay(&a),
         Command::Demo(a) => demo::run(&a),
         Command::Validate(a) => validate::run(&a),
         Command::Calibrate(a) => calibrate::run(&a),
