@@ -338,3 +338,141 @@ impl Follower {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use std::io::Write;
+
+    use super::*;
+
+    const RIG: &str = "[depth]\nwidth = 8\nheight = 6\nfx = 5.0\nfy = 5.0\ncx = 3.5\ncy = 2.5\ndepth_scale = 1000.0\n\n[thermal]\nwidth = 4\nheight = 3\nfx = 2.0\nfy = 2.0\ncx = 1.5\ncy = 1.0\nencoding = \"centikelvin\"\n\n[thermal.depth_from_thermal]\ntranslation = [0.0, 0.0, 0.0]\nrotation_xyzw = [0.0, 0.0, 0.0, 1.0]\n";
+
+    fn append(dir: &Path, list: &str, text: &str) {
+        let mut f = OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(dir.join(list))
+            .unwrap();
+        f.write_all(text.as_bytes()).unwrap();
+    }
+
+    fn png(dir: &Path, rel: &str) {
+        let p = dir.join(rel);
+        std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+        image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_pixel(4, 3, image::Luma([29315]))
+            .save(&p)
+            .unwrap();
+    }
+
+    use std::fs::OpenOptions;
+
+    /// A line still being written is left for the next poll; a file that has not appeared holds
+    /// its list for MISSING_WAIT_S, then is skipped with a warning naming the line and the file;
+    /// a line that goes back in time is skipped and named; the stream goes on after each.
+    #[test]
+    fn half_lines_wait_and_bad_lines_are_named_and_skipped() {
+        let d = tempfile::tempdir().unwrap();
+        let dir = d.path();
+        std::fs::write(dir.join("rig.toml"), RIG).unwrap();
+        let mut f = Follower::new(dir, None).unwrap();
+        png(dir, "thermal/0.png");
+        append(
+            dir,
+            "thermal.txt",
+            "# header\n10.0 thermal/0.png\n10.1 ther",
+        );
+        f.poll();
+        assert_eq!(f.rec.thermal.len(), 1);
+        assert_eq!(f.taken.len(), 1);
+        png(dir, "thermal/1.png");
+        append(dir, "thermal.txt", "mal/1.png\n");
+        f.poll();
+        assert_eq!(f.rec.thermal.len(), 2, "the completed line is taken");
+        assert_eq!(f.rec.thermal[1].line, 3);
+        // A file that never appears, then a good frame behind it.
+        png(dir, "thermal/3.png");
+        append(
+            dir,
+            "thermal.txt",
+            "10.2 thermal/2.png\n10.3 thermal/3.png\n",
+        );
+        f.poll();
+        assert_eq!(f.rec.thermal.len(), 2, "the list waits for line 4's file");
+        assert_eq!(f.thermal_received(), 4);
+        std::thread::sleep(std::time::Duration::from_secs_f64(MISSING_WAIT_S + 0.1));
+        f.poll();
+        assert_eq!(f.rec.thermal.len(), 3);
+        assert!((f.rec.thermal[2].t - 10.3).abs() < 1e-12);
+        assert_eq!(f.warnings.len(), 1, "{:?}", f.warnings);
+        assert!(
+            f.warnings[0]
+                .contains("thermal.txt line 4 points to thermal/2.png, which has not appeared"),
+            "{}",
+            f.warnings[0]
+        );
+        // Back in time, and a line that is not 'timestamp path'.
+        png(dir, "thermal/4.png");
+        append(
+            dir,
+            "thermal.txt",
+            "9.0 thermal/0.png\nnonsense\n10.4 thermal/4.png\n",
+        );
+        f.poll();
+        assert_eq!(f.rec.thermal.len(), 4);
+        assert!(
+            f.warnings[1].contains("thermal.txt line 6: its time 9.000000 goes back"),
+            "{}",
+            f.warnings[1]
+        );
+        assert!(
+            f.warnings[2].contains("thermal.txt line 7: expected 'timestamp path'"),
+            "{}",
+            f.warnings[2]
+        );
+        // Poses: a half line waits, a pose back in time is named.
+        append(
+            dir,
+            "trajectory.txt",
+            "10.0 0 0 0 0 0 0 1\n10.1 0 0 0 0 0 0 1\n10.05 0 0 0 0 0 0 1\n10.2 0 0",
+        );
+        f.poll();
+        assert_eq!(f.rec.trajectory.len(), 2);
+        assert!(
+            f.warnings[3].contains("trajectory.txt line 3: its time 10.050000 goes back"),
+            "{}",
+            f.warnings[3]
+        );
+        append(dir, "trajectory.txt", " 0 0 0 0 1\n");
+        f.poll();
+        assert_eq!(f.rec.trajectory.len(), 3);
+        assert_eq!(f.warning_count, 4);
+    }
+
+    /// A PNG is taken only once it is whole (its end chunk written).
+    #[test]
+    fn a_frame_is_taken_once_its_file_is_whole() {
+        let d = tempfile::tempdir().unwrap();
+        let dir = d.path();
+        std::fs::write(dir.join("rig.toml"), RIG).unwrap();
+        let mut f = Follower::new(dir, Some(0.05)).unwrap();
+        png(dir, "depth/full.png");
+        let bytes = std::fs::read(dir.join("depth/full.png")).unwrap();
+        std::fs::write(dir.join("depth/0.png"), &bytes[..bytes.len() - 12]).unwrap();
+        append(dir, "depth.txt", "1.0 depth/0.png\n");
+        f.poll();
+        assert!(
+            f.rec.depth.is_empty(),
+            "a PNG without its end is waited for"
+        );
+        std::fs::write(dir.join("depth/0.png"), &bytes).unwrap();
+        f.poll();
+        assert_eq!(f.rec.depth.len(), 1);
+        // The thermal stamps are moved onto the depth clock by the offset given.
+        png(dir, "thermal/0.png");
+        append(dir, "thermal.txt", "2.0 thermal/0.png\n");
+        f.poll();
+        assert!((f.rec.thermal[0].t - 2.05).abs() < 1e-12);
+        assert!(f.warnings.is_empty(), "{:?}", f.warnings);
+    }
+}

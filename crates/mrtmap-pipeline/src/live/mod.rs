@@ -41,8 +41,8 @@ const POLL_S: f64 = 0.1;
 /// The state is sent at least this often (s).
 pub const STATE_EVERY_S: f64 = 1.0;
 
-/// Thermal frames a refresh textures the room model from at most (evenly spread over the scan):
-/// texturing reads each, and the scan grows.
+/// Thermal frames a refresh textures the room model from at most, and mask frames it labels
+/// features by (evenly spread over the scan): each is read at each refresh, and the scan grows.
 const TEXTURE_FRAMES: usize = 60;
 
 /// Frame latencies kept for the state's median.
@@ -187,7 +187,7 @@ fn refresh(rec: &Recording, mut fused: Fused, p: &Project, work: &Path) -> Resul
     write_fused(rec, &p.fuse.params()?, &fused, run.fuse().dir())?;
     let inputs = SegmentInputs {
         recording: Some(rec),
-        masks: false,
+        masks: p.segment.masks && !rec.masks.is_empty(),
         texture: p.segment.texture,
     };
     let level = crate::level::LevelInputs::of(rec, p)?;
@@ -383,7 +383,7 @@ pub fn live(
                     last = Some(r.outcome);
                     refresh_problem = None;
                 }
-                Some(Ok(Err(e))) => refresh_problem = Some(e.to_string()),
+                Some(Ok(Err(e))) => refresh_problem = Some(in_words(&e)),
                 Some(Err(_)) | None => {
                     refresh_problem = Some("the refresh stopped unexpectedly".into())
                 }
@@ -397,12 +397,10 @@ pub fn live(
             }
             last_refresh = Instant::now();
             fused_at_refresh = fusion.fused();
-            let (rec, snap, p2, dir) = (
-                follower.rec.clone(),
-                fusion.snapshot(),
-                p.clone(),
-                work.path().to_path_buf(),
-            );
+            let mut rec = follower.rec.clone();
+            let keep = mrtmap_report::view3d::evenly_spaced(rec.masks.len(), TEXTURE_FRAMES);
+            rec.masks = keep.iter().map(|&i| rec.masks[i].clone()).collect();
+            let (snap, p2, dir) = (fusion.snapshot(), p.clone(), work.path().to_path_buf());
             job = Some(std::thread::spawn(move || refresh(&rec, snap, &p2, &dir)));
         }
         let idle = opts
@@ -481,6 +479,21 @@ fn update_state(
     } else if last.is_none() {
         state.reasons = vec!["the room is not put together yet: keep scanning".into()];
     }
+}
+
+/// An error with its causes, in one line.
+fn in_words(e: &Error) -> String {
+    let mut s = e.to_string();
+    let mut cause = std::error::Error::source(e);
+    while let Some(c) = cause {
+        let c_s = c.to_string();
+        if !s.contains(&c_s) {
+            s.push_str(": ");
+            s.push_str(&c_s);
+        }
+        cause = c.source();
+    }
+    s
 }
 
 /// The frames fusion could not read, in words.
