@@ -4,6 +4,7 @@
 mod architecture;
 mod calibrate;
 mod cli;
+mod live;
 mod pipeline;
 mod readme;
 mod sources;

@@ -334,43 +334,11 @@ fn report_numbers_match_the_csv_and_it_renders() {
     assert!(
         (value("point-P") - summary["marks"][0]["mrt_c"].as_f64().unwrap()).abs() <= 0.005 + 1e-9
     );
-    // Headless Chromium (CI installs Debian's chromium and sets MRTMAP_REQUIRE_CHROMIUM).
-    let chromium = ["chromium", "chromium-browser", "google-chrome"]
-        .into_iter()
-        .find(|c| {
-            Command::new(c)
-                .arg("--version")
-                .output()
-                .is_ok_and(|o| o.status.success())
-        });
-    let Some(chromium) = chromium else {
-        assert!(
-            std::env::var_os("MRTMAP_REQUIRE_CHROMIUM").is_none(),
-            "MRTMAP_REQUIRE_CHROMIUM is set but no chromium was found"
-        );
-        eprintln!("chromium not installed: the rendering check was not run");
+    let Some(chrome) = Chrome::find(dir.path()) else {
         return;
     };
-    let profile = dir.path().join("chromium-profile");
-    let common = [
-        "--headless",
-        "--no-sandbox",
-        "--disable-gpu",
-        "--disable-quic",
-        "--no-first-run",
-        "--disable-background-networking",
-        "--disable-component-update",
-        "--disable-sync",
-    ];
     let url = format!("file://{}", out.join("report.html").display());
-    let chrome = |args: &[&str]| {
-        Command::new(chromium)
-            .args(common)
-            .arg(format!("--user-data-dir={}", profile.display()))
-            .args(args)
-            .output()
-            .unwrap()
-    };
+    let chrome = |args: &[&str]| chrome.run(args);
     let dom = chrome(&["--dump-dom", &url]);
     let dom = String::from_utf8_lossy(&dom.stdout);
     assert!(
@@ -449,7 +417,59 @@ fn report_numbers_match_the_csv_and_it_renders() {
 
 /// A 1000×800 screenshot of the 3D view is not blank, the room fills its middle, and both the
 /// cold window and the warm room show in their colours.
-fn assert_view3d_drawn(png: &Path) {
+/// Headless Chromium (CI installs Debian's chromium and sets MRTMAP_REQUIRE_CHROMIUM), with its
+/// own profile folder.
+pub struct Chrome {
+    program: &'static str,
+    profile: PathBuf,
+}
+
+impl Chrome {
+    /// Chromium when installed; `None` (and a word on stderr) when not, unless
+    /// MRTMAP_REQUIRE_CHROMIUM is set.
+    pub fn find(dir: &Path) -> Option<Self> {
+        let program = ["chromium", "chromium-browser", "google-chrome"]
+            .into_iter()
+            .find(|c| {
+                Command::new(c)
+                    .arg("--version")
+                    .output()
+                    .is_ok_and(|o| o.status.success())
+            });
+        if program.is_none() {
+            assert!(
+                std::env::var_os("MRTMAP_REQUIRE_CHROMIUM").is_none(),
+                "MRTMAP_REQUIRE_CHROMIUM is set but no chromium was found"
+            );
+            eprintln!("chromium not installed: the rendering check was not run");
+        }
+        Some(Chrome {
+            program: program?,
+            profile: dir.join("chromium-profile"),
+        })
+    }
+
+    /// Runs it headless with `args`.
+    pub fn run(&self, args: &[&str]) -> std::process::Output {
+        Command::new(self.program)
+            .args([
+                "--headless",
+                "--no-sandbox",
+                "--disable-gpu",
+                "--disable-quic",
+                "--no-first-run",
+                "--disable-background-networking",
+                "--disable-component-update",
+                "--disable-sync",
+            ])
+            .arg(format!("--user-data-dir={}", self.profile.display()))
+            .args(args)
+            .output()
+            .unwrap()
+    }
+}
+
+pub fn assert_view3d_drawn(png: &Path) {
     let img = image::open(png).unwrap().to_rgb8();
     let background = |p: &image::Rgb<u8>| {
         p.0.iter()

@@ -1,0 +1,283 @@
+//! `mrtmap live` following a scan replayed at its own pace (`mrtmap replay`), as a person on
+//! site would: the state answers every second and keeps up, the page loads in a browser, a bad
+//! frame is named and the view goes on, and the final run is `mrtmap run`'s.
+
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::TcpStream;
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use serde_json::Value;
+
+use crate::ok;
+use crate::pipeline::recording;
+
+/// GET `path` from the live server (HTTP/1.0: the server closes the connection after answering).
+fn get(addr: &str, path: &str) -> Option<(String, String)> {
+    let mut s = TcpStream::connect(addr).ok()?;
+    s.set_read_timeout(Some(Duration::from_secs(5))).ok()?;
+    s.write_all(format!("GET {path} HTTP/1.0\r\nHost: {addr}\r\n\r\n").as_bytes())
+        .ok()?;
+    let mut text = String::new();
+    s.read_to_string(&mut text).ok()?;
+    let (head, body) = text.split_once("\r\n\r\n")?;
+    Some((head.to_string(), body.to_string()))
+}
+
+/// The first `n` events of the state's stream.
+fn events(addr: &str, n: usize) -> Vec<Value> {
+    let mut s = TcpStream::connect(addr).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+    s.write_all(format!("GET /events HTTP/1.1\r\nHost: {addr}\r\n\r\n").as_bytes())
+        .unwrap();
+    let mut lines = BufReader::new(s).lines().map_while(Result::ok);
+    let head = lines.next().unwrap();
+    assert!(head.starts_with("HTTP/1.1 200"), "{head}");
+    let mut got = Vec::new();
+    let mut event = String::new();
+    for l in lines {
+        if let Some(e) = l.strip_prefix("event: ") {
+            event = e.to_string();
+        } else if let Some(d) = l.strip_prefix("data: ") {
+            assert_eq!(event, "state");
+            got.push(serde_json::from_str(d).unwrap());
+            if got.len() == n {
+                break;
+            }
+        }
+    }
+    got
+}
+
+/// Appends a thermal line whose file is a frame of another size, just after the newest line.
+fn inject_wrong_size_frame(rec: &Path) {
+    let list = std::fs::read_to_string(rec.join("thermal.txt")).unwrap();
+    let last: f64 = list
+        .lines()
+        .rev()
+        .find(|l| !l.starts_with('#'))
+        .and_then(|l| l.split_whitespace().next())
+        .and_then(|t| t.parse().ok())
+        .unwrap();
+    image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_pixel(40, 30, image::Luma([29315]))
+        .save(rec.join("thermal/wrong_size.png"))
+        .unwrap();
+    let mut f = std::fs::OpenOptions::new()
+        .append(true)
+        .open(rec.join("thermal.txt"))
+        .unwrap();
+    f.write_all(format!("{:.6} thermal/wrong_size.png\n", last + 0.001).as_bytes())
+        .unwrap();
+}
+
+#[test]
+fn live_follows_a_replayed_scan_and_ends_with_the_full_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("rec");
+    let out = dir.path().join("out");
+    let mut replay = Command::new(env!("CARGO_BIN_EXE_mrtmap"))
+        .args([
+            "replay",
+            recording().to_str().unwrap(),
+            "--into",
+            rec.to_str().unwrap(),
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let t0 = Instant::now();
+    while !rec.join("rig.toml").exists() && t0.elapsed() < Duration::from_secs(30) {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let mut live = Command::new(env!("CARGO_BIN_EXE_mrtmap"))
+        .args(["live", rec.to_str().unwrap(), "--serve", "127.0.0.1:0"])
+        .args(["--out", out.to_str().unwrap(), "--exit-when-idle", "3"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let (tx, rx) = std::sync::mpsc::channel::<String>();
+    let stderr = live.stderr.take().unwrap();
+    let reader = std::thread::spawn(move || {
+        let mut all = String::new();
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            let _ = tx.send(line.clone());
+            all.push_str(&line);
+            all.push('\n');
+        }
+        all
+    });
+    let first = rx.recv_timeout(Duration::from_secs(60)).unwrap();
+    let addr = first
+        .split("http://")
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .unwrap_or_else(|| panic!("no address in {first}"))
+        .to_string();
+    let (head, page) = get(&addr, "/").unwrap();
+    assert!(
+        head.starts_with("HTTP/1.") && head.contains(" 200 OK"),
+        "{head}"
+    );
+    assert!(
+        page.contains("<title>mrtmap live</title>") && page.contains("EventSource(\"/events\")")
+    );
+    assert!(
+        !page.contains("http://") && !page.contains("https://"),
+        "the page loads nothing from outside"
+    );
+    let (mut states, mut last_fused, mut worst_behind, mut injected, mut shot) =
+        (0, 0, 0.0f64, false, false);
+    let mut last: Value = Value::Null;
+    while live.try_wait().unwrap().is_none() {
+        let asked = Instant::now();
+        let Some((_, body)) = get(&addr, "/state.json") else {
+            // The server goes when the final run is done.
+            std::thread::sleep(Duration::from_millis(200));
+            continue;
+        };
+        assert!(
+            asked.elapsed() < Duration::from_secs(1),
+            "/state.json took {:?}",
+            asked.elapsed()
+        );
+        let s: Value = serde_json::from_str(&body).unwrap();
+        if s["phase"] == "following" {
+            states += 1;
+            let fused = s["frames_fused"].as_u64().unwrap();
+            assert!(
+                fused >= last_fused,
+                "frames_fused went back: {fused} < {last_fused}"
+            );
+            last_fused = fused;
+            worst_behind = worst_behind.max(s["behind_s"].as_f64().unwrap());
+            if !injected && fused > 60 {
+                inject_wrong_size_frame(&rec);
+                injected = true;
+            }
+            if states == 3 {
+                // Pushed: two states a second apart, without asking again.
+                let e = events(&addr, 2);
+                assert_eq!(e.len(), 2);
+                assert!(e[1]["elapsed_s"].as_f64() > e[0]["elapsed_s"].as_f64());
+            }
+            if !shot && s["refreshes"].as_u64().unwrap() >= 2 {
+                shot = true;
+                screenshot_live_page(&addr, dir.path());
+            }
+            last = s;
+        }
+        std::thread::sleep(Duration::from_secs(1).saturating_sub(asked.elapsed()));
+    }
+    let status = live.wait().unwrap();
+    let said = reader.join().unwrap();
+    assert!(status.success(), "mrtmap live failed: {said}");
+    assert!(replay.wait().unwrap().success());
+    // 20 s of scan at its own pace, answered every second.
+    assert!(states >= 15, "{states} states while following");
+    assert!(
+        worst_behind <= 3.0,
+        "fusion fell {worst_behind} s of scan behind"
+    );
+    assert!(last["refreshes"].as_u64().unwrap() >= 3, "{last}");
+    assert!(last["map_max_std_error_k"].as_f64().is_some(), "{last}");
+    assert!(last["camera"]["position"].is_array(), "{last}");
+    assert!(!last["surfaces"].as_array().unwrap().is_empty(), "{last}");
+    assert!(last["latency_median_s"].as_f64().unwrap() < 1.0, "{last}");
+    // The bad frame is named on the page's state and on the terminal, and fusion went on.
+    let named = |w: &Value| w.as_str().is_some_and(|w| w.contains("wrong_size.png"));
+    assert!(
+        last["warnings"].as_array().unwrap().iter().any(named),
+        "{last}"
+    );
+    assert!(
+        said.contains("warning: fusion skipped a frame") && said.contains("wrong_size.png"),
+        "{said}"
+    );
+    assert!(last["frames_fused"].as_u64().unwrap() > last_fused.min(150) - 10);
+    // The final run is what `mrtmap run` makes of the finished recording.
+    let reference = dir.path().join("reference");
+    ok(&[
+        "run",
+        rec.to_str().unwrap(),
+        "--out",
+        reference.to_str().unwrap(),
+    ]);
+    let grid = |d: &Path| -> Vec<f64> {
+        let text = std::fs::read_to_string(d.join("map-1.10m/mrt_grid.csv")).unwrap();
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let k = header.iter().position(|h| *h == "mrt_c").unwrap();
+        lines
+            .map(|l| {
+                l.split(',')
+                    .nth(k)
+                    .unwrap()
+                    .parse::<f64>()
+                    .unwrap_or(f64::NAN)
+            })
+            .collect()
+    };
+    let (a, b) = (grid(&out), grid(&reference));
+    assert_eq!(a.len(), b.len());
+    assert!(a.len() >= 100);
+    for (x, y) in a.iter().zip(&b) {
+        assert!(
+            x.is_nan() && y.is_nan() || (x - y).abs() <= 0.05,
+            "{x} vs {y}"
+        );
+    }
+    assert!(out.join("report.html").is_file());
+}
+
+/// The page in a real browser while the scan is replayed: the verdict, the advice and the scan's
+/// figures are filled in from the pushed state, and the 3D view is drawn.
+fn screenshot_live_page(addr: &str, dir: &Path) {
+    let Some(chrome) = crate::pipeline::Chrome::find(dir) else {
+        return;
+    };
+    let url = format!("http://{addr}/#once");
+    let budget = ["--window-size=1400,900", "--virtual-time-budget=4000"];
+    let dom = chrome.run(&[&budget[..], &["--dump-dom", &url]].concat());
+    let dom = String::from_utf8_lossy(&dom.stdout);
+    let fused = dom
+        .split("<td id=\"fused\">")
+        .nth(1)
+        .and_then(|r| r.split('<').next())
+        .and_then(|n| n.parse::<u64>().ok());
+    assert!(
+        fused.is_some_and(|n| n > 0),
+        "the page shows no frames fused: {}",
+        &dom[..dom.len().min(2000)]
+    );
+    assert!(dom.contains("id=\"verdict\""));
+    let shot = dir.join("live.png");
+    let s = chrome.run(
+        &[
+            &budget[..],
+            &[&format!("--screenshot={}", shot.display()), &url],
+        ]
+        .concat(),
+    );
+    assert!(s.status.success());
+    assert!(
+        std::fs::metadata(&shot).unwrap().len() > 20_000,
+        "a blank screenshot"
+    );
+    // The 3D view the page frames, alone.
+    let shot3d = dir.join("live-view3d.png");
+    let s = chrome.run(&[
+        "--window-size=1000,800",
+        "--virtual-time-budget=5000",
+        &format!("--screenshot={}", shot3d.display()),
+        &format!("http://{addr}/view.html"),
+    ]);
+    assert!(s.status.success());
+    crate::pipeline::assert_view3d_drawn(&shot3d);
+    if let Some(keep) = std::env::var_os("MRTMAP_KEEP_SCREENSHOTS") {
+        let _ = std::fs::copy(&shot, Path::new(&keep).join("live.png"));
+        let _ = std::fs::copy(&shot3d, Path::new(&keep).join("live-view3d.png"));
+    }
+}
