@@ -100,6 +100,9 @@ pub struct CameraNow {
 pub struct LiveState {
     /// "following", "final run", "done" or "failed".
     pub phase: String,
+    /// Where the poses come from: "the recording" (trajectory.txt) or "tracked live" (the
+    /// built-in tracker, on a recording without poses).
+    pub poses_from: String,
     /// Thermal frames listed (taken or waiting for their file).
     pub frames_received: usize,
     /// Thermal frames fused.
@@ -338,9 +341,15 @@ pub fn live(
     let work = tempfile::tempdir()
         .map_err(|e| mrtmap_io::FileError::io(Path::new("a temporary folder"), e))?;
     let mut fusion = LiveFusion::new(&params);
+    // Without trajectory.txt from the start, the built-in tracker places the colour frames.
+    let track_live = !recording.join("trajectory.txt").exists()
+        && follower.rec.rig.rgb.is_some()
+        && p.track.mode != crate::settings::TrackMode::Never;
+    let mut tracker: Option<mrtmap_track::LiveTracker> = None;
     let t0 = Instant::now();
     let mut state = LiveState {
         phase: "following".into(),
+        poses_from: if track_live { "tracked live" } else { "the recording" }.into(),
         verdict: "keep scanning".into(),
         ..LiveState::default()
     };
@@ -355,6 +364,9 @@ pub fn live(
     loop {
         let round = Instant::now();
         follower.poll();
+        if track_live {
+            track_more(&mut tracker, &mut follower.rec, &p);
+        }
         written.extend(follower.taken.iter().map(|t| (t.index, t.written)));
         let adv = fusion.advance(&follower.rec);
         let now = SystemTime::now();
@@ -437,6 +449,23 @@ pub fn live(
     state.phase = if done.is_ok() { "done" } else { "failed" }.into();
     sink.state(&state);
     done
+}
+
+/// Places the colour frames the depth list has passed and appends their poses to the trajectory
+/// (the tracker starts at the first colour frame).
+fn track_more(tracker: &mut Option<mrtmap_track::LiveTracker>, rec: &mut Recording, p: &Project) {
+    if tracker.is_none() && !rec.rgb.is_empty() {
+        *tracker = mrtmap_track::LiveTracker::new(rec, &p.track.params()).ok();
+    }
+    let Some(t) = tracker.as_mut() else {
+        return;
+    };
+    for (t, pose) in t.advance(rec) {
+        if rec.trajectory.stamps.last().is_none_or(|&l| t > l) {
+            rec.trajectory.stamps.push(t);
+            rec.trajectory.poses.push(pose);
+        }
+    }
 }
 
 /// The state from the follower, the fusion and the last refresh.

@@ -56,24 +56,20 @@ fn depth_in_colour(depth: &mrtmap_io::Image16, cams: &Cameras, rays: &RayTable) 
     z
 }
 /// Reads a colour frame's corners with the depth frame nearest in time.
-pub(super) struct FrameReader<'a> {
-    rec: &'a Recording,
-    params: &'a TrackParams,
+pub(super) struct FrameReader {
+    params: TrackParams,
     cams: Cameras,
     pairs: Vec<TestPair>,
-    depth_t: Vec<f64>,
     rays: RayTable,
     sampling: DepthSampling,
 }
 
-impl<'a> FrameReader<'a> {
-    pub(super) fn new(rec: &'a Recording, params: &'a TrackParams, cams: Cameras) -> Self {
+impl FrameReader {
+    pub(super) fn new(params: &TrackParams, cams: Cameras) -> Self {
         Self {
-            rec,
-            params,
+            params: *params,
             cams,
             pairs: test_pairs(),
-            depth_t: rec.depth.iter().map(|e| e.t).collect(),
             rays: RayTable::new(&cams.depth),
             sampling: DepthSampling {
                 stride: CLOUD_STRIDE,
@@ -84,20 +80,20 @@ impl<'a> FrameReader<'a> {
     }
 
     /// The depth frame nearest to time `t`, within the sync tolerance.
-    fn nearest_depth(&self, t: f64) -> Option<usize> {
-        let depth_t = &self.depth_t;
-        let k = depth_t.partition_point(|&x| x < t);
-        [k.checked_sub(1), (k < depth_t.len()).then_some(k)]
+    fn nearest_depth(&self, rec: &Recording, t: f64) -> Option<usize> {
+        let depth = &rec.depth;
+        let k = depth.partition_point(|x| x.t < t);
+        [k.checked_sub(1), (k < depth.len()).then_some(k)]
             .into_iter()
             .flatten()
-            .min_by(|&a, &b| (depth_t[a] - t).abs().total_cmp(&(depth_t[b] - t).abs()))
-            .filter(|&k| (depth_t[k] - t).abs() <= self.params.sync_tolerance_s)
+            .min_by(|&a, &b| (depth[a].t - t).abs().total_cmp(&(depth[b].t - t).abs()))
+            .filter(|&k| (depth[k].t - t).abs() <= self.params.sync_tolerance_s)
     }
 
     /// Colour frame `i`'s corners, their depth and the depth cloud (a frame of another size is
     /// returned empty with `wrong_size`).
-    pub(super) fn read(&self, i: usize) -> Result<Features, TrackError> {
-        let (rec, cams) = (self.rec, &self.cams);
+    pub(super) fn read(&self, rec: &Recording, i: usize) -> Result<Features, TrackError> {
+        let cams = &self.cams;
         let e = &rec.rgb[i];
         let path = rec.path_of(e);
         let grey = image::ImageReader::open(&path)
@@ -117,7 +113,7 @@ impl<'a> FrameReader<'a> {
             });
         }
         let mut cloud = None;
-        let depth = match self.nearest_depth(e.t) {
+        let depth = match self.nearest_depth(rec, e.t) {
             Some(k) => {
                 let img = rec.read_depth(&rec.depth[k])?;
                 let mut pts = depth_points(&img, &self.rays, cams.depth_scale, &self.sampling);
@@ -128,12 +124,12 @@ impl<'a> FrameReader<'a> {
                 cloud = Some(std::sync::Arc::new(pts));
                 Some((
                     std::sync::Arc::new(depth_in_colour(&img, cams, &self.rays)),
-                    self.depth_t[k] - e.t,
+                    rec.depth[k].t - e.t,
                 ))
             }
             None => None,
         };
-        let mut f = features(&grey, depth, cams, &self.pairs, self.params);
+        let mut f = features(&grey, depth, cams, &self.pairs, &self.params);
         f.cloud = cloud;
         Ok(f)
     }

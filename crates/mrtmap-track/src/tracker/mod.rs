@@ -37,6 +37,7 @@ mod depth_only;
 mod evaluate;
 mod features;
 mod frames;
+mod live;
 mod loops;
 mod matching;
 mod motion;
@@ -62,6 +63,7 @@ use motion::{Gyro, Twist, predict};
 use pose::{Found, Seen, estimate};
 
 pub use evaluate::{TrajectoryError, align, expressed_in, trajectory_error};
+pub use live::LiveTracker;
 /// Tracking settings.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -305,23 +307,23 @@ pub fn track(
 ) -> Result<(Trajectory, TrackReport), TrackError> {
     let t0 = Instant::now();
     let mut tracker = Tracker::new(rec, params)?;
-    let reader = FrameReader::new(rec, params, tracker.cams);
+    let reader = FrameReader::new(params, tracker.cams);
     let n = rec.rgb.len();
     let mut start = 0;
     while start < n {
         let end = (start + FRAME_CHUNK).min(n);
         let feats: Vec<Features> = (start..end)
             .into_par_iter()
-            .map(|i| reader.read(i))
+            .map(|i| reader.read(rec, i))
             .collect::<Result<_, _>>()?;
         for (i, f) in (start..end).zip(feats) {
             progress(i + 1, n);
-            tracker.step(i, f);
+            tracker.step(rec, i, f);
         }
         start = end;
     }
     tracker.optimise_graph();
-    tracker.finish(t0)
+    tracker.finish(rec, t0)
 }
 
 /// How a frame was placed.
@@ -335,9 +337,8 @@ enum Placed {
 }
 
 /// The tracking state over the colour frames, in time order.
-struct Tracker<'a> {
-    rec: &'a Recording,
-    params: &'a TrackParams,
+pub(crate) struct Tracker {
+    params: TrackParams,
     cams: Cameras,
     gyro: Option<Gyro>,
     /// world_from_colour of each tracked frame.
@@ -356,9 +357,9 @@ struct Tracker<'a> {
     report: TrackReport,
 }
 
-impl<'a> Tracker<'a> {
+impl Tracker {
     /// Checks that the recording can be tracked (a colour camera and frames) and sets up.
-    fn new(rec: &'a Recording, params: &'a TrackParams) -> Result<Self, TrackError> {
+    fn new(rec: &Recording, params: &TrackParams) -> Result<Self, TrackError> {
         let Some(rgb) = rec.rig.rgb else {
             return Err(TrackError::NoColour(format!(
                 "{}: the rig has no [rgb] camera; tracking needs the colour camera's intrinsics and its pose in the depth camera",
@@ -388,8 +389,7 @@ impl<'a> Tracker<'a> {
             ..TrackReport::default()
         };
         Ok(Self {
-            rec,
-            params,
+            params: *params,
             cams,
             gyro,
             poses: vec![None; n],
@@ -412,10 +412,13 @@ impl<'a> Tracker<'a> {
 
     /// Places colour frame `i`, and makes it a keyframe when it has moved away from its
     /// reference.
-    fn step(&mut self, i: usize, f: Features) {
+    fn step(&mut self, rec: &Recording, i: usize, f: Features) {
+        if self.poses.len() <= i {
+            self.poses.resize(i + 1, None);
+            self.anchor.resize(i + 1, None);
+        }
         if let Some((w, h)) = f.wrong_size {
             self.report.wrong_size += 1;
-            let rec = self.rec;
             self.report
                 .wrong_size_first
                 .get_or_insert_with(|| (rec.path_of(&rec.rgb[i]).display().to_string(), w, h));
@@ -423,7 +426,7 @@ impl<'a> Tracker<'a> {
         }
         self.corners_sum += f.px.len();
         self.report.unsynced += f.zmap.is_none() as usize;
-        let t_now = self.rec.rgb[i].t;
+        let t_now = rec.rgb[i].t;
         // The depth's points at the colour frame's time: colour(t) from colour(t + dt).
         let motion = self.predict(t_now, t_now + f.dt);
         let xyz_now = f.moved(&motion, &self.cams.colour, self.params.max_depth_m);
@@ -431,14 +434,14 @@ impl<'a> Tracker<'a> {
             self.start(i, f, xyz_now, &motion);
             return;
         }
-        let Some((reference, fd)) = self.locate(i, &f, &xyz_now, &motion) else {
+        let Some((reference, fd)) = self.locate(rec, i, &f, &xyz_now, &motion) else {
             self.report.lost += 1;
             return;
         };
         let kf_from_frame = fd.pose.inverse();
         let world = self.keyframes[reference].pose * kf_from_frame;
         if let Some((k, p)) = self.last {
-            let dt = t_now - self.rec.rgb[k].t;
+            let dt = t_now - rec.rgb[k].t;
             if dt > MIN_VELOCITY_DT_S {
                 self.velocity = Twist::from_motion(&(p.inverse() * world), dt);
             }
@@ -452,14 +455,14 @@ impl<'a> Tracker<'a> {
         // A frame placed by depth alone (no inliers) starts a keyframe only by moving away.
         let by_depth = fd.inliers == 0;
         let kref = &self.keyframes[reference];
-        let p = self.params;
+        let p = &self.params;
         let new_kf = (!by_depth
             && (fd.inliers as f64) < p.keyframe_inlier_ratio * kref.with_depth as f64)
             || kf_from_frame.translation.vector.norm() > p.keyframe_move_m
             || rotation_deg(&kf_from_frame) > p.keyframe_turn_deg
             || reference != self.keyframes.len() - 1;
         if new_kf {
-            self.add_keyframe(i, f, reference, &fd, world);
+            self.add_keyframe(rec, i, f, reference, &fd, world);
         }
     }
 
@@ -502,18 +505,19 @@ impl<'a> Tracker<'a> {
     /// newest first; else the depth alone. `None`: lost.
     fn locate(
         &mut self,
+        rec: &Recording,
         i: usize,
         f: &Features,
         xyz_now: &[Option<Point3<f64>>],
         motion: &Isometry3<f64>,
     ) -> Option<(usize, Found)> {
-        let (p, cams, kfs) = (self.params, &self.cams, &self.keyframes);
-        let t_now = self.rec.rgb[i].t;
+        let (p, cams, kfs) = (&self.params, &self.cams, &self.keyframes);
+        let t_now = rec.rgb[i].t;
         let newest = kfs.len() - 1;
         let kf = &kfs[newest];
         let predicted_world = self
             .last
-            .map(|(k, pose)| pose * self.predict(self.rec.rgb[k].t, t_now));
+            .map(|(k, pose)| pose * self.predict(rec.rgb[k].t, t_now));
         let predicted = predicted_world.map(|w| w.inverse() * kf.pose);
         let seen = Seen {
             norm: &f.norm,
@@ -560,13 +564,14 @@ impl<'a> Tracker<'a> {
     /// its depth allows), linked to its reference, and loops are closed.
     fn add_keyframe(
         &mut self,
+        rec: &Recording,
         i: usize,
         f: Features,
         reference: usize,
         fd: &Found,
         world: Isometry3<f64>,
     ) {
-        let t_now = self.rec.rgb[i].t;
+        let t_now = rec.rgb[i].t;
         // The motion model now holds this frame's velocity: move its depth again.
         let motion = self.predict(t_now, t_now + f.dt);
         let xyz = f.moved(&motion, &self.cams.colour, self.params.max_depth_m);
@@ -605,7 +610,7 @@ impl<'a> Tracker<'a> {
                 &mut self.keyframes,
                 &mut self.edges,
                 &self.cams,
-                self.params,
+                &self.params,
                 &mut self.report,
             );
         }
@@ -642,8 +647,8 @@ impl<'a> Tracker<'a> {
 
     /// The trajectory of the depth camera (the first tracked frame's is the world) and the
     /// report; an error when too few frames were tracked.
-    fn finish(mut self, t0: Instant) -> Result<(Trajectory, TrackReport), TrackError> {
-        let n = self.rec.rgb.len();
+    fn finish(mut self, rec: &Recording, t0: Instant) -> Result<(Trajectory, TrackReport), TrackError> {
+        let n = rec.rgb.len();
         let report = &mut self.report;
         report.keyframes = self.keyframes.len();
         report.mean_corners = self.corners_sum as f64 / n.max(1) as f64;
@@ -652,7 +657,7 @@ impl<'a> Tracker<'a> {
         let mut traj = Trajectory::default();
         for (i, p) in self.poses.iter().enumerate() {
             if let Some(p) = p {
-                traj.stamps.push(self.rec.rgb[i].t);
+                traj.stamps.push(rec.rgb[i].t);
                 // world_from_depth = world_from_colour · colour_from_depth.
                 traj.poses
                     .push(renormalised(&(p * self.cams.colour_from_depth)));
@@ -666,7 +671,7 @@ impl<'a> Tracker<'a> {
             }
         }
         report.seconds = t0.elapsed().as_secs_f64();
-        if let Some(gt) = &self.rec.groundtruth {
+        if let Some(gt) = &rec.groundtruth {
             report.accuracy = trajectory_error(&traj, gt);
         }
         if report.tracked < 2 || report.tracked * 2 < n {

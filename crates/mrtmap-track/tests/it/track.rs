@@ -184,3 +184,43 @@ fn real_icl_nuim_frames_are_tracked_like_their_ground_truth() {
     assert!(e.rpe_rotation_rmse_deg < 0.2, "{e:?}");
     assert!(e.ate_rmse_m < 0.005, "{e:?}");
 }
+
+/// The tracker fed a growing recording (`mrtmap live` without poses) places each colour frame
+/// once the depth list has passed it, as batch tracking places it (without the gyro and loop
+/// closure, which batch tracking uses over the whole scan).
+#[test]
+fn a_walk_tracked_as_it_grows_gets_the_batch_poses() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec_dir = dir.path().join("scan");
+    pose_less_walk(5.0, NoiseLevel::Realistic, &rec_dir);
+    let whole = Recording::open(&rec_dir).unwrap();
+    let params = TrackParams {
+        use_imu: false,
+        loop_closure: false,
+        ..TrackParams::default()
+    };
+    let (batch, _) = track(&whole, &params, &|_, _| {}).unwrap();
+    let mut grown = whole.clone();
+    let (t0, t1) = (whole.depth[0].t, whole.depth.last().unwrap().t);
+    let mut live: Option<mrtmap_track::LiveTracker> = None;
+    let mut placed = Vec::new();
+    for k in 1..=5 {
+        let until = t0 + (t1 - t0) * f64::from(k) / 5.0;
+        grown.depth = whole.depth.iter().filter(|e| e.t <= until).cloned().collect();
+        grown.rgb = whole.rgb.iter().filter(|e| e.t <= until).cloned().collect();
+        let l = live.get_or_insert_with(|| mrtmap_track::LiveTracker::new(&grown, &params).unwrap());
+        let new = l.advance(&grown);
+        for (t, _) in &new {
+            assert!(t + params.sync_tolerance_s <= grown.depth.last().unwrap().t);
+        }
+        placed.extend(new);
+    }
+    assert!(live.unwrap().problems().is_empty());
+    assert!(placed.len() * 10 >= batch.len() * 9, "{} of {}", placed.len(), batch.len());
+    for (t, p) in &placed {
+        let k = batch.stamps.iter().position(|s| s == t).unwrap();
+        let q = batch.poses[k];
+        assert!((p.translation.vector - q.translation.vector).norm() < 1e-9, "at {t}");
+        assert!(p.rotation.angle_to(&q.rotation) < 1e-9, "at {t}");
+    }
+}
