@@ -452,9 +452,20 @@ def survey(recordings, out, client=None, config=None, n_workers=None, progress=N
 # ---- comfort formulas, vectorised, named and unitised as pythermalcomfort's ----
 
 def _broadcast(*xs):
-    arrays = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in xs))
-    shape = arrays[0].shape
-    return shape, [np.ascontiguousarray(a).ravel() for a in arrays]
+    """The inputs' broadcast shape and each input flat: of the shape's size, or one value where
+    the input is a scalar (the native side repeats it; no copy of it for every element)."""
+    arrays = [np.asarray(x, dtype=np.float64) for x in xs]
+    shape = np.broadcast_shapes(*(a.shape for a in arrays))
+    size = int(np.prod(shape))
+
+    def flat(a):
+        if a.size == 1 and size > 0:
+            return a.reshape(1)
+        if a.shape != shape:
+            a = np.broadcast_to(a, shape)
+        return np.ascontiguousarray(a).ravel()
+
+    return shape, [flat(a) for a in arrays]
 
 
 def _shaped(a: np.ndarray, shape: tuple):

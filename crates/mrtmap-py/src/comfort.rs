@@ -32,15 +32,20 @@ type Two<'py> = (
 /// Elements per parallel block.
 const BLOCK: usize = 2048;
 
-/// Views of 1-D arrays of one length (broadcast already by the Python layer), named in the error
-/// when one differs. Views, not copies: the arrays stay borrowed while the GIL is released.
+/// Views of 1-D arrays of one length `n` (broadcast already by the Python layer) or of one value
+/// (a scalar, the same for every element: no copy of it n times), named in the error when one
+/// differs. Views, not copies: the arrays stay borrowed while the GIL is released.
 fn columns<'a, const N: usize>(
     arrays: [&'a PyArrayLike1<'_, f64, AllowTypeChange>; N],
     names: [&str; N],
 ) -> PyResult<[ArrayView1<'a, f64>; N]> {
     let cols = arrays.map(|a| a.as_array());
-    let n = cols.first().map_or(0, ArrayView1::len);
-    match cols.iter().zip(names).find(|(c, _)| c.len() != n) {
+    let n = elements(&cols);
+    match cols
+        .iter()
+        .zip(names)
+        .find(|(c, _)| c.len() != n && c.len() != 1)
+    {
         Some((c, name)) => Err(MrtmapError::new_err(format!(
             "{name} has {} values where the others have {n}",
             c.len()
@@ -49,9 +54,24 @@ fn columns<'a, const N: usize>(
     }
 }
 
+/// The number of elements: the columns' length, 1 when all are single values, 0 when one is empty.
+fn elements<const N: usize>(cols: &[ArrayView1<'_, f64>; N]) -> usize {
+    if cols.iter().any(|c| c.is_empty()) {
+        0
+    } else {
+        cols.iter().map(ArrayView1::len).max().unwrap_or(0)
+    }
+}
+
+/// Element `k` of a column, or its single value.
+#[inline]
+fn at(c: &ArrayView1<'_, f64>, k: usize) -> f64 {
+    if c.len() == 1 { c[0] } else { c[k] }
+}
+
 /// Whether any input of element `k` is NaN.
 fn any_nan<const N: usize>(cols: &[ArrayView1<'_, f64>; N], k: usize) -> bool {
-    cols.iter().any(|c| c[k].is_nan())
+    cols.iter().any(|c| at(c, k).is_nan())
 }
 
 /// Counts a refusal of element `k` (unless an input of it is NaN), keeping the first message.
@@ -82,7 +102,7 @@ fn each<const N: usize, E: std::error::Error>(
     cols: &[ArrayView1<'_, f64>; N],
     f: impl Fn(usize) -> Result<f64, E> + Sync,
 ) -> (Vec<f64>, Refusals) {
-    let n = cols.first().map_or(0, ArrayView1::len);
+    let n = elements(cols);
     let mut out = vec![0.0; n];
     let blocks = py.detach(|| {
         out.par_chunks_mut(BLOCK)
@@ -135,7 +155,7 @@ pub(crate) fn pmv_ppd<'py>(
         [&tdb, &tr, &vr, &rh, &met, &clo, &wme],
         ["tdb", "tr", "vr", "rh", "met", "clo", "wme"],
     )?;
-    let n = cols[0].len();
+    let n = elements(&cols);
     // Blocks of inputs in parallel, written in place; within a block, several PMVs iterate
     // interleaved.
     let mut pmv = vec![0.0; n];
@@ -152,13 +172,13 @@ pub(crate) fn pmv_ppd<'py>(
                     |j| {
                         let k = start + j;
                         PmvInputs {
-                            air: Temperature::from_celsius(cols[0][k]),
-                            mrt: Temperature::from_celsius(cols[1][k]),
-                            relative_air_speed_m_s: cols[2][k],
-                            relative_humidity_pct: cols[3][k],
-                            met: cols[4][k],
-                            clo: cols[5][k],
-                            external_work_met: cols[6][k],
+                            air: Temperature::from_celsius(at(&cols[0], k)),
+                            mrt: Temperature::from_celsius(at(&cols[1], k)),
+                            relative_air_speed_m_s: at(&cols[2], k),
+                            relative_humidity_pct: at(&cols[3], k),
+                            met: at(&cols[4], k),
+                            clo: at(&cols[5], k),
+                            external_work_met: at(&cols[6], k),
                         }
                     },
                     edition,
@@ -207,9 +227,9 @@ pub(crate) fn operative<'py>(
     };
     let (out, (count, first)) = each(py, &cols, |k| {
         operative_temperature(
-            Temperature::from_celsius(cols[0][k]),
-            Temperature::from_celsius(cols[1][k]),
-            cols[2][k],
+            Temperature::from_celsius(at(&cols[0], k)),
+            Temperature::from_celsius(at(&cols[1], k)),
+            at(&cols[2], k),
             method,
         )
         .map(|t| t.celsius())
@@ -242,17 +262,17 @@ pub(crate) fn mrt_from_globe<'py>(
     .method(Convection::Larger);
     let (out, (count, first)) = each(py, &cols, |k| {
         let globe = Globe {
-            diameter_m: cols[3][k],
-            emissivity: cols[4][k],
+            diameter_m: at(&cols[3], k),
+            emissivity: at(&cols[4], k),
         };
         if mixed && !MIXED_CONVECTION_DIAMETERS_M.contains(&globe.diameter_m) {
             return Ok(f64::NAN);
         }
         convert_globe(
-            GlobeInput::Globe(cols[0][k]),
+            GlobeInput::Globe(at(&cols[0], k)),
             &globe,
-            cols[1][k],
-            cols[2][k],
+            at(&cols[1], k),
+            at(&cols[2], k),
             method,
         )
         .map(|c| c.mrt_c)
@@ -307,15 +327,15 @@ pub(crate) fn solar_gain<'py>(
     )?;
     let gain = |k: usize| {
         let inputs = SolarInputs {
-            altitude_deg: c[0][k],
-            sharp_deg: c[1][k],
-            dni_w_m2: c[2][k],
-            transmittance: c[3][k],
-            f_svv: c[4][k],
-            f_bes: c[5][k],
-            asw: c[6][k],
+            altitude_deg: at(&c[0], k),
+            sharp_deg: at(&c[1], k),
+            dni_w_m2: at(&c[2], k),
+            transmittance: at(&c[3], k),
+            f_svv: at(&c[4], k),
+            f_bes: at(&c[5], k),
+            asw: at(&c[6], k),
             posture,
-            floor_reflectance: c[7][k],
+            floor_reflectance: at(&c[7], k),
         };
         if !(0.0..=90.0).contains(&inputs.altitude_deg)
             || !(0.0..=180.0).contains(&inputs.sharp_deg)
@@ -346,7 +366,7 @@ pub(crate) fn f_svv<'py>(
 ) -> PyResult<One<'py>> {
     let cols = columns([&w, &h, &d], ["w", "h", "d"])?;
     let (out, (count, first)) = each(py, &cols, |k| {
-        mrtmap_pipeline::comfort::f_svv(cols[0][k], cols[1][k], cols[2][k])
+        mrtmap_pipeline::comfort::f_svv(at(&cols[0], k), at(&cols[1], k), at(&cols[2], k))
     });
     Ok((PyArray1::from_vec(py, out), count, first))
 }
