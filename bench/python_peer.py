@@ -3,10 +3,12 @@
 
     python_peer.py MRTMAP_BIN
 
-1. PMV/PPD on a 777×444 grid (pythermalcomfort #227's size) of random valid inputs:
-   mrtmap.pmv_ppd_iso beside pythermalcomfort.models.pmv_ppd_iso, same arrays, round_output=False;
-   medians of 15 alternated runs after one warm-up (numba compiles on its first call); the largest
-   difference.
+1. PMV/PPD on 777×444 inputs (pythermalcomfort #227's size), three sets: random inputs over ISO
+   7730's ranges, inputs all valid (no NaN out), and docs/python.md's broadcast grid (a column of
+   air temperatures against a row of radiant ones): mrtmap.pmv_ppd_iso beside
+   pythermalcomfort.models.pmv_ppd_iso, same arrays, round_output=False; medians of 5 alternated
+   runs after one warm-up each (numba compiles on its first call); the largest difference.
+   `python_peer.py --pmv-only` runs this part alone.
 2. MRT on a 100×100 grid at 1.1 m of the example office: `scene.map(grid=(100, 100))` from Python
    beside `mrtmap map --grid 100x100` (wall time of the process, which also draws the PNG and SVG)
    and beside the map's own compute time the CLI reports; and `scene.mrt` at the same 10,000
@@ -37,40 +39,58 @@ def median_time(f, runs=5):
     return statistics.median(times), out
 
 
-def comfort():
+def pmv_inputs():
+    """The three input sets (issue 54), each 777×444 (pythermalcomfort #227's size)."""
+    rng = np.random.default_rng(1)
+    shape = (777, 444)
+    iso = dict(tdb=rng.uniform(10, 30, shape), tr=rng.uniform(10, 40, shape),
+               vr=rng.uniform(0, 1, shape), rh=rng.uniform(5, 95, shape),
+               met=rng.uniform(0.8, 4, shape), clo=rng.uniform(0, 2, shape))
+    # Every element within ISO 7730's ranges, the PMV too: no NaN comes out.
+    valid = dict(tdb=rng.uniform(22, 25, shape), tr=rng.uniform(22, 26, shape),
+                 vr=rng.uniform(0, 0.2, shape), rh=rng.uniform(30, 60, shape),
+                 met=rng.uniform(1.1, 1.3, shape), clo=rng.uniform(0.5, 0.8, shape))
+    # docs/python.md's example: a column of air temperatures against a row of radiant ones.
+    grid = dict(tdb=np.linspace(18, 28, 777)[:, None], tr=np.linspace(15, 35, 444)[None, :],
+                vr=0.1, rh=50, met=1.2, clo=0.7)
+    return {"random_iso_ranges": iso, "all_valid": valid, "docs_broadcast_grid": grid}
+
+
+def comfort(runs=5):
+    """PMV/PPD beside pythermalcomfort on each input set: the two tools' calls alternated in one
+    process (so that the machine's slow and fast moments fall on both alike), medians of `runs`
+    after one warm-up each (numba compiles on its first call)."""
     import mrtmap
     from pythermalcomfort.models import pmv_ppd_iso
 
-    rng = np.random.default_rng(1)
-    shape = (777, 444)
-    args = dict(tdb=rng.uniform(10, 30, shape), tr=rng.uniform(10, 40, shape),
-                vr=rng.uniform(0, 1, shape), rh=rng.uniform(5, 95, shape),
-                met=rng.uniform(0.8, 4, shape), clo=rng.uniform(0, 2, shape))
-    pmv_ppd_iso(**args, round_output=False)  # numba's compilation
-    mrtmap.pmv_ppd_iso(**args, round_output=False)
-    # Alternated, so that the machine's slow and fast moments fall on both alike.
-    tp, to = [], []
-    for _ in range(15):
-        t0 = time.perf_counter()
-        peer = pmv_ppd_iso(**args, round_output=False)
-        t1 = time.perf_counter()
-        ours = mrtmap.pmv_ppd_iso(**args, round_output=False)
-        tp.append(t1 - t0)
-        to.append(time.perf_counter() - t1)
-    t_peer, t_ours = statistics.median(tp), statistics.median(to)
-    same_nan = bool((np.isnan(ours.pmv) == np.isnan(peer.pmv)).all())
-    d = np.nanmax(np.abs(ours.pmv - peer.pmv))
-    dp = np.nanmax(np.abs(ours.ppd - peer.ppd))
-    return {
-        "cells": int(np.prod(shape)),
-        "pythermalcomfort_s": round(t_peer, 4),
-        "mrtmap_s": round(t_ours, 4),
-        "speedup": round(t_peer / t_ours, 1),
-        "max_abs_diff_pmv": float(d),
-        "max_abs_diff_ppd": float(dp),
-        "nan_alike": same_nan,
-        "within_1e-6": bool(d <= 1e-6 and dp <= 1e-6 and same_nan),
-    }
+    out = {}
+    for name, args in pmv_inputs().items():
+        pmv_ppd_iso(**args, round_output=False)
+        mrtmap.pmv_ppd_iso(**args, round_output=False)
+        tp, to = [], []
+        for _ in range(runs):
+            t0 = time.perf_counter()
+            peer = pmv_ppd_iso(**args, round_output=False)
+            t1 = time.perf_counter()
+            ours = mrtmap.pmv_ppd_iso(**args, round_output=False)
+            tp.append(t1 - t0)
+            to.append(time.perf_counter() - t1)
+        t_peer, t_ours = statistics.median(tp), statistics.median(to)
+        same_nan = bool((np.isnan(ours.pmv) == np.isnan(peer.pmv)).all())
+        d = float(np.nanmax(np.abs(ours.pmv - peer.pmv)))
+        dp = float(np.nanmax(np.abs(ours.ppd - peer.ppd)))
+        out[name] = {
+            "cells": int(np.size(ours.pmv)),
+            "nan_cells": int(np.isnan(ours.pmv).sum()),
+            "pythermalcomfort_s": round(t_peer, 4),
+            "mrtmap_s": round(t_ours, 4),
+            "speedup": round(t_peer / t_ours, 1),
+            "max_abs_diff_pmv": d,
+            "max_abs_diff_ppd": dp,
+            "nan_alike": same_nan,
+            "within_1e-6": bool(d <= 1e-6 and dp <= 1e-6 and same_nan),
+        }
+    return out
 
 
 def grid(bin_path, runs, **mrt):
@@ -116,6 +136,9 @@ def grid(bin_path, runs, **mrt):
 
 
 if __name__ == "__main__":
+    if sys.argv[1:] == ["--pmv-only"]:
+        print(json.dumps({"pmv_ppd_777x444": comfort()}, indent=1))
+        sys.exit(0)
     print(json.dumps({
         "pmv_ppd_777x444": comfort(),
         "mrt_100x100_exact": grid(sys.argv[1], 15),

@@ -1,7 +1,8 @@
 """Type stubs of mrtmap's native module (crates/mrtmap-py). Use the package's API (`mrtmap.Scene`,
-`mrtmap.run`, …); these are the calls it makes."""
+`mrtmap.run`, …); these are the calls it makes. The comfort functions return, after their arrays,
+how many elements with no NaN input the formula refused (NaN there) and the first one's message."""
 
-from typing import Callable, Optional
+from typing import Any, Callable, Optional, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -11,7 +12,14 @@ __version__: str
 class MrtmapError(ValueError):
     """An error of mrtmap's: the one-sentence message the command line prints."""
 
+class MrtmapFileNotFoundError(MrtmapError, FileNotFoundError):
+    """A file mrtmap was given does not exist: both a MrtmapError and a FileNotFoundError."""
+
+_F = npt.NDArray[np.float64]
+
 class Scene:
+    def __init__(self, json: str, source: Optional[str] = None) -> None: ...
+    def __reduce__(self) -> tuple[type["Scene"], tuple[str, str]]: ...
     @staticmethod
     def load(path: str, temperatures: Optional[str] = None, room: Optional[str] = None) -> "Scene": ...
     @staticmethod
@@ -20,30 +28,64 @@ class Scene:
     def source(self) -> str: ...
     def export(self, path: str, to: Optional[str] = None, name: Optional[str] = None) -> int: ...
     def to_json(self) -> str: ...
+    def ids(self) -> list[str]: ...
+    def with_surface_temperature(self, id: str, temperature_c: float) -> "Scene": ...
     def mrt(
-        self, points: npt.ArrayLike, frame: str, mrt_json: str
-    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+        self,
+        points: npt.ArrayLike,
+        *,
+        frame: str = "room",
+        method: Optional[str] = None,
+        rays: Optional[int] = None,
+        seed: Optional[int] = None,
+        directions: Optional[str] = None,
+        replicates: Optional[int] = None,
+        allow_open: Optional[bool] = None,
+        placement_std_m: Optional[float] = None,
+    ) -> dict[str, _F]: ...
     def person(
         self,
         points: npt.ArrayLike,
-        standing: bool,
-        facing_deg: Optional[float],
-        frame: str,
-        mrt_json: str,
-    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+        posture: str = "seated",
+        facing_deg: Optional[float] = None,
+        *,
+        frame: str = "room",
+        method: Optional[str] = None,
+        rays: Optional[int] = None,
+        seed: Optional[int] = None,
+        directions: Optional[str] = None,
+        replicates: Optional[int] = None,
+        allow_open: Optional[bool] = None,
+        placement_std_m: Optional[float] = None,
+    ) -> dict[str, _F]: ...
     def plane_radiant(
-        self, points: npt.ArrayLike, frame: str, mrt_json: str
-    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], str]: ...
+        self,
+        points: npt.ArrayLike,
+        *,
+        frame: str = "room",
+        method: Optional[str] = None,
+        rays: Optional[int] = None,
+        seed: Optional[int] = None,
+        directions: Optional[str] = None,
+        replicates: Optional[int] = None,
+        allow_open: Optional[bool] = None,
+        placement_std_m: Optional[float] = None,
+    ) -> dict[str, Any]: ...
     def map(
-        self, height_m: float, nx: int, ny: int, margin_m: float, mrt_json: str
-    ) -> tuple[
-        npt.NDArray[np.float64],
-        npt.NDArray[np.float64],
-        npt.NDArray[np.float64],
-        npt.NDArray[np.float64],
-        npt.NDArray[np.float64],
-        str,
-    ]: ...
+        self,
+        height_m: float,
+        nx: int,
+        ny: int,
+        margin_m: float,
+        *,
+        method: Optional[str] = None,
+        rays: Optional[int] = None,
+        seed: Optional[int] = None,
+        directions: Optional[str] = None,
+        replicates: Optional[int] = None,
+        allow_open: Optional[bool] = None,
+        placement_std_m: Optional[float] = None,
+    ) -> dict[str, Any]: ...
 
 class RunLayout:
     """Where a run's files are (``mrtmap run … --out root``); every path is a ``str``."""
@@ -87,10 +129,10 @@ class RunLayout:
 def run(
     recording: str,
     out: str,
-    config: object = None,
+    config: Union[None, str, dict[str, Any]] = None,
     force: bool = False,
     progress: Optional[Callable[[str, int, int], None]] = None,
-) -> tuple[list[str], float, str]: ...
+) -> dict[str, Any]: ...
 def pmv_ppd(
     tdb: npt.ArrayLike,
     tr: npt.ArrayLike,
@@ -102,10 +144,10 @@ def pmv_ppd(
     edition: int,
     limit: bool,
     round: bool,
-) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+) -> tuple[_F, _F, int, Optional[str]]: ...
 def operative(
     tdb: npt.ArrayLike, tr: npt.ArrayLike, v: npt.ArrayLike, ashrae: bool
-) -> npt.NDArray[np.float64]: ...
+) -> tuple[_F, int, Optional[str]]: ...
 def mrt_from_globe(
     tg: npt.ArrayLike,
     tdb: npt.ArrayLike,
@@ -113,7 +155,7 @@ def mrt_from_globe(
     d: npt.ArrayLike,
     emissivity: npt.ArrayLike,
     mixed: bool,
-) -> npt.NDArray[np.float64]: ...
+) -> tuple[_F, int, Optional[str]]: ...
 def solar_gain(
     sol_altitude: npt.ArrayLike,
     sharp: npt.ArrayLike,
@@ -124,8 +166,8 @@ def solar_gain(
     asw: npt.ArrayLike,
     floor_reflectance: npt.ArrayLike,
     posture: str,
-) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]: ...
+) -> tuple[_F, _F, int, Optional[str]]: ...
 def f_svv(
     w: npt.ArrayLike, h: npt.ArrayLike, d: npt.ArrayLike
-) -> npt.NDArray[np.float64]: ...
+) -> tuple[_F, int, Optional[str]]: ...
 def cli_main(argv: list[str]) -> int: ...

@@ -16,9 +16,10 @@ other rooms go on. The table is also written to ``out/survey.csv`` (whole or not
 from __future__ import annotations
 
 import os
+import sys
 import traceback
 from pathlib import Path
-from typing import Any, Iterable, Optional, Union
+from typing import Any, Callable, Iterable, Optional, Union
 
 COLUMNS = [
     "room", "recording", "status", "error", "height_m", "nodes", "mrt_min_c", "mrt_mean_c",
@@ -58,6 +59,11 @@ def map_room(recording: str, out: str, config: Any = None) -> dict:
     return row
 
 
+def _print_progress(done: int, total: int, row: dict) -> None:
+    print(f"survey: {row['room']} {row['status']} ({done} of {total} rooms)", file=sys.stderr,
+          flush=True)
+
+
 def _write_csv_atomically(df, path: Path) -> None:
     tmp = path.with_name(path.name + ".tmp")
     df.to_csv(tmp, index=False)
@@ -70,6 +76,7 @@ def survey(
     client: Optional[Any] = None,
     config: Any = None,
     n_workers: Optional[int] = None,
+    progress: Union[None, bool, Callable[[int, int, dict], None]] = None,
 ):
     """Maps each of ``recordings`` into ``out/<room>`` as an independent Dask task and returns
     the table (a pandas DataFrame, one row per recording, in their order; also ``out/survey.csv``).
@@ -82,9 +89,17 @@ def survey(
     Columns: room, recording, status ("ok" or "failed"), error, height_m, nodes, mrt_min_c,
     mrt_mean_c, mrt_max_c, max_std_error_k, share_a, share_b, share_c, share_outside, surfaces,
     features, warnings, seconds, out.
+    ``progress``: True prints ``survey: room-2 ok (2 of 3 rooms)`` to stderr as each room
+    finishes; a callable is called as ``progress(done, total, row)`` (``row`` the room's row of
+    the table), in the order the rooms finish.
     """
     import pandas as pd
-    from dask.distributed import Client, LocalCluster
+    from dask.distributed import Client, LocalCluster, as_completed
+
+    if progress is True:
+        progress = _print_progress
+    elif progress is not None and progress is not False and not callable(progress):
+        raise TypeError(f"progress must be None, True or a callable (done, total, row); got {progress!r}")
 
     recs = [str(r) for r in recordings]
     if not recs:
@@ -104,13 +119,17 @@ def survey(
         client = Client(cluster)
     try:
         futures = client.map(map_room, recs, outs, config=config, pure=False)
-        rows = []
-        for rec, o, fut in zip(recs, outs, futures):
+        index = {f.key: k for k, f in enumerate(futures)}
+        rows: list = [None] * len(futures)
+        for done, fut in enumerate(as_completed(futures), start=1):
+            k = index[fut.key]
             try:
-                rows.append(fut.result())
+                rows[k] = fut.result()
             except Exception as e:  # noqa: BLE001 — a worker lost mid-task: report the room
-                rows.append(_row(rec, o, status="failed",
-                                 error=f"the task failed on its worker: {e}"))
+                rows[k] = _row(recs[k], outs[k], status="failed",
+                               error=f"the task failed on its worker: {e}")
+            if progress:
+                progress(done, len(futures), rows[k])
     finally:
         if own:
             client.close()

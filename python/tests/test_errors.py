@@ -16,7 +16,6 @@ def scene():
     (np.zeros((2, 3, 1)), "(N, 3)"),
     ([[1.0, float("nan"), 1.0]], "not a finite position"),
     ([[1.0, 1.0, float("inf")]], "not a finite position"),
-    ([["a", 1, 1]], "numbers"),
     ([[20.0, 1.0, 1.1]], "outside the walls"),
     ([[1.0, 1.0, -0.5]], "below the floor"),
 ])
@@ -30,7 +29,7 @@ def test_bad_points(scene, points, words):
 def test_bad_settings(scene):
     with pytest.raises(mrtmap.MrtmapError, match="rays"):
         scene.mrt([[1, 1, 1]], rays=0)
-    with pytest.raises(mrtmap.MrtmapError, match="unknown view-factor setting"):
+    with pytest.raises(TypeError, match="'ray'"):
         scene.mrt([[1, 1, 1]], ray=10)
     with pytest.raises(mrtmap.MrtmapError, match="method"):
         scene.mrt([[1, 1, 1]], method="magic")
@@ -49,7 +48,7 @@ def test_bad_settings(scene):
 
 
 def test_bad_files_and_runs(tmp_path):
-    with pytest.raises(mrtmap.MrtmapError, match="does not exist"):
+    with pytest.raises(mrtmap.MrtmapFileNotFoundError, match="missing.json does not exist"):
         mrtmap.Scene.load(tmp_path / "missing.json")
     bad = tmp_path / "scene.json"
     bad.write_text("{not json")
@@ -65,11 +64,9 @@ def test_bad_files_and_runs(tmp_path):
         mrtmap.run(tmp_path, tmp_path / "out", toml)
 
 
-def test_bad_comfort_inputs():
-    with pytest.raises(mrtmap.MrtmapError, match="element 1"):
-        mrtmap.pmv_ppd_iso([22, 22], 22, 0.1, [50, 150], 1.2, 0.5)
-    with pytest.raises(mrtmap.MrtmapError, match="element 0"):
-        mrtmap.pmv_ppd_iso(float("nan"), 22, 0.1, 50, 1.2, 0.5)
+def test_bad_comfort_arguments():
+    # One element's inputs never raise (test_pythonic.py); arguments that are wrong for every
+    # element do.
     with pytest.raises(ValueError):
         mrtmap.pmv_ppd_iso([20, 21, 22], [20, 21], 0.1, 50, 1.2, 0.5)  # shapes do not broadcast
     with pytest.raises(mrtmap.MrtmapError, match="model"):
@@ -78,5 +75,3 @@ def test_bad_comfort_inputs():
         mrtmap.pmv_ppd_iso(72, 72, 0.3, 50, 1.2, 0.5, units="IP")
     with pytest.raises(mrtmap.MrtmapError, match="standard"):
         mrtmap.operative_tmp(22, 24, 0.1, standard="CIBSE")
-    with pytest.raises(mrtmap.MrtmapError, match="element 0"):
-        mrtmap.mean_radiant_tmp(25, 22, -0.1, standard="ISO")

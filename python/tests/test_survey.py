@@ -16,8 +16,13 @@ def test_survey_reports_the_broken_room_and_maps_the_others(scans, tmp_path, fre
 
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                       dashboard_address=None) as cluster, Client(cluster) as client:
+        seen = []
         table = mrtmap.survey(rooms, tmp_path / "survey", client=client,
-                              config={"map": {"grid": [8, 8]}})
+                              config={"map": {"grid": [8, 8]}},
+                              progress=lambda done, total, row: seen.append((done, total, row)))
+    # Progress: one call per room as it finishes, counting up to three.
+    assert [(d, t) for d, t, _ in seen] == [(1, 3), (2, 3), (3, 3)]
+    assert sorted(r["room"] for _, _, r in seen) == ["room-1", "room-2", "room-3"]
     assert list(table["room"]) == ["room-1", "room-2", "room-3"]
     assert list(table["status"]) == ["ok", "failed", "ok"]
     assert "rig.toml" in table.loc[1, "error"]

@@ -56,6 +56,13 @@ pub enum Error {
         #[source]
         source: mrtmap_radiation::MrtError,
     },
+    /// The run was stopped on request ([`Progress::stopped`](crate::Progress::stopped)) before
+    /// `stage`; the stages before it are complete and reused by the next run.
+    #[error("stopped before {stage}, as asked")]
+    Stopped {
+        /// The stage that did not run.
+        stage: &'static str,
+    },
     /// A map could not be laid over a scene.
     #[error("cannot map {scene}")]
     Map {

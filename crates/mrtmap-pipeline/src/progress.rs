@@ -7,6 +7,11 @@ pub trait Progress: Sync {
     fn begin(&self, what: &str);
     /// `done` of `total` units of the current step.
     fn advance(&self, done: u64, total: u64);
+    /// Whether the run should stop (a person pressed Ctrl-C); the pipeline asks between stages
+    /// and answers [`Error::Stopped`](crate::Error::Stopped). Never, by default.
+    fn stopped(&self) -> bool {
+        false
+    }
 }
 
 /// Progress that goes nowhere.

@@ -775,6 +775,11 @@ pub fn run_recording(
     let t0 = std::time::Instant::now();
     let prepared = crate::source::prepare(recording, out, source)?;
     let outcome = crate::run::run(&prepared.dir, out, project, force, progress)?;
+    if progress.stopped() {
+        return Err(crate::Error::Stopped {
+            stage: "the report",
+        });
+    }
     let data = report_data(
         &outcome,
         "Mean radiant temperature of a scanned room",

@@ -685,6 +685,14 @@ pub fn check_out_apart(recording: &Path, out: &Path) -> Result<()> {
     Ok(())
 }
 
+/// `Err(Stopped)` when `progress` asks the run to stop before `stage`.
+fn go_on(progress: &dyn Progress, stage: &'static str) -> Result<()> {
+    if progress.stopped() {
+        return Err(Error::Stopped { stage });
+    }
+    Ok(())
+}
+
 /// Runs fuse → segment → maps on the recording folder `recording` into `out`.
 pub fn run(
     recording: &Path,
@@ -709,7 +717,9 @@ pub fn run(
         .filter(|w| **w != RecordingWarning::NoTrajectory)
         .cloned()
         .collect();
+    go_on(progress, "tracking")?;
     let tracked = track_stage(&mut rec, &layout, p, force, progress)?;
+    go_on(progress, "fusion")?;
     let (fused, fusion) = fuse_stage(&rec, &layout, p, force, progress)?;
     if fusion.clock.offset_s != 0.0 && !fusion.skipped.contains_key(&SkipReason::NoPose) {
         recording_warnings.retain(|w| !on_depth_clock(w));
@@ -734,6 +744,7 @@ pub fn run(
             fusion.pose_check.dropped, fusion.pose_check.poses
         ));
     }
+    go_on(progress, "segmentation")?;
     let (segmented, segment) = segment_stage(&rec, &layout, p, force, progress)?;
     warnings.extend(
         segment
@@ -749,11 +760,13 @@ pub fn run(
     stages.extend([fused, segmented]);
     let mut maps = Vec::new();
     for &h in &p.map.heights_m {
+        go_on(progress, "a map")?;
         let (st, m) = map_stage(&scene, &layout, p, h, force, progress)?;
         stages.push(st);
         maps.push(m);
     }
     let level: Option<Level> = read_json(&layout.level_json()).ok();
+    go_on(progress, "the comfort maps")?;
     let comfort = match comfort_stage(&scene, &layout, p, force, progress)? {
         Some((st, c)) => {
             stages.push(st);
