@@ -129,7 +129,7 @@ impl<'a> Namer<'a> {
     }
 
     /// Where a point lies seen from where the scan started: "ahead of", "to the left of"…
-    fn from_start(&self, p: &Point3<f64>) -> Option<&'static str> {
+    fn seen_from_start(&self, p: &Point3<f64>) -> Option<&'static str> {
         let s = self.start?;
         let forward = s.rotation * Vector3::z();
         let (yaw, _, _) = angles(&forward, &(p - Point3::from(s.translation.vector)));
@@ -156,7 +156,7 @@ impl<'a> Namer<'a> {
         let feature = Self::main_feature(s);
         let unique = feature
             .is_some_and(|f| walls().filter(|w| Self::main_feature(w) == Some(f)).count() == 1);
-        let place = self.from_start(&centroid(&s.polygon));
+        let place = self.seen_from_start(&centroid(&s.polygon));
         match (feature, unique, place) {
             (Some(f), true, _) => format!("the wall with the {f} ({id})"),
             (Some(f), false, Some(p)) => {

@@ -186,7 +186,7 @@ fn refresh(rec: &Recording, mut fused: Fused, p: &Project, work: &Path) -> Resul
     let t0 = Instant::now();
     let run = RunLayout::new(work);
     let keep = mrtmap_report::view3d::evenly_spaced(fused.frames.len(), TEXTURE_FRAMES);
-    fused.frames = keep.iter().map(|&i| fused.frames[i].clone()).collect();
+    fused.frames = keep.iter().map(|&i| fused.frames[i]).collect();
     write_fused(rec, &p.fuse.params()?, &fused, run.fuse().dir())?;
     let inputs = SegmentInputs {
         recording: Some(rec),
@@ -349,7 +349,12 @@ pub fn live(
     let t0 = Instant::now();
     let mut state = LiveState {
         phase: "following".into(),
-        poses_from: if track_live { "tracked live" } else { "the recording" }.into(),
+        poses_from: if track_live {
+            "tracked live"
+        } else {
+            "the recording"
+        }
+        .into(),
         verdict: "keep scanning".into(),
         ..LiveState::default()
     };
@@ -397,7 +402,7 @@ pub fn live(
                 }
                 Some(Ok(Err(e))) => refresh_problem = Some(in_words(&e)),
                 Some(Err(_)) | None => {
-                    refresh_problem = Some("the refresh stopped unexpectedly".into())
+                    refresh_problem = Some("the refresh stopped unexpectedly".into());
                 }
             }
         }

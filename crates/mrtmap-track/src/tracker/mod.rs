@@ -647,7 +647,11 @@ impl Tracker {
 
     /// The trajectory of the depth camera (the first tracked frame's is the world) and the
     /// report; an error when too few frames were tracked.
-    fn finish(mut self, rec: &Recording, t0: Instant) -> Result<(Trajectory, TrackReport), TrackError> {
+    fn finish(
+        mut self,
+        rec: &Recording,
+        t0: Instant,
+    ) -> Result<(Trajectory, TrackReport), TrackError> {
         let n = rec.rgb.len();
         let report = &mut self.report;
         report.keyframes = self.keyframes.len();

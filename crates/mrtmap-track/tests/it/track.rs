@@ -206,9 +206,15 @@ fn a_walk_tracked_as_it_grows_gets_the_batch_poses() {
     let mut placed = Vec::new();
     for k in 1..=5 {
         let until = t0 + (t1 - t0) * f64::from(k) / 5.0;
-        grown.depth = whole.depth.iter().filter(|e| e.t <= until).cloned().collect();
+        grown.depth = whole
+            .depth
+            .iter()
+            .filter(|e| e.t <= until)
+            .cloned()
+            .collect();
         grown.rgb = whole.rgb.iter().filter(|e| e.t <= until).cloned().collect();
-        let l = live.get_or_insert_with(|| mrtmap_track::LiveTracker::new(&grown, &params).unwrap());
+        let l =
+            live.get_or_insert_with(|| mrtmap_track::LiveTracker::new(&grown, &params).unwrap());
         let new = l.advance(&grown);
         for (t, _) in &new {
             assert!(t + params.sync_tolerance_s <= grown.depth.last().unwrap().t);
@@ -216,11 +222,19 @@ fn a_walk_tracked_as_it_grows_gets_the_batch_poses() {
         placed.extend(new);
     }
     assert!(live.unwrap().problems().is_empty());
-    assert!(placed.len() * 10 >= batch.len() * 9, "{} of {}", placed.len(), batch.len());
+    assert!(
+        placed.len() * 10 >= batch.len() * 9,
+        "{} of {}",
+        placed.len(),
+        batch.len()
+    );
     for (t, p) in &placed {
         let k = batch.stamps.iter().position(|s| s == t).unwrap();
         let q = batch.poses[k];
-        assert!((p.translation.vector - q.translation.vector).norm() < 1e-9, "at {t}");
+        assert!(
+            (p.translation.vector - q.translation.vector).norm() < 1e-9,
+            "at {t}"
+        );
         assert!(p.rotation.angle_to(&q.rotation) < 1e-9, "at {t}");
     }
 }

@@ -427,6 +427,7 @@ pub struct Chrome {
 impl Chrome {
     /// Chromium when installed; `None` (and a word on stderr) when not, unless
     /// MRTMAP_REQUIRE_CHROMIUM is set.
+    #[allow(clippy::print_stderr)]
     pub fn find(dir: &Path) -> Option<Self> {
         let program = ["chromium", "chromium-browser", "google-chrome"]
             .into_iter()
