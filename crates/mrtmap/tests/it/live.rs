@@ -281,3 +281,82 @@ fn screenshot_live_page(addr: &str, dir: &Path) {
         let _ = std::fs::copy(&shot3d, Path::new(&keep).join("live-view3d.png"));
     }
 }
+
+/// Ctrl-C once stops following and makes the full run (exit 0); twice stops at once (exit 130).
+#[test]
+fn ctrl_c_once_makes_the_full_run_and_twice_stops_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let start = |out: &Path| {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_mrtmap"))
+            .args([
+                "live",
+                recording().to_str().unwrap(),
+                "--serve",
+                "127.0.0.1:0",
+            ])
+            .args(["--out", out.to_str().unwrap()])
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut lines = BufReader::new(child.stderr.take().unwrap()).lines();
+        let first = lines.next().unwrap().unwrap();
+        let addr = first
+            .split("http://")
+            .nth(1)
+            .unwrap()
+            .split_whitespace()
+            .next()
+            .unwrap()
+            .to_string();
+        // Following: every frame of the finished recording is fused.
+        let t0 = Instant::now();
+        loop {
+            let s: Value = serde_json::from_str(&get(&addr, "/state.json").unwrap().1).unwrap();
+            if s["frames_fused"].as_u64().unwrap_or(0) > 100 {
+                break;
+            }
+            assert!(t0.elapsed() < Duration::from_secs(60), "{s}");
+            std::thread::sleep(Duration::from_millis(300));
+        }
+        let rest =
+            std::thread::spawn(move || lines.map_while(Result::ok).collect::<Vec<_>>().join("\n"));
+        (child, rest)
+    };
+    let interrupt = |pid: u32| {
+        assert!(
+            Command::new("kill")
+                .args(["-INT", &pid.to_string()])
+                .status()
+                .unwrap()
+                .success()
+        );
+    };
+    let once = dir.path().join("once");
+    let (mut child, rest) = start(&once);
+    interrupt(child.id());
+    let status = child.wait().unwrap();
+    let said = rest.join().unwrap();
+    assert!(status.success(), "{said}");
+    assert!(
+        said.contains("stopping: following ends and the full run is made"),
+        "{said}"
+    );
+    assert!(once.join("report.html").is_file());
+    let twice = dir.path().join("twice");
+    let (mut child, rest) = start(&twice);
+    interrupt(child.id());
+    std::thread::sleep(Duration::from_millis(300));
+    interrupt(child.id());
+    let status = child.wait().unwrap();
+    let said = rest.join().unwrap();
+    assert_eq!(status.code(), Some(130), "{said}");
+    assert!(
+        said.contains("interrupted: every file already written is complete"),
+        "{said}"
+    );
+    assert!(
+        !twice.join("report.html").exists(),
+        "the full run was not stopped"
+    );
+}
