@@ -358,83 +358,33 @@ pub fn live(
         verdict: "keep scanning".into(),
         ..LiveState::default()
     };
-    let mut written: VecDeque<(usize, SystemTime)> = VecDeque::new();
-    let mut latencies: VecDeque<f64> = VecDeque::new();
-    let mut job: Option<JoinHandle<Result<Refreshed>>> = None;
-    let mut last: Option<RunOutcome> = None;
-    let (mut last_refresh, mut last_state) =
-        (Instant::now(), Instant::now() - Duration::from_secs(10));
-    let mut fused_at_refresh = 0;
-    let mut refresh_problem: Option<String> = None;
+    let mut latency = Latency::default();
+    let mut r = Refresher {
+        job: None,
+        last: None,
+        started: Instant::now(),
+        fused_at: 0,
+        problem: None,
+        work: work.path().to_path_buf(),
+    };
+    let mut last_state = Instant::now() - Duration::from_secs(10);
     loop {
         let round = Instant::now();
         follower.poll();
         if track_live {
             track_more(&mut tracker, &mut follower.rec, &p);
         }
-        written.extend(follower.taken.iter().map(|t| (t.index, t.written)));
-        let adv = fusion.advance(&follower.rec);
-        let now = SystemTime::now();
-        for i in &adv.taken {
-            while let Some(&(k, w)) = written.front() {
-                if k > *i {
-                    break;
-                }
-                written.pop_front();
-                if k == *i {
-                    latencies.push_back(now.duration_since(w).map_or(0.0, |d| d.as_secs_f64()));
-                    if latencies.len() > LATENCIES_KEPT {
-                        latencies.pop_front();
-                    }
-                }
-            }
-        }
-        if job.as_ref().is_some_and(|j| j.is_finished()) {
-            match job.take().map(|j| j.join()) {
-                Some(Ok(Ok(r))) => {
-                    state.refreshes += 1;
-                    state.refresh_took_s = Some(r.secs);
-                    state.view_version += 1;
-                    sink.view(view_page(&r, &follower.rec.trajectory, opts.target_k));
-                    state.map_nodes = r.nodes;
-                    last = Some(r.outcome);
-                    refresh_problem = None;
-                }
-                Some(Ok(Err(e))) => refresh_problem = Some(in_words(&e)),
-                Some(Err(_)) | None => {
-                    refresh_problem = Some("the refresh stopped unexpectedly".into());
-                }
-            }
-        }
-        let due = last_refresh.elapsed().as_secs_f64() >= opts.refresh_s;
-        if job.is_none() && due && fusion.fused() > fused_at_refresh && fusion.fused() >= 10 {
-            let gap = last_refresh.elapsed().as_secs_f64();
-            if state.refreshes > 0 {
-                state.refresh_gap_max_s = Some(state.refresh_gap_max_s.unwrap_or(0.0).max(gap));
-            }
-            last_refresh = Instant::now();
-            fused_at_refresh = fusion.fused();
-            let mut rec = follower.rec.clone();
-            let keep = mrtmap_report::view3d::evenly_spaced(rec.masks.len(), TEXTURE_FRAMES);
-            rec.masks = keep.iter().map(|&i| rec.masks[i].clone()).collect();
-            let (snap, p2, dir) = (fusion.snapshot(), p.clone(), work.path().to_path_buf());
-            job = Some(std::thread::spawn(move || refresh(&rec, snap, &p2, &dir)));
-        }
+        latency.written(&follower.taken);
+        latency.fused(&fusion.advance(&follower.rec).taken);
+        r.collect(&mut state, sink, &follower.rec.trajectory, opts.target_k);
+        r.start_when_due(&mut state, &follower.rec, &fusion, &p, opts.refresh_s);
         let idle = opts
             .exit_when_idle_s
             .is_some_and(|s| follower.last_growth.elapsed().as_secs_f64() > s);
         let stopping = idle || stop.load(Ordering::Relaxed);
         if stopping || last_state.elapsed().as_secs_f64() >= STATE_EVERY_S - POLL_S / 2.0 {
             last_state = Instant::now();
-            update_state(
-                &mut state,
-                &follower,
-                &fusion,
-                &latencies,
-                last.as_ref(),
-                opts,
-                &refresh_problem,
-            );
+            update_state(&mut state, &follower, &fusion, &latency, &r, opts);
             state.elapsed_s = t0.elapsed().as_secs_f64();
             state.rss_mb = rss_mb();
             sink.state(&state);
@@ -445,7 +395,7 @@ pub fn live(
         let spent = round.elapsed().as_secs_f64();
         std::thread::sleep(Duration::from_secs_f64((POLL_S - spent).max(0.005)));
     }
-    if let Some(j) = job.take() {
+    if let Some(j) = r.job.take() {
         let _ = j.join();
     }
     state.phase = "final run".into();
@@ -454,6 +404,117 @@ pub fn live(
     state.phase = if done.is_ok() { "done" } else { "failed" }.into();
     sink.state(&state);
     done
+}
+
+/// From a thermal file written to its frame fused: the recent frames' times.
+#[derive(Default)]
+struct Latency {
+    /// Frames taken by the follower, not yet by fusion: their index and when written.
+    waiting: VecDeque<(usize, SystemTime)>,
+    /// The recent frames' latencies (s).
+    recent: VecDeque<f64>,
+}
+
+impl Latency {
+    fn written(&mut self, taken: &[follow::Taken]) {
+        self.waiting
+            .extend(taken.iter().map(|t| (t.index, t.written)));
+    }
+
+    fn fused(&mut self, taken: &[usize]) {
+        let now = SystemTime::now();
+        for i in taken {
+            while let Some(&(k, w)) = self.waiting.front() {
+                if k > *i {
+                    break;
+                }
+                self.waiting.pop_front();
+                if k == *i {
+                    self.recent
+                        .push_back(now.duration_since(w).map_or(0.0, |d| d.as_secs_f64()));
+                    if self.recent.len() > LATENCIES_KEPT {
+                        self.recent.pop_front();
+                    }
+                }
+            }
+        }
+    }
+
+    /// The median and the largest of the recent latencies.
+    fn median_max(&self) -> (Option<f64>, Option<f64>) {
+        let mut l: Vec<f64> = self.recent.iter().copied().collect();
+        l.sort_by(f64::total_cmp);
+        (l.get(l.len() / 2).copied(), l.last().copied())
+    }
+}
+
+/// The refreshes: the one running on its thread, the last one done, and why the last failed.
+struct Refresher {
+    job: Option<JoinHandle<Result<Refreshed>>>,
+    last: Option<RunOutcome>,
+    started: Instant,
+    fused_at: usize,
+    problem: Option<String>,
+    work: PathBuf,
+}
+
+impl Refresher {
+    /// Takes a finished refresh: the state's counts, the map's nodes and a new view page.
+    fn collect(
+        &mut self,
+        state: &mut LiveState,
+        sink: &dyn LiveSink,
+        traj: &Trajectory,
+        target_k: f64,
+    ) {
+        if !self.job.as_ref().is_some_and(|j| j.is_finished()) {
+            return;
+        }
+        match self.job.take().map(JoinHandle::join) {
+            Some(Ok(Ok(r))) => {
+                state.refreshes += 1;
+                state.refresh_took_s = Some(r.secs);
+                state.view_version += 1;
+                sink.view(view_page(&r, traj, target_k));
+                state.map_nodes = r.nodes;
+                self.last = Some(r.outcome);
+                self.problem = None;
+            }
+            Some(Ok(Err(e))) => self.problem = Some(in_words(&e)),
+            Some(Err(_)) | None => {
+                self.problem = Some("the refresh stopped unexpectedly".into());
+            }
+        }
+    }
+
+    /// Starts a refresh on a snapshot when none runs, one is due and frames were fused since.
+    fn start_when_due(
+        &mut self,
+        state: &mut LiveState,
+        rec: &Recording,
+        fusion: &LiveFusion,
+        p: &Project,
+        every_s: f64,
+    ) {
+        let gap = self.started.elapsed().as_secs_f64();
+        if self.job.is_some()
+            || gap < every_s
+            || fusion.fused() <= self.fused_at
+            || fusion.fused() < 10
+        {
+            return;
+        }
+        if state.refreshes > 0 {
+            state.refresh_gap_max_s = Some(state.refresh_gap_max_s.unwrap_or(0.0).max(gap));
+        }
+        self.started = Instant::now();
+        self.fused_at = fusion.fused();
+        let mut rec = rec.clone();
+        let keep = mrtmap_report::view3d::evenly_spaced(rec.masks.len(), TEXTURE_FRAMES);
+        rec.masks = keep.iter().map(|&i| rec.masks[i].clone()).collect();
+        let (snap, p, dir) = (fusion.snapshot(), p.clone(), self.work.clone());
+        self.job = Some(std::thread::spawn(move || refresh(&rec, snap, &p, &dir)));
+    }
 }
 
 /// Places the colour frames the depth list has passed and appends their poses to the trajectory
@@ -478,11 +539,11 @@ fn update_state(
     state: &mut LiveState,
     follower: &follow::Follower,
     fusion: &LiveFusion,
-    latencies: &VecDeque<f64>,
-    last: Option<&RunOutcome>,
+    latency: &Latency,
+    r: &Refresher,
     opts: &LiveOptions,
-    refresh_problem: &Option<String>,
 ) {
+    let (last, refresh_problem) = (r.last.as_ref(), &r.problem);
     let rec = &follower.rec;
     state.frames_received = follower.thermal_received();
     state.frames_fused = fusion.fused();
@@ -492,10 +553,7 @@ fn update_state(
         (Some(newest), None) => newest.t - rec.thermal[0].t,
         _ => 0.0,
     };
-    let mut l: Vec<f64> = latencies.iter().copied().collect();
-    l.sort_by(f64::total_cmp);
-    state.latency_median_s = l.get(l.len() / 2).copied();
-    state.latency_max_s = l.last().copied();
+    (state.latency_median_s, state.latency_max_s) = latency.median_max();
     let camera = rec.trajectory.poses.last();
     let start = rec.trajectory.poses.first();
     state.camera = camera_now(&rec.trajectory, last.map(|o| &o.scene));

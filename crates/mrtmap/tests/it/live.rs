@@ -25,6 +25,75 @@ fn get(addr: &str, path: &str) -> Option<(String, String)> {
     Some((head.to_string(), body.to_string()))
 }
 
+/// What the test saw of the state while following.
+struct Watched {
+    states: usize,
+    last_fused: u64,
+    worst_behind: f64,
+    last: Value,
+}
+
+/// Asks for the state every second until `live` exits: each answer within a second, frames_fused
+/// never going back; a wrong-size frame injected once 60 frames are fused; the event stream read
+/// once; the page shown in a browser once the room model has been refreshed.
+fn watch(live: &mut std::process::Child, addr: &str, rec: &Path, dir: &Path) -> Watched {
+    let (mut states, mut last_fused, mut worst_behind, mut injected, mut shot) =
+        (0, 0, 0.0f64, false, None);
+    let mut last: Value = Value::Null;
+    while live.try_wait().unwrap().is_none() {
+        let asked = Instant::now();
+        let Some((_, body)) = get(addr, "/state.json") else {
+            // The server goes when the final run is done.
+            std::thread::sleep(Duration::from_millis(200));
+            continue;
+        };
+        assert!(
+            asked.elapsed() < Duration::from_secs(1),
+            "/state.json took {:?}",
+            asked.elapsed()
+        );
+        let s: Value = serde_json::from_str(&body).unwrap();
+        if s["phase"] == "following" {
+            states += 1;
+            let fused = s["frames_fused"].as_u64().unwrap();
+            assert!(
+                fused >= last_fused,
+                "frames_fused went back: {fused} < {last_fused}"
+            );
+            last_fused = fused;
+            worst_behind = worst_behind.max(s["behind_s"].as_f64().unwrap());
+            if !injected && fused > 60 {
+                inject_wrong_size_frame(rec);
+                injected = true;
+            }
+            if states == 3 {
+                // Pushed: two states a second apart, without asking again.
+                let e = events(addr, 2);
+                assert_eq!(e.len(), 2);
+                assert!(e[1]["elapsed_s"].as_f64() > e[0]["elapsed_s"].as_f64());
+            }
+            if shot.is_none() && s["refreshes"].as_u64().unwrap() >= 1 {
+                // In a thread of its own: the state is still asked for every second meanwhile.
+                let (addr, dir) = (addr.to_string(), dir.to_path_buf());
+                shot = Some(std::thread::spawn(move || {
+                    screenshot_live_page(&addr, &dir)
+                }));
+            }
+            last = s;
+        }
+        std::thread::sleep(Duration::from_secs(1).saturating_sub(asked.elapsed()));
+    }
+    if let Some(t) = shot {
+        t.join().unwrap();
+    }
+    Watched {
+        states,
+        last_fused,
+        worst_behind,
+        last,
+    }
+}
+
 /// The first `n` events of the state's stream.
 fn events(addr: &str, n: usize) -> Vec<Value> {
     let mut s = TcpStream::connect(addr).unwrap();
@@ -128,49 +197,12 @@ fn live_follows_a_replayed_scan_and_ends_with_the_full_run() {
         !page.contains("http://") && !page.contains("https://"),
         "the page loads nothing from outside"
     );
-    let (mut states, mut last_fused, mut worst_behind, mut injected, mut shot) =
-        (0, 0, 0.0f64, false, false);
-    let mut last: Value = Value::Null;
-    while live.try_wait().unwrap().is_none() {
-        let asked = Instant::now();
-        let Some((_, body)) = get(&addr, "/state.json") else {
-            // The server goes when the final run is done.
-            std::thread::sleep(Duration::from_millis(200));
-            continue;
-        };
-        assert!(
-            asked.elapsed() < Duration::from_secs(1),
-            "/state.json took {:?}",
-            asked.elapsed()
-        );
-        let s: Value = serde_json::from_str(&body).unwrap();
-        if s["phase"] == "following" {
-            states += 1;
-            let fused = s["frames_fused"].as_u64().unwrap();
-            assert!(
-                fused >= last_fused,
-                "frames_fused went back: {fused} < {last_fused}"
-            );
-            last_fused = fused;
-            worst_behind = worst_behind.max(s["behind_s"].as_f64().unwrap());
-            if !injected && fused > 60 {
-                inject_wrong_size_frame(&rec);
-                injected = true;
-            }
-            if states == 3 {
-                // Pushed: two states a second apart, without asking again.
-                let e = events(&addr, 2);
-                assert_eq!(e.len(), 2);
-                assert!(e[1]["elapsed_s"].as_f64() > e[0]["elapsed_s"].as_f64());
-            }
-            if !shot && s["refreshes"].as_u64().unwrap() >= 2 {
-                shot = true;
-                screenshot_live_page(&addr, dir.path());
-            }
-            last = s;
-        }
-        std::thread::sleep(Duration::from_secs(1).saturating_sub(asked.elapsed()));
-    }
+    let Watched {
+        states,
+        last_fused,
+        worst_behind,
+        last,
+    } = watch(&mut live, &addr, &rec, dir.path());
     let status = live.wait().unwrap();
     let said = reader.join().unwrap();
     assert!(status.success(), "mrtmap live failed: {said}");
