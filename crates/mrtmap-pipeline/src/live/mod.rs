@@ -18,6 +18,7 @@ pub mod replay;
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{Receiver, Sender, channel};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant, SystemTime};
 
@@ -359,14 +360,7 @@ pub fn live(
         ..LiveState::default()
     };
     let mut latency = Latency::default();
-    let mut r = Refresher {
-        job: None,
-        last: None,
-        started: Instant::now(),
-        fused_at: 0,
-        problem: None,
-        work: work.path().to_path_buf(),
-    };
+    let mut r = Refresher::new(work.path());
     let mut last_state = Instant::now() - Duration::from_secs(10);
     loop {
         let round = Instant::now();
@@ -395,9 +389,7 @@ pub fn live(
         let spent = round.elapsed().as_secs_f64();
         std::thread::sleep(Duration::from_secs_f64((POLL_S - spent).max(0.005)));
     }
-    if let Some(j) = r.job.take() {
-        let _ = j.join();
-    }
+    r.finish();
     state.phase = "final run".into();
     sink.state(&state);
     let done = pipeline.run(recording, out);
@@ -450,12 +442,17 @@ impl Latency {
 
 /// The refreshes: the one running on its thread, the last one done, and why the last failed.
 struct Refresher {
-    job: Option<JoinHandle<Result<Refreshed>>>,
+    /// Snapshots to the refresh thread (one thread for every refresh: a thread started per
+    /// refresh got memory of its own from the allocator each time, and the process grew by about
+    /// 7 MB a refresh over the 343 s scan).
+    jobs: Sender<Job>,
+    done: Receiver<Result<Refreshed>>,
+    busy: bool,
+    worker: Option<JoinHandle<()>>,
     last: Option<RunOutcome>,
     started: Instant,
     fused_at: usize,
     problem: Option<String>,
-    work: PathBuf,
 }
 
 impl Refresher {
@@ -467,11 +464,16 @@ impl Refresher {
         traj: &Trajectory,
         target_k: f64,
     ) {
-        if !self.job.as_ref().is_some_and(|j| j.is_finished()) {
+        let Ok(result) = self.done.try_recv() else {
+            if self.busy && self.worker.as_ref().is_some_and(JoinHandle::is_finished) {
+                self.busy = false;
+                self.problem = Some("the refresh stopped unexpectedly".into());
+            }
             return;
-        }
-        match self.job.take().map(JoinHandle::join) {
-            Some(Ok(Ok(r))) => {
+        };
+        self.busy = false;
+        match result {
+            Ok(r) => {
                 state.refreshes += 1;
                 state.refresh_took_s = Some(r.secs);
                 state.view_version += 1;
@@ -480,10 +482,7 @@ impl Refresher {
                 self.last = Some(r.outcome);
                 self.problem = None;
             }
-            Some(Ok(Err(e))) => self.problem = Some(in_words(&e)),
-            Some(Err(_)) | None => {
-                self.problem = Some("the refresh stopped unexpectedly".into());
-            }
+            Err(e) => self.problem = Some(in_words(&e)),
         }
     }
 
@@ -497,11 +496,7 @@ impl Refresher {
         every_s: f64,
     ) {
         let gap = self.started.elapsed().as_secs_f64();
-        if self.job.is_some()
-            || gap < every_s
-            || fusion.fused() <= self.fused_at
-            || fusion.fused() < 10
-        {
+        if self.busy || gap < every_s || fusion.fused() <= self.fused_at || fusion.fused() < 10 {
             return;
         }
         if state.refreshes > 0 {
@@ -512,10 +507,45 @@ impl Refresher {
         let mut rec = rec.clone();
         let keep = mrtmap_report::view3d::evenly_spaced(rec.masks.len(), TEXTURE_FRAMES);
         rec.masks = keep.iter().map(|&i| rec.masks[i].clone()).collect();
-        let (snap, p, dir) = (fusion.snapshot(), p.clone(), self.work.clone());
-        self.job = Some(std::thread::spawn(move || refresh(&rec, snap, &p, &dir)));
+        self.busy = self.jobs.send((rec, fusion.snapshot(), p.clone())).is_ok();
+    }
+
+    /// A refresher whose thread writes into `work`.
+    fn new(work: &Path) -> Self {
+        let (jobs, inbox) = channel::<Job>();
+        let (outbox, done) = channel();
+        let dir = work.to_path_buf();
+        let worker = std::thread::spawn(move || {
+            for (rec, snap, p) in inbox {
+                if outbox.send(refresh(&rec, snap, &p, &dir)).is_err() {
+                    return;
+                }
+            }
+        });
+        Refresher {
+            jobs,
+            done,
+            busy: false,
+            worker: Some(worker),
+            last: None,
+            started: Instant::now(),
+            fused_at: 0,
+            problem: None,
+        }
+    }
+
+    /// Waits for the refresh running, then ends the thread.
+    fn finish(mut self) {
+        let (jobs, _) = channel();
+        drop(std::mem::replace(&mut self.jobs, jobs));
+        if let Some(w) = self.worker.take() {
+            let _ = w.join();
+        }
     }
 }
+
+/// A refresh's inputs: the recording so far, the fusion's snapshot and the coarse settings.
+type Job = (Recording, Fused, Project);
 
 /// Places the colour frames the depth list has passed and appends their poses to the trajectory
 /// (the tracker starts at the first colour frame).
