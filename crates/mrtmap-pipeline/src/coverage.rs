@@ -18,9 +18,6 @@ use crate::progress::Progress;
 use crate::run::{RunOutcome, run};
 use crate::settings::Project;
 
-/// The target a scan is judged against by default (K, 2σ).
-pub const DEFAULT_TARGET_K: f64 = 0.2;
-
 /// One surface's coverage.
 #[derive(Clone, Debug, Serialize)]
 pub struct SurfaceCoverage {
@@ -268,22 +265,9 @@ impl Coverage {
     }
 }
 
-/// `mrtmap coverage` in one call: checks the target (K, 2σ), reads the project file when given,
-/// prepares the recording (any source `run` takes) and runs the coarse check into `out`, or into
-/// a temporary folder that is removed.
-pub fn coverage_of(
-    recording: &Path,
-    out: Option<&Path>,
-    config: Option<&Path>,
-    source: &crate::source::SourceOptions,
-    target_k: f64,
-    progress: &dyn Progress,
-) -> Result<Coverage> {
-    let p = Project::resolve(config, &crate::Overrides::new())?;
-    coverage_with(recording, out, &p, source, target_k, progress)
-}
-
-/// [`coverage_of`] with the settings resolved.
+/// `mrtmap coverage` in one call, with the settings `p`: checks the target (K, 2σ), prepares the
+/// recording (any source `run` takes) and runs the coarse check into `out`, or into a temporary
+/// folder that is removed.
 pub(crate) fn coverage_with(
     recording: &Path,
     out: Option<&Path>,

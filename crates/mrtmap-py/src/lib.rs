@@ -427,7 +427,7 @@ fn run(
 }
 
 /// A run's figures for Python: stages, maps' summaries, comfort shares, level, warnings.
-fn outcome_json(o: &mrtmap_pipeline::run::RunOutcome) -> serde_json::Result<String> {
+fn outcome_json(o: &mrtmap_pipeline::RunOutcome) -> serde_json::Result<String> {
     let maps: Vec<_> = o
         .maps
         .iter()

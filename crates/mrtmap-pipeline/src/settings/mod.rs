@@ -10,22 +10,28 @@ use crate::error::{Error, Result};
 
 mod comfort;
 mod emissivity;
-mod export;
+pub(crate) mod export;
 mod map;
-mod mrt;
+pub(crate) mod mrt;
 mod references;
 mod scan;
-mod sun;
+pub(crate) mod sun;
 
-pub use comfort::*;
-pub use emissivity::*;
-pub use export::*;
-pub use map::*;
-pub use mrt::*;
+/// Contact readings as text (references.csv).
+pub use crate::level::parse_references;
+pub use comfort::{AirSection, ComfortSection};
+pub use emissivity::EmissivitySection;
+pub(crate) use export::ExportFormat;
+pub use export::ExportSection;
+pub use map::{MapSection, PointEntry, PointFrame, Quantity, RoomSection};
+pub(crate) use mrt::MrtSection;
+pub use mrt::{DirectionChoice, MethodChoice};
+pub use references::Reference;
+pub use scan::{FuseSection, SegmentSection, TrackMode, TrackSection};
+pub use sun::SunSection;
+
+pub(crate) use comfort::*;
 pub(crate) use references::default_std;
-pub use references::*;
-pub use scan::*;
-pub use sun::*;
 
 /// The documented example, shown by `mrtmap run --help`.
 pub const PROJECT_EXAMPLE: &str = r#"# project.toml: every key is optional (defaults shown); flags override them.
@@ -239,6 +245,7 @@ mod tests {
     /// Issue 54: a ray count that cannot be answered is refused before anything runs.
     #[test]
     fn too_many_rays_are_refused_naming_the_flag() {
+        use super::mrt::MAX_RAYS;
         let mut m = MrtSection {
             rays: MAX_RAYS,
             ..MrtSection::default()
