@@ -26,7 +26,7 @@
 //!   [`simulation`], [`export`], [`points`] and [`maps`] (scenes, their points and grids),
 //!   [`comfort`], [`validation`] (also globe ↔ MRT), [`thermal_image`] (one thermal file);
 //!   [`parse`]: the text forms flags share (`20x20`, `X,Y,Z`, `on|off`); [`files`]: mrtmap-io's
-//!   types a front end handles itself; [`level`]: contact readings as text.
+//!   types a front end handles itself; [`parse_references`]: contact readings as text.
 //!
 //! Everything here returns data, text lines and files; nothing prints.
 //!
@@ -75,6 +75,7 @@ pub mod files {
 pub use error::{Error, Result};
 pub use front::{FuseDone, Pipeline, SegmentDone, TrackDone};
 pub use layout::{DemoLayout, RunLayout};
+pub use level::parse_references;
 pub use progress::{Progress, Silent};
 pub use resolve::{MrtFlags, Overrides};
 pub use run::RunOutcome;

@@ -17,8 +17,6 @@ mod references;
 mod scan;
 pub(crate) mod sun;
 
-/// Contact readings as text (references.csv).
-pub use crate::level::parse_references;
 pub use comfort::{AirSection, ComfortSection};
 pub use emissivity::EmissivitySection;
 pub(crate) use export::ExportFormat;
