@@ -111,7 +111,7 @@ fn mark_records(
     Ok((records, map_marks))
 }
 
-/// What [`map_scene`] made: the MRT map and, when a person's quantities were asked for, the
+/// What [`crate::Pipeline::map`] made: the MRT map and, when a person's quantities were asked for, the
 /// comfort maps beside it.
 pub struct SceneMaps {
     /// The MRT map.
@@ -323,7 +323,7 @@ pub struct MapArrays {
 }
 
 /// The MRT of `scene` (from `source`, named in errors) over `spec`'s grid with the view-factor
-/// settings `mrt`, as arrays; nothing is written. The same nodes and values as [`make_map`]'s
+/// settings `mrt`, as arrays; nothing is written. The same nodes and values as `mrtmap map`'s
 /// mrt_grid.csv.
 pub fn map_arrays(
     scene: &RadiantScene,

@@ -1,6 +1,6 @@
 //! Scan sources: what a source holds ([`inspect`]), turning a bag, MCAP file, ROS 2 bag or RTAB-Map
 //! database into the recording layout, or a recording folder into one of those ([`convert_any`]),
-//! and the recording folder `fuse` and `run` read ([`prepare`]: the
+//! and the recording folder `fuse` and `run` read (`prepare`: the
 //! source itself, or its conversion, reused while the source and options are unchanged).
 
 use std::path::{Path, PathBuf};

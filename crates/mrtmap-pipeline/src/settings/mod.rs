@@ -1,6 +1,6 @@
 //! What a user sets: `project.toml` (every key optional), one section per file, and the
 //! view-factor settings shared by `run`, `map` and `mrt`. Flags and files meet once, in
-//! [`crate::resolve`]; everything after that reads typed values.
+//! `resolve` ([`crate::Overrides`]); everything after that reads typed values.
 
 use std::path::Path;
 
