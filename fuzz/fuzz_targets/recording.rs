@@ -9,9 +9,7 @@
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 use mrtmap_io::{Image16, Recording, encode_png16, encode_png_rgb8};
-use mrtmap_pipeline::Silent;
-use mrtmap_pipeline::run::{fuse_into, track_into};
-use mrtmap_pipeline::settings::{FuseSection, TrackSection};
+use mrtmap_pipeline::{Pipeline, Project};
 use std::path::{Path, PathBuf};
 
 /// Unpacks the folder; names that are not plain relative paths are skipped.
@@ -120,17 +118,17 @@ fuzz_target!(|data: &[u8]| {
     let Ok(rec) = Recording::open(&rec_dir) else {
         return;
     };
-    if let Ok(params) = FuseSection::default().params()
-        && let Ok(report) = fuse_into(&rec, &params, &dir.join("fuse"), &Silent)
-    {
+    let pipeline = Pipeline::new(Project::default());
+    if let Ok(done) = pipeline.fuse(&rec_dir, &dir.join("fuse")) {
+        let report = done.report;
         let skipped: usize = report.skipped.values().sum();
         assert_eq!(report.used_frames + skipped, report.thermal_frames);
         assert_eq!(report.thermal_frames, rec.thermal.len());
     }
     if !rec.rgb.is_empty()
-        && let Ok((traj, report)) =
-            track_into(&rec, &TrackSection::default().params(), &dir.join("track"), &Silent)
+        && let Ok(done) = pipeline.track(&rec_dir, &dir.join("track"))
     {
+        let (traj, report) = (done.trajectory, done.report);
         assert!(traj.len() <= rec.rgb.len());
         assert!(report.wrong_size <= rec.rgb.len());
     }

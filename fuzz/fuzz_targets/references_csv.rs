@@ -2,7 +2,7 @@
 //! what is accepted is finite and in range.
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use mrtmap_pipeline::level::parse_references;
+use mrtmap_pipeline::parse_references;
 use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {

@@ -2,7 +2,7 @@
 //!
 //! The page `mrtmap live` serves while a scan is recorded: offline (nothing from a CDN), pushed
 //! to by Server-Sent Events. [`Server`] is a [`LiveSink`]: the pipeline's live run
-//! ([`mrtmap_pipeline::live::live`]) sends it the state every second and a new 3D view after each
+//! ([`mrtmap_pipeline::Pipeline::live`]) sends it the state every second and a new 3D view after each
 //! refresh, and it serves:
 //!
 //! | path | what |
@@ -17,7 +17,7 @@ use std::net::SocketAddr;
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::Duration;
 
-use mrtmap_pipeline::live::{LiveSink, LiveState};
+use mrtmap_pipeline::{LiveSink, LiveState};
 
 /// The page (HTML, CSS and JavaScript in one file).
 const PAGE: &str = include_str!("page.html");

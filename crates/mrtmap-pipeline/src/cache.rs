@@ -103,6 +103,7 @@ pub struct Stage {
     pub outputs: Vec<PathBuf>,
 }
 
+#[cfg(test)]
 impl Stage {
     /// A stage working in its own folder: stamp `dir/stage.json`, outputs named inside `dir`.
     pub fn in_dir(name: impl Into<String>, dir: &Path, outputs: &[&str]) -> Self {

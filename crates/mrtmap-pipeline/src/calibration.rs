@@ -7,16 +7,17 @@ use std::path::{Path, PathBuf};
 use mrtmap_calib::report::{draw_corners, overlay, png};
 use mrtmap_calib::rig::{rig_toml, updated_rig};
 /// The calibration's inputs and results (mrtmap-calib's types).
-pub use mrtmap_calib::{
-    Board, DistortionModel, GridSize, MonoResult, PairStatus, StereoOptions, StereoResult,
-    plausibility, synth::SynthOptions,
+pub use mrtmap_calib::synth::SynthOptions;
+pub(crate) use mrtmap_calib::{
+    Board, DistortionModel, GridSize, MonoResult, StereoOptions, StereoResult,
 };
 use mrtmap_calib::{
     DetectOptions, Detection, Gray, ImagePair, PairInput, ViewError, calibrate_mono,
     calibrate_stereo, detect_variants, find_pairs, list_images,
 };
+pub(crate) use mrtmap_calib::{PairStatus, plausibility};
 /// A camera's intrinsics.
-pub use mrtmap_geometry::camera::PinholeCamera;
+pub(crate) use mrtmap_geometry::camera::PinholeCamera;
 use mrtmap_io::{FileError, PoseFile, Rig, write_atomic};
 use rayon::prelude::*;
 use serde_json::json;
@@ -25,7 +26,7 @@ use crate::cache::write_json;
 use crate::error::{Error, Result};
 
 /// An image read and searched, or why not.
-pub struct Seen {
+pub(crate) struct Seen {
     /// The image in grey (absent when it could not be read or had the wrong size).
     pub gray: Option<Gray>,
     /// The board's corners, when found.
@@ -74,7 +75,7 @@ fn see(path: &Path, board: &Board, size: Option<(u32, u32)>) -> Seen {
 }
 
 /// Reads and searches images in parallel; all must share the first readable image's size.
-pub fn see_all(paths: &[PathBuf], board: &Board) -> (Vec<Seen>, Option<(u32, u32)>) {
+pub(crate) fn see_all(paths: &[PathBuf], board: &Board) -> (Vec<Seen>, Option<(u32, u32)>) {
     let size = paths.iter().find_map(|p| {
         image::ImageReader::open(p)
             .ok()?
@@ -88,7 +89,7 @@ pub fn see_all(paths: &[PathBuf], board: &Board) -> (Vec<Seen>, Option<(u32, u32
 }
 
 /// Every image of a folder searched for the board.
-pub struct ImageDetections {
+pub(crate) struct ImageDetections {
     /// The images.
     pub paths: Vec<PathBuf>,
     /// What was seen in each.
@@ -105,7 +106,7 @@ impl ImageDetections {
 }
 
 /// Reads the images in `dir` and searches each for the board.
-pub fn detect_images(dir: &Path, board: &Board) -> Result<ImageDetections> {
+pub(crate) fn detect_images(dir: &Path, board: &Board) -> Result<ImageDetections> {
     let paths = list_images(dir)?;
     if paths.is_empty() {
         return Err(Error::source(dir, "holds no PNG, JPEG or TIFF images"));
@@ -118,7 +119,7 @@ pub fn detect_images(dir: &Path, board: &Board) -> Result<ImageDetections> {
 }
 
 /// One camera's intrinsics from its images' detections.
-pub fn calibrate_images(
+pub(crate) fn calibrate_images(
     d: &ImageDetections,
     board: &Board,
     model: DistortionModel,
@@ -150,7 +151,7 @@ fn corners_json(d: Option<&Detection>) -> serde_json::Value {
 }
 
 /// A file stem for people.
-pub fn file_stem(p: &Path) -> String {
+pub(crate) fn file_stem(p: &Path) -> String {
     p.file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default()
@@ -161,7 +162,7 @@ fn create_dir(dir: &Path) -> Result<()> {
 }
 
 /// Writes the corners drawn on every image and `calibration.json` into `rep`.
-pub fn write_mono_report(
+pub(crate) fn write_mono_report(
     rep: &Path,
     board: &Board,
     d: &ImageDetections,
@@ -195,7 +196,7 @@ pub fn write_mono_report(
 }
 
 /// Every pair of a folder searched for the board.
-pub struct PairDetections {
+pub(crate) struct PairDetections {
     /// The pairs.
     pub pairs: Vec<ImagePair>,
     /// Images without a partner.
@@ -211,12 +212,12 @@ pub struct PairDetections {
 }
 
 /// Images of `seen` in which the board was found.
-pub fn found(seen: &[Seen]) -> usize {
+pub(crate) fn found(seen: &[Seen]) -> usize {
     seen.iter().filter(|s| s.det.is_some()).count()
 }
 
 /// Pairs the images in `dir` and searches each for the board.
-pub fn detect_pairs(dir: &Path, board: &Board, max_dt: f64) -> Result<PairDetections> {
+pub(crate) fn detect_pairs(dir: &Path, board: &Board, max_dt: f64) -> Result<PairDetections> {
     let pairing = find_pairs(dir, max_dt)?;
     let rgb_paths: Vec<PathBuf> = pairing.pairs.iter().map(|p| p.rgb.clone()).collect();
     let th_paths: Vec<PathBuf> = pairing.pairs.iter().map(|p| p.thermal.clone()).collect();
@@ -239,7 +240,7 @@ pub fn detect_pairs(dir: &Path, board: &Board, max_dt: f64) -> Result<PairDetect
 }
 
 /// Both cameras and the thermal camera's pose from the pairs' detections.
-pub fn calibrate_pairs(
+pub(crate) fn calibrate_pairs(
     d: &PairDetections,
     board: &Board,
     opts: &StereoOptions,
@@ -264,7 +265,12 @@ pub fn calibrate_pairs(
 
 /// Writes the result into the rig.toml `out`, updating an existing one (its `[depth]` is kept);
 /// returns whether one existed.
-pub fn write_rig(out: &Path, board: &Board, d: &PairDetections, r: &StereoResult) -> Result<bool> {
+pub(crate) fn write_rig(
+    out: &Path,
+    board: &Board,
+    d: &PairDetections,
+    r: &StereoResult,
+) -> Result<bool> {
     let existing = if out.exists() {
         Some(Rig::read(out).map_err(|e| {
             Error::source(out, format!("exists but is not a rig.toml to update: {e}"))
@@ -336,12 +342,12 @@ fn pair_images(
 }
 
 /// A reprojection error for a table cell.
-pub fn error_cell(x: Option<ViewError>) -> String {
+pub(crate) fn error_cell(x: Option<ViewError>) -> String {
     x.map_or("—".into(), |e| format!("{:.3}", e.mean_px))
 }
 
 /// A pair's status in words.
-pub fn status_text(s: &PairStatus) -> String {
+pub(crate) fn status_text(s: &PairStatus) -> String {
     match s {
         PairStatus::Used => "used".to_string(),
         PairStatus::Rejected(why) => format!("rejected: {why}"),
@@ -406,7 +412,7 @@ fn index_html(board: &Board, r: &StereoResult, rows: &str) -> String {
 }
 
 /// Writes the report folder `rep`: every pair's images, calibration.json and index.html.
-pub fn write_stereo_report(
+pub(crate) fn write_stereo_report(
     rep: &Path,
     board: &Board,
     d: &PairDetections,
@@ -443,7 +449,7 @@ pub fn write_stereo_report(
 }
 
 /// Checks a board's square size.
-pub fn board(cols: u32, rows: u32, square_m: f64) -> Result<Board> {
+pub(crate) fn board(cols: u32, rows: u32, square_m: f64) -> Result<Board> {
     Board::new(cols, rows, square_m).ok_or_else(|| {
         Error::setting(
             "--square-m",
@@ -516,7 +522,7 @@ fn describe(name: &str, c: &PinholeCamera, m: &MonoResult, std: Option<&[f64]>) 
 
 /// What a one-camera calibration found, in lines: the camera and the fit's error, with the
 /// images left out by name.
-pub fn mono_lines(d: &ImageDetections, r: &MonoResult) -> Vec<String> {
+pub(crate) fn mono_lines(d: &ImageDetections, r: &MonoResult) -> Vec<String> {
     let mut lines = Vec::new();
     lines.push(describe(
         "camera",
@@ -587,7 +593,10 @@ fn extrinsic_line(r: &StereoResult) -> String {
 
 /// What a rig calibration found, in lines: both cameras, the extrinsic, how the model was
 /// chosen, plausibility warnings, the joint fit's errors and a table of the pairs.
-pub fn stereo_lines<'a>(r: &StereoResult, names: impl Iterator<Item = &'a str>) -> Vec<String> {
+pub(crate) fn stereo_lines<'a>(
+    r: &StereoResult,
+    names: impl Iterator<Item = &'a str>,
+) -> Vec<String> {
     let mut lines = Vec::new();
     let std = r.std.as_deref();
     lines.push(describe(
@@ -635,4 +644,183 @@ pub fn stereo_lines<'a>(r: &StereoResult, names: impl Iterator<Item = &'a str>) 
         ));
     }
     lines
+}
+
+/// `mrtmap calibrate`: the flags.
+#[derive(Debug, Clone, clap::Args)]
+#[command(after_long_help = "Examples:
+  mrtmap simulate-board --out boards
+  mrtmap calibrate --pairs boards --board 8x6 --square-m 0.06 --out rig.toml --report calib-report
+  mrtmap calibrate --images thermal-shots --board 11x9 --square-m 0.0505 --report r
+
+The pairs folder holds rgb/ and thermal/ sub-folders (images paired by file stem, or by the nearest
+timestamp when the stems are numbers), or files tagged like 0001_rgb.png + 0001_thermal.png.
+Thermal images may be 16-bit radiometric (any scale: they are stretched) or 8-bit grey or
+colour-mapped. At least one pair must show all inner corners in both images; other pairs may show
+part of the board.")]
+pub struct CalibrateArgs {
+    /// Folder of colour + thermal image pairs.
+    #[arg(long, value_name = "DIR", conflicts_with = "images")]
+    pub(crate) pairs: Option<PathBuf>,
+    /// Folder of one camera's images: its intrinsics only.
+    #[arg(long, value_name = "DIR")]
+    pub(crate) images: Option<PathBuf>,
+    /// Inner corners per row and column, COLSxROWS (a board of 9×7 squares has 8x6).
+    #[arg(long, value_name = "COLSxROWS")]
+    pub(crate) board: GridSize,
+    /// Side of one square (m).
+    #[arg(long, value_name = "M")]
+    pub(crate) square_m: f64,
+    /// rig.toml to write. An existing one keeps its [depth] section and encoding; a new one takes
+    /// the colour camera as the depth camera (a RealSense with depth aligned to colour).
+    #[arg(long, value_name = "FILE")]
+    pub(crate) out: Option<PathBuf>,
+    /// Report folder: corners drawn on every image, thermal-over-colour overlays, index.html,
+    /// calibration.json.
+    #[arg(long, value_name = "DIR")]
+    pub(crate) report: Option<PathBuf>,
+    /// Distortion model of the colour camera (or of the --images camera).
+    #[arg(long, value_enum, default_value = "auto")]
+    pub(crate) distortion: DistortionModel,
+    /// Distortion model of the thermal camera.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub(crate) thermal_distortion: DistortionModel,
+    /// Largest time difference (s) when pairing images by timestamp.
+    #[arg(long, default_value_t = 0.05, value_name = "S")]
+    pub(crate) max_dt: f64,
+    /// Fit only the corners found in both images of a pair (as OpenCV's stereoCalibrate).
+    #[arg(long)]
+    pub(crate) common_corners: bool,
+}
+
+/// The images searched for the board, before the fit ([`detect`]).
+pub struct Detected {
+    board: Board,
+    images: Images,
+}
+
+/// One camera's images, or colour + thermal pairs.
+enum Images {
+    Mono(ImageDetections),
+    Stereo(PairDetections),
+}
+
+/// `mrtmap calibrate`, first step: the board checked, and the images of `--images` or the pairs
+/// of `--pairs` read and searched for it.
+pub fn detect(a: &CalibrateArgs) -> Result<Detected> {
+    let board = board(a.board.cols, a.board.rows, a.square_m)?;
+    let images = match (&a.pairs, &a.images) {
+        (Some(dir), None) => Images::Stereo(detect_pairs(dir, &board, a.max_dt)?),
+        (None, Some(dir)) => {
+            if a.out.is_some() {
+                return Err(Error::setting(
+                    "--out",
+                    "writes a rig.toml, which needs --pairs (colour + thermal); with --images the result goes to the screen and --report",
+                ));
+            }
+            Images::Mono(detect_images(dir, &board)?)
+        }
+        _ => {
+            return Err(Error::setting(
+                "give",
+                "--pairs DIR (colour + thermal pairs) or --images DIR (one camera's intrinsics)",
+            ));
+        }
+    };
+    Ok(Detected { board, images })
+}
+
+impl Detected {
+    /// Why images were left out, one line each.
+    pub fn problems(&self) -> Vec<String> {
+        let seen: Vec<&Seen> = match &self.images {
+            Images::Mono(d) => d.seen.iter().collect(),
+            Images::Stereo(d) => d.rgb_seen.iter().chain(&d.thermal_seen).collect(),
+        };
+        seen.iter().filter_map(|s| s.problem.clone()).collect()
+    }
+
+    /// What was found, as `mrtmap calibrate` prints it before the fit.
+    pub fn lines(&self) -> Vec<String> {
+        let b = &self.board;
+        match &self.images {
+            Images::Mono(d) => vec![format!(
+                "board {}x{} of {} mm squares found in {} of {} images ({}×{})",
+                b.cols,
+                b.rows,
+                b.square_m * 1e3,
+                d.found(),
+                d.paths.len(),
+                d.size.0,
+                d.size.1
+            )],
+            Images::Stereo(d) => {
+                let mut lines = Vec::new();
+                if let Some(first) = d.unmatched.first() {
+                    lines.push(format!(
+                        "{} image(s) without a partner were left out (first: {})",
+                        d.unmatched.len(),
+                        first.display()
+                    ));
+                }
+                lines.push(format!(
+                    "{} pairs; board {}x{} ({} mm squares) found in {} colour ({}×{}) and {} thermal ({}×{}) images",
+                    d.pairs.len(),
+                    b.cols,
+                    b.rows,
+                    b.square_m * 1e3,
+                    found(&d.rgb_seen),
+                    d.rgb_size.0,
+                    d.rgb_size.1,
+                    found(&d.thermal_seen),
+                    d.thermal_size.0,
+                    d.thermal_size.1
+                ));
+                lines
+            }
+        }
+    }
+
+    /// `mrtmap calibrate`, second step: the fit, rig.toml (`--out`) and the report folder
+    /// (`--report`) written; gives what the CLI prints.
+    pub fn calibrate(&self, a: &CalibrateArgs) -> Result<Vec<String>> {
+        let board = &self.board;
+        match &self.images {
+            Images::Mono(d) => {
+                let r = calibrate_images(d, board, a.distortion)?;
+                let mut lines = mono_lines(d, &r);
+                if let Some(rep) = &a.report {
+                    write_mono_report(rep, board, d, &r)?;
+                    lines.push(format!("report: {}", rep.display()));
+                }
+                Ok(lines)
+            }
+            Images::Stereo(d) => {
+                let opts = StereoOptions {
+                    model_rgb: a.distortion,
+                    model_thermal: a.thermal_distortion,
+                    common_corners: a.common_corners,
+                };
+                let r = calibrate_pairs(d, board, &opts)?;
+                let mut lines = stereo_lines(&r, d.pairs.iter().map(|p| p.name.as_str()));
+                if let Some(out) = &a.out {
+                    let updated = write_rig(out, board, d, &r)?;
+                    lines.push(format!(
+                        "wrote {} ({})",
+                        out.display(),
+                        if updated {
+                            "updated [thermal] and [rgb]; [depth] kept"
+                        } else {
+                            "new: the colour camera is taken as the depth camera (depth aligned to colour); check [depth]"
+                        }
+                    ));
+                }
+                if let Some(rep) = &a.report {
+                    write_stereo_report(rep, board, d, &r)?;
+                    lines.push(format!("report: {}", rep.join("index.html").display()));
+                }
+                Ok(lines)
+            }
+        }
+    }
 }

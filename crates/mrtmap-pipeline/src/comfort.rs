@@ -13,18 +13,17 @@ use std::path::Path;
 
 use mrtmap_geometry::nalgebra::Point2;
 use mrtmap_io::FileError;
+use mrtmap_physics::PhysicsError;
 use mrtmap_physics::{Category, Posture, Temperature, pmv_ppd};
-/// The sun on a person (SolarCal) and where the sun is, for callers with their own inputs
+/// The sun on a person (SolarCal), for callers with their own inputs
 /// (mrtmap-physics').
 pub use mrtmap_physics::{
-    DEFAULT_ASW, DEFAULT_FLOOR_REFLECTANCE, PhysicsError, SolarGain, SolarInputs, SolarPosture,
-    SunPosition, UtcTime, f_svv, room_azimuth_deg, sharp_deg, solar_gain, sun_position,
+    DEFAULT_ASW, DEFAULT_FLOOR_REFLECTANCE, SolarInputs, SolarPosture, f_svv, solar_gain,
 };
 /// The comfort formulas themselves, for callers with their own inputs (a binding's arrays):
 /// PMV/PPD by edition of ISO 7730 and the operative temperature (mrtmap-physics').
 pub use mrtmap_physics::{
-    Iso7730Edition, OperativeMethod, Pmv, PmvInputs, operative_temperature, pmv_ppd_each,
-    pmv_ppd_edition, pmv_ppd_many,
+    Iso7730Edition, OperativeMethod, PmvInputs, operative_temperature, pmv_ppd_each,
 };
 use mrtmap_radiation::{
     AsymmetryVerdict, Facing, GridSpec, MapFrame, MrtEngine, MrtError, MrtField, RadiantAsymmetry,
@@ -41,7 +40,7 @@ use crate::points::SunQuery;
 use crate::settings::{AirSection, ComfortSection, Quantity};
 
 /// The relative air speed ISO 7730 uses: v + 0.3 (met − 1) for met > 1.
-pub fn relative_air_speed(v: f64, met: f64) -> f64 {
+pub(crate) fn relative_air_speed(v: f64, met: f64) -> f64 {
     if met > 1.0 { v + 0.3 * (met - 1.0) } else { v }
 }
 
@@ -83,7 +82,11 @@ pub struct Thermal {
 }
 
 /// Operative temperature and PMV/PPD of a person at mean radiant temperature `tr_c` ± `tr_se_k`.
-pub fn thermal(air: &Air, tr_c: f64, tr_se_k: f64) -> std::result::Result<Thermal, PhysicsError> {
+pub(crate) fn thermal(
+    air: &Air,
+    tr_c: f64,
+    tr_se_k: f64,
+) -> std::result::Result<Thermal, PhysicsError> {
     let c = Temperature::from_celsius;
     let vr = relative_air_speed(air.speed_m_s, air.met);
     let pmv_at = |tr: f64| {
@@ -200,13 +203,13 @@ fn wants(quantities: &[Quantity], q: Quantity) -> bool {
 }
 
 /// The sun for a comfort map: the tracer on the scene and the sun.
-pub type SunContext<'s, 'a> = (&'s SunTracer<'a>, &'s SunQuery);
+pub(crate) type SunContext<'s, 'a> = (&'s SunTracer<'a>, &'s SunQuery);
 
 /// The person's quantities at map coordinates `xy` (`stream` selects the random streams); with
 /// `sun`, the person of `[comfort]`'s posture gets SolarCal's ΔMRT, facing `[comfort] facing_deg`
 /// or, unset, the sun (SHARP 0), and operative temperature, PMV and PPD use that MRT.
 #[allow(clippy::too_many_arguments)]
-pub fn comfort_at(
+pub(crate) fn comfort_at(
     engine: &MrtEngine<'_>,
     frame: &MapFrame,
     xy: Point2<f64>,
@@ -298,7 +301,7 @@ pub fn comfort_at(
 }
 
 /// One quantity's value and standard error at a point, when computed.
-pub fn value_of(p: &ComfortPoint, q: Quantity) -> Option<(f64, f64)> {
+pub(crate) fn value_of(p: &ComfortPoint, q: Quantity) -> Option<(f64, f64)> {
     match q {
         Quantity::Mrt => None,
         Quantity::MrtSeated => p.mrt_seated,
@@ -312,7 +315,7 @@ pub fn value_of(p: &ComfortPoint, q: Quantity) -> Option<(f64, f64)> {
 }
 
 /// The title of a quantity's map.
-pub fn comfort_title(q: Quantity, c: &ComfortSection) -> String {
+pub(crate) fn comfort_title(q: Quantity, c: &ComfortSection) -> String {
     title_of(q, c).0
 }
 
@@ -469,7 +472,7 @@ impl SunlitPatch {
 }
 
 /// The PMV/PPD variant, in words.
-pub const PMV_MODEL: &str = "ISO 7730:2025 annex D (Fanger), as pythermalcomfort 4 pmv_ppd_iso; vr = v + 0.3 (met − 1) above 1 met; clo as given";
+pub(crate) const PMV_MODEL: &str = "ISO 7730:2025 annex D (Fanger), as pythermalcomfort 4 pmv_ppd_iso; vr = v + 0.3 (met − 1) above 1 met; clo as given";
 
 /// A comfort map set computed and written.
 pub struct ComfortOutput {
@@ -484,7 +487,7 @@ pub struct ComfortOutput {
 /// `sun` (`[sun]`), `mrt_sun` can be mapped and operative temperature, PMV and PPD include the
 /// sun; `mrt_sun` without it is refused.
 #[allow(clippy::too_many_arguments)]
-pub fn make_comfort_maps(
+pub(crate) fn make_comfort_maps(
     engine: &MrtEngine<'_>,
     scene: &RadiantScene,
     source: &str,
@@ -883,7 +886,7 @@ pub fn comfort_csv(path: &Path) -> Result<Vec<String>> {
 }
 
 /// What `mrtmap solar-gain` reports: the model, its inputs and its answer.
-pub const SOLAR_MODEL: &str =
+pub(crate) const SOLAR_MODEL: &str =
     "SolarCal (ASHRAE 55-2023 Appendix C), as pythermalcomfort 4.8 solar_gain; h_r 6 W/m²K";
 
 /// The sun's gain on a person: SolarCal's inputs and answer.

@@ -21,9 +21,6 @@ use crate::progress::Progress;
 use crate::run::{RunOutcome, run};
 use crate::settings::Project;
 
-/// The target a scan is judged against by default (K, 2σ).
-pub const DEFAULT_TARGET_K: f64 = 0.2;
-
 /// One surface's coverage.
 #[derive(Clone, Debug, Serialize)]
 pub struct SurfaceCoverage {
@@ -118,6 +115,17 @@ pub fn coverage(
         }),
         Err(e) => Err(e),
     }
+}
+
+/// Refuses a target that is not a positive number of kelvin, at most 10.
+pub(crate) fn check_target(target_k: f64) -> Result<()> {
+    if !(target_k.is_finite() && target_k > 0.0 && target_k <= 10.0) {
+        return Err(Error::setting(
+            format!("--target-k {target_k}"),
+            "give the map's target as a positive number of kelvin (2σ), at most 10",
+        ));
+    }
+    Ok(())
 }
 
 /// The verdict on a run's outcome; the advice names walls from where the scan started (`start`,
@@ -289,22 +297,9 @@ impl Coverage {
     }
 }
 
-/// `mrtmap coverage` in one call: checks the target (K, 2σ), reads the project file when given,
-/// prepares the recording (any source `run` takes) and runs the coarse check into `out`, or into
-/// a temporary folder that is removed.
-pub fn coverage_of(
-    recording: &Path,
-    out: Option<&Path>,
-    config: Option<&Path>,
-    source: &crate::source::SourceOptions,
-    target_k: f64,
-    progress: &dyn Progress,
-) -> Result<Coverage> {
-    let p = Project::resolve(config, &crate::Overrides::new())?;
-    coverage_with(recording, out, &p, source, target_k, progress)
-}
-
-/// [`coverage_of`] with the settings resolved.
+/// `mrtmap coverage` in one call, with the settings `p`: checks the target (K, 2σ), prepares the
+/// recording (any source `run` takes) and runs the coarse check into `out`, or into a temporary
+/// folder that is removed.
 pub(crate) fn coverage_with(
     recording: &Path,
     out: Option<&Path>,
@@ -314,12 +309,7 @@ pub(crate) fn coverage_with(
     progress: &dyn Progress,
 ) -> Result<Coverage> {
     p.check_heights_above_floor()?;
-    if !(target_k.is_finite() && target_k > 0.0 && target_k <= 10.0) {
-        return Err(Error::setting(
-            format!("--target-k {target_k}"),
-            "give the map's target as a positive number of kelvin (2σ), at most 10",
-        ));
-    }
+    check_target(target_k)?;
     let temp = match out {
         Some(_) => None,
         None => Some(

@@ -28,7 +28,7 @@ const GRID_STREAM0: u64 = 10_000;
 
 /// What the demo simulates.
 #[derive(Clone, Debug)]
-pub struct DemoSettings {
+pub(crate) struct DemoSettings {
     /// A preset room.
     pub room: String,
     /// Length of the scan (s).
@@ -53,7 +53,7 @@ pub struct DemoSettings {
 
 /// The error over the truth's grid.
 #[derive(Clone, Copy, Debug, Serialize)]
-pub struct GridError {
+pub(crate) struct GridError {
     /// Nodes compared.
     pub nodes: usize,
     /// Largest |ours − truth| (K).
@@ -64,7 +64,7 @@ pub struct GridError {
 
 /// What the demo did and found.
 #[derive(Clone, Debug)]
-pub struct DemoOutcome {
+pub(crate) struct DemoOutcome {
     /// The room's name.
     pub room: String,
     /// The simulation stage.
@@ -81,16 +81,85 @@ pub struct DemoOutcome {
     pub grid: GridError,
 }
 
+impl DemoOutcome {
+    /// What `mrtmap demo` prints: the stages, the seed paper's table, the grid's error, the report,
+    /// and how much `out` holds; `secs` is the whole demo's time.
+    pub fn lines(&self, s: &DemoSettings, out: &Path, secs: f64) -> Vec<String> {
+        let mut lines = vec![
+            format!(
+                "simulated {:.0} s of scanning the {} room ({:?} noise), ran the pipeline:",
+                s.seconds, self.room, s.noise
+            ),
+            format!(
+                "  {:<14} {:>7.1} s{}",
+                "simulate",
+                self.simulate.secs,
+                if self.simulate.skipped {
+                    "  (reused)"
+                } else {
+                    ""
+                }
+            ),
+        ];
+        lines.extend(self.run.lines(&self.run_dir, secs));
+        lines.push(String::new());
+        lines.push("MRT at the validation points (°C), as in the seed paper's table:".into());
+        lines.push(format!(
+            "  {:<6} {:>12} {:>18} {:>10} {:>16}",
+            "point", "truth", "black globe (ISO)", "mrtmap", "mrtmap − truth"
+        ));
+        for r in &self.rows {
+            lines.push(format!(
+                "  {:<6} {:>12.2} {:>18.2} {:>10.2} {:>14} K",
+                r.name,
+                r.truth_c,
+                r.globe_c,
+                r.ours_c,
+                mrtmap_report::numbers::signed(r.diff_k, 2)
+            ));
+        }
+        lines.push(format!(
+            "over the 20×20 grid at 1.1 m ({} nodes): max |Δ| {:.3} K, RMSE {:.3} K",
+            self.grid.nodes, self.grid.max_abs_error_k, self.grid.rmse_k
+        ));
+        lines.push(format!(
+            "report: {}",
+            RunLayout::new(&self.run_dir).report_html().display()
+        ));
+        lines.push(format!(
+            "{} holds {:.0} MB (recording, fused cloud, maps, report)",
+            out.display(),
+            folder_bytes(out) as f64 / 1e6
+        ));
+        lines
+    }
+}
+
+/// The bytes of the files under `dir` (what cannot be read counts as nothing).
+fn folder_bytes(dir: &Path) -> u64 {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return 0;
+    };
+    entries
+        .flatten()
+        .map(|e| match e.file_type() {
+            Ok(t) if t.is_dir() => folder_bytes(&e.path()),
+            Ok(t) if t.is_file() => e.metadata().map_or(0, |m| m.len()),
+            _ => 0,
+        })
+        .sum()
+}
+
 /// Walking speeds the demo may choose, slowest first (m/s): a careful scan walks at 0.5 m/s; a
 /// shorter one walks faster, up to a brisk 1 m/s, so that it still sees every wall.
-pub const DEMO_SPEEDS_M_S: [f64; 6] = [0.5, 0.6, 0.7, 0.8, 0.9, 1.0];
+pub(crate) const DEMO_SPEEDS_M_S: [f64; 6] = [0.5, 0.6, 0.7, 0.8, 0.9, 1.0];
 
 /// The shortest demo walk of `room` at `speed_m_s` (s): one and a half times the time the walk
 /// takes until every wall has been in view (the simulator's own coverage test on the floor plan),
 /// at least 15 s, in whole 5 s (3600 s when it never does). Measured on 2026-12-03 at 0.5 m/s: the
 /// office maps within 0.09 K from 15 s; the L-shaped room's 15 s walk missed two walls and its
 /// 25 s walk placed a wall 0.7 m short (0.44 K).
-pub fn shortest_walk_s(room: &mrtmap_sim::Room, seed: u64, speed_m_s: f64) -> f64 {
+pub(crate) fn shortest_walk_s(room: &mrtmap_sim::Room, seed: u64, speed_m_s: f64) -> f64 {
     let params = mrtmap_sim::WalkParams {
         speed_m_s,
         ..mrtmap_sim::WalkParams::default()
@@ -104,7 +173,7 @@ pub fn shortest_walk_s(room: &mrtmap_sim::Room, seed: u64, speed_m_s: f64) -> f6
 
 /// The slowest of [`DEMO_SPEEDS_M_S`] at which a walk of `seconds` sees every wall of `room`, or
 /// the shortest walk at the fastest speed.
-pub fn walk_speed_for(
+pub(crate) fn walk_speed_for(
     room: &mrtmap_sim::Room,
     seed: u64,
     seconds: f64,
@@ -346,8 +415,92 @@ fn write_demo_outputs(
     )
 }
 
+/// `mrtmap demo`: the flags.
+#[derive(Debug, Clone, clap::Args)]
+pub struct DemoArgs {
+    /// Output folder (the recording goes in DIR/recording, the run in DIR/run); about 200 MB for
+    /// the default 30 s scan, 380 MB for 60 s, 2 GB with --full. The default folder is git-ignored
+    /// in mrtmap's own repository.
+    #[arg(long, value_name = "DIR", default_value = "mrtmap-demo")]
+    pub(crate) out: PathBuf,
+    /// Length of the simulated scan (s): 15 at least for the office (a shorter walk has not seen
+    /// the whole room).
+    #[arg(long, default_value_t = 30.0)]
+    pub(crate) seconds: f64,
+    /// Simulate the seed paper's full 343 s scan (overrides --seconds).
+    #[arg(long)]
+    pub(crate) full: bool,
+    /// The preset room.
+    #[arg(long, default_value = "office")]
+    pub(crate) room: String,
+    /// Sensor noise.
+    #[arg(long, value_enum, default_value_t = NoiseLevel::Realistic)]
+    pub(crate) noise: NoiseLevel,
+    /// Air speed at the simulated globes (m/s).
+    #[arg(long, default_value_t = 0.1)]
+    pub(crate) air_speed: f64,
+    /// Depth image size of the simulated scan, WIDTHxHEIGHT (smaller runs faster).
+    #[arg(long, default_value = "640x480", value_parser = crate::parse::parse_grid)]
+    pub(crate) depth_size: (usize, usize),
+    /// Depth frame rate of the simulated scan (Hz); 15 Hz is what many D4xx rigs record.
+    #[arg(long, default_value_t = 15.0)]
+    pub(crate) depth_hz: f64,
+    /// Random seed of the simulation.
+    #[arg(long, default_value_t = 1)]
+    pub(crate) seed: u64,
+    #[command(flatten)]
+    pub(crate) camera: crate::simulation::CameraErrorArgs,
+    /// Rerun every stage.
+    #[arg(long)]
+    pub(crate) force: bool,
+}
+
+impl DemoArgs {
+    /// The demo's settings.
+    fn settings(&self) -> DemoSettings {
+        DemoSettings {
+            room: self.room.clone(),
+            seconds: if self.full { 343.0 } else { self.seconds },
+            seed: self.seed,
+            noise: self.noise,
+            air_speed_m_s: self.air_speed,
+            depth_size: self.depth_size,
+            depth_hz: self.depth_hz,
+            radiometric: self.camera.model(self.noise),
+            references: self.camera.references(self.noise),
+            force: self.force,
+        }
+    }
+
+    /// Where the demo writes and about how much, for people to read before it starts.
+    pub fn size_note(&self) -> String {
+        // Measured (2026-12-03, with glass and late stamps): 15 s at 640×480 and 30 Hz wrote 154 MB
+        // (depth 94 MB, colour 32, thermal 4, the run 20), 60 s 577 MB; at 15 Hz 30 s wrote 197 MB
+        // and 60 s 373 MB: about 20 MB for the run, 2.7 MB per second of scan plus 6.6 MB per
+        // second of 640×480 depth at 30 Hz.
+        // Depth data per second against 640×480 at 30 Hz.
+        let depth_share =
+            (self.depth_size.0 * self.depth_size.1) as f64 / (640.0 * 480.0) * self.depth_hz / 30.0;
+        let estimate_mb = 20.0 + self.settings().seconds * (2.7 + 6.6 * depth_share);
+        format!(
+            "writing into {} (about {:.0} MB; remove it when done)",
+            self.out.display(),
+            estimate_mb
+        )
+    }
+}
+
+/// `mrtmap demo`: the scan simulated, the pipeline run, and the comparison with the exact truth,
+/// into the folder `a` names; gives what the CLI prints.
+pub fn run_demo(a: &DemoArgs, progress: &dyn Progress) -> Result<Vec<String>> {
+    let t0 = std::time::Instant::now();
+    let s = a.settings();
+    let d = demo(&a.out, &s, progress)?;
+    Ok(d.lines(&s, &a.out, t0.elapsed().as_secs_f64()))
+}
+
 /// Runs the demo into `out` (recording in `out/recording`, the run in `out/run`).
-pub fn demo(out: &Path, s: &DemoSettings, progress: &dyn Progress) -> Result<DemoOutcome> {
+pub(crate) fn demo(out: &Path, s: &DemoSettings, progress: &dyn Progress) -> Result<DemoOutcome> {
     let t0 = std::time::Instant::now();
     let (simulated, room) = simulate_stage(out, s, progress)?;
     let layout = DemoLayout::new(out);

@@ -6,18 +6,17 @@ use std::path::{Path, PathBuf};
 use mrtmap_io::{read_cloud_ply, write_atomic};
 
 pub use mrtmap_export::CloudPoints;
-pub use mrtmap_export::gbxml::{floor_area, room_volume};
-pub use mrtmap_export::hbjson::Temperatures;
 use mrtmap_export::{ImportError, gbxml, gltf, hbjson, radiance};
 use mrtmap_radiation::RadiantScene;
 
 use crate::layout::{FuseDir, RunLayout, SegmentDir};
-pub use crate::settings::{DEFAULT_MAX_POINTS, ExportFormat, ExportSection};
+pub(crate) use crate::settings::ExportSection;
+pub use crate::settings::export::{DEFAULT_MAX_POINTS, ExportFormat};
 use crate::{Error, Result};
 
 /// What an export starts from.
 #[derive(Clone, Debug)]
-pub struct ExportInput {
+pub(crate) struct ExportInput {
     /// The scene.
     pub scene: RadiantScene,
     /// Where it came from, for people.
@@ -52,7 +51,7 @@ fn import_error(path: &Path, e: ImportError) -> Error {
 }
 
 /// Whether `path` names a Honeybee model (by its extension).
-pub fn is_hbjson(path: &Path) -> bool {
+pub(crate) fn is_hbjson(path: &Path) -> bool {
     path.extension()
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case("hbjson"))
@@ -61,7 +60,7 @@ pub fn is_hbjson(path: &Path) -> bool {
 /// A Honeybee model's room as a scene, with temperatures from `temperatures` (a table by
 /// identifier) or the model's own; `room` picks one of several rooms. The string says what was
 /// read, for people.
-pub fn load_hbjson(
+pub(crate) fn load_hbjson(
     path: &Path,
     temperatures: Option<&Path>,
     room: Option<&str>,
@@ -179,7 +178,7 @@ pub fn export_scene(
 }
 
 /// The built-in example office, to export.
-pub fn example_for_export() -> ExportInput {
+pub(crate) fn example_for_export() -> ExportInput {
     ExportInput {
         scene: mrtmap_radiation::example_office(),
         source: "the built-in example office".into(),
@@ -190,7 +189,11 @@ pub fn example_for_export() -> ExportInput {
 
 /// Opens what `mrtmap export` is given: a scene file (`scene.json`, or a Honeybee model with its
 /// temperatures), a segmentation folder, or a run's output folder (its scene and thermal cloud).
-pub fn open_for_export(path: &Path, src: &ExportSource, max_points: usize) -> Result<ExportInput> {
+pub(crate) fn open_for_export(
+    path: &Path,
+    src: &ExportSource,
+    max_points: usize,
+) -> Result<ExportInput> {
     let temperatures = src.temperatures.as_deref();
     let name = |p: &Path| {
         p.file_stem()
@@ -256,7 +259,7 @@ pub fn open_for_export(path: &Path, src: &ExportSource, max_points: usize) -> Re
 }
 
 /// The bytes of `input` in `format`.
-pub fn export_bytes(input: &ExportInput, format: ExportFormat) -> Vec<u8> {
+pub(crate) fn export_bytes(input: &ExportInput, format: ExportFormat) -> Vec<u8> {
     let s = &input.scene;
     match format {
         ExportFormat::Hbjson => hbjson::write(s, &input.name).into_bytes(),
@@ -325,7 +328,7 @@ pub fn export_file(
 }
 
 /// Writes `input` in `format` to `out` (atomically).
-pub fn export(input: &ExportInput, format: ExportFormat, out: &Path) -> Result<ExportDone> {
+pub(crate) fn export(input: &ExportInput, format: ExportFormat, out: &Path) -> Result<ExportDone> {
     if out.is_dir() {
         return Err(Error::setting(
             out.display().to_string(),
@@ -343,7 +346,7 @@ pub fn export(input: &ExportInput, format: ExportFormat, out: &Path) -> Result<E
 
 /// The exports `[export]` asks of a run: `out/export/room.EXT`, with the run's `cloud` (see
 /// [`run_cloud`]) in the glTF.
-pub fn export_run(
+pub(crate) fn export_run(
     out: &Path,
     scene: &RadiantScene,
     section: &ExportSection,

@@ -18,14 +18,17 @@ use std::path::Path;
 use mrtmap_io::{Recording, RecordingWarning, Trajectory};
 use mrtmap_radiation::RadiantScene;
 use mrtmap_scan::FusionReport;
+use mrtmap_scan::segment::SegmentReport;
 use mrtmap_track::TrackReport;
 
 use crate::coverage::Coverage;
 use crate::error::Result;
+use crate::layout::TrackDir;
 use crate::maps::{GridSpec, Mark, SceneMaps};
 use crate::points::{PointAnswers, PointQuery};
 use crate::progress::{Progress, Silent};
 use crate::report::RunDone;
+use crate::run::SegmentJob;
 use crate::settings::Project;
 use crate::source::{Prepared, SourceOptions};
 
@@ -46,6 +49,80 @@ pub struct FuseDone {
     pub warnings: Vec<RecordingWarning>,
     /// Fusion's report (fusion.json).
     pub report: FusionReport,
+    /// The voxel size fused at (m).
+    pub voxel_m: f64,
+}
+
+impl FuseDone {
+    /// What `mrtmap fuse` prints (the warnings apart): the conversion, the frames fused, the clock,
+    /// the poses dropped, the frames skipped, the depth points, ICP, the files written in `out`.
+    pub fn lines(&self, recording: &Path, out: &Path) -> Vec<String> {
+        let mut lines = Vec::new();
+        if let Some(c) = &self.prepared.conversion {
+            lines.extend(c.lines());
+        } else if self.prepared.reused {
+            lines.push(format!(
+                "using {} (converted earlier from {})",
+                self.prepared.dir.display(),
+                recording.display()
+            ));
+        }
+        let r = &self.report;
+        lines.push(format!(
+            "fused {} of {} thermal frames into {} voxels of {} m in {:.1} s ({:.0} frames/s)",
+            r.used_frames,
+            r.thermal_frames,
+            r.voxels,
+            self.voxel_m,
+            r.timing_s.total,
+            r.frames_per_second
+        ));
+        lines.push(format!("  {}", r.clock.describe()));
+        for line in r.pose_check.jump_lines() {
+            lines.push(format!("  warning: {line}"));
+        }
+        if r.pose_check.dropped > 0 {
+            lines.push(format!(
+                "  dropped {} of {} poses that jumped away from their neighbours' motion and back (the largest {:.2} m)",
+                r.pose_check.dropped,
+                r.pose_check.poses,
+                r.pose_check
+                    .examples
+                    .iter()
+                    .fold(0.0f64, |m, d| m.max(d.off_m))
+            ));
+        }
+        for (why, n) in &r.skipped {
+            lines.push(format!("  skipped {n} frames: {why}"));
+        }
+        for p in &r.problems {
+            lines.push(format!("  problem: {p}"));
+        }
+        let o = &r.observations;
+        lines.push(format!(
+            "  depth points: {} kept, {} outside the thermal view, {} hidden from it, {} grazing, {} on strong thermal edges",
+            o.kept, o.outside, o.occluded, o.grazing, o.edge
+        ));
+        if r.icp.enabled {
+            lines.push(format!(
+                "  ICP: {} of {} refinements accepted (mean fitness {:.2}, inlier RMSE {:.1} mm); final correction {:.1} cm, {:.2}°",
+                r.icp.accepted,
+                r.icp.attempted,
+                r.icp.mean_fitness,
+                r.icp.mean_inlier_rmse_m * 1e3,
+                r.icp.final_correction_m * 100.0,
+                r.icp.final_correction_deg
+            ));
+            for (why, n) in &r.icp.rejected {
+                lines.push(format!("    rejected {n}: {why}"));
+            }
+        }
+        lines.push(format!(
+            "wrote cloud.ply, fusion.json, poses.txt in {}",
+            out.display()
+        ));
+        lines
+    }
 }
 
 /// What [`Pipeline::track`] did.
@@ -56,6 +133,81 @@ pub struct TrackDone {
     pub trajectory: Trajectory,
     /// The tracker's report (track.json).
     pub report: TrackReport,
+}
+
+impl TrackDone {
+    /// What `mrtmap track` prints (the warnings apart): frames tracked, corners and inliers, the
+    /// error against groundtruth.txt when there is one, the trajectory written in `out`.
+    pub fn lines(&self, out: &Path) -> Vec<String> {
+        let r = &self.report;
+        let mut lines = vec![
+            format!(
+                "tracked {} of {} colour frames in {:.1} s: {} keyframes, {} loop closures accepted of {} tried, {} frames lost, {} found again, {} placed by depth alone",
+                r.tracked,
+                r.frames,
+                r.seconds,
+                r.keyframes,
+                r.loops_accepted,
+                r.loops_tried,
+                r.lost,
+                r.relocalised,
+                r.depth_only
+            ),
+            format!(
+                "  {:.0} corners per frame, {:.0} inliers per tracked frame, reprojection {:.2} px; {} frames without depth near in time; {}",
+                r.mean_corners,
+                r.mean_inliers,
+                r.mean_reprojection_px,
+                r.unsynced,
+                if r.gyro_samples > 0 {
+                    format!(
+                        "rotation predicted from {} gyro samples (imu.txt)",
+                        r.gyro_samples
+                    )
+                } else {
+                    "no gyro: constant-velocity prediction".to_string()
+                }
+            ),
+        ];
+        if let Some(e) = r.accuracy {
+            lines.push(format!(
+                "  against groundtruth.txt ({} poses): ATE RMSE {:.1} mm (max {:.1} mm), {:.2}° after alignment; frame to frame {:.2} mm, {:.3}°; over {:.2} s: {:.1} mm, {:.2}° (RMSE)",
+                e.poses,
+                e.ate_rmse_m * 1000.0,
+                e.ate_max_m * 1000.0,
+                e.ate_rotation_rmse_deg,
+                e.rpe_translation_rmse_m * 1000.0,
+                e.rpe_rotation_rmse_deg,
+                e.drift_span_s,
+                e.drift_translation_rmse_m * 1000.0,
+                e.drift_rotation_rmse_deg
+            ));
+        }
+        lines.push(format!(
+            "wrote {} poses to {}",
+            self.trajectory.len(),
+            TrackDir::new(out).trajectory_txt().display()
+        ));
+        lines
+    }
+}
+
+/// What [`Pipeline::segment`] did: segmentation's report (segment.json).
+pub struct SegmentDone {
+    /// Segmentation's report.
+    pub report: SegmentReport,
+}
+
+impl SegmentDone {
+    /// What `mrtmap segment` prints: the room, its surfaces and features, the files in `out`.
+    pub fn lines(&self, out: &Path) -> Vec<String> {
+        let mut lines = crate::run::segment_lines(&self.report);
+        lines.push(format!(
+            "wrote scene.json, segments.ply, segment.json in {}",
+            out.display()
+        ));
+        lines
+    }
 }
 
 impl Pipeline<'static> {
@@ -123,6 +275,7 @@ impl<'p> Pipeline<'p> {
             prepared,
             warnings: rec.warnings,
             report,
+            voxel_m: self.project.fuse.voxel_m,
         })
     }
 
@@ -138,6 +291,31 @@ impl<'p> Pipeline<'p> {
             trajectory,
             report,
         })
+    }
+
+    /// `mrtmap segment`: the fusion in `fused` (cloud.ply, poses.txt) segmented into `out`
+    /// (scene.json, segments.ply, segment.json) with `[segment]` and `[room]`; the features
+    /// labelled by the instance masks of the recording `masks`, what the cloud missed textured from
+    /// the thermal frames of `recording` (the masks' when not given), the temperature level fixed
+    /// by the contact readings in `references`.
+    pub fn segment(
+        &self,
+        fused: &Path,
+        masks: Option<&Path>,
+        recording: Option<&Path>,
+        references: Option<&Path>,
+        out: &Path,
+    ) -> Result<SegmentDone> {
+        let report = crate::run::segment_folder(&SegmentJob {
+            fused,
+            masks,
+            recording,
+            section: self.project.segment.clone(),
+            origin_corner: self.project.room.origin_corner,
+            references,
+            out,
+        })?;
+        Ok(SegmentDone { report })
     }
 
     /// `mrtmap map`: the MRT map at the first of `[map] heights_m` over `[map] grid`, and the
@@ -187,6 +365,48 @@ impl<'p> Pipeline<'p> {
             target_k,
             self.progress,
         )
+    }
+
+    /// `mrtmap live`: follows `recording` while a recorder writes it, sending what is known to
+    /// `sink` (the state at least every second, a 3D view after each refresh, judged against
+    /// ±`target_k`), until it has not grown for `exit_when_idle_s` or `stop` is set; then the
+    /// whole run into `out`, as [`Pipeline::run`].
+    pub fn live(
+        &self,
+        recording: &Path,
+        out: &Path,
+        target_k: f64,
+        exit_when_idle_s: Option<f64>,
+        stop: &std::sync::atomic::AtomicBool,
+        sink: &dyn crate::LiveSink,
+    ) -> Result<RunDone> {
+        crate::coverage::check_target(target_k)?;
+        if let Some(s) = exit_when_idle_s.filter(|s| !(s.is_finite() && *s > 0.0)) {
+            return Err(crate::Error::setting(
+                format!("--exit-when-idle {s}"),
+                "give a positive number of seconds",
+            ));
+        }
+        self.project.check_heights_above_floor()?;
+        let opts = crate::live::LiveOptions {
+            target_k,
+            exit_when_idle_s,
+            ..crate::live::LiveOptions::default()
+        };
+        crate::live::live(self, recording, out, &opts, stop, sink)
+    }
+
+    /// `mrtmap replay`: the finished recording `from` written into the new folder `into` at
+    /// `speed` times its own pace, as a recorder writes one, until the end or `stop`;
+    /// `progress(scan seconds written, scan length)` about every second of scan.
+    pub fn replay(
+        from: &Path,
+        into: &Path,
+        speed: f64,
+        stop: &std::sync::atomic::AtomicBool,
+        progress: &dyn Fn(f64, f64),
+    ) -> Result<crate::ReplayDone> {
+        crate::live::replay::replay(from, into, speed, stop, progress)
     }
 }
 

@@ -33,19 +33,19 @@ use mrtmap_scan::segment::Segmentation;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
-pub use crate::settings::Reference;
+use crate::settings::Reference;
 use crate::settings::{EmissivitySection, MrtSection, PointFrame, Project};
 
 /// A thermal camera's absolute accuracy when the rig does not state one (K): the Lepton 3.5's
 /// datasheet (high gain).
-pub const DEFAULT_CAMERA_ACCURACY_K: f64 = 5.0;
+pub(crate) const DEFAULT_CAMERA_ACCURACY_K: f64 = 5.0;
 
 fn one() -> f64 {
     1.0
 }
 
 /// Reads `references.csv`; errors name the file and line.
-pub fn read_references(path: &Path) -> Result<Vec<Reference>> {
+pub(crate) fn read_references(path: &Path) -> Result<Vec<Reference>> {
     let text = std::fs::read_to_string(path).map_err(|e| mrtmap_io::FileError::io(path, e))?;
     parse_references(&text, path)
 }
@@ -206,13 +206,13 @@ pub struct Level {
 /// The largest gain error of a thermal camera that a fit may find (|β − 1|): radiometric cameras
 /// are off mostly in offset, by a few per cent in gain. Two readings implying more disagree with
 /// each other (a typo: a wall read 40 instead of 20.9 gave a gain of 0.34 and a map 17 K warm).
-pub const MAX_GAIN_ERROR: f64 = 0.1;
+pub(crate) const MAX_GAIN_ERROR: f64 = 0.1;
 
 /// The standard uncertainty of a thermal camera's gain when the readings do not fix it (one
 /// reading, or several within 2 K of each other): radiometric cameras are off by a few per cent
 /// in gain (a Lepton 3.5's datasheet: ±5 % of the reading), so an offset fixed at a reading
 /// leaves 3 % of the distance from it, 0.25 K at a room 8 K warmer than the window read.
-pub const GAIN_STD: f64 = 0.03;
+pub(crate) const GAIN_STD: f64 = 0.03;
 
 /// The camera's fused temperature around a point (°C): within 5 cm, else 10 cm; `None` unseen.
 fn camera_at(cloud: &ThermalCloud, p: &Point3<f64>) -> Option<(f64, f64)> {
@@ -275,7 +275,7 @@ type Seen = (f64, f64, f64, usize);
 /// What the camera should read at a reading: the radiant temperature of the surface read (°C) and
 /// the emissivity taken for it.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Expected {
+pub(crate) struct Expected {
     /// The radiant temperature (°C).
     pub radiant_c: f64,
     /// The emissivity.
@@ -362,7 +362,7 @@ fn judge_readings(
 /// `cloud`, for a scene whose mean temperature is `mean_c`; `camera_accuracy_k` when none is usable.
 /// `expected` is what the camera should read at each reading (empty: the readings themselves, as
 /// on black surfaces).
-pub fn find_level(
+pub(crate) fn find_level(
     refs: &[Reference],
     expected: &[Expected],
     cloud: &ThermalCloud,
@@ -488,7 +488,7 @@ impl Level {
 /// and what turns the camera's radiant temperatures into surface temperatures: the emissivities
 /// and the engine that gives each surface's irradiance.
 #[derive(Clone, Debug, Default)]
-pub struct LevelInputs {
+pub(crate) struct LevelInputs {
     /// Contact-thermometer readings (references.csv and `[[references]]`).
     pub references: Vec<Reference>,
     /// The camera's stated absolute accuracy (K), used when no reading is usable.
@@ -502,13 +502,13 @@ pub struct LevelInputs {
 }
 
 /// Readings closer than this to each other (m), in the same frame, are one spot read again.
-pub const SAME_SPOT_M: f64 = 0.02;
+pub(crate) const SAME_SPOT_M: f64 = 0.02;
 
 /// Readings of one spot merged into one: their mean temperature, with the largest of their own
 /// uncertainties and their spread (a repeated reading of one spot shares its contact's error, so
 /// it is not an independent reading: two identical rows once took the level's ± from 0.12 to
 /// 0.07 K). Returns the readings and a warning per merge.
-pub fn merge_same_spot(refs: Vec<Reference>) -> (Vec<Reference>, Vec<String>) {
+pub(crate) fn merge_same_spot(refs: Vec<Reference>) -> (Vec<Reference>, Vec<String>) {
     let mut groups: Vec<Vec<Reference>> = Vec::new();
     for r in refs {
         let near = |g: &Vec<Reference>| {
@@ -662,7 +662,7 @@ fn mean_temperature_c(scene: &RadiantScene) -> f64 {
 /// a contact reading on a window, where glass gives no depth, meets what texturing found), the
 /// level fitted, the scene's temperatures corrected, segment.json's tables with them, and the
 /// level's warnings added to segmentation's.
-pub fn level_segmentation(
+pub(crate) fn level_segmentation(
     seg: &mut Segmentation,
     cloud: &ThermalCloud,
     level: &LevelInputs,

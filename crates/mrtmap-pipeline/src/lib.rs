@@ -1,88 +1,86 @@
 //! # mrtmap-pipeline
 //!
 //! Orchestration: what runs in which order, where its files go, and when a stage's outputs can be
-//! reused. The CLI parses flags into these types, calls one function, and prints what comes back.
+//! reused. A front end (the CLI, the Python binding) resolves its flags into a [`Project`], holds a
+//! [`Pipeline`] (the front door: one method per command), and prints what comes back.
 //!
 //! ```text
-//!  source (bag, MCAP, ROS 2 bag, RTAB-Map db) ──source::prepare──► recording folder
-//!  recording ──run::run──► fuse/ ──► segment/ (scene.json) ──► map-H.HHm/ per height
-//!            └─ report::report_data ──► report.html, run.json
+//!  source (bag, MCAP, ROS 2 bag, RTAB-Map db) ──convert──► recording folder
+//!  recording ──Pipeline::run──► fuse/ ──► segment/ (scene.json) ──► map-H.HHm/ per height
+//!            └─ report.html, run.json
 //!  demo::demo = simulate (sim) + run + comparison with the exact truth
 //!  calibration: image pairs ──► rig.toml + report folder
 //! ```
 //!
-//! - [`settings`]: [`Project`] (project.toml) and the typed choices
-//!   shared by flags and files ([`MethodChoice`], [`DirectionChoice`]).
-//! - [`resolve`]: settings resolved once for every front end: the defaults, then project.toml,
-//!   then the flags given ([`Overrides`], [`Project::resolve`]; `[mrt]`'s flags as [`MrtFlags`]).
-//! - [`cache`]: a stage's [`Fingerprint`] and [`run_or_reuse`]; the run's stages, source
-//!   conversion and the demo's simulation all use it.
-//! - [`progress`]: the [`Progress`] trait the CLI implements with progress bars.
-//! - [`layout`]: where a run's files go, [`RunLayout`] (and each stage's folder, the demo's
-//!   [`DemoLayout`]); no other module spells a file name of the run folder.
-//! - [`source`], [`run`], [`maps`], [`report`], [`demo`], [`calibration`]: one job each.
-//! - [`points`]: MRT at points of a scene (a sphere's, a person's, the plane radiant
-//!   temperatures) from one call, [`points::mrt_at_points`].
-//! - [`coverage`], [`comfort`], [`validation`] (also globe ↔ MRT), [`thermal_image`] (one thermal
-//!   file), [`simulation`]: one job each; [`parse`]: the text forms flags share (`20x20`,
-//!   `X,Y,Z`, `on|off`); [`files`]: mrtmap-io's types a front end handles itself.
+//! The public API is kept small (issue 53: at most 150 items, counted by
+//! `crates/mrtmap/tests/it/architecture.rs`); the stages themselves are crate-private.
 //!
-//! Everything here returns data, text lines and files; nothing prints. A result a person reads
-//! has a `lines()` (or `*_lines`) giving what the CLI prints, so a binding can show the same.
+//! - [`Pipeline`]: `run`, `fuse`, `track`, `segment`, `map`, `mrt`, `coverage`; each result has a
+//!   `lines()` giving what the CLI prints, so a binding can show the same.
+//! - [`Project`] (project.toml, [`settings`]), resolved once for every front end: the defaults,
+//!   then project.toml, then the flags given ([`Overrides`], [`Project::resolve`]; `[mrt]`'s flags
+//!   as [`MrtFlags`]).
+//! - [`Progress`]: the trait the CLI implements with progress bars ([`Silent`]: none).
+//! - [`RunLayout`]: where a run's files go (the demo's folder: [`DemoLayout`]).
+//! - Commands that need no project: [`source`] (inspect, convert), [`demo`], [`calibration`],
+//!   [`simulation`], [`export`], [`points`] and [`maps`] (scenes, their points and grids),
+//!   [`comfort`], [`validation`] (also globe ↔ MRT), [`thermal_image`] (one thermal file);
+//!   [`parse`]: the text forms flags share (`20x20`, `X,Y,Z`, `on|off`); [`parse_references`]:
+//!   contact readings as text.
+//! - On site, live: [`Pipeline::live`] follows a recording as it is written and sends a
+//!   [`LiveState`] to a [`LiveSink`] (the live page's server, `mrtmap-live`);
+//!   [`Pipeline::replay`] writes a recording again at its own pace.
+//!
+//! Everything here returns data, text lines and files; nothing prints.
 //!
 //! ```no_run
-//! use mrtmap_pipeline::{Project, Silent, run::run};
+//! use mrtmap_pipeline::{Overrides, Pipeline, Project, Silent};
 //! # fn main() -> Result<(), mrtmap_pipeline::Error> {
-//! let outcome = run(
-//!     std::path::Path::new("scan"),
-//!     std::path::Path::new("out"),
-//!     &Project::default(),
-//!     false,
-//!     &Silent,
-//! )?;
-//! println!("{} maps", outcome.maps.len());
+//! let project = Project::resolve(None, &Overrides::new())?;
+//! let done = Pipeline::new(project)
+//!     .progress(&Silent)
+//!     .run("scan".as_ref(), "out".as_ref())?;
+//! println!("{} maps", done.outcome.maps.len());
 //! # Ok(())
 //! # }
 //! ```
 
 mod advice;
-pub mod cache;
+mod cache;
 pub mod calibration;
 pub mod comfort;
 mod conversion;
-pub mod coverage;
+mod coverage;
 pub mod demo;
 mod error;
 pub mod export;
-pub mod front;
-pub mod layout;
-pub mod level;
-pub mod live;
-pub mod lock;
+mod front;
+mod layout;
+mod level;
+mod live;
+mod lock;
 pub mod maps;
 pub mod parse;
 pub mod points;
-pub mod progress;
-pub mod report;
-pub mod resolve;
-pub mod run;
+mod progress;
+mod report;
+mod resolve;
+mod run;
 pub mod settings;
 pub mod simulation;
 pub mod source;
 pub mod thermal_image;
 pub mod validation;
 
-/// The file formats a front end reads or writes itself (mrtmap-io's): a recording, its rig,
-/// atomic writes, and I/O errors in words.
-pub mod files {
-    pub use mrtmap_io::{FileError, InterpolationLimits, Recording, Rig, io_words, write_atomic};
-}
-
-pub use advice::Advice;
-pub use cache::{Fingerprint, Stage, StageOutcome, run_or_reuse};
 pub use error::{Error, Result};
-pub use front::{FuseDone, Pipeline, TrackDone};
+pub use front::{FuseDone, Pipeline, SegmentDone, TrackDone};
 pub use layout::{DemoLayout, RunLayout};
+pub use level::parse_references;
+pub use live::replay::ReplayDone;
+pub use live::{LiveSink, LiveState};
 pub use progress::{Progress, Silent};
+pub use report::RunDone;
 pub use resolve::{MrtFlags, Overrides};
-pub use settings::{DirectionChoice, MethodChoice, MrtSection, Project};
+pub use run::RunOutcome;
+pub use settings::Project;
+pub use settings::mrt::MrtSection;

@@ -6,12 +6,13 @@ use std::time::Instant;
 
 use mrtmap_geometry::nalgebra::{Point2, Point3};
 use mrtmap_io::write_atomic;
+pub(crate) use mrtmap_radiation::FieldSummary;
 /// A map's grid, the summary of its values and the radiant scene it is computed on
 /// (mrtmap-radiation's).
-pub use mrtmap_radiation::{FieldSummary, GridSpec, RadiantScene};
+pub use mrtmap_radiation::{GridSpec, RadiantScene};
 use mrtmap_radiation::{MapFrame, Method, MrtEngine, MrtError, MrtField, PointRecord};
 /// Where a map lies in the scene (mrtmap-report's).
-pub use mrtmap_report::MapAxes;
+pub(crate) use mrtmap_report::MapAxes;
 use mrtmap_report::numbers::{fixed, uncertainty, xyz};
 use mrtmap_report::{MapInput, MapMark, MapSummary, grid_csv, render_png, render_svg};
 use serde::{Deserialize, Serialize};
@@ -19,7 +20,7 @@ use serde::{Deserialize, Serialize};
 use crate::cache::write_json;
 use crate::error::{Error, Result};
 use crate::layout::MapDir;
-use crate::settings::MrtSection;
+use crate::settings::{MrtSection, Quantity};
 
 /// A point to mark on a map: map coordinates U,V at the map's height, or scene coordinates X,Y,Z.
 #[derive(Clone, Debug, PartialEq)]
@@ -110,7 +111,7 @@ fn mark_records(
     Ok((records, map_marks))
 }
 
-/// What [`map_scene`] made: the MRT map and, when a person's quantities were asked for, the
+/// What [`crate::Pipeline::map`] made: the MRT map and, when a person's quantities were asked for, the
 /// comfort maps beside it.
 pub struct SceneMaps {
     /// The MRT map.
@@ -119,10 +120,89 @@ pub struct SceneMaps {
     pub comfort: Option<crate::comfort::ComfortOutput>,
 }
 
+impl SceneMaps {
+    /// What `mrtmap map` prints: the scene `source`, the method, the map's summary, and for the
+    /// person's `quantities` their summary and values at the marks; the files are in `out`.
+    pub fn lines(&self, source: &str, quantities: &[Quantity], out: &Path) -> Vec<String> {
+        let m = &self.map;
+        let mut lines = vec![format!("scene: {source}"), format!("method: {}", m.method)];
+        lines.extend(m.summary.lines());
+        lines.push(format!(
+            "computed in {:.3} s; wrote mrt_grid.csv, mrt_map.png, mrt_map.svg, summary.json in {}",
+            m.summary.map.compute_secs,
+            out.display()
+        ));
+        let Some(c) = &self.comfort else {
+            return lines;
+        };
+        let person = Quantity::person(quantities);
+        let s = &c.summary;
+        lines.push(String::new());
+        lines.push(format!(
+            "a {} person, {}: {} nodes in {:.1} s",
+            s.comfort.posture.as_str(),
+            s.comfort.facing().describe(),
+            s.nodes,
+            s.compute_secs
+        ));
+        if let Some(sh) = s.pmv_category_share {
+            lines.push(format!(
+                "  floor by ISO 7730 PMV category: A {:.0} %, B {:.0} %, C {:.0} %, outside {:.0} %",
+                100.0 * sh[0],
+                100.0 * sh[1],
+                100.0 * sh[2],
+                100.0 * sh[3]
+            ));
+        }
+        if let Some(share) = s.outside_iso_ranges_share.filter(|x| *x > 0.0) {
+            lines.push(format!(
+                "  PMV inputs outside ISO 7730's ranges on {:.0} % of the floor: PMV and PPD there are indicative only",
+                100.0 * share
+            ));
+        }
+        if let Some((w, xy)) = &s.worst_asymmetry {
+            lines.push(format!(
+                "  worst radiant asymmetry {:.2} K at ({}, {}): PD {:.1} %, category {}",
+                w.worst.delta_k,
+                fixed(xy[0], 2),
+                fixed(xy[1], 2),
+                w.worst.pd_pct,
+                w.worst.category.as_str()
+            ));
+        }
+        if let Some(sun) = &s.sun {
+            lines.push(format!(
+                "  the sun (SolarCal): the beam reaches the person on {:.0} % of the floor; ΔMRT up to {:.2} K at ({}, {})",
+                100.0 * sun.sunlit_share,
+                sun.max_delta_mrt_k,
+                fixed(sun.max_at[0], 2),
+                fixed(sun.max_at[1], 2)
+            ));
+        }
+        for (name, p) in &s.marks {
+            let cells: Vec<String> = person
+                .iter()
+                .filter_map(|q| {
+                    crate::comfort::value_of(p, *q)
+                        .map(|(v, e)| format!("{} {v:.2} ± {}", q.name(), uncertainty(e, 2)))
+                })
+                .collect();
+            lines.push(format!("  {name}: {}", cells.join(", ")));
+        }
+        let names: Vec<String> = person.iter().map(|q| format!("{}.png", q.name())).collect();
+        lines.push(format!(
+            "wrote {} and comfort.json in {}",
+            names.join(", "),
+            out.display()
+        ));
+        lines
+    }
+}
+
 /// What `mrtmap map` writes into `out`: the MRT over `spec`'s grid of `scene` (view factors by
 /// `project.mrt`) with `marks`, and the person's comfort maps that `project.map.quantities` asks
 /// for (the person and the air from `project`, checked before anything is computed).
-pub fn map_scene(
+pub(crate) fn map_scene(
     scene: &RadiantScene,
     source: &str,
     project: &crate::Project,
@@ -130,11 +210,11 @@ pub fn map_scene(
     marks: &[Mark],
     out: &Path,
 ) -> Result<SceneMaps> {
-    let person = crate::settings::Quantity::person(&project.map.quantities);
+    let person = Quantity::person(&project.map.quantities);
     project.comfort.check(&project.air, &person)?;
     project.sun.check()?;
     let sun = project.sun.query()?;
-    if person.contains(&crate::settings::Quantity::MrtSun) && sun.is_none() {
+    if person.contains(&Quantity::MrtSun) && sun.is_none() {
         return Err(crate::settings::no_sun_error());
     }
     let map = make_map(scene, source, &project.mrt, spec, marks, out)?;
@@ -243,7 +323,7 @@ pub struct MapArrays {
 }
 
 /// The MRT of `scene` (from `source`, named in errors) over `spec`'s grid with the view-factor
-/// settings `mrt`, as arrays; nothing is written. The same nodes and values as [`make_map`]'s
+/// settings `mrt`, as arrays; nothing is written. The same nodes and values as `mrtmap map`'s
 /// mrt_grid.csv.
 pub fn map_arrays(
     scene: &RadiantScene,
@@ -286,7 +366,7 @@ pub fn map_arrays(
 /// Computes the MRT map of `scene` (from `source`, for people) on `spec` with `marks`, and writes
 /// mrt_grid.csv, mrt_map.png, mrt_map.svg and summary.json into `out`. The height and the marks
 /// are checked against the room before anything is computed.
-pub fn make_map(
+pub(crate) fn make_map(
     scene: &RadiantScene,
     source: &str,
     mrt: &MrtSection,
@@ -342,7 +422,7 @@ pub fn make_map(
 
 /// A map's nodes read back from its `mrt_grid.csv`: x, y, z (m) and the MRT (°C) of each node
 /// that has one.
-pub fn read_grid_nodes(csv: &Path) -> Result<Vec<[f64; 4]>> {
+pub(crate) fn read_grid_nodes(csv: &Path) -> Result<Vec<[f64; 4]>> {
     let text = std::fs::read_to_string(csv).map_err(|e| mrtmap_io::FileError::io(csv, e))?;
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();

@@ -14,7 +14,7 @@ impl From<String> for ParseError {
 }
 
 /// Comma-separated finite numbers, as many as one of `n`; `what` says what was expected.
-pub fn numbers(s: &str, n: &[usize], what: &str) -> Result<Vec<f64>, ParseError> {
+pub(crate) fn numbers(s: &str, n: &[usize], what: &str) -> Result<Vec<f64>, ParseError> {
     let v: Result<Vec<f64>, _> = s.split(',').map(|x| x.trim().parse::<f64>()).collect();
     match v {
         Ok(v) if n.contains(&v.len()) && v.iter().all(|x| x.is_finite()) => Ok(v),
@@ -51,7 +51,10 @@ pub fn parse_sun(s: &str) -> Result<[f64; 2], ParseError> {
 }
 
 /// "AxB" (also "A×B") as two numbers; `bad` says what was expected.
-pub fn parse_pair(s: &str, bad: &dyn Fn() -> ParseError) -> Result<(usize, usize), ParseError> {
+pub(crate) fn parse_pair(
+    s: &str,
+    bad: &dyn Fn() -> ParseError,
+) -> Result<(usize, usize), ParseError> {
     let (a, b) = s.split_once(['x', 'X', '×']).ok_or_else(bad)?;
     Ok((
         a.trim().parse::<usize>().map_err(|_| bad())?,
@@ -60,7 +63,7 @@ pub fn parse_pair(s: &str, bad: &dyn Fn() -> ParseError) -> Result<(usize, usize
 }
 
 /// An image size WIDTHxHEIGHT, 1…16384 pixels a side.
-pub fn parse_image_size(s: &str) -> Result<(u32, u32), ParseError> {
+pub(crate) fn parse_image_size(s: &str) -> Result<(u32, u32), ParseError> {
     let (w, h) = parse_pair(s, &|| {
         format!("expected WIDTHxHEIGHT such as 160x120, got '{s}'").into()
     })?;
@@ -98,7 +101,7 @@ pub fn parse_mark(s: &str) -> Result<(String, Vec<f64>), ParseError> {
 }
 
 /// An interval MIN,MAX of seconds, 0 ≤ MIN ≤ MAX.
-pub fn parse_interval(s: &str) -> Result<[f64; 2], ParseError> {
+pub(crate) fn parse_interval(s: &str) -> Result<[f64; 2], ParseError> {
     let v = numbers(s, &[2], "MIN,MAX (two numbers in seconds)")?;
     if !(v[0] >= 0.0 && v[1] >= v[0]) {
         return Err(format!("expected 0 <= MIN <= MAX, got '{s}'").into());

@@ -2,8 +2,9 @@
 //! its angle factors) and the six plane radiant temperatures with the radiant asymmetry. What
 //! `mrtmap mrt` prints, and what a binding returns, from one call.
 
+pub(crate) use mrtmap_physics::AsymmetryKind;
 /// A person's posture and the asymmetry kinds (mrtmap-physics' types).
-pub use mrtmap_physics::{AsymmetryKind, Posture};
+pub use mrtmap_physics::Posture;
 use std::path::Path;
 
 use mrtmap_geometry::nalgebra::Point3;
@@ -11,18 +12,25 @@ use mrtmap_physics::PhysicsError;
 use mrtmap_physics::{SolarInputs, sharp_deg, solar_gain};
 /// A sphere's MRT at a point with its view-factor table (mrtmap-radiation's).
 pub use mrtmap_radiation::PointRecord;
+/// The sun in the room's frame and a person's exposure to it (mrtmap-radiation's).
+pub(crate) use mrtmap_radiation::SunExposure;
+pub(crate) use mrtmap_radiation::{AsymmetryVerdict, ENCLOSURE_TOLERANCE};
 /// Which way a person faces, an asymmetry's verdict, the enclosure tolerance and the built-in
 /// example scene (mrtmap-radiation's).
-pub use mrtmap_radiation::{AsymmetryVerdict, ENCLOSURE_TOLERANCE, EXAMPLE_OFFICE_JSON, Facing};
+pub use mrtmap_radiation::{EXAMPLE_OFFICE_JSON, Facing};
+
+/// Writes the built-in example scene (an office with a cold window) to `path`, whole or not at all.
+pub fn write_example_scene(path: &Path) -> Result<()> {
+    mrtmap_io::write_atomic(path, EXAMPLE_OFFICE_JSON.as_bytes())?;
+    Ok(())
+}
 use mrtmap_radiation::{PersonMrt, RadiantAsymmetry, RadiantScene, SunTracer};
-/// The sun in the room's frame and a person's exposure to it (mrtmap-radiation's).
-pub use mrtmap_radiation::{SunDirection, SunExposure};
 use mrtmap_report::numbers::{fixed, uncertainty};
 use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-pub use crate::settings::SunQuery;
+pub use crate::settings::sun::SunQuery;
 use crate::settings::{MrtSection, PointFrame};
 
 /// What to compute at the points.
@@ -451,7 +459,7 @@ fn person_and_plane_lines(persons: &[PersonAnswer], planes: &[PlaneAnswer]) -> V
 
 /// A point of `frame` in the scene's own frame: a scan-frame point is carried through the scene's
 /// `world_from_room` (`source` names the scene for the error when it has none).
-pub fn to_scene_frame(
+pub(crate) fn to_scene_frame(
     xyz: [f64; 3],
     frame: PointFrame,
     scene: &RadiantScene,

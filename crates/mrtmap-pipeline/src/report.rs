@@ -6,7 +6,7 @@ use mrtmap_report::numbers::{fixed, signed, uncertainty};
 use mrtmap_report::view3d::GridLayer;
 use mrtmap_report::{KeyValues, ReportData, ReportMap};
 /// Numbers for people, and the ± parts and unseen patches in words (mrtmap-report's).
-pub use mrtmap_report::{numbers, parts_line, unseen_line};
+pub use mrtmap_report::{parts_line, unseen_line};
 use mrtmap_scan::FusionReport;
 use mrtmap_scan::segment::SegmentReport;
 use serde::Serialize;

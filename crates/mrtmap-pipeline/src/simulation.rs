@@ -1,18 +1,20 @@
 //! Rooms and simulator settings shared by `simulate` and `demo`.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 use mrtmap_sim::preset;
-/// The simulator's rooms, settings and noise models (mrtmap-sim's types).
-pub use mrtmap_sim::{
-    Drift, NoiseLevel, PRESETS, RadiometricModel, Room, SimConfig, SimSun, Surfaces, ThermalNoise,
-    simulate,
+pub(crate) use mrtmap_sim::{
+    Drift, NoiseLevel, RadiometricModel, SimConfig, SimSun, Surfaces, ThermalNoise, simulate,
 };
+/// The simulator's preset rooms (mrtmap-sim's).
+pub use mrtmap_sim::{PRESETS, Room};
 
 use crate::error::{Error, Result};
+use crate::progress::Progress;
 
 /// A preset room by name, or a room TOML file.
-pub fn load_room(spec: &str) -> Result<Room> {
+pub(crate) fn load_room(spec: &str) -> Result<Room> {
     if let Some(r) = preset(spec) {
         return Ok(r?);
     }
@@ -30,7 +32,7 @@ pub fn load_room(spec: &str) -> Result<Room> {
 
 /// Sets the depth (and colour) image size of `cfg`, scaling the intrinsics; the size must keep
 /// the default camera's aspect.
-pub fn set_depth_size(cfg: &mut SimConfig, (w, h): (usize, usize)) -> Result<()> {
+pub(crate) fn set_depth_size(cfg: &mut SimConfig, (w, h): (usize, usize)) -> Result<()> {
     let s = w as f64 / cfg.depth_camera.width as f64;
     if (h as f64 / cfg.depth_camera.height as f64 - s).abs() > 1e-9 {
         return Err(Error::setting(
@@ -45,9 +47,221 @@ pub fn set_depth_size(cfg: &mut SimConfig, (w, h): (usize, usize)) -> Result<()>
     Ok(())
 }
 
+/// A simulated effect: on, off, or the noise level's default.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum AutoOnOff {
+    /// On with --noise realistic, off with none.
+    Auto,
+    /// On.
+    On,
+    /// Off.
+    Off,
+}
+
+impl AutoOnOff {
+    /// `None` for auto.
+    pub fn choice(self) -> Option<bool> {
+        match self {
+            Self::Auto => None,
+            Self::On => Some(true),
+            Self::Off => Some(false),
+        }
+    }
+}
+
+/// SLAM drift of a simulation's trajectory.txt.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum DriftChoice {
+    /// trajectory.txt equals groundtruth.txt.
+    None,
+    /// Visual SLAM without loop closure: 4 mm/√s in position, 0.03°/√s in heading.
+    Slam,
+    /// Plain odometry: 1 cm/√s, 0.1°/√s.
+    Odometry,
+}
+
+/// `mrtmap simulate`: a handheld scan of a room, with exact truth.
+#[derive(Debug, Clone, clap::Args)]
+pub struct SimulateArgs {
+    /// A preset room (office, l-shaped, radiant-ceiling; see `mrtmap rooms`) or a room TOML file.
+    #[arg(long, default_value = "office")]
+    pub(crate) room: String,
+    /// Output folder for the recording (written as DIR.partial, renamed when complete).
+    #[arg(long, value_name = "DIR")]
+    pub(crate) out: PathBuf,
+    /// Length of the scan (s); the seed paper's took 343 s.
+    #[arg(long, default_value_t = 343.0)]
+    pub(crate) seconds: f64,
+    /// Random seed.
+    #[arg(long, default_value_t = 1)]
+    pub(crate) seed: u64,
+    /// Sensor noise.
+    #[arg(long, value_enum, default_value_t = NoiseLevel::Realistic)]
+    pub(crate) noise: NoiseLevel,
+    /// SLAM drift in trajectory.txt (groundtruth.txt always has the true poses).
+    #[arg(long, value_enum, default_value_t = DriftChoice::None)]
+    pub(crate) drift: DriftChoice,
+    /// Constant thermal camera offset (K), added to every reading.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub(crate) thermal_bias: f64,
+    /// Thermal optical blur, Gaussian σ in pixels (realistic noise only).
+    #[arg(long, default_value_t = 0.5)]
+    pub(crate) thermal_blur: f64,
+    /// Depth (and colour) image size, WIDTHxHEIGHT; intrinsics scale with it.
+    #[arg(long, default_value = "640x480", value_parser = crate::parse::parse_grid)]
+    pub(crate) depth_size: (usize, usize),
+    /// Depth frame rate (Hz).
+    #[arg(long, default_value_t = 30.0)]
+    pub(crate) depth_hz: f64,
+    /// Thermal frame rate (Hz).
+    #[arg(long, default_value_t = 8.7)]
+    pub(crate) thermal_hz: f64,
+    /// Colour and instance-mask frame rate (Hz).
+    #[arg(long, default_value_t = 5.0)]
+    pub(crate) rgb_hz: f64,
+    /// Leave trajectory.txt out: a recording without a pose source (colour, depth and thermal
+    /// only), for `mrtmap track`; groundtruth.txt still has the true poses.
+    #[arg(long)]
+    pub(crate) no_poses: bool,
+    /// How late the thermal frames are stamped (ms): a USB thermal board's frames are stamped on
+    /// arrival. Default: drawn from the seed, 40–120 ms, with --noise realistic; 0 with none.
+    #[arg(long, value_name = "MS")]
+    pub(crate) thermal_lag_ms: Option<f64>,
+    /// The microbolometer's time constant (ms): fast turns smear the thermal image (realistic
+    /// noise only).
+    #[arg(long, value_name = "MS", default_value_t = 12.0)]
+    pub(crate) thermal_time_constant_ms: f64,
+    /// Windows as an active-stereo depth camera sees them: no depth on the glass (10 % of its
+    /// pixels see 4 m beyond); off: panes return depth like a wall. Auto: on with --noise
+    /// realistic, off with none.
+    #[arg(long, value_enum, default_value_t = AutoOnOff::Auto)]
+    pub(crate) glass: AutoOnOff,
+    /// The room's surfaces: grey (window glass emissivity 0.84 mirroring the room and the
+    /// operator holding the camera, every other surface 0.90–0.95 drawn from the seed, unless the
+    /// room's TOML gives emissivities; the camera reads radiosities, the contact readings true
+    /// temperatures) or black (ε = 1: the camera reads each surface's own temperature). Default:
+    /// grey with --noise realistic, black with none.
+    #[arg(long, value_enum)]
+    pub(crate) surfaces: Option<Surfaces>,
+    /// The sun outside the room, for truth.json only (the recording is unchanged: a long-wave
+    /// camera cannot see the beam): its altitude and azimuth in the room's frame (degrees, 0 = the
+    /// sun beyond the +x side). truth.json gets SolarCal's ΔMRT of a seated person facing the sun
+    /// at each grid node. Needs --dni and --transmittance.
+    #[arg(long, value_name = "ALT,AZ", allow_hyphen_values = true, value_parser = crate::parse::parse_sun, requires_all = ["dni", "transmittance"])]
+    pub(crate) sun: Option<[f64; 2]>,
+    /// Direct normal irradiance outside (W/m²), with --sun.
+    #[arg(
+        long,
+        value_name = "W_M2",
+        allow_negative_numbers = true,
+        requires = "sun"
+    )]
+    pub(crate) dni: Option<f64>,
+    /// The windows' total solar transmittance with their shades (0…1), with --sun.
+    #[arg(
+        long,
+        value_name = "T",
+        allow_negative_numbers = true,
+        requires = "sun"
+    )]
+    pub(crate) transmittance: Option<f64>,
+    /// Monte Carlo rays per truth point (rooms with furniture or not convex).
+    #[arg(long, default_value_t = 100_000)]
+    pub(crate) truth_rays: usize,
+    #[command(flatten)]
+    pub(crate) camera: CameraErrorArgs,
+}
+
+impl SimulateArgs {
+    /// The simulator's settings these flags describe (the room's depth size checked).
+    fn config(&self) -> Result<SimConfig> {
+        let mut cfg = SimConfig {
+            seconds: self.seconds,
+            seed: self.seed,
+            noise: self.noise,
+            drift: match self.drift {
+                DriftChoice::None => Drift::NONE,
+                DriftChoice::Slam => Drift::SLAM,
+                DriftChoice::Odometry => Drift::ODOMETRY,
+            },
+            thermal_noise: ThermalNoise {
+                bias_k: self.thermal_bias,
+                blur_sigma_px: self.thermal_blur,
+                time_constant_s: self.thermal_time_constant_ms / 1000.0,
+                ..ThermalNoise::REALISTIC
+            },
+            glass: self.glass.choice(),
+            surfaces: self.surfaces,
+            sun: self.sun.map(|[altitude_deg, azimuth_deg]| SimSun {
+                altitude_deg,
+                azimuth_deg,
+                dni_w_m2: self.dni.unwrap_or_default(),
+                transmittance: self.transmittance.unwrap_or_default(),
+            }),
+            depth_hz: self.depth_hz,
+            thermal_hz: self.thermal_hz,
+            rgb_hz: self.rgb_hz,
+            poses_in_recording: !self.no_poses,
+            truth_rays: self.truth_rays,
+            radiometric: self.camera.model(self.noise),
+            references: self.camera.references(self.noise),
+            ..SimConfig::default()
+        };
+        if let Some(ms) = self.thermal_lag_ms {
+            cfg.thermal_lag_s = Some(ms / 1000.0);
+        }
+        set_depth_size(&mut cfg, self.depth_size)?;
+        Ok(cfg)
+    }
+}
+
+/// `mrtmap simulate`: the scan `a` describes, written to `a.out` (recording, truth.json); gives
+/// what the CLI prints.
+pub fn simulate_recording(a: &SimulateArgs, progress: &dyn Progress) -> Result<Vec<String>> {
+    let room = load_room(&a.room)?;
+    let cfg = a.config()?;
+    progress.begin(&format!("simulating {}", room.file.name));
+    let t0 = Instant::now();
+    let summary = simulate(&room, &cfg, &a.out, &|done, total| {
+        progress.advance(done, total);
+    })?;
+    Ok(vec![
+        format!(
+            "simulated {:.0} s of scanning the {} room in {:.1} s: {} depth, {} thermal, {} colour + mask frames, {} poses; {:.1} MB in {}",
+            a.seconds,
+            room.file.name,
+            t0.elapsed().as_secs_f64(),
+            summary.depth_frames,
+            summary.thermal_frames,
+            summary.rgb_frames,
+            summary.poses,
+            summary.bytes as f64 / 1e6,
+            summary.out.display()
+        ),
+        format!(
+            "thermal frames stamped {:.1} ms after their exposure (truth.json: thermal_lag_s); glass {}; surfaces {}",
+            cfg.lag_s() * 1000.0,
+            if cfg.glass_on() {
+                "gives no depth"
+            } else {
+                "returns depth like a wall"
+            },
+            match cfg.surfaces() {
+                Surfaces::Grey =>
+                    "grey (the camera reads radiosities; truth.json's scene gives each surface's emissivity and true temperature)",
+                Surfaces::Black => "black",
+            }
+        ),
+        format!(
+            "truth.json: MRT at the validation points and on the 20×20 grid at 1.1 m ({} view factors)",
+            summary.truth_method
+        ),
+    ])
+}
+
 /// A simulated camera's radiometric errors.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum CameraErrorsArg {
+pub(crate) enum CameraErrorsArg {
     /// Realistic with --noise realistic, none with --noise none.
     Auto,
     /// A perfect camera (the NETD and blur of --noise remain).
@@ -60,35 +274,35 @@ pub enum CameraErrorsArg {
 /// The thermal camera's radiometric errors in a simulation; each term can be set on its own (the
 /// flags of `mrtmap simulate` and `mrtmap demo`).
 #[derive(Debug, clap::Args, Clone)]
-pub struct CameraErrorArgs {
+pub(crate) struct CameraErrorArgs {
     /// The camera's radiometric errors (the truth goes to radiometric_truth.json).
     #[arg(long, value_enum, default_value_t = CameraErrorsArg::Auto)]
-    pub camera_errors: CameraErrorsArg,
+    pub(crate) camera_errors: CameraErrorsArg,
     /// This unit's constant offset (K).
     #[arg(long, allow_negative_numbers = true)]
-    pub unit_offset_k: Option<f64>,
+    pub(crate) unit_offset_k: Option<f64>,
     /// Relative gain error about 20 °C (0.02: contrasts 2 % too large).
     #[arg(long, allow_negative_numbers = true)]
-    pub gain: Option<f64>,
+    pub(crate) gain: Option<f64>,
     /// Time between flat-field corrections, MIN,MAX seconds (0,0: none).
     #[arg(long, value_name = "MIN,MAX", value_parser = crate::parse::parse_interval)]
-    pub ffc_interval_s: Option<[f64; 2]>,
+    pub(crate) ffc_interval_s: Option<[f64; 2]>,
     /// σ of the offset each flat-field correction sets (K).
     #[arg(long)]
-    pub ffc_offset_k: Option<f64>,
+    pub(crate) ffc_offset_k: Option<f64>,
     /// σ of the offset's drift between flat-field corrections (K per minute).
     #[arg(long)]
-    pub drift_k_per_min: Option<f64>,
+    pub(crate) drift_k_per_min: Option<f64>,
     /// Vignetting: what the image corners read more than the centre (K).
     #[arg(long, allow_negative_numbers = true)]
-    pub vignetting_k: Option<f64>,
+    pub(crate) vignetting_k: Option<f64>,
     /// σ of the per-pixel fixed pattern (K).
     #[arg(long)]
-    pub fixed_pattern_k: Option<f64>,
+    pub(crate) fixed_pattern_k: Option<f64>,
     /// Contact-thermometer readings of surface points to write to references.csv (default: 2 with
     /// camera errors, 0 without).
     #[arg(long)]
-    pub references: Option<usize>,
+    pub(crate) references: Option<usize>,
 }
 
 impl CameraErrorArgs {

@@ -1,19 +1,22 @@
 //! Scan sources: what a source holds ([`inspect`]), turning a bag, MCAP file, ROS 2 bag or RTAB-Map
-//! database into the recording layout ([`convert`]), a recording folder into one of those
-//! ([`write_container`]), and the recording folder `fuse` and `run` read ([`prepare`]: the
+//! database into the recording layout, or a recording folder into one of those ([`convert_any`]),
+//! and the recording folder `fuse` and `run` read (`prepare`: the
 //! source itself, or its conversion, reused while the source and options are unchanged).
 
 use std::path::{Path, PathBuf};
 
 use mrtmap_io::{FileError, Recording, Rig, StreamEntry};
 /// What a source holds and how it is written (mrtmap-sources' types).
-pub use mrtmap_sources::SourceKind;
+pub(crate) use mrtmap_sources::SourceKind;
 use mrtmap_sources::resolve_source;
+use mrtmap_sources::ros::Container;
+pub use mrtmap_sources::ros::Plan;
+pub(crate) use mrtmap_sources::ros::PoseSource;
 pub use mrtmap_sources::ros::bag::Compression;
 use mrtmap_sources::ros::{self, RosWriteOptions, Survey};
-pub use mrtmap_sources::ros::{Container, Plan, PoseSource};
 use mrtmap_sources::rtabmap;
-pub use mrtmap_sources::rtabmap::{DbSummary, Schema};
+pub(crate) use mrtmap_sources::rtabmap::DbSummary;
+pub use mrtmap_sources::rtabmap::Schema;
 use serde::Serialize;
 
 use crate::cache::{Fingerprint, Stage, run_or_reuse};
@@ -23,7 +26,7 @@ use crate::layout::RunLayout;
 
 /// One stream of a recording folder.
 #[derive(Clone, Debug, Serialize)]
-pub struct StreamSummary {
+pub(crate) struct StreamSummary {
     /// "depth", "thermal", "rgb", "masks" or "trajectory".
     pub name: &'static str,
     /// Frames or poses.
@@ -60,7 +63,7 @@ impl StreamSummary {
 
 /// A recording folder at a glance.
 #[derive(Clone, Debug)]
-pub struct FolderSummary {
+pub(crate) struct FolderSummary {
     /// Depth, thermal, colour, masks, trajectory.
     pub streams: Vec<StreamSummary>,
     /// The rig.
@@ -71,7 +74,7 @@ pub struct FolderSummary {
 
 /// A bag, MCAP file or ROS 2 bag at a glance.
 #[derive(Clone, Debug)]
-pub struct RosSummary {
+pub(crate) struct RosSummary {
     /// The container.
     pub container: Container,
     /// A ROS 2 bag split over several files.
@@ -97,9 +100,9 @@ impl RosSummary {
     }
 }
 
-/// What a source holds.
+/// What a source holds, by kind.
 #[derive(Clone, Debug)]
-pub enum Inspection {
+pub(crate) enum Inspected {
     /// A recording folder.
     Folder(FolderSummary),
     /// A ROS 1 bag, MCAP file or ROS 2 bag.
@@ -113,20 +116,20 @@ pub enum Inspection {
     },
 }
 
-impl Inspection {
+impl Inspected {
     /// What `mrtmap inspect --json` prints: the source, its kind, what it holds and whether it
     /// is ready to be a scan.
     pub fn to_json(&self, source: &Path) -> serde_json::Value {
         let source = source.display().to_string();
         match self {
-            Inspection::Folder(f) => serde_json::json!({
+            Inspected::Folder(f) => serde_json::json!({
                 "source": source,
                 "kind": SourceKind::Folder,
                 "streams": f.streams,
                 "warnings": f.warnings,
                 "ready": f.warnings.is_empty(),
             }),
-            Inspection::Ros(r) => serde_json::json!({
+            Inspected::Ros(r) => serde_json::json!({
                 "source": source,
                 "kind": match r.container {
                     Container::Bag => SourceKind::Bag,
@@ -138,7 +141,7 @@ impl Inspection {
                 "plan": r.plan,
                 "ready": r.plan.missing.is_empty() && r.plan.rig.is_some(),
             }),
-            Inspection::RtabMap { summary, missing } => serde_json::json!({
+            Inspected::RtabMap { summary, missing } => serde_json::json!({
                 "source": source,
                 "kind": SourceKind::RtabMap,
                 "database": summary,
@@ -149,13 +152,13 @@ impl Inspection {
     }
 }
 
-impl Inspection {
+impl Inspected {
     /// What `mrtmap inspect` prints about `source`, in lines.
     pub fn lines(&self, source: &Path) -> Vec<String> {
         match self {
-            Inspection::Folder(f) => folder_lines(source, f),
-            Inspection::Ros(r) => ros_lines(source, r),
-            Inspection::RtabMap { summary, missing } => {
+            Inspected::Folder(f) => folder_lines(source, f),
+            Inspected::Ros(r) => ros_lines(source, r),
+            Inspected::RtabMap { summary, missing } => {
                 let mut lines = database_lines(source, summary);
                 lines.extend(missing_lines(missing));
                 lines
@@ -319,7 +322,7 @@ pub fn plan_lines(p: &Plan) -> Vec<String> {
 }
 
 /// Whether a source is ready for a scan, or what it lacks, in lines.
-pub fn missing_lines(missing: &[String]) -> Vec<String> {
+pub(crate) fn missing_lines(missing: &[String]) -> Vec<String> {
     let mut lines = Vec::new();
     if missing.is_empty() {
         lines.push("ready: mrtmap convert / fuse / run can use it".to_string());
@@ -344,8 +347,31 @@ fn source_bytes(file: &Path, c: Container) -> Result<u64> {
     })
 }
 
-/// Says what `source` holds and whether it can be made into a scan.
+/// What a source holds: its streams, counts and what a scan still lacks, as lines for people and
+/// as JSON.
+#[derive(Clone, Debug)]
+pub struct Inspection(Inspected);
+
+impl Inspection {
+    /// What `mrtmap inspect --json` prints: the source, its kind, what it holds and whether it
+    /// is ready to be a scan.
+    pub fn to_json(&self, source: &Path) -> serde_json::Value {
+        self.0.to_json(source)
+    }
+
+    /// What `mrtmap inspect` prints about `source`, in lines.
+    pub fn lines(&self, source: &Path) -> Vec<String> {
+        self.0.lines(source)
+    }
+}
+
+/// Says what `source` holds (a recording folder, bag, MCAP file, ROS 2 bag or RTAB-Map database)
+/// and whether it can be made into a scan.
 pub fn inspect(source: &Path, o: &SourceOptions) -> Result<Inspection> {
+    inspect_source(source, o).map(Inspection)
+}
+
+fn inspect_source(source: &Path, o: &SourceOptions) -> Result<Inspected> {
     let (kind, file) = resolve_source(source)?;
     match kind {
         SourceKind::Folder => {
@@ -357,7 +383,7 @@ pub fn inspect(source: &Path, o: &SourceOptions) -> Result<Inspection> {
                 t0: traj.stamps.first().copied().unwrap_or(0.0),
                 t1: traj.stamps.last().copied().unwrap_or(-1.0),
             };
-            Ok(Inspection::Folder(FolderSummary {
+            Ok(Inspected::Folder(FolderSummary {
                 streams: vec![
                     StreamSummary::of("depth", &rec.depth),
                     StreamSummary::of("thermal", &rec.thermal),
@@ -372,14 +398,14 @@ pub fn inspect(source: &Path, o: &SourceOptions) -> Result<Inspection> {
         SourceKind::RtabMap => {
             let summary = rtabmap::summarize(source)?;
             let missing = rtabmap::convert::missing(&summary, o);
-            Ok(Inspection::RtabMap { summary, missing })
+            Ok(Inspected::RtabMap { summary, missing })
         }
         SourceKind::Bag | SourceKind::Mcap | SourceKind::Db3 => {
             let c = container_of(kind);
             let bytes = source_bytes(&file, c)?;
             let survey = ros::survey(c, file.as_path()).map_err(|e| e.in_file(&file))?;
             let plan = ros::plan(&survey, &o.ros()?);
-            Ok(Inspection::Ros(Box::new(RosSummary {
+            Ok(Inspected::Ros(Box::new(RosSummary {
                 container: c,
                 split: file.is_dir(),
                 bytes,
@@ -396,7 +422,7 @@ fn container_of(kind: SourceKind) -> Container {
 
 /// Converts `source` (a bag, MCAP file, ROS 2 bag or RTAB-Map database) into the recording layout
 /// at `out`.
-pub fn convert(source: &Path, out: &Path, o: &SourceOptions) -> Result<Conversion> {
+pub(crate) fn convert(source: &Path, out: &Path, o: &SourceOptions) -> Result<Conversion> {
     let (kind, file) = resolve_source(source)?;
     let source = file.as_path();
     match kind {
@@ -434,9 +460,46 @@ pub fn convert(source: &Path, out: &Path, o: &SourceOptions) -> Result<Conversio
     }
 }
 
+/// `mrtmap convert`: `source` written as the container `out`'s extension names when it names one
+/// (`.bag`, `.mcap`, `.db3` with `compression`; `.db`, an RTAB-Map-layout database with `schema`;
+/// the source must then be a recording folder), else `source` (a bag, MCAP file, ROS 2 bag or
+/// RTAB-Map database) converted into the recording folder `out`; gives what the CLI prints.
+pub fn convert_any(
+    source: &Path,
+    out: &Path,
+    compression: Compression,
+    schema: Schema,
+    o: &SourceOptions,
+) -> Result<Vec<String>> {
+    let ext = out
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    let what = match ext.as_str() {
+        "db" => ContainerOut::RtabMap(schema),
+        "bag" => ContainerOut::Ros(Container::Bag, compression),
+        "mcap" => ContainerOut::Ros(Container::Mcap, compression),
+        "db3" => ContainerOut::Ros(Container::Db3, compression),
+        _ => return Ok(convert(source, out, o)?.lines()),
+    };
+    let w = write_container(source, out, what)?;
+    let [d, t, c, p] = w.counts;
+    Ok(vec![match (w.nodes, what) {
+        (Some(n), ContainerOut::RtabMap(schema)) => {
+            format!("wrote {} ({n} nodes, {schema:?} schema)", out.display())
+        }
+        _ => format!(
+            "wrote {} ({} bytes): {d} depth, {t} thermal, {c} colour frames, {p} poses",
+            out.display(),
+            w.bytes.unwrap_or(0)
+        ),
+    }])
+}
+
 /// Containers a recording folder can be written as.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ContainerOut {
+pub(crate) enum ContainerOut {
     /// A RealSense-style ROS 1 bag, MCAP file or ROS 2 `.db3`.
     Ros(Container, Compression),
     /// An RTAB-Map-layout database.
@@ -445,7 +508,7 @@ pub enum ContainerOut {
 
 /// What [`write_container`] wrote.
 #[derive(Clone, Debug)]
-pub struct Written {
+pub(crate) struct Written {
     /// Bytes written (bags, MCAP, `.db3`).
     pub bytes: Option<usize>,
     /// Depth, thermal, colour frames and poses in the recording.
@@ -455,7 +518,7 @@ pub struct Written {
 }
 
 /// Writes the recording folder `recording` as `out` (a bag, MCAP file, `.db3` or database).
-pub fn write_container(recording: &Path, out: &Path, what: ContainerOut) -> Result<Written> {
+pub(crate) fn write_container(recording: &Path, out: &Path, what: ContainerOut) -> Result<Written> {
     let rec = Recording::open(recording).map_err(|e| {
         Error::source(
             out,
@@ -512,7 +575,7 @@ pub struct Prepared {
 /// The recording folder for `fuse` / `run`: `source` itself when it is a folder, else
 /// `out/recording`, converted now unless it already holds this source's conversion with these
 /// options (the files the options name, a rig or thermal frames, count as inputs too).
-pub fn prepare(source: &Path, out: &Path, o: &SourceOptions) -> Result<Prepared> {
+pub(crate) fn prepare(source: &Path, out: &Path, o: &SourceOptions) -> Result<Prepared> {
     if resolve_source(source)?.0 == SourceKind::Folder {
         return Ok(Prepared {
             dir: source.to_path_buf(),

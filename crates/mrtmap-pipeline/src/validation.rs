@@ -3,15 +3,16 @@
 use std::path::{Path, PathBuf};
 
 use mrtmap_geometry::nalgebra::Point3;
+use mrtmap_physics::PhysicsError;
 /// Globe ↔ MRT conversions and why one fails (mrtmap-physics').
-pub use mrtmap_physics::{
-    Convection, Globe, GlobeFormula, GlobeMethod, GlobeReading, MIXED_CONVECTION_DIAMETERS_M,
-    PhysicsError, Temperature, globe_temperature, mrt_from_globe,
+pub use mrtmap_physics::{Convection, Globe, MIXED_CONVECTION_DIAMETERS_M, Temperature};
+pub(crate) use mrtmap_physics::{
+    GlobeFormula, GlobeMethod, GlobeReading, globe_temperature, mrt_from_globe,
 };
 use mrtmap_radiation::{Method, MonteCarlo, MrtEngine, RadiantScene};
 use mrtmap_report::{GlobeRow, ValidationRow, parse_globe_csv, validate, validation_csv};
 /// The ISO 7726 accuracy bounds a validation judges by (mrtmap-report's).
-pub use mrtmap_report::{IN_SUN_NOTE, ISO_DESIRED_K, ISO_REQUIRED_K};
+use mrtmap_report::{IN_SUN_NOTE, ISO_DESIRED_K, ISO_REQUIRED_K};
 
 use serde::Serialize;
 
@@ -33,6 +34,93 @@ pub struct Validation {
     /// The shift given to every temperature so that the map matches the calibrating readings (K),
     /// when some were named.
     pub level_shift_k: Option<f64>,
+}
+
+impl Validation {
+    /// What `mrtmap validate` prints: the scene, a row per reading with ISO 7726's verdict, the
+    /// level's shift when `calibrate_with` fixed it, notes on missing values, the files in `out`.
+    pub fn lines(&self, calibrate_with: &[String], out: &Path) -> Vec<String> {
+        use mrtmap_report::numbers::{signed, uncertainty};
+        let mut lines = vec![
+            format!("scene: {}", self.scene.display()),
+            format!(
+                "{:<10} {:>7} {:>7} {:>5} {:>9} {:>9} {:>15} {:>8} {:>8}  ISO 7726",
+                "location",
+                "Tg °C",
+                "Ta °C",
+                "v",
+                "ISO °C",
+                "mixed °C",
+                "mrtmap °C",
+                "Δ ISO",
+                "Δ mixed"
+            ),
+        ];
+        let mut notes = Vec::new();
+        for r in &self.rows {
+            let label = &r.globe.label;
+            let mut f = |what: &str, x: std::result::Result<f64, String>| match x {
+                Ok(v) => format!("{v:.2}"),
+                Err(e) => {
+                    notes.push(format!("{label}: no {what}: {e}"));
+                    format!("— ({})", notes.len())
+                }
+            };
+            let words =
+                |x: &std::result::Result<f64, PhysicsError>| x.clone().map_err(|e| e.to_string());
+            let iso = f("ISO 7726 MRT", words(&r.mrt_iso_c));
+            let mixed = f("mixed-convection MRT", words(&r.mrt_mixed_c));
+            let ours = match &r.ours_c {
+                Ok((o, s)) => format!("{o:.2} ± {}", uncertainty(*s, 2)),
+                Err(e) => {
+                    notes.push(format!("{label}: no mrtmap MRT: {e}"));
+                    format!("— ({})", notes.len())
+                }
+            };
+            let class = match (r.meets_desired, r.meets_required) {
+                _ if r.in_sun.is_some() => IN_SUN_NOTE.to_string() + " (not judged)",
+                _ if r.calibrates => "fixed the level: not judged".into(),
+                (Some(true), _) => format!("meets desired ±{ISO_DESIRED_K} K"),
+                (_, Some(true)) => format!("meets required ±{ISO_REQUIRED_K} K"),
+                (_, Some(false)) => format!("outside ±{ISO_REQUIRED_K} K"),
+                _ => "not judged: a value is missing (see the notes)".into(),
+            };
+            lines.push(format!(
+                "{:<10} {:>7.2} {:>7.2} {:>5.2} {:>9} {:>9} {:>15} {:>8} {:>8}  {class}",
+                label,
+                r.globe.tg_c,
+                r.globe.ta_c,
+                r.globe.va_m_s,
+                iso,
+                mixed,
+                ours,
+                r.diff_iso_k.map_or("—".into(), |v| signed(v, 2)),
+                r.diff_mixed_k.map_or("—".into(), |v| signed(v, 2)),
+            ));
+        }
+        if let Some(s) = self.level_shift_k {
+            lines.push(format!(
+                "every temperature shifted by {s:+.2} K so that the map matches {} (ISO 7726); the others are compared",
+                calibrate_with.join(", ")
+            ));
+        }
+        for (k, n) in notes.iter().enumerate() {
+            lines.push(format!("({}) {n}", k + 1));
+        }
+        lines.push(format!(
+            "wrote validation.csv and validation.json in {}",
+            out.display()
+        ));
+        lines
+    }
+
+    /// The readings judged against the map: none missing a value, in the sun, or fixing the level.
+    pub fn judged(&self) -> usize {
+        self.rows
+            .iter()
+            .filter(|r| r.meets_required.is_some() && r.in_sun.is_none() && !r.calibrates)
+            .count()
+    }
 }
 
 /// The scene of a `run` output folder or of a folder holding scene.json.

@@ -162,7 +162,7 @@ pub(crate) fn run<'py>(
 /// A run's figures for Python, each under its own name.
 fn outcome_dict<'py>(
     py: Python<'py>,
-    done: &mrtmap_pipeline::report::RunDone,
+    done: &mrtmap_pipeline::RunDone,
     recording: &std::path::Path,
     out: &std::path::Path,
 ) -> PyResult<Bound<'py, PyDict>> {

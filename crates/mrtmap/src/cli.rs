@@ -4,6 +4,8 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use mrtmap_pipeline::MrtFlags;
+use mrtmap_pipeline::calibration::CalibrateArgs;
+use mrtmap_pipeline::demo::DemoArgs;
 use mrtmap_pipeline::export::{DEFAULT_MAX_POINTS, ExportFormat, ExportSource};
 use mrtmap_pipeline::maps::SceneSource;
 use mrtmap_pipeline::parse::{
@@ -11,8 +13,7 @@ use mrtmap_pipeline::parse::{
 };
 use mrtmap_pipeline::settings::{FuseSection, SegmentSection};
 use mrtmap_pipeline::settings::{PointFrame, Quantity};
-use mrtmap_pipeline::simulation::CameraErrorArgs;
-use mrtmap_pipeline::simulation::{NoiseLevel, Surfaces};
+use mrtmap_pipeline::simulation::SimulateArgs;
 use mrtmap_pipeline::source::SourceOptions;
 use mrtmap_pipeline::thermal_image::ThermalReading;
 use mrtmap_pipeline::validation::GlobeFormulaChoice;
@@ -206,53 +207,6 @@ pub struct ThermalArgs {
     pub reading: ThermalReading,
 }
 
-/// `mrtmap calibrate`.
-#[derive(Debug, Args)]
-#[command(after_long_help = "Examples:
-  mrtmap simulate-board --out boards
-  mrtmap calibrate --pairs boards --board 8x6 --square-m 0.06 --out rig.toml --report calib-report
-  mrtmap calibrate --images thermal-shots --board 11x9 --square-m 0.0505 --report r
-
-The pairs folder holds rgb/ and thermal/ sub-folders (images paired by file stem, or by the nearest
-timestamp when the stems are numbers), or files tagged like 0001_rgb.png + 0001_thermal.png.
-Thermal images may be 16-bit radiometric (any scale: they are stretched) or 8-bit grey or
-colour-mapped. At least one pair must show all inner corners in both images; other pairs may show
-part of the board.")]
-pub struct CalibrateArgs {
-    /// Folder of colour + thermal image pairs.
-    #[arg(long, value_name = "DIR", conflicts_with = "images")]
-    pub pairs: Option<PathBuf>,
-    /// Folder of one camera's images: its intrinsics only.
-    #[arg(long, value_name = "DIR")]
-    pub images: Option<PathBuf>,
-    /// Inner corners per row and column, COLSxROWS (a board of 9×7 squares has 8x6).
-    #[arg(long, value_name = "COLSxROWS")]
-    pub board: mrtmap_pipeline::calibration::GridSize,
-    /// Side of one square (m).
-    #[arg(long, value_name = "M")]
-    pub square_m: f64,
-    /// rig.toml to write. An existing one keeps its [depth] section and encoding; a new one takes
-    /// the colour camera as the depth camera (a RealSense with depth aligned to colour).
-    #[arg(long, value_name = "FILE")]
-    pub out: Option<PathBuf>,
-    /// Report folder: corners drawn on every image, thermal-over-colour overlays, index.html,
-    /// calibration.json.
-    #[arg(long, value_name = "DIR")]
-    pub report: Option<PathBuf>,
-    /// Distortion model of the colour camera (or of the --images camera).
-    #[arg(long, value_enum, default_value = "auto")]
-    pub distortion: mrtmap_pipeline::calibration::DistortionModel,
-    /// Distortion model of the thermal camera.
-    #[arg(long, value_enum, default_value = "auto")]
-    pub thermal_distortion: mrtmap_pipeline::calibration::DistortionModel,
-    /// Largest time difference (s) when pairing images by timestamp.
-    #[arg(long, default_value_t = 0.05, value_name = "S")]
-    pub max_dt: f64,
-    /// Fit only the corners found in both images of a pair (as OpenCV's stereoCalibrate).
-    #[arg(long)]
-    pub common_corners: bool,
-}
-
 /// `mrtmap simulate-board`.
 #[derive(Debug, Args)]
 pub struct SimulateBoardArgs {
@@ -411,46 +365,6 @@ pub struct ReplayArgs {
     pub speed: f64,
 }
 
-/// `mrtmap demo`.
-#[derive(Debug, Args)]
-pub struct DemoArgs {
-    /// Output folder (the recording goes in DIR/recording, the run in DIR/run); about 200 MB for
-    /// the default 30 s scan, 380 MB for 60 s, 2 GB with --full. The default folder is git-ignored
-    /// in mrtmap's own repository.
-    #[arg(long, value_name = "DIR", default_value = "mrtmap-demo")]
-    pub out: PathBuf,
-    /// Length of the simulated scan (s): 15 at least for the office (a shorter walk has not seen
-    /// the whole room).
-    #[arg(long, default_value_t = 30.0)]
-    pub seconds: f64,
-    /// Simulate the seed paper's full 343 s scan (overrides --seconds).
-    #[arg(long)]
-    pub full: bool,
-    /// The preset room.
-    #[arg(long, default_value = "office")]
-    pub room: String,
-    /// Sensor noise.
-    #[arg(long, value_enum, default_value_t = NoiseLevel::Realistic)]
-    pub noise: NoiseLevel,
-    /// Air speed at the simulated globes (m/s).
-    #[arg(long, default_value_t = 0.1)]
-    pub air_speed: f64,
-    /// Depth image size of the simulated scan, WIDTHxHEIGHT (smaller runs faster).
-    #[arg(long, default_value = "640x480", value_parser = parse_grid)]
-    pub depth_size: (usize, usize),
-    /// Depth frame rate of the simulated scan (Hz); 15 Hz is what many D4xx rigs record.
-    #[arg(long, default_value_t = 15.0)]
-    pub depth_hz: f64,
-    /// Random seed of the simulation.
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
-    #[command(flatten)]
-    pub camera: CameraErrorArgs,
-    /// Rerun every stage.
-    #[arg(long)]
-    pub force: bool,
-}
-
 /// `mrtmap validate`.
 #[derive(Debug, Args)]
 pub struct ValidateArgs {
@@ -531,39 +445,6 @@ pub struct FuseArgs {
     pub fuse: FuseSection,
 }
 
-/// A simulated effect: on, off, or the noise level's default.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum AutoOnOff {
-    /// On with --noise realistic, off with none.
-    Auto,
-    /// On.
-    On,
-    /// Off.
-    Off,
-}
-
-impl AutoOnOff {
-    /// `None` for auto.
-    pub fn choice(self) -> Option<bool> {
-        match self {
-            Self::Auto => None,
-            Self::On => Some(true),
-            Self::Off => Some(false),
-        }
-    }
-}
-
-/// SLAM drift of a simulation's trajectory.txt.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum DriftArg {
-    /// trajectory.txt equals groundtruth.txt.
-    None,
-    /// Visual SLAM without loop closure: 4 mm/√s in position, 0.03°/√s in heading.
-    Slam,
-    /// Plain odometry: 1 cm/√s, 0.1°/√s.
-    Odometry,
-}
-
 /// `mrtmap track`.
 #[derive(Debug, Args)]
 pub struct TrackArgs {
@@ -581,98 +462,6 @@ pub struct TrackArgs {
     /// FAST corner threshold (grey levels); lower finds more corners on weak texture.
     #[arg(long, default_value_t = 12)]
     pub fast_threshold: u8,
-}
-
-/// `mrtmap simulate`.
-#[derive(Debug, Args)]
-pub struct SimulateArgs {
-    /// A preset room (office, l-shaped, radiant-ceiling; see `mrtmap rooms`) or a room TOML file.
-    #[arg(long, default_value = "office")]
-    pub room: String,
-    /// Output folder for the recording (written as DIR.partial, renamed when complete).
-    #[arg(long, value_name = "DIR")]
-    pub out: PathBuf,
-    /// Length of the scan (s); the seed paper's took 343 s.
-    #[arg(long, default_value_t = 343.0)]
-    pub seconds: f64,
-    /// Random seed.
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
-    /// Sensor noise.
-    #[arg(long, value_enum, default_value_t = NoiseLevel::Realistic)]
-    pub noise: NoiseLevel,
-    /// SLAM drift in trajectory.txt (groundtruth.txt always has the true poses).
-    #[arg(long, value_enum, default_value_t = DriftArg::None)]
-    pub drift: DriftArg,
-    /// Constant thermal camera offset (K), added to every reading.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub thermal_bias: f64,
-    /// Thermal optical blur, Gaussian σ in pixels (realistic noise only).
-    #[arg(long, default_value_t = 0.5)]
-    pub thermal_blur: f64,
-    /// Depth (and colour) image size, WIDTHxHEIGHT; intrinsics scale with it.
-    #[arg(long, default_value = "640x480", value_parser = parse_grid)]
-    pub depth_size: (usize, usize),
-    /// Depth frame rate (Hz).
-    #[arg(long, default_value_t = 30.0)]
-    pub depth_hz: f64,
-    /// Thermal frame rate (Hz).
-    #[arg(long, default_value_t = 8.7)]
-    pub thermal_hz: f64,
-    /// Colour and instance-mask frame rate (Hz).
-    #[arg(long, default_value_t = 5.0)]
-    pub rgb_hz: f64,
-    /// Leave trajectory.txt out: a recording without a pose source (colour, depth and thermal
-    /// only), for `mrtmap track`; groundtruth.txt still has the true poses.
-    #[arg(long)]
-    pub no_poses: bool,
-    /// How late the thermal frames are stamped (ms): a USB thermal board's frames are stamped on
-    /// arrival. Default: drawn from the seed, 40–120 ms, with --noise realistic; 0 with none.
-    #[arg(long, value_name = "MS")]
-    pub thermal_lag_ms: Option<f64>,
-    /// The microbolometer's time constant (ms): fast turns smear the thermal image (realistic
-    /// noise only).
-    #[arg(long, value_name = "MS", default_value_t = 12.0)]
-    pub thermal_time_constant_ms: f64,
-    /// Windows as an active-stereo depth camera sees them: no depth on the glass (10 % of its
-    /// pixels see 4 m beyond); off: panes return depth like a wall. Auto: on with --noise
-    /// realistic, off with none.
-    #[arg(long, value_enum, default_value_t = AutoOnOff::Auto)]
-    pub glass: AutoOnOff,
-    /// The room's surfaces: grey (window glass emissivity 0.84 mirroring the room and the
-    /// operator holding the camera, every other surface 0.90–0.95 drawn from the seed, unless the
-    /// room's TOML gives emissivities; the camera reads radiosities, the contact readings true
-    /// temperatures) or black (ε = 1: the camera reads each surface's own temperature). Default:
-    /// grey with --noise realistic, black with none.
-    #[arg(long, value_enum)]
-    pub surfaces: Option<Surfaces>,
-    /// The sun outside the room, for truth.json only (the recording is unchanged: a long-wave
-    /// camera cannot see the beam): its altitude and azimuth in the room's frame (degrees, 0 = the
-    /// sun beyond the +x side). truth.json gets SolarCal's ΔMRT of a seated person facing the sun
-    /// at each grid node. Needs --dni and --transmittance.
-    #[arg(long, value_name = "ALT,AZ", allow_hyphen_values = true, value_parser = parse_sun, requires_all = ["dni", "transmittance"])]
-    pub sun: Option<[f64; 2]>,
-    /// Direct normal irradiance outside (W/m²), with --sun.
-    #[arg(
-        long,
-        value_name = "W_M2",
-        allow_negative_numbers = true,
-        requires = "sun"
-    )]
-    pub dni: Option<f64>,
-    /// The windows' total solar transmittance with their shades (0…1), with --sun.
-    #[arg(
-        long,
-        value_name = "T",
-        allow_negative_numbers = true,
-        requires = "sun"
-    )]
-    pub transmittance: Option<f64>,
-    /// Monte Carlo rays per truth point (rooms with furniture or not convex).
-    #[arg(long, default_value_t = 100_000)]
-    pub truth_rays: usize,
-    #[command(flatten)]
-    pub camera: CameraErrorArgs,
 }
 
 /// `mrtmap rooms`.

@@ -28,10 +28,7 @@ pub fn write_stdout(args: std::fmt::Arguments<'_>) {
         if e.kind() == std::io::ErrorKind::BrokenPipe {
             std::process::exit(0);
         }
-        eprintln!(
-            "error: cannot write to standard output: {}",
-            mrtmap_pipeline::files::io_words(&e)
-        );
+        eprintln!("error: cannot write to standard output: {e}");
         std::process::exit(1);
     }
 }

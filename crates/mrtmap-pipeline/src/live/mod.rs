@@ -13,7 +13,7 @@
 //!    is made into `out` by [`crate::Pipeline::run`], exactly as `mrtmap run` makes it.
 
 mod follow;
-pub mod replay;
+pub(crate) mod replay;
 
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
@@ -40,7 +40,7 @@ use crate::settings::Project;
 const POLL_S: f64 = 0.1;
 
 /// The state is sent at least this often (s).
-pub const STATE_EVERY_S: f64 = 1.0;
+pub(crate) const STATE_EVERY_S: f64 = 1.0;
 
 /// Thermal frames a refresh textures the room model from at most, and mask frames it labels
 /// features by (evenly spread over the scan): each is read at each refresh, and the scan grows.
@@ -51,7 +51,7 @@ const LATENCIES_KEPT: usize = 300;
 
 /// What `mrtmap live` is asked.
 #[derive(Clone, Debug)]
-pub struct LiveOptions {
+pub(crate) struct LiveOptions {
     /// The map's target (K, 2σ).
     pub target_k: f64,
     /// Stop following once the recording has not grown for this long (s).
@@ -63,7 +63,7 @@ pub struct LiveOptions {
 impl Default for LiveOptions {
     fn default() -> Self {
         LiveOptions {
-            target_k: crate::coverage::DEFAULT_TARGET_K,
+            target_k: 0.2,
             exit_when_idle_s: None,
             refresh_s: 2.0,
         }
@@ -322,7 +322,7 @@ fn camera_now(traj: &Trajectory, scene: Option<&RadiantScene>) -> Option<CameraN
 /// Follows `recording` as it is written, sending what is known to `sink`, until it stops growing
 /// for `opts.exit_when_idle_s` or `stop` is set; then makes the whole run into `out` with
 /// `pipeline` (as `mrtmap run`) and returns it.
-pub fn live(
+pub(crate) fn live(
     pipeline: &crate::Pipeline<'_>,
     recording: &Path,
     out: &Path,
@@ -330,8 +330,8 @@ pub fn live(
     stop: &AtomicBool,
     sink: &dyn LiveSink,
 ) -> Result<crate::report::RunDone> {
+    check_live_out(recording, out)?;
     let p = coarse(pipeline.project());
-    crate::run::check_out_dir(out)?;
     let params = p.fuse.params()?;
     let fixed_offset = match params.clock {
         mrtmap_scan::clock::ClockOffset::Fixed(o) => Some(o),
@@ -628,7 +628,7 @@ fn fusion_problems(fusion: &LiveFusion) -> Vec<String> {
 }
 
 /// The folder a live run's final outputs go to, checked before following begins.
-pub fn check_live_out(recording: &Path, out: &Path) -> Result<PathBuf> {
+pub(crate) fn check_live_out(recording: &Path, out: &Path) -> Result<PathBuf> {
     crate::run::check_out_dir(out)?;
     crate::run::check_out_apart(recording, out)?;
     if !recording.join("rig.toml").is_file() {

@@ -1,6 +1,6 @@
 //! What a user sets: `project.toml` (every key optional), one section per file, and the
 //! view-factor settings shared by `run`, `map` and `mrt`. Flags and files meet once, in
-//! [`crate::resolve`]; everything after that reads typed values.
+//! `resolve` ([`crate::Overrides`]); everything after that reads typed values.
 
 use std::path::Path;
 
@@ -10,22 +10,26 @@ use crate::error::{Error, Result};
 
 mod comfort;
 mod emissivity;
-mod export;
+pub(crate) mod export;
 mod map;
-mod mrt;
+pub(crate) mod mrt;
 mod references;
 mod scan;
-mod sun;
+pub(crate) mod sun;
 
-pub use comfort::*;
-pub use emissivity::*;
-pub use export::*;
-pub use map::*;
-pub use mrt::*;
+pub use comfort::{AirSection, ComfortSection};
+pub use emissivity::EmissivitySection;
+pub(crate) use export::ExportFormat;
+pub use export::ExportSection;
+pub use map::{MapSection, PointEntry, PointFrame, Quantity, RoomSection};
+pub(crate) use mrt::MrtSection;
+pub use mrt::{DirectionChoice, MethodChoice};
+pub use references::Reference;
+pub use scan::{FuseSection, SegmentSection, TrackMode, TrackSection};
+pub use sun::SunSection;
+
+pub(crate) use comfort::*;
 pub(crate) use references::default_std;
-pub use references::*;
-pub use scan::*;
-pub use sun::*;
 
 /// The documented example, shown by `mrtmap run --help`.
 pub const PROJECT_EXAMPLE: &str = r#"# project.toml: every key is optional (defaults shown); flags override them.
@@ -239,6 +243,7 @@ mod tests {
     /// Issue 54: a ray count that cannot be answered is refused before anything runs.
     #[test]
     fn too_many_rays_are_refused_naming_the_flag() {
+        use super::mrt::MAX_RAYS;
         let mut m = MrtSection {
             rays: MAX_RAYS,
             ..MrtSection::default()

@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use mrtmap_pipeline::Project;
-use mrtmap_pipeline::level::parse_references;
+use mrtmap_pipeline::parse_references;
 use proptest::prelude::*;
 
 fn cell() -> impl Strategy<Value = String> {

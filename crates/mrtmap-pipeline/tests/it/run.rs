@@ -1,10 +1,22 @@
 use std::path::Path;
 use std::sync::Mutex;
 
-use mrtmap_pipeline::run::run;
 use mrtmap_pipeline::settings::{PointEntry, PointFrame};
-use mrtmap_pipeline::{Progress, Project};
+use mrtmap_pipeline::{Pipeline, Progress, Project, RunOutcome};
 use mrtmap_sim::{NoiseLevel, SimConfig, preset, simulate};
+
+/// The whole run through the front door, as `mrtmap run` makes it.
+fn run(
+    rec: &Path,
+    out: &Path,
+    p: &Project,
+    progress: &dyn Progress,
+) -> mrtmap_pipeline::Result<RunOutcome> {
+    Pipeline::new(p.clone())
+        .progress(progress)
+        .run(rec, out)
+        .map(|done| done.outcome)
+}
 
 /// Records what the pipeline says it is doing.
 #[derive(Default)]
@@ -47,7 +59,7 @@ fn a_run_reports_progress_and_reuses_unchanged_stages() {
         frame: PointFrame::Scan,
     });
     let log = Log::default();
-    let first = run(&rec, &out, &p, false, &log).unwrap();
+    let first = run(&rec, &out, &p, &log).unwrap();
     let said = log.0.lock().unwrap().clone();
     assert_eq!(
         said,
@@ -61,7 +73,7 @@ fn a_run_reports_progress_and_reuses_unchanged_stages() {
     assert!(first.stages.iter().all(|s| !s.skipped));
     assert_eq!(first.maps.len(), 1);
     assert_eq!(first.maps[0].summary.marks.len(), 1);
-    let again = run(&rec, &out, &p, false, &mrtmap_pipeline::Silent).unwrap();
+    let again = run(&rec, &out, &p, &mrtmap_pipeline::Silent).unwrap();
     assert!(again.stages.iter().all(|s| s.skipped), "{:?}", again.stages);
     assert_eq!(
         again.maps[0].summary.marks[0].mrt_c,
@@ -69,7 +81,7 @@ fn a_run_reports_progress_and_reuses_unchanged_stages() {
     );
     // A new map height runs only that map.
     p.map.heights_m.push(1.7);
-    let more = run(&rec, &out, &p, false, &mrtmap_pipeline::Silent).unwrap();
+    let more = run(&rec, &out, &p, &mrtmap_pipeline::Silent).unwrap();
     let skipped: Vec<bool> = more.stages.iter().map(|s| s.skipped).collect();
     assert_eq!(skipped, [true, true, true, false]);
 }
@@ -83,7 +95,6 @@ fn settings_are_checked_before_any_stage_runs() {
         &dir.path().join("no-such-scan"),
         &dir.path().join("out"),
         &p,
-        false,
         &mrtmap_pipeline::Silent,
     )
     .unwrap_err()
@@ -114,7 +125,7 @@ fn a_recording_without_poses_is_tracked_then_mapped() {
     let mut p = Project::default();
     // Refused when tracking is switched off: the recording has no poses.
     p.track.mode = mrtmap_pipeline::settings::TrackMode::Never;
-    let err = run(&rec, &out, &p, false, &mrtmap_pipeline::Silent)
+    let err = run(&rec, &out, &p, &mrtmap_pipeline::Silent)
         .unwrap_err()
         .to_string();
     assert!(
@@ -125,7 +136,7 @@ fn a_recording_without_poses_is_tracked_then_mapped() {
     p.fuse.depth_stride = 1;
     p.map.grid = [6, 5];
     let log = Log::default();
-    let first = run(&rec, &out, &p, false, &log).unwrap();
+    let first = run(&rec, &out, &p, &log).unwrap();
     assert_eq!(first.stages[0].stage, "track");
     assert_eq!(
         log.0.lock().unwrap()[0],
@@ -149,7 +160,7 @@ fn a_recording_without_poses_is_tracked_then_mapped() {
             frame: PointFrame::Scan,
         });
     }
-    let again = run(&rec, &out, &p, false, &mrtmap_pipeline::Silent).unwrap();
+    let again = run(&rec, &out, &p, &mrtmap_pipeline::Silent).unwrap();
     // Tracking, fusion and segmentation reused; only the map ran again.
     let skipped: Vec<bool> = again.stages.iter().map(|s| s.skipped).collect();
     assert_eq!(skipped, [true, true, true, false]);

@@ -4,28 +4,14 @@
 use std::sync::Mutex;
 use std::sync::atomic::Ordering;
 
-use mrtmap_pipeline::live::{
-    LiveOptions, LiveSink, LiveState, check_live_out, live, replay::replay as replay_into,
-};
-use mrtmap_pipeline::{Overrides, Pipeline, Project};
+use mrtmap_pipeline::{LiveSink, LiveState, Overrides, Pipeline, Project};
 
 use crate::cli::{LiveArgs, ReplayArgs};
 use crate::output::print_lines;
 use crate::{STOP, STOP_GRACEFULLY};
 
 pub fn run(a: &LiveArgs) -> anyhow::Result<()> {
-    let project = Project::resolve(a.config.as_deref(), &Overrides::new())?;
-    project.check_heights_above_floor()?;
-    if !(a.target_k.is_finite() && a.target_k > 0.0 && a.target_k <= 10.0) {
-        anyhow::bail!(
-            "--target-k {}: give the map's target as a positive number of kelvin (2σ), at most 10",
-            a.target_k
-        );
-    }
-    if let Some(s) = a.exit_when_idle.filter(|s| !(s.is_finite() && *s > 0.0)) {
-        anyhow::bail!("--exit-when-idle {s}: give a positive number of seconds");
-    }
-    check_live_out(&a.recording, &a.out)?;
+    let pipeline = Pipeline::new(Project::resolve(a.config.as_deref(), &Overrides::new())?);
     let server = mrtmap_live::Server::start(&a.serve)?;
     eprintln!(
         "live page: http://{} (state: /state.json); following {}; Ctrl-C stops following and makes the full run into {}",
@@ -34,17 +20,18 @@ pub fn run(a: &LiveArgs) -> anyhow::Result<()> {
         a.out.display()
     );
     STOP_GRACEFULLY.store(true, Ordering::SeqCst);
-    let opts = LiveOptions {
-        target_k: a.target_k,
-        exit_when_idle_s: a.exit_when_idle,
-        ..LiveOptions::default()
-    };
-    let pipeline = Pipeline::new(project);
     let sink = Terminal {
         server: &server,
         said: Mutex::new((0, String::new())),
     };
-    let done = live(&pipeline, &a.recording, &a.out, &opts, &STOP, &sink)?;
+    let done = pipeline.live(
+        &a.recording,
+        &a.out,
+        a.target_k,
+        a.exit_when_idle,
+        &STOP,
+        &sink,
+    )?;
     print_lines(done.lines(&a.recording, &a.out));
     Ok(())
 }
@@ -84,7 +71,7 @@ impl LiveSink for Terminal<'_> {
 
 pub fn replay(a: &ReplayArgs) -> anyhow::Result<()> {
     STOP_GRACEFULLY.store(true, Ordering::SeqCst);
-    let done = replay_into(&a.recording, &a.into, a.speed, &STOP, &|t, total| {
+    let done = Pipeline::replay(&a.recording, &a.into, a.speed, &STOP, &|t, total| {
         eprintln!("replayed {t:.0} of {total:.0} s");
     })?;
     outln!(

@@ -1,10 +1,7 @@
 //! `mrtmap map`: MRT over a grid, written as CSV, PNG, SVG and JSON; with `--quantity`, a
 //! person's comfort maps beside it.
 
-use mrtmap_pipeline::comfort::value_of;
 use mrtmap_pipeline::maps::{Mark, MarkAt, load_scene};
-use mrtmap_pipeline::report::numbers::{fixed, uncertainty};
-use mrtmap_pipeline::settings::Quantity;
 use mrtmap_pipeline::{Overrides, Pipeline, Project};
 
 use crate::cli::MapArgs;
@@ -41,77 +38,6 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
         .collect();
     let front = Pipeline::new(project);
     let maps = front.map(&scene, &source, &marks, &a.out)?;
-    let project = front.project();
-    let m = &maps.map;
-    outln!("scene: {source}");
-    outln!("method: {}", m.method);
-    print_lines(m.summary.lines());
-    outln!(
-        "computed in {:.3} s; wrote mrt_grid.csv, mrt_map.png, mrt_map.svg, summary.json in {}",
-        m.summary.map.compute_secs,
-        a.out.display()
-    );
-    let Some(c) = &maps.comfort else {
-        return Ok(());
-    };
-    let person = Quantity::person(&project.map.quantities);
-    let s = &c.summary;
-    outln!();
-    outln!(
-        "a {} person, {}: {} nodes in {:.1} s",
-        s.comfort.posture.as_str(),
-        s.comfort.facing().describe(),
-        s.nodes,
-        s.compute_secs
-    );
-    if let Some(sh) = s.pmv_category_share {
-        outln!(
-            "  floor by ISO 7730 PMV category: A {:.0} %, B {:.0} %, C {:.0} %, outside {:.0} %",
-            100.0 * sh[0],
-            100.0 * sh[1],
-            100.0 * sh[2],
-            100.0 * sh[3]
-        );
-    }
-    if let Some(share) = s.outside_iso_ranges_share.filter(|x| *x > 0.0) {
-        outln!(
-            "  PMV inputs outside ISO 7730's ranges on {:.0} % of the floor: PMV and PPD there are indicative only",
-            100.0 * share
-        );
-    }
-    if let Some((w, xy)) = &s.worst_asymmetry {
-        outln!(
-            "  worst radiant asymmetry {:.2} K at ({}, {}): PD {:.1} %, category {}",
-            w.worst.delta_k,
-            fixed(xy[0], 2),
-            fixed(xy[1], 2),
-            w.worst.pd_pct,
-            w.worst.category.as_str()
-        );
-    }
-    if let Some(sun) = &s.sun {
-        outln!(
-            "  the sun (SolarCal): the beam reaches the person on {:.0} % of the floor; ΔMRT up to {:.2} K at ({}, {})",
-            100.0 * sun.sunlit_share,
-            sun.max_delta_mrt_k,
-            fixed(sun.max_at[0], 2),
-            fixed(sun.max_at[1], 2)
-        );
-    }
-    for (name, p) in &s.marks {
-        let cells: Vec<String> = person
-            .iter()
-            .filter_map(|q| {
-                value_of(p, *q).map(|(v, e)| format!("{} {v:.2} ± {}", q.name(), uncertainty(e, 2)))
-            })
-            .collect();
-        outln!("  {name}: {}", cells.join(", "));
-    }
-    let names: Vec<String> = person.iter().map(|q| format!("{}.png", q.name())).collect();
-    outln!(
-        "wrote {} and comfort.json in {}",
-        names.join(", "),
-        a.out.display()
-    );
+    print_lines(maps.lines(&source, &front.project().map.quantities, &a.out));
     Ok(())
 }

@@ -1,24 +1,26 @@
 //! `mrtmap segment`: thermal cloud → radiant scene.
 
-use mrtmap_pipeline::run::{SegmentJob, segment_folder, segment_lines};
+use mrtmap_pipeline::settings::RoomSection;
+use mrtmap_pipeline::{Pipeline, Project};
 
 use crate::cli::SegmentArgs;
 use crate::output::print_lines;
 
 pub fn run(a: &SegmentArgs) -> anyhow::Result<()> {
-    let report = segment_folder(&SegmentJob {
-        fused: &a.fused,
-        masks: a.masks.as_deref(),
-        recording: a.recording.as_deref(),
-        section: a.section.clone(),
-        origin_corner: a.origin_corner,
-        references: a.references.as_deref(),
-        out: &a.out,
-    })?;
-    print_lines(segment_lines(&report));
-    outln!(
-        "wrote scene.json, segments.ply, segment.json in {}",
-        a.out.display()
-    );
+    let project = Project {
+        segment: a.section.clone(),
+        room: RoomSection {
+            origin_corner: a.origin_corner,
+        },
+        ..Project::default()
+    };
+    let done = Pipeline::new(project).segment(
+        &a.fused,
+        a.masks.as_deref(),
+        a.recording.as_deref(),
+        a.references.as_deref(),
+        &a.out,
+    )?;
+    print_lines(done.lines(&a.out));
     Ok(())
 }

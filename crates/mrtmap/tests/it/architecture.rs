@@ -287,3 +287,172 @@ fn the_cycle_check_sees_a_cycle() {
     std::fs::write(src.join("b/inner.rs"), "#[cfg(test)]\nuse crate::a::Y;\n").unwrap();
     assert_eq!(a_cycle(&module_graph(src)), None);
 }
+
+/// The file of module `name` declared in `file` (`name.rs` or `name/mod.rs` beside a `lib.rs` or
+/// `mod.rs`, else in the folder named after `file`).
+fn module_file(file: &Path, name: &str) -> Option<PathBuf> {
+    let parent = file.parent()?;
+    let stem = file.file_stem()?.to_string_lossy();
+    let dir = if stem == "lib" || stem == "mod" {
+        parent.to_path_buf()
+    } else {
+        parent.join(stem.as_ref())
+    };
+    [
+        dir.join(format!("{name}.rs")),
+        dir.join(name).join("mod.rs"),
+    ]
+    .into_iter()
+    .find(|p| p.is_file())
+}
+
+/// The names a `pub use` statement (the text after `pub use`, up to its `;`) re-exports: one per
+/// leaf of its tree (`a::{B, c::{D, E}}` is three; `X as Y` is one).
+fn use_leaves(tree: &str) -> Vec<String> {
+    tree.replace(['{', '}'], "")
+        .split(',')
+        .map(|leaf| leaf.split_whitespace().collect::<Vec<_>>().join(" "))
+        .filter(|leaf| !leaf.is_empty())
+        .collect()
+}
+
+/// The public items of the module in `file`, named under `path`, pushed onto `items`. The rule
+/// (issue 53's count of a crate's API): from `lib.rs`, every file of a `pub mod`, followed down (a
+/// `mod` without `pub` is private and not read); in each, the items that start a line (not
+/// indented: methods, fields and variants belong to their type) declared `pub` (not `pub(crate)`):
+/// fn, struct, enum, const, static, trait, type, union, mod; each name a `pub use` re-exports
+/// (`pub use m::*` counts the public items of the child module `m` as its own); an inline `pub mod x { … }`
+/// counts itself and its items indented once; nothing after the file's first `#[cfg(test)]`.
+fn public_items(file: &Path, path: &str, items: &mut Vec<String>) {
+    let text = std::fs::read_to_string(file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+    let code = text.split("#[cfg(test)]").next().unwrap_or("");
+    let lines: Vec<&str> = code.lines().collect();
+    let mut inline: Option<String> = None;
+    let mut i = 0;
+    while i < lines.len() {
+        let line = lines[i];
+        i += 1;
+        let (item, within) = match &inline {
+            Some(_) if line == "}" => {
+                inline = None;
+                continue;
+            }
+            Some(m) => match line.strip_prefix("    ") {
+                Some(l) if !l.starts_with(' ') => (l, format!("{path}::{m}")),
+                _ => continue,
+            },
+            None if line.starts_with(char::is_whitespace) => continue,
+            None => (line, path.to_string()),
+        };
+        let Some(rest) = item.strip_prefix("pub ") else {
+            continue;
+        };
+        let words: Vec<&str> = rest.split_whitespace().collect();
+        let mut k = 0;
+        while k + 1 < words.len()
+            && (["unsafe", "async", "extern", "\"C\""].contains(&words[k])
+                || (words[k] == "const" && words[k + 1] == "fn"))
+        {
+            k += 1;
+        }
+        let kind = words.get(k).copied().unwrap_or("");
+        if kind == "use" {
+            let mut statement = rest.trim_start_matches("use").to_string();
+            while !statement.contains(';') && i < lines.len() {
+                statement.push_str(lines[i]);
+                i += 1;
+            }
+            let tree = statement.split(';').next().unwrap_or("");
+            for leaf in use_leaves(tree) {
+                if let Some(module) = leaf.strip_suffix("::*") {
+                    let child = module_file(file, module.trim()).unwrap_or_else(|| {
+                        panic!("{}: cannot count `pub use {leaf}`", file.display())
+                    });
+                    public_items(&child, &within, items);
+                } else {
+                    let name = leaf.rsplit([' ', ':']).next().unwrap_or("");
+                    items.push(format!("{within}::{name}"));
+                }
+            }
+            continue;
+        }
+        let name: String = words
+            .get(k + 1)
+            .unwrap_or(&"")
+            .chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_')
+            .collect();
+        items.push(format!("{within}::{name}"));
+        if kind == "mod" {
+            if rest.trim_end().ends_with('{') {
+                inline = Some(name);
+            } else if let Some(child) = module_file(file, &name) {
+                public_items(&child, &format!("{within}::{name}"), items);
+            }
+        }
+    }
+}
+
+/// The counting rule on a small crate: what it reads and what it leaves out.
+#[test]
+fn the_public_item_count_follows_its_rule() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("src");
+    std::fs::create_dir_all(src.join("b")).unwrap();
+    std::fs::write(
+        src.join("lib.rs"),
+        "pub mod a;\nmod b;\nmod c;\npub use b::{X, y::{Z, W as V}};\npub use c::*;\n\
+         pub(crate) fn hidden() {}\npub mod files {\n    pub use std::fs::{read, write};\n}\n\
+         pub const N: usize = 1;\n",
+    )
+    .unwrap();
+    std::fs::write(
+        src.join("a.rs"),
+        "pub fn f() {}\npub struct S {\n    pub field: u8,\n}\nimpl S {\n    pub fn m() {}\n}\n\
+         pub(crate) struct T;\n#[cfg(test)]\nmod tests {\n    pub fn t() {}\n}\npub fn after_tests() {}\n",
+    )
+    .unwrap();
+    std::fs::write(src.join("b/mod.rs"), "pub fn private_module() {}\n").unwrap();
+    std::fs::write(src.join("c.rs"), "pub enum E {}\npub(crate) fn g() {}\n").unwrap();
+    let mut items = Vec::new();
+    public_items(&src.join("lib.rs"), "crate", &mut items);
+    assert_eq!(
+        items,
+        [
+            "crate::a",
+            "crate::a::f",
+            "crate::a::S",
+            "crate::X",
+            "crate::Z",
+            "crate::V",
+            "crate::E",
+            "crate::files",
+            "crate::files::read",
+            "crate::files::write",
+            "crate::N",
+        ]
+    );
+}
+
+/// Issue 53: mrtmap-pipeline's API grew to some 350 public items (every stage function, every
+/// library type a module used); a front end needs the front door (`Pipeline`), the settings and
+/// the types its results carry. At most 150, counted by `public_items`'s rule.
+#[test]
+fn the_pipelines_public_api_stays_small() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let mut items = Vec::new();
+    public_items(
+        &root.join("crates/mrtmap-pipeline/src/lib.rs"),
+        "mrtmap_pipeline",
+        &mut items,
+    );
+    assert!(
+        items.iter().any(|i| i == "mrtmap_pipeline::Pipeline"),
+        "the count found no Pipeline: {items:#?}"
+    );
+    assert!(
+        items.len() <= 150,
+        "mrtmap-pipeline has {} public items, at most 150 (issue 53): make what no front end uses pub(crate)\n{items:#?}",
+        items.len()
+    );
+}

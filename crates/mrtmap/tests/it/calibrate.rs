@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use mrtmap_pipeline::files::Rig;
+use mrtmap_io::Rig;
 use serde_json::Value;
 
 use crate::{mrtmap, ok};

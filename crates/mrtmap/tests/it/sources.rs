@@ -272,9 +272,9 @@ fn convert_round_trips_every_source() {
                 src == "legacy.db",
                 "{src}: {text}"
             );
-            let a = mrtmap_pipeline::files::Recording::open(&d.join("scan")).unwrap();
-            let b = mrtmap_pipeline::files::Recording::open(&conv).unwrap();
-            let limits = mrtmap_pipeline::files::InterpolationLimits::default();
+            let a = mrtmap_io::Recording::open(&d.join("scan")).unwrap();
+            let b = mrtmap_io::Recording::open(&conv).unwrap();
+            let limits = mrtmap_io::InterpolationLimits::default();
             let worst = b
                 .trajectory
                 .stamps

@@ -1,0 +1,236 @@
+//! The sun: SolarCal by itself (`solar-gain`), through a scene's windows (`mrt --sun`), in maps and
+//! in globe validation.
+
+use serde_json::Value;
+
+use crate::cli::edited_example;
+use crate::{fails_with, mrtmap, ok_json};
+
+#[test]
+fn solar_gain_equals_solarcal_and_names_a_bad_flag() {
+    // grey-and-sun.md, the first vector (pythermalcomfort 4.8.1 solar_gain, unrounded): seated,
+    // facing a 1.8 × 1.3 m window 1.55 m away, wholly in a 30° beam.
+    let args = [
+        "solar-gain",
+        "--altitude",
+        "30",
+        "--sharp",
+        "0",
+        "--dni",
+        "700",
+        "--transmittance",
+        "0.6",
+        "--f-svv",
+        "0.04233",
+        "--f-bes",
+        "1",
+    ];
+    let v = ok_json(&[&args[..], &["--posture", "sitting", "--json"]].concat());
+    assert!(
+        (v["erf_w_m2"].as_f64().unwrap() - 68.522).abs() < 0.01,
+        "{v}"
+    );
+    assert!(
+        (v["delta_mrt_k"].as_f64().unwrap() - 16.4084).abs() < 0.005,
+        "{v}"
+    );
+    // The inputs come back, with pythermalcomfort's defaults for those not given.
+    assert_eq!(v["posture"], "seated");
+    assert_eq!(v["asw"], 0.7);
+    assert_eq!(v["floor_reflectance"], 0.6);
+    assert_eq!(v["f_svv"], 0.04233);
+    let text = crate::ok(&args);
+    assert!(text.contains("ΔMRT +16.41 K"), "{text}");
+    // Out of range: one sentence naming the flag, exit code 1 as any refused input.
+    let mut bad = args.to_vec();
+    bad[2] = "95";
+    let out = mrtmap(&bad);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        err.trim(),
+        "error: --altitude 95 is outside 0…90 (the solar altitude in degrees)"
+    );
+    let mut bad = args.to_vec();
+    bad[10] = "NaN";
+    fails_with(&bad, "--f-svv NaN is not a finite number");
+    fails_with(
+        &[&args[..], &["--posture", "lying"]].concat(),
+        "invalid value 'lying'",
+    );
+}
+
+/// Issue 52: the sun through the example office's window (on the +x wall) onto a seated person
+/// facing it: ΔMRT beside the MRT, within 10 % of SolarCal for a person wholly in the beam
+/// (16.41 K); --sun needs --facing, --dni and --transmittance.
+#[test]
+fn mrt_adds_the_sun_through_the_window_for_a_person() {
+    let v = ok_json(&[
+        "mrt",
+        "--at",
+        "2.65,1.8,0.6",
+        "--person",
+        "seated",
+        "--facing",
+        "0",
+        "--sun",
+        "30,0",
+        "--dni",
+        "700",
+        "--transmittance",
+        "0.6",
+        "--json",
+    ]);
+    let p = &v["persons"][0];
+    let d = p["delta_mrt_k"].as_f64().unwrap();
+    assert!((d - 16.41).abs() < 1.641, "{p}");
+    assert!(p["f_bes"].as_f64().unwrap() > 0.95, "{p}");
+    assert_eq!(p["sharp_deg"], 0.0);
+    let with_sun = p["mrt_with_sun_c"].as_f64().unwrap();
+    assert!((with_sun - p["mrt_c"].as_f64().unwrap() - d).abs() < 1e-9);
+    fails_with(
+        &[
+            "mrt",
+            "--at",
+            "2.65,1.8,0.6",
+            "--person",
+            "seated",
+            "--sun",
+            "30,0",
+            "--dni",
+            "700",
+            "--transmittance",
+            "0.6",
+        ],
+        "--facing",
+    );
+    fails_with(
+        &[
+            "mrt",
+            "--at",
+            "2.65,1.8,0.6",
+            "--person",
+            "seated",
+            "--facing",
+            "0",
+            "--sun",
+            "30",
+            "--dni",
+            "700",
+            "--transmittance",
+            "0.6",
+        ],
+        "expected ALT,AZ",
+    );
+}
+
+/// The example office's window is on the +x wall; `[sun]` 30° high due +x puts a globe in front
+/// of it (2.65, 1.8, 1.1) in the beam and one at y = 0.3 in the shade.
+const SUNNY_PROJECT: &str =
+    "[sun]\naltitude_deg = 30.0\nazimuth_deg = 0.0\ndni_w_m2 = 700\ntransmittance = 0.6\n";
+
+#[test]
+fn validate_flags_a_globe_in_the_sun_and_does_not_judge_it() {
+    let dir = tempfile::tempdir().unwrap();
+    edited_example(dir.path(), "scene.json", |_| {});
+    let globe = dir.path().join("globe.csv");
+    std::fs::write(
+        &globe,
+        "label,x,y,z,tg_c,ta_c,va_m_s,diameter_m,emissivity\n\
+         lit,2.65,1.8,1.1,30.0,21.0,0.1,0.15,0.95\n\
+         shade,2.65,0.3,1.1,22.0,21.0,0.1,0.15,0.95\n",
+    )
+    .unwrap();
+    let project = dir.path().join("project.toml");
+    std::fs::write(&project, SUNNY_PROJECT).unwrap();
+    let (d, g, p) = (
+        dir.path().to_str().unwrap(),
+        globe.to_str().unwrap(),
+        project.to_str().unwrap(),
+    );
+    let text = crate::ok(&["validate", "--map", d, "--globe", g, "--config", p]);
+    assert!(
+        text.contains("in sun: its reading includes short-wave the long-wave map does not"),
+        "{text}"
+    );
+    let v: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("validation.json")).unwrap())
+            .unwrap();
+    assert!(v[0]["in_sun"].is_string(), "{v}");
+    assert!(v[0]["meets_required"].is_null(), "{v}");
+    assert!(
+        v[0]["diff_iso_k"].is_number(),
+        "the difference is still shown: {v}"
+    );
+    assert!(v[1].get("in_sun").is_none(), "{v}");
+    assert!(v[1]["meets_required"].is_boolean(), "{v}");
+    let csv = std::fs::read_to_string(dir.path().join("validation.csv")).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert!(lines[0].ends_with(",in_sun"), "{csv}");
+    assert!(!lines[1].ends_with(','), "{csv}");
+    assert!(lines[2].ends_with(','), "{csv}");
+    // Without the project, the same globe is judged.
+    crate::ok(&["validate", "--map", d, "--globe", g]);
+    let v: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("validation.json")).unwrap())
+            .unwrap();
+    assert!(v[0]["meets_required"].is_boolean(), "{v}");
+    fails_with(
+        &[
+            "validate",
+            "--map",
+            d,
+            "--globe",
+            g,
+            "--config",
+            p,
+            "--calibrate-with",
+            "lit",
+        ],
+        "--calibrate-with lit names a globe in the sun",
+    );
+}
+
+#[test]
+fn map_draws_the_mrt_with_the_sun_from_the_projects_sun() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("map");
+    let o = out.to_str().unwrap();
+    fails_with(
+        &["map", "--grid", "4x3", "--quantity", "mrt_sun", "--out", o],
+        "[sun]",
+    );
+    let project = dir.path().join("project.toml");
+    std::fs::write(&project, SUNNY_PROJECT).unwrap();
+    let text = crate::ok(&[
+        "map",
+        "--grid",
+        "4x3",
+        "--quantity",
+        "mrt_sun",
+        "--config",
+        project.to_str().unwrap(),
+        "--mark",
+        "lit=2.65,1.8",
+        "--out",
+        o,
+    ]);
+    assert!(text.contains("mrt_sun"), "{text}");
+    assert!(text.contains("the beam reaches the person on"), "{text}");
+    let csv = std::fs::read_to_string(out.join("mrt_sun.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 13, "{csv}");
+    let c: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("comfort.json")).unwrap()).unwrap();
+    let lit = &c["marks"][0][1];
+    let d = lit["sun"]["delta_mrt_k"].as_f64().unwrap();
+    let share = c["sun"]["sunlit_share"].as_f64().unwrap();
+    assert!(
+        share > 0.0 && share < 1.0,
+        "part of the floor is in the beam: {share}"
+    );
+    assert!(c["sun"]["max_delta_mrt_k"].as_f64().unwrap() > 10.0, "{c}");
+    assert!(d > 10.0, "{lit}");
+    let m = lit["mrt_sun"][0].as_f64().unwrap();
+    let lw = lit["sun"]["mrt_long_wave_c"].as_f64().unwrap();
+    assert!((m - lw - d).abs() < 1e-6, "{lit}");
+}
