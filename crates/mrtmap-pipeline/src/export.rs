@@ -27,7 +27,7 @@ pub(crate) struct ExportInput {
     pub name: String,
 }
 
-/// One file written by [`export`].
+/// One file written by an export (`mrtmap export`, or a run's `[export]`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ExportDone {
     /// The format.

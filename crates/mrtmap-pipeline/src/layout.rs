@@ -82,7 +82,7 @@ impl RunLayout {
     }
 
     /// The path of a run's file inside any run folder, `/`-separated on every platform, as the
-    /// report and [`crate::run::MapResult::csv`] give it: `RunLayout::name_in_run(|r|
+    /// report and each map of [`crate::RunOutcome`] (its `csv`) give it: `RunLayout::name_in_run(|r|
     /// r.mrt_grid_csv(1.1))` is `map-1.10m/mrt_grid.csv`.
     pub fn name_in_run(file: impl FnOnce(&RunLayout) -> PathBuf) -> String {
         file(&RunLayout::new(""))
