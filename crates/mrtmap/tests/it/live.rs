@@ -76,7 +76,7 @@ fn watch(live: &mut std::process::Child, addr: &str, rec: &Path, dir: &Path) -> 
                 // In a thread of its own: the state is still asked for every second meanwhile.
                 let (addr, dir) = (addr.to_string(), dir.to_path_buf());
                 shot = Some(std::thread::spawn(move || {
-                    screenshot_live_page(&addr, &dir)
+                    screenshot_live_page(&addr, &dir);
                 }));
             }
             last = s;
