@@ -142,6 +142,10 @@ pub(crate) fn run<'py>(
                     watch.stop_with(e);
                 }
             }
+            // A Ctrl-C that came while the last stage was finishing is raised all the same.
+            if let Err(e) = Python::attach(|py| py.check_signals()) {
+                watch.stop_with(e);
+            }
             worker.join()
         })
     });
