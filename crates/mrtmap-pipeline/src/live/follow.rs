@@ -93,6 +93,8 @@ pub(crate) struct Follower {
     pub(crate) last_growth: Instant,
     /// The thermal frames taken at the last poll, with when each was written.
     pub(crate) taken: Vec<Taken>,
+    /// trajectory.txt is not read (the poses are tracked live instead).
+    pub(crate) ignore_trajectory: bool,
 }
 
 /// Whether a file is whole: a PNG up to its end chunk; another format once its size stands.
@@ -161,6 +163,7 @@ impl Follower {
             warning_count: 0,
             last_growth: Instant::now(),
             taken: Vec::new(),
+            ignore_trajectory: false,
         })
     }
 
@@ -221,7 +224,9 @@ impl Follower {
                 continue;
             }
             if list == List::Trajectory {
-                self.take_pose(k, n, s, &path);
+                if !self.ignore_trajectory {
+                    self.take_pose(k, n, s, &path);
+                }
                 continue;
             }
             let mut it = s.split_whitespace();

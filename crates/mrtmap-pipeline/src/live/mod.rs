@@ -46,6 +46,9 @@ pub(crate) const STATE_EVERY_S: f64 = 1.0;
 /// features by (evenly spread over the scan): each is read at each refresh, and the scan grows.
 const TEXTURE_FRAMES: usize = 60;
 
+/// Where the poses come from is decided once this much of the scan's depth frames is listed (s).
+const DECIDE_POSES_AFTER_S: f64 = 1.0;
+
 /// Frame latencies kept for the state's median.
 const LATENCIES_KEPT: usize = 300;
 
@@ -342,20 +345,18 @@ pub(crate) fn live(
     let work = tempfile::tempdir()
         .map_err(|e| mrtmap_io::FileError::io(Path::new("a temporary folder"), e))?;
     let mut fusion = LiveFusion::new(&params);
-    // Without trajectory.txt from the start, the built-in tracker places the colour frames.
-    let track_live = !recording.join("trajectory.txt").exists()
-        && follower.rec.rig.rgb.is_some()
-        && p.track.mode != crate::settings::TrackMode::Never;
+    // Where the poses come from is decided once a second of depth frames is listed:
+    // trajectory.txt when it exists then, else the built-in tracker (a recorder may create
+    // trajectory.txt after rig.toml and its first frames; deciding at the start tracked a
+    // recording that had poses, and kept the tracker's keyframes: about 2.4 MB a second of scan).
+    let can_track =
+        follower.rec.rig.rgb.is_some() && p.track.mode != crate::settings::TrackMode::Never;
+    let mut track_live: Option<bool> = None;
     let mut tracker: Option<mrtmap_track::LiveTracker> = None;
     let t0 = Instant::now();
     let mut state = LiveState {
         phase: "following".into(),
-        poses_from: if track_live {
-            "tracked live"
-        } else {
-            "the recording"
-        }
-        .into(),
+        poses_from: "not known yet".into(),
         verdict: "keep scanning".into(),
         ..LiveState::default()
     };
@@ -365,7 +366,22 @@ pub(crate) fn live(
     loop {
         let round = Instant::now();
         follower.poll();
-        if track_live {
+        let listed_s = match (follower.rec.depth.first(), follower.rec.depth.last()) {
+            (Some(a), Some(b)) => b.t - a.t,
+            _ => 0.0,
+        };
+        if track_live.is_none() && listed_s >= DECIDE_POSES_AFTER_S {
+            let tracked = can_track && !recording.join("trajectory.txt").exists();
+            follower.ignore_trajectory = tracked;
+            state.poses_from = if tracked {
+                "tracked live"
+            } else {
+                "the recording"
+            }
+            .into();
+            track_live = Some(tracked);
+        }
+        if track_live == Some(true) {
             track_more(&mut tracker, &mut follower.rec, &p);
         }
         latency.written(&follower.taken);
