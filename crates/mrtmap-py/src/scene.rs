@@ -81,6 +81,31 @@ fn grid_counts(nx: i64, ny: i64) -> PyResult<(usize, usize)> {
     }
 }
 
+impl PyScene {
+    /// The pipeline's answers at `points`: MRT, with a person's or the plane radiant
+    /// temperatures when asked (what `mrt`, `person` and `plane_radiant` share).
+    fn answers(
+        &self,
+        py: Python<'_>,
+        points: &PyArrayLike2<'_, f64, AllowTypeChange>,
+        frame: &str,
+        kw: &MrtKeywords,
+        person: Option<(Posture, Facing)>,
+        planes: bool,
+    ) -> PyResult<mrtmap_pipeline::points::PointAnswers> {
+        let q = PointQuery {
+            at: points_of(points)?,
+            frame: frame_of(frame)?,
+            person,
+            planes,
+            sun: None,
+        };
+        let mrt = kw.resolve()?;
+        py.detach(|| mrt_at_points(&self.scene, &self.source, &mrt, &q))
+            .map_err(py_err)
+    }
+}
+
 #[pymethods]
 impl PyScene {
     /// A scene from scene.json's text; `source` says where it came from (for messages).
@@ -209,17 +234,7 @@ impl PyScene {
             allow_open,
             placement_std_m,
         };
-        let q = PointQuery {
-            at: points_of(&points)?,
-            frame: frame_of(frame)?,
-            person: None,
-            planes: false,
-            sun: None,
-        };
-        let mrt = kw.resolve()?;
-        let a = py
-            .detach(|| mrt_at_points(&self.scene, &self.source, &mrt, &q))
-            .map_err(py_err)?;
+        let a = self.answers(py, &points, frame, &kw, None, false)?;
         let col = |f: fn(&mrtmap_pipeline::points::PointRecord) -> f64| {
             PyArray1::from_vec(py, a.points.iter().map(f).collect())
         };
@@ -277,17 +292,7 @@ impl PyScene {
                 )));
             }
         };
-        let q = PointQuery {
-            at: points_of(&points)?,
-            frame: frame_of(frame)?,
-            person: Some((posture, facing)),
-            planes: false,
-            sun: None,
-        };
-        let mrt = kw.resolve()?;
-        let a = py
-            .detach(|| mrt_at_points(&self.scene, &self.source, &mrt, &q))
-            .map_err(py_err)?;
+        let a = self.answers(py, &points, frame, &kw, Some((posture, facing)), false)?;
         let d = PyDict::new(py);
         let col = |f: fn(&mrtmap_pipeline::points::PersonAnswer) -> f64| {
             PyArray1::from_vec(py, a.persons.iter().map(f).collect())
@@ -325,17 +330,7 @@ impl PyScene {
             allow_open,
             placement_std_m,
         };
-        let q = PointQuery {
-            at: points_of(&points)?,
-            frame: frame_of(frame)?,
-            person: None,
-            planes: true,
-            sun: None,
-        };
-        let mrt = kw.resolve()?;
-        let a = py
-            .detach(|| mrt_at_points(&self.scene, &self.source, &mrt, &q))
-            .map_err(py_err)?;
+        let a = self.answers(py, &points, frame, &kw, None, true)?;
         let n = a.planes.len();
         let grid = |f: fn(&(String, f64, f64)) -> f64| -> PyResult<Bound<'py, PyAny>> {
             let v: Vec<f64> = a
