@@ -452,20 +452,14 @@ def survey(recordings, out, client=None, config=None, n_workers=None, progress=N
 # ---- comfort formulas, vectorised, named and unitised as pythermalcomfort's ----
 
 def _broadcast(*xs):
-    """The inputs' broadcast shape and each input flat: of the shape's size, or one value where
-    the input is a scalar (the native side repeats it; no copy of it for every element)."""
+    """The inputs' broadcast shape and each input as a contiguous array in its own shape: the
+    native side reads them in the broadcast shape where they lie (a column against a row is not
+    copied to the grid's size)."""
     arrays = [np.asarray(x, dtype=np.float64) for x in xs]
+    # (ascontiguousarray would make a scalar's 0-d array 1-d; a 0-d array is contiguous.)
+    arrays = [a if a.flags.c_contiguous else np.ascontiguousarray(a) for a in arrays]
     shape = np.broadcast_shapes(*(a.shape for a in arrays))
-    size = int(np.prod(shape))
-
-    def flat(a):
-        if a.size == 1 and size > 0:
-            return a.reshape(1)
-        if a.shape != shape:
-            a = np.broadcast_to(a, shape)
-        return np.ascontiguousarray(a).ravel()
-
-    return shape, [flat(a) for a in arrays]
+    return shape, [list(shape)] + arrays
 
 
 def _shaped(a: np.ndarray, shape: tuple):

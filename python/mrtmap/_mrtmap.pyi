@@ -134,6 +134,7 @@ def run(
     progress: Optional[Callable[[str, int, int], None]] = None,
 ) -> dict[str, Any]: ...
 def pmv_ppd(
+    shape: list[int],
     tdb: npt.ArrayLike,
     tr: npt.ArrayLike,
     vr: npt.ArrayLike,
@@ -146,9 +147,11 @@ def pmv_ppd(
     round: bool,
 ) -> tuple[_F, _F, int, Optional[str]]: ...
 def operative(
+    shape: list[int],
     tdb: npt.ArrayLike, tr: npt.ArrayLike, v: npt.ArrayLike, ashrae: bool
 ) -> tuple[_F, int, Optional[str]]: ...
 def mrt_from_globe(
+    shape: list[int],
     tg: npt.ArrayLike,
     tdb: npt.ArrayLike,
     v: npt.ArrayLike,
@@ -157,6 +160,7 @@ def mrt_from_globe(
     mixed: bool,
 ) -> tuple[_F, int, Optional[str]]: ...
 def solar_gain(
+    shape: list[int],
     sol_altitude: npt.ArrayLike,
     sharp: npt.ArrayLike,
     sol_radiation_dir: npt.ArrayLike,
@@ -168,6 +172,7 @@ def solar_gain(
     posture: str,
 ) -> tuple[_F, _F, int, Optional[str]]: ...
 def f_svv(
+    shape: list[int],
     w: npt.ArrayLike, h: npt.ArrayLike, d: npt.ArrayLike
 ) -> tuple[_F, int, Optional[str]]: ...
 def cli_main(argv: list[str]) -> int: ...

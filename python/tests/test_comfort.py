@@ -83,3 +83,29 @@ def test_mean_radiant_tmp(inputs):
         peer = ptc_mrt(tg, tdb, v, d, e, standard=std)
         np.testing.assert_array_equal(np.isnan(ours), np.isnan(peer))
         np.testing.assert_allclose(ours, peer, rtol=0, atol=1e-6, equal_nan=True)
+
+
+def test_inputs_broadcast_where_they_lie_as_numpy_does():
+    """Inputs are read in the broadcast shape without being copied to it: a column against a
+    row, a strided and a transposed array, three axes with ones in between; each element equals
+    the same computation on inputs broadcast by numpy first."""
+    rng = np.random.default_rng(7)
+    cases = [
+        (np.linspace(18, 28, 9)[:, None], np.linspace(15, 35, 6)[None, :], 0.1),
+        (rng.uniform(18, 28, (6, 9)).T, rng.uniform(15, 35, 12)[::2], rng.uniform(0, 0.5, (9, 1))),
+        (rng.uniform(18, 28, (3, 1, 5)), rng.uniform(15, 35, (4, 1)), rng.uniform(0, 0.5, (1, 4, 5))),
+    ]
+    for tdb, tr, vr in cases:
+        shape = np.broadcast_shapes(np.shape(tdb), np.shape(tr), np.shape(vr))
+        ours = mrtmap.pmv_ppd_iso(tdb, tr, vr, 50, 1.2, 0.5, round_output=False)
+        full = [np.array(np.broadcast_to(x, shape)).ravel() for x in (tdb, tr, vr)]
+        flat = mrtmap.pmv_ppd_iso(*full, 50, 1.2, 0.5, round_output=False)
+        assert ours.pmv.shape == shape
+        np.testing.assert_array_equal(ours.pmv.ravel(), flat.pmv)
+        np.testing.assert_array_equal(ours.ppd.ravel(), flat.ppd)
+        peer = ptc_models.pmv_ppd_iso(*full, 50, 1.2, 0.5, round_output=False)
+        np.testing.assert_allclose(ours.pmv.ravel(), peer.pmv, rtol=0, atol=1e-9)
+        to = mrtmap.operative_tmp(tdb, tr, vr)
+        np.testing.assert_allclose(to.ravel(), mrtmap.operative_tmp(*full), rtol=0, atol=0)
+    with pytest.raises(ValueError, match="shape mismatch|broadcast"):
+        mrtmap.pmv_ppd_iso(np.zeros(3) + 20, np.zeros(4) + 20, 0.1, 50, 1.2, 0.5)

@@ -1,8 +1,11 @@
-//! The comfort formulas element by element over 1-D arrays (the Python layer broadcasts): in
-//! parallel without the GIL, NaN at an element whose inputs a formula refuses, never an error for
-//! one element. Each returns, beside its arrays, how many elements with no NaN among their inputs
-//! were refused and the first one's message, for the Python layer's warning (a NaN in gives a NaN
-//! out silently, as numpy's arithmetic does).
+//! The comfort formulas element by element over numpy arrays: in parallel without the GIL, NaN
+//! at an element whose inputs a formula refuses, never an error for one element. The inputs come
+//! as they were given, each in its own shape, with the shape they broadcast to: a column of air
+//! temperatures against a row of radiant ones is read where it lies, not copied to the grid's
+//! size (a copy made fresh memory, whose page faults cost as much as the PMVs). Each function
+//! returns, beside its arrays, how many elements with no NaN among their inputs were refused and
+//! the first one's message, for the Python layer's warning (a NaN in gives a NaN out silently, as
+//! numpy's arithmetic does).
 
 use mrtmap_pipeline::comfort::{
     Iso7730Edition, OperativeMethod, PmvInputs, SolarInputs, SolarPosture, operative_temperature,
@@ -12,8 +15,7 @@ use mrtmap_pipeline::validation::{
     Convection, Globe, GlobeFormulaChoice, GlobeInput, MIXED_CONVECTION_DIAMETERS_M, Temperature,
     convert_globe,
 };
-use numpy::ndarray::ArrayView1;
-use numpy::{AllowTypeChange, PyArray1, PyArrayLike1};
+use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 
@@ -28,66 +30,150 @@ type Two<'py> = (
     usize,
     Option<String>,
 );
+/// An input as Python passes it: a C-contiguous array of any shape that broadcasts to the
+/// elements' shape.
+type Input<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
 
 /// Elements per parallel block.
 const BLOCK: usize = 2048;
 
-/// Views of 1-D arrays of one length `n` (broadcast already by the Python layer) or of one value
-/// (a scalar, the same for every element: no copy of it n times), named in the error when one
-/// differs. Views, not copies: the arrays stay borrowed while the GIL is released.
+/// One input read in the elements' broadcast shape (numpy's rules: shapes aligned at their last
+/// axis, an axis of one repeated), element `k` in C order.
+enum Column<'a> {
+    /// One value for every element.
+    One(f64),
+    /// A value per element, in order.
+    Flat(&'a [f64]),
+    /// Fewer values, repeated along some axes: element k's is `data[Σ index_d(k) · strides[d]]`.
+    Repeated {
+        data: &'a [f64],
+        shape: Vec<usize>,
+        strides: Vec<usize>,
+    },
+}
+
+/// A block's values of one column: borrowed where they lie in order, gathered otherwise.
+enum Values<'a> {
+    One(f64),
+    Slice(&'a [f64]),
+    Gathered(Vec<f64>),
+}
+
+impl Values<'_> {
+    #[inline]
+    fn at(&self, j: usize) -> f64 {
+        match self {
+            Values::One(v) => *v,
+            Values::Slice(s) => s[j],
+            Values::Gathered(v) => v[j],
+        }
+    }
+}
+
+impl<'a> Column<'a> {
+    /// `data` (C order, of shape `own`) read in `shape`; None when `own` does not broadcast to it.
+    fn new(data: &'a [f64], own: &[usize], shape: &[usize]) -> Option<Self> {
+        if data.len() == 1 {
+            return Some(Column::One(data[0]));
+        }
+        if own == shape {
+            return Some(Column::Flat(data));
+        }
+        if own.len() > shape.len() {
+            return None;
+        }
+        // Its shape padded with ones on the left, then its C-order strides, 0 where repeated.
+        let mut padded = vec![1; shape.len() - own.len()];
+        padded.extend_from_slice(own);
+        let mut strides = vec![0; shape.len()];
+        let mut step = 1;
+        for d in (0..shape.len()).rev() {
+            match (padded[d], shape[d]) {
+                (1, _) => {}
+                (a, b) if a == b => strides[d] = step,
+                _ => return None,
+            }
+            step *= padded[d];
+        }
+        Some(Column::Repeated {
+            data,
+            shape: shape.to_vec(),
+            strides,
+        })
+    }
+
+    /// Elements `start..start + len`'s values.
+    fn block(&self, start: usize, len: usize) -> Values<'a> {
+        match self {
+            Column::One(v) => Values::One(*v),
+            Column::Flat(d) => Values::Slice(&d[start..start + len]),
+            Column::Repeated {
+                data,
+                shape,
+                strides,
+            } => {
+                // The first element's index, then one step at a time with carries.
+                let mut index = vec![0; shape.len()];
+                let mut rest = start;
+                for d in (0..shape.len()).rev() {
+                    index[d] = rest % shape[d];
+                    rest /= shape[d];
+                }
+                let mut offset: usize = index.iter().zip(strides).map(|(i, s)| i * s).sum();
+                let mut out = Vec::with_capacity(len);
+                for _ in 0..len {
+                    out.push(data[offset]);
+                    for d in (0..shape.len()).rev() {
+                        index[d] += 1;
+                        offset += strides[d];
+                        if index[d] < shape[d] {
+                            break;
+                        }
+                        offset -= strides[d] * shape[d];
+                        index[d] = 0;
+                    }
+                }
+                Values::Gathered(out)
+            }
+        }
+    }
+}
+
+/// The inputs as columns over the elements' shape `shape` (numpy's broadcast of theirs, found by
+/// the Python layer), and the number of elements; an input that does not broadcast to it is
+/// named.
 fn columns<'a, const N: usize>(
-    arrays: [&'a PyArrayLike1<'_, f64, AllowTypeChange>; N],
+    arrays: [&'a Input<'_>; N],
     names: [&str; N],
-) -> PyResult<[ArrayView1<'a, f64>; N]> {
-    let cols = arrays.map(|a| a.as_array());
-    let n = elements(&cols);
-    match cols
-        .iter()
-        .zip(names)
-        .find(|(c, _)| c.len() != n && c.len() != 1)
-    {
-        Some((c, name)) => Err(MrtmapError::new_err(format!(
-            "{name} has {} values where the others have {n}",
-            c.len()
-        ))),
-        None => Ok(cols),
+    shape: &[usize],
+) -> PyResult<([Column<'a>; N], usize)> {
+    let n = shape.iter().product();
+    let mut cols = Vec::with_capacity(N);
+    for (a, name) in arrays.into_iter().zip(names) {
+        let data = a.as_slice().map_err(|_| {
+            MrtmapError::new_err(format!("{name} is not a contiguous array of numbers"))
+        })?;
+        let column = Column::new(data, a.shape(), shape).ok_or_else(|| {
+            MrtmapError::new_err(format!(
+                "{name} has shape {:?}, which does not broadcast to {shape:?}",
+                a.shape()
+            ))
+        })?;
+        cols.push(column);
     }
+    let cols: [Column<'a>; N] = cols
+        .try_into()
+        .map_err(|_| MrtmapError::new_err("an input went missing"))?;
+    Ok((cols, n))
 }
 
-/// The number of elements: the columns' length, 1 when all are single values, 0 when one is empty.
-fn elements<const N: usize>(cols: &[ArrayView1<'_, f64>; N]) -> usize {
-    if cols.iter().any(|c| c.is_empty()) {
-        0
-    } else {
-        cols.iter().map(ArrayView1::len).max().unwrap_or(0)
-    }
-}
-
-/// Element `k` of a column, or its single value.
-#[inline]
-fn at(c: &ArrayView1<'_, f64>, k: usize) -> f64 {
-    if c.len() == 1 { c[0] } else { c[k] }
-}
-
-/// Whether any input of element `k` is NaN.
-fn any_nan<const N: usize>(cols: &[ArrayView1<'_, f64>; N], k: usize) -> bool {
-    cols.iter().any(|c| at(c, k).is_nan())
-}
-
-/// Counts a refusal of element `k` (unless an input of it is NaN), keeping the first message.
-fn refuse<const N: usize>(
-    r: &mut Refusals,
-    cols: &[ArrayView1<'_, f64>; N],
-    k: usize,
-    e: &dyn std::error::Error,
-) {
-    if any_nan(cols, k) {
-        return;
-    }
-    r.0 += 1;
-    if r.1.is_none() {
-        r.1 = Some(format!("element {k}: {}", message(e)));
-    }
+/// Every column's values for the block of `len` elements from `start`.
+fn block_values<'a, const N: usize>(
+    cols: &[Column<'a>; N],
+    start: usize,
+    len: usize,
+) -> [Values<'a>; N] {
+    std::array::from_fn(|i| cols[i].block(start, len))
 }
 
 /// Block refusals merged in order: the total and the first message.
@@ -96,23 +182,43 @@ fn merge(blocks: Vec<Refusals>) -> Refusals {
     (count, blocks.into_iter().find_map(|b| b.1))
 }
 
-/// `f(k)` for every element in parallel blocks, NaN where it refuses.
+/// Element `j` of a block's columns.
+#[inline]
+fn row<const N: usize>(values: &[Values<'_>; N], j: usize) -> [f64; N] {
+    std::array::from_fn(|i| values[i].at(j))
+}
+
+/// Counts a refusal of element `k` (unless one of its inputs `x` is NaN), keeping the first
+/// message.
+fn refuse<const N: usize>(r: &mut Refusals, x: &[f64; N], k: usize, e: &dyn std::error::Error) {
+    if x.iter().any(|v| v.is_nan()) {
+        return;
+    }
+    r.0 += 1;
+    if r.1.is_none() {
+        r.1 = Some(format!("element {k}: {}", message(e)));
+    }
+}
+
+/// `f(inputs)` for every element in parallel, NaN where it refuses.
 fn each<const N: usize, E: std::error::Error>(
     py: Python<'_>,
-    cols: &[ArrayView1<'_, f64>; N],
-    f: impl Fn(usize) -> Result<f64, E> + Sync,
+    cols: &[Column<'_>; N],
+    n: usize,
+    f: impl Fn(&[f64; N]) -> Result<f64, E> + Sync,
 ) -> (Vec<f64>, Refusals) {
-    let n = elements(cols);
     let mut out = vec![0.0; n];
     let blocks = py.detach(|| {
         out.par_chunks_mut(BLOCK)
             .enumerate()
             .map(|(b, chunk)| {
+                let start = b * BLOCK;
+                let values = block_values(cols, start, chunk.len());
                 let mut r = (0, None);
                 for (j, o) in chunk.iter_mut().enumerate() {
-                    let k = b * BLOCK + j;
-                    *o = f(k).unwrap_or_else(|e| {
-                        refuse(&mut r, cols, k, &e);
+                    let x = row(&values, j);
+                    *o = f(&x).unwrap_or_else(|e| {
+                        refuse(&mut r, &x, start + j, &e);
                         f64::NAN
                     });
                 }
@@ -131,13 +237,14 @@ fn each<const N: usize, E: std::error::Error>(
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn pmv_ppd<'py>(
     py: Python<'py>,
-    tdb: PyArrayLike1<'py, f64, AllowTypeChange>,
-    tr: PyArrayLike1<'py, f64, AllowTypeChange>,
-    vr: PyArrayLike1<'py, f64, AllowTypeChange>,
-    rh: PyArrayLike1<'py, f64, AllowTypeChange>,
-    met: PyArrayLike1<'py, f64, AllowTypeChange>,
-    clo: PyArrayLike1<'py, f64, AllowTypeChange>,
-    wme: PyArrayLike1<'py, f64, AllowTypeChange>,
+    shape: Vec<usize>,
+    tdb: Input<'py>,
+    tr: Input<'py>,
+    vr: Input<'py>,
+    rh: Input<'py>,
+    met: Input<'py>,
+    clo: Input<'py>,
+    wme: Input<'py>,
     edition: u32,
     limit: bool,
     round: bool,
@@ -151,11 +258,11 @@ pub(crate) fn pmv_ppd<'py>(
             )));
         }
     };
-    let cols = columns(
+    let (cols, n) = columns(
         [&tdb, &tr, &vr, &rh, &met, &clo, &wme],
         ["tdb", "tr", "vr", "rh", "met", "clo", "wme"],
+        &shape,
     )?;
-    let n = elements(&cols);
     // Blocks of inputs in parallel, written in place; within a block, several PMVs iterate
     // interleaved.
     let mut pmv = vec![0.0; n];
@@ -166,19 +273,20 @@ pub(crate) fn pmv_ppd<'py>(
             .enumerate()
             .map(|(b, (pmv, ppd))| {
                 let start = b * BLOCK;
+                let values = block_values(&cols, start, pmv.len());
                 let mut r = (0, None);
                 pmv_ppd_each(
                     pmv.len(),
                     |j| {
-                        let k = start + j;
+                        let [ta, tr, vr, rh, met, clo, wme] = row(&values, j);
                         PmvInputs {
-                            air: Temperature::from_celsius(at(&cols[0], k)),
-                            mrt: Temperature::from_celsius(at(&cols[1], k)),
-                            relative_air_speed_m_s: at(&cols[2], k),
-                            relative_humidity_pct: at(&cols[3], k),
-                            met: at(&cols[4], k),
-                            clo: at(&cols[5], k),
-                            external_work_met: at(&cols[6], k),
+                            air: Temperature::from_celsius(ta),
+                            mrt: Temperature::from_celsius(tr),
+                            relative_air_speed_m_s: vr,
+                            relative_humidity_pct: rh,
+                            met,
+                            clo,
+                            external_work_met: wme,
                         }
                     },
                     edition,
@@ -193,7 +301,7 @@ pub(crate) fn pmv_ppd<'py>(
                         Ok(p) => (pmv[j], ppd[j]) = (p.pmv, p.ppd_pct),
                         Err(e) => {
                             (pmv[j], ppd[j]) = (f64::NAN, f64::NAN);
-                            refuse(&mut r, &cols, start + j, &e);
+                            refuse(&mut r, &row(&values, j), start + j, &e);
                         }
                     },
                 );
@@ -214,22 +322,23 @@ pub(crate) fn pmv_ppd<'py>(
 #[pyfunction]
 pub(crate) fn operative<'py>(
     py: Python<'py>,
-    tdb: PyArrayLike1<'py, f64, AllowTypeChange>,
-    tr: PyArrayLike1<'py, f64, AllowTypeChange>,
-    v: PyArrayLike1<'py, f64, AllowTypeChange>,
+    shape: Vec<usize>,
+    tdb: Input<'py>,
+    tr: Input<'py>,
+    v: Input<'py>,
     ashrae: bool,
 ) -> PyResult<One<'py>> {
-    let cols = columns([&tdb, &tr, &v], ["tdb", "tr", "v"])?;
+    let (cols, n) = columns([&tdb, &tr, &v], ["tdb", "tr", "v"], &shape)?;
     let method = if ashrae {
         OperativeMethod::Ashrae55
     } else {
         OperativeMethod::Iso
     };
-    let (out, (count, first)) = each(py, &cols, |k| {
+    let (out, (count, first)) = each(py, &cols, n, |x| {
         operative_temperature(
-            Temperature::from_celsius(at(&cols[0], k)),
-            Temperature::from_celsius(at(&cols[1], k)),
-            at(&cols[2], k),
+            Temperature::from_celsius(x[0]),
+            Temperature::from_celsius(x[1]),
+            x[2],
             method,
         )
         .map(|t| t.celsius())
@@ -243,16 +352,18 @@ pub(crate) fn operative<'py>(
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn mrt_from_globe<'py>(
     py: Python<'py>,
-    tg: PyArrayLike1<'py, f64, AllowTypeChange>,
-    tdb: PyArrayLike1<'py, f64, AllowTypeChange>,
-    v: PyArrayLike1<'py, f64, AllowTypeChange>,
-    d: PyArrayLike1<'py, f64, AllowTypeChange>,
-    emissivity: PyArrayLike1<'py, f64, AllowTypeChange>,
+    shape: Vec<usize>,
+    tg: Input<'py>,
+    tdb: Input<'py>,
+    v: Input<'py>,
+    d: Input<'py>,
+    emissivity: Input<'py>,
     mixed: bool,
 ) -> PyResult<One<'py>> {
-    let cols = columns(
+    let (cols, n) = columns(
         [&tg, &tdb, &v, &d, &emissivity],
         ["tg", "tdb", "v", "d", "emissivity"],
+        &shape,
     )?;
     let method = if mixed {
         GlobeFormulaChoice::Mixed
@@ -260,22 +371,15 @@ pub(crate) fn mrt_from_globe<'py>(
         GlobeFormulaChoice::Iso
     }
     .method(Convection::Larger);
-    let (out, (count, first)) = each(py, &cols, |k| {
+    let (out, (count, first)) = each(py, &cols, n, |x| {
         let globe = Globe {
-            diameter_m: at(&cols[3], k),
-            emissivity: at(&cols[4], k),
+            diameter_m: x[3],
+            emissivity: x[4],
         };
         if mixed && !MIXED_CONVECTION_DIAMETERS_M.contains(&globe.diameter_m) {
             return Ok(f64::NAN);
         }
-        convert_globe(
-            GlobeInput::Globe(at(&cols[0], k)),
-            &globe,
-            at(&cols[1], k),
-            at(&cols[2], k),
-            method,
-        )
-        .map(|c| c.mrt_c)
+        convert_globe(GlobeInput::Globe(x[0]), &globe, x[1], x[2], method).map(|c| c.mrt_c)
     });
     Ok((PyArray1::from_vec(py, out), count, first))
 }
@@ -288,14 +392,15 @@ pub(crate) fn mrt_from_globe<'py>(
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn solar_gain<'py>(
     py: Python<'py>,
-    sol_altitude: PyArrayLike1<'py, f64, AllowTypeChange>,
-    sharp: PyArrayLike1<'py, f64, AllowTypeChange>,
-    sol_radiation_dir: PyArrayLike1<'py, f64, AllowTypeChange>,
-    sol_transmittance: PyArrayLike1<'py, f64, AllowTypeChange>,
-    f_svv: PyArrayLike1<'py, f64, AllowTypeChange>,
-    f_bes: PyArrayLike1<'py, f64, AllowTypeChange>,
-    asw: PyArrayLike1<'py, f64, AllowTypeChange>,
-    floor_reflectance: PyArrayLike1<'py, f64, AllowTypeChange>,
+    shape: Vec<usize>,
+    sol_altitude: Input<'py>,
+    sharp: Input<'py>,
+    sol_radiation_dir: Input<'py>,
+    sol_transmittance: Input<'py>,
+    f_svv: Input<'py>,
+    f_bes: Input<'py>,
+    asw: Input<'py>,
+    floor_reflectance: Input<'py>,
     posture: &str,
 ) -> PyResult<Two<'py>> {
     let posture = SolarPosture::from_name(posture).ok_or_else(|| {
@@ -303,7 +408,7 @@ pub(crate) fn solar_gain<'py>(
             "posture '{posture}' is none of 'sitting', 'standing' and 'supine'"
         ))
     })?;
-    let c = columns(
+    let (c, n) = columns(
         [
             &sol_altitude,
             &sharp,
@@ -324,18 +429,19 @@ pub(crate) fn solar_gain<'py>(
             "asw",
             "floor_reflectance",
         ],
+        &shape,
     )?;
-    let gain = |k: usize| {
+    let gain = |x: &[f64; 8]| {
         let inputs = SolarInputs {
-            altitude_deg: at(&c[0], k),
-            sharp_deg: at(&c[1], k),
-            dni_w_m2: at(&c[2], k),
-            transmittance: at(&c[3], k),
-            f_svv: at(&c[4], k),
-            f_bes: at(&c[5], k),
-            asw: at(&c[6], k),
+            altitude_deg: x[0],
+            sharp_deg: x[1],
+            dni_w_m2: x[2],
+            transmittance: x[3],
+            f_svv: x[4],
+            f_bes: x[5],
+            asw: x[6],
             posture,
-            floor_reflectance: at(&c[7], k),
+            floor_reflectance: x[7],
         };
         if !(0.0..=90.0).contains(&inputs.altitude_deg)
             || !(0.0..=180.0).contains(&inputs.sharp_deg)
@@ -344,9 +450,9 @@ pub(crate) fn solar_gain<'py>(
         }
         solarcal(&inputs).map(|g| (g.erf_w_m2, g.delta_mrt_k))
     };
-    let (erf, r) = each(py, &c, |k| gain(k).map(|g| g.0));
+    let (erf, r) = each(py, &c, n, |x| gain(x).map(|g| g.0));
     // The second pass recomputes (SolarCal is cheap); its refusals are the first's.
-    let (dmrt, _) = each(py, &c, |k| gain(k).map(|g| g.1));
+    let (dmrt, _) = each(py, &c, n, |x| gain(x).map(|g| g.1));
     Ok((
         PyArray1::from_vec(py, erf),
         PyArray1::from_vec(py, dmrt),
@@ -360,13 +466,14 @@ pub(crate) fn solar_gain<'py>(
 #[pyfunction]
 pub(crate) fn f_svv<'py>(
     py: Python<'py>,
-    w: PyArrayLike1<'py, f64, AllowTypeChange>,
-    h: PyArrayLike1<'py, f64, AllowTypeChange>,
-    d: PyArrayLike1<'py, f64, AllowTypeChange>,
+    shape: Vec<usize>,
+    w: Input<'py>,
+    h: Input<'py>,
+    d: Input<'py>,
 ) -> PyResult<One<'py>> {
-    let cols = columns([&w, &h, &d], ["w", "h", "d"])?;
-    let (out, (count, first)) = each(py, &cols, |k| {
-        mrtmap_pipeline::comfort::f_svv(at(&cols[0], k), at(&cols[1], k), at(&cols[2], k))
+    let (cols, n) = columns([&w, &h, &d], ["w", "h", "d"], &shape)?;
+    let (out, (count, first)) = each(py, &cols, n, |x| {
+        mrtmap_pipeline::comfort::f_svv(x[0], x[1], x[2])
     });
     Ok((PyArray1::from_vec(py, out), count, first))
 }
