@@ -58,8 +58,20 @@ pub struct BvhRayCaster {
 }
 
 impl BvhRayCaster {
-    /// Builds the BVH over `triangles`.
+    /// Builds the BVH over `triangles` (obvhs' medium build: quick to build, quick to trace).
     pub fn new(triangles: &[Tri]) -> Self {
+        Self::build(triangles, BvhBuildParams::medium_build())
+    }
+
+    /// Builds the BVH over `triangles` with obvhs' most careful build, for a caster that will
+    /// trace millions of rays: the simulator's truth (100,000 rays at each of 404 points) traced
+    /// about a fifth faster through it, on the same nearest hits (a ray meeting two triangles at
+    /// the same distance, on a shared edge, may report the other).
+    pub fn for_many_rays(triangles: &[Tri]) -> Self {
+        Self::build(triangles, BvhBuildParams::very_slow_build())
+    }
+
+    fn build(triangles: &[Tri], params: BvhBuildParams) -> Self {
         if triangles.is_empty() {
             return Self {
                 bvh: None,
@@ -76,11 +88,7 @@ impl BvhRayCaster {
                 v2: v3a(&t[2]),
             })
             .collect();
-        let bvh = build_cwbvh_from_tris(
-            &tris,
-            BvhBuildParams::medium_build(),
-            &mut std::time::Duration::default(),
-        );
+        let bvh = build_cwbvh_from_tris(&tris, params, &mut std::time::Duration::default());
         let rt = bvh
             .primitive_indices
             .iter()

@@ -390,14 +390,26 @@ pub struct MrtEngine<'a> {
 /// Step (m) of the central differences that give the MRT's gradient for the placement term.
 const PLACEMENT_STEP_M: f64 = 0.02;
 
-fn caster(tris: &[mrtmap_geometry::Tri]) -> Box<dyn RayCaster> {
+/// Rays per point from which the BVH is built with more care ([`BvhRayCaster::for_many_rays`]):
+/// the simulator's truth casts 100,000; a map's default 20,000 keeps the quick build (and its
+/// results as they were).
+///
+/// [`BvhRayCaster::for_many_rays`]: mrtmap_geometry::BvhRayCaster::for_many_rays
+const MANY_RAYS: usize = 50_000;
+
+fn caster(tris: &[mrtmap_geometry::Tri], rays: usize) -> Box<dyn RayCaster> {
     #[cfg(feature = "embree")]
     {
+        let _ = rays;
         Box::new(mrtmap_geometry::EmbreeRayCaster::new(tris))
     }
     #[cfg(not(feature = "embree"))]
     {
-        Box::new(mrtmap_geometry::BvhRayCaster::new(tris))
+        if rays >= MANY_RAYS {
+            Box::new(mrtmap_geometry::BvhRayCaster::for_many_rays(tris))
+        } else {
+            Box::new(mrtmap_geometry::BvhRayCaster::new(tris))
+        }
     }
 }
 
@@ -457,8 +469,12 @@ impl<'a> MrtEngine<'a> {
                 owner.push(Owner::Occluder(oi));
             }
         }
+        let rays = match method {
+            Method::Exact => 0,
+            Method::MonteCarlo(mc) | Method::Auto(mc) => mc.rays,
+        };
         let tracer = Some(Tracer {
-            caster: caster(&tris),
+            caster: caster(&tris, rays),
             owner,
         });
         Ok(Self {

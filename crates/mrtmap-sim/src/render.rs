@@ -5,7 +5,7 @@
 use mrtmap_geometry::nalgebra::{Isometry3, Point2, Point3, Rotation3, Vector3};
 use mrtmap_geometry::polygon::point_in_polygon_fast;
 
-use crate::room::{Room, SurfaceRef};
+use crate::room::Room;
 
 /// What a ray hit.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -166,11 +166,6 @@ impl RoomRenderer {
                 })
                 .collect(),
         }
-    }
-
-    /// The surface reference of a plane index.
-    pub fn surface_ref(room: &Room, surface: usize) -> SurfaceRef {
-        room.surfaces()[surface]
     }
 }
 
@@ -357,7 +352,7 @@ pub fn temperature_at(room: &Room, hit: &Hit, point: &Point3<f64>) -> f64 {
         Element::Surface {
             surface,
             feature: None,
-        } => room.background_radiant_c(RoomRenderer::surface_ref(room, surface), point.z),
+        } => room.background_radiant_c(Room::surface_at(surface), point.z),
         Element::Furniture(b) => room.file.furniture[b].temperature_c,
     }
 }

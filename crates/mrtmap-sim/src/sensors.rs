@@ -435,7 +435,7 @@ fn colour(room: &Room, hit: &Hit) -> [f64; 3] {
         Element::Surface {
             feature: Some(f), ..
         } => by_label(&room.features[f].label),
-        Element::Surface { surface, .. } => match RoomRenderer::surface_ref(room, surface) {
+        Element::Surface { surface, .. } => match Room::surface_at(surface) {
             crate::room::SurfaceRef::Floor => [150.0, 110.0, 80.0],
             crate::room::SurfaceRef::Ceiling => [235.0, 235.0, 230.0],
             crate::room::SurfaceRef::Wall(i) => {

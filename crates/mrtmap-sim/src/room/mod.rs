@@ -696,9 +696,17 @@ impl Room {
 
     /// All surfaces in a fixed order: floor, ceiling, walls 0….
     pub fn surfaces(&self) -> Vec<SurfaceRef> {
-        let mut v = vec![SurfaceRef::Floor, SurfaceRef::Ceiling];
-        v.extend((0..self.wall_count()).map(SurfaceRef::Wall));
-        v
+        (0..2 + self.wall_count()).map(Self::surface_at).collect()
+    }
+
+    /// Surface `index` of [`Room::surfaces`] without making the list (the renderers ask per
+    /// pixel): the floor, the ceiling, then the walls in order.
+    pub fn surface_at(index: usize) -> SurfaceRef {
+        match index {
+            0 => SurfaceRef::Floor,
+            1 => SurfaceRef::Ceiling,
+            i => SurfaceRef::Wall(i - 2),
+        }
     }
 
     /// Id of a surface in scenes.
