@@ -115,7 +115,7 @@ def grid(bin_path, runs, **mrt):
             computes.append(summary["compute_secs"])
     t_py, py_compute, t_cli, cli_compute = (
         statistics.median(x) for x in (py, py_computes, walls, computes))
-    ok = np.isfinite(m.mrt)
+    ok = np.isfinite(m.mrt_c)
     pts = m.xyz[ok]
     t_pts, r = median_time(lambda: scene.mrt(pts, **mrt), runs)
     return {
@@ -129,8 +129,8 @@ def grid(bin_path, runs, **mrt):
         "python_map_over_cli_wall": round(t_py / t_cli, 3),
         "python_map_over_cli_compute": round(t_py / cli_compute, 3),
         "computes_ratio": round(py_compute / cli_compute, 3),
-        "same_mean_c": abs(float(np.nanmean(m.mrt)) - summary["mean_c"]) < 1e-9,
-        "points_equal_map": bool(np.allclose(r.mrt, m.mrt[ok], atol=1e-9, rtol=0))
+        "same_mean_c": abs(float(np.nanmean(m.mrt_c)) - summary["mean_c"]) < 1e-9,
+        "points_equal_map": bool(np.allclose(r.mrt_c, m.mrt_c[ok], atol=1e-9, rtol=0))
         if not mrt else "streams differ (point k vs node j·nx+i)",
     }
 
