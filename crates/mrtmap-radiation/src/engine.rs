@@ -395,6 +395,7 @@ const PLACEMENT_STEP_M: f64 = 0.02;
 /// results as they were).
 ///
 /// [`BvhRayCaster::for_many_rays`]: mrtmap_geometry::BvhRayCaster::for_many_rays
+#[cfg(not(feature = "embree"))]
 const MANY_RAYS: usize = 50_000;
 
 fn caster(tris: &[mrtmap_geometry::Tri], rays: usize) -> Box<dyn RayCaster> {
