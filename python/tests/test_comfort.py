@@ -109,3 +109,13 @@ def test_inputs_broadcast_where_they_lie_as_numpy_does():
         np.testing.assert_allclose(to.ravel(), mrtmap.operative_tmp(*full), rtol=0, atol=0)
     with pytest.raises(ValueError, match="shape mismatch|broadcast"):
         mrtmap.pmv_ppd_iso(np.zeros(3) + 20, np.zeros(4) + 20, 0.1, 50, 1.2, 0.5)
+
+
+def test_a_broadcast_too_big_for_memory_raises_memory_error():
+    """A column of 100,000 against a row of 100,000 asks 80 GB for each result: a MemoryError,
+    not an aborted interpreter."""
+    with pytest.raises(MemoryError, match="do not fit in memory"):
+        mrtmap.pmv_ppd_iso(np.zeros((100_000, 1)) + 22, np.zeros((1, 100_000)) + 22,
+                           0.1, 50, 1.2, 0.7)
+    with pytest.raises(MemoryError):
+        mrtmap.operative_tmp(np.zeros((100_000, 1)) + 22, np.zeros((1, 100_000)) + 22, 0.1)

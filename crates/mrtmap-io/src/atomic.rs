@@ -5,7 +5,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use crate::error::FileError;
+use crate::error::{FileError, FileErrorKind};
 
 /// Writes `bytes` to `path` atomically (temporary file + rename), creating the folder if needed.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
@@ -31,6 +31,43 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
     Ok(())
 }
 
+/// The file in a finished [`PartialDir`] listing the entries it was finished with: what a later
+/// run may replace.
+pub const MADE: &str = ".mrtmap-made";
+
+/// Refuses `target` when it exists and is not empty, unless [`MADE`] lists all it holds.
+fn check_replaceable(target: &Path) -> Result<(), FileError> {
+    let Ok(entries) = std::fs::read_dir(target) else {
+        return Ok(()); // absent (a file there fails later, named)
+    };
+    let made = std::fs::read_to_string(target.join(MADE)).unwrap_or_default();
+    let made: std::collections::HashSet<&str> = made.lines().collect();
+    let mut names: Vec<String> = entries
+        .filter_map(|e| e.ok().map(|e| e.file_name().to_string_lossy().into_owned()))
+        .filter(|n| n != MADE)
+        .collect();
+    names.sort();
+    let Some(first) = names.iter().find(|n| !made.contains(n.as_str())) else {
+        return Ok(());
+    };
+    let what = if made.is_empty() {
+        format!(
+            "already exists and holds {} entr{} mrtmap did not write there (the first: {first})",
+            names.len(),
+            if names.len() == 1 { "y" } else { "ies" }
+        )
+    } else {
+        format!("holds {first}, which mrtmap did not write there")
+    };
+    Err(FileError::new(
+        target,
+        None,
+        FileErrorKind::Syntax(format!(
+            "{what}: give a new or empty folder, or move what is in it (mrtmap replaces only a folder it made)"
+        )),
+    ))
+}
+
 /// A folder being built: files go into `FINAL.partial/`; [`PartialDir::finish`] renames it to
 /// `FINAL` (replacing an older one). Dropped unfinished, the partial folder stays for inspection
 /// and the final name is untouched.
@@ -40,8 +77,11 @@ pub struct PartialDir {
 }
 
 impl PartialDir {
-    /// Starts building `target` (removing a stale partial folder).
+    /// Starts building `target` (removing a stale partial folder). A `target` that exists must be
+    /// empty or a folder this type finished before holding nothing else (its [`MADE`] list names
+    /// every entry): a folder of the user's, or one they added files to, is refused, not replaced.
     pub fn create(target: &Path) -> Result<Self, FileError> {
+        check_replaceable(target)?;
         let mut name = target
             .file_name()
             .map(|n| n.to_os_string())
@@ -63,12 +103,63 @@ impl PartialDir {
         &self.partial
     }
 
-    /// Moves the folder to its final name.
+    /// Moves the folder to its final name, listing what it holds in [`MADE`].
     pub fn finish(self) -> Result<PathBuf, FileError> {
+        let mut names: Vec<String> = std::fs::read_dir(&self.partial)
+            .map_err(|e| FileError::io(&self.partial, e))?
+            .filter_map(|e| e.ok().map(|e| e.file_name().to_string_lossy().into_owned()))
+            .collect();
+        names.sort();
+        names.push(String::new());
+        let made = self.partial.join(MADE);
+        std::fs::write(&made, names.join("\n")).map_err(|e| FileError::io(&made, e))?;
         if self.target.exists() {
             std::fs::remove_dir_all(&self.target).map_err(|e| FileError::io(&self.target, e))?;
         }
         std::fs::rename(&self.partial, &self.target).map_err(|e| FileError::io(&self.target, e))?;
         Ok(self.target)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn finish_with(target: &Path, files: &[&str]) -> Result<PathBuf, FileError> {
+        let dir = PartialDir::create(target)?;
+        for f in files {
+            std::fs::write(dir.path().join(f), b"x").map_err(|e| FileError::io(target, e))?;
+        }
+        dir.finish()
+    }
+
+    /// A folder of the user's is refused, not replaced (`convert` and `simulate` deleted a
+    /// folder's notes and subfolders); a folder mrtmap finished is replaced, until the user puts
+    /// something of their own in it.
+    #[test]
+    fn only_an_empty_folder_or_one_mrtmap_made_is_replaced() -> Result<(), FileError> {
+        let tmp = tempfile::tempdir().map_err(|e| FileError::io(Path::new("tmp"), e))?;
+        let out = tmp.path().join("out");
+        std::fs::create_dir(&out).map_err(|e| FileError::io(&out, e))?;
+        finish_with(&out, &["a.txt"])?; // empty: taken
+        finish_with(&out, &["b.txt"])?; // made by mrtmap: replaced
+        assert!(out.join("b.txt").exists() && !out.join("a.txt").exists());
+        std::fs::write(out.join("notes.txt"), b"mine").map_err(|e| FileError::io(&out, e))?;
+        let err = finish_with(&out, &["c.txt"]).err().map(|e| e.to_string());
+        assert!(
+            err.as_deref()
+                .is_some_and(|e| e.contains("notes.txt") && e.contains("mrtmap did not write")),
+            "{err:?}"
+        );
+        assert!(out.join("notes.txt").exists() && out.join("b.txt").exists());
+        let user = tmp.path().join("precious");
+        std::fs::create_dir_all(user.join("sub")).map_err(|e| FileError::io(&user, e))?;
+        let err = finish_with(&user, &["d.txt"]).err().map(|e| e.to_string());
+        assert!(
+            err.as_deref().is_some_and(|e| e.contains("already exists")),
+            "{err:?}"
+        );
+        assert!(user.join("sub").is_dir());
+        Ok(())
     }
 }

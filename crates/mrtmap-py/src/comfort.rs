@@ -147,7 +147,14 @@ fn columns<'a, const N: usize>(
     names: [&str; N],
     shape: &[usize],
 ) -> PyResult<([Column<'a>; N], usize)> {
-    let n = shape.iter().product();
+    let n = shape
+        .iter()
+        .try_fold(1usize, |n, &d| n.checked_mul(d))
+        .ok_or_else(|| {
+            pyo3::exceptions::PyMemoryError::new_err(format!(
+                "the inputs broadcast to {shape:?}, more elements than memory can address"
+            ))
+        })?;
     let mut cols = Vec::with_capacity(N);
     for (a, name) in arrays.into_iter().zip(names) {
         let data = a.as_slice().map_err(|_| {
@@ -165,6 +172,19 @@ fn columns<'a, const N: usize>(
         .try_into()
         .map_err(|_| MrtmapError::new_err("an input went missing"))?;
     Ok((cols, n))
+}
+
+/// An output of `n` values, or a `MemoryError` when it does not fit (a broadcast of a 100,000
+/// column against a 100,000 row asks 80 GB; allocating it outright aborted the interpreter).
+fn zeros(n: usize) -> PyResult<Vec<f64>> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n).map_err(|_| {
+        pyo3::exceptions::PyMemoryError::new_err(format!(
+            "{n} results of 8 bytes do not fit in memory: compute the inputs in smaller pieces"
+        ))
+    })?;
+    v.resize(n, 0.0);
+    Ok(v)
 }
 
 /// Every column's values for the block of `len` elements from `start`.
@@ -239,8 +259,8 @@ fn each<const N: usize, E: std::error::Error>(
     cols: &[Column<'_>; N],
     n: usize,
     f: impl Fn(&[f64; N]) -> Result<f64, E> + Sync,
-) -> (Vec<f64>, Refusals) {
-    let mut out = vec![0.0; n];
+) -> PyResult<(Vec<f64>, Refusals)> {
+    let mut out = zeros(n)?;
     let blocks = py.detach(|| {
         shared(out.chunks_mut(BLOCK).enumerate(), |(b, chunk)| {
             let start = b * BLOCK;
@@ -256,7 +276,7 @@ fn each<const N: usize, E: std::error::Error>(
             r
         })
     });
-    (out, merge(blocks))
+    Ok((out, merge(blocks)))
 }
 
 /// PMV and PPD element by element; with `limit`, NaN where the inputs or the PMV lie outside ISO
@@ -295,8 +315,8 @@ pub(crate) fn pmv_ppd<'py>(
     )?;
     // Blocks of inputs in parallel, written in place; within a block, several PMVs iterate
     // interleaved.
-    let mut pmv = vec![0.0; n];
-    let mut ppd = vec![0.0; n];
+    let mut pmv = zeros(n)?;
+    let mut ppd = zeros(n)?;
     let blocks: Vec<Refusals> = py.detach(|| {
         shared(
             pmv.chunks_mut(BLOCK).zip(ppd.chunks_mut(BLOCK)).enumerate(),
@@ -371,7 +391,7 @@ pub(crate) fn operative<'py>(
             method,
         )
         .map(|t| t.celsius())
-    });
+    })?;
     Ok((PyArray1::from_vec(py, out), count, first))
 }
 
@@ -409,7 +429,7 @@ pub(crate) fn mrt_from_globe<'py>(
             return Ok(f64::NAN);
         }
         convert_globe(GlobeInput::Globe(x[0]), &globe, x[1], x[2], method).map(|c| c.mrt_c)
-    });
+    })?;
     Ok((PyArray1::from_vec(py, out), count, first))
 }
 
@@ -479,9 +499,9 @@ pub(crate) fn solar_gain<'py>(
         }
         solarcal(&inputs).map(|g| (g.erf_w_m2, g.delta_mrt_k))
     };
-    let (erf, r) = each(py, &c, n, |x| gain(x).map(|g| g.0));
+    let (erf, r) = each(py, &c, n, |x| gain(x).map(|g| g.0))?;
     // The second pass recomputes (SolarCal is cheap); its refusals are the first's.
-    let (dmrt, _) = each(py, &c, n, |x| gain(x).map(|g| g.1));
+    let (dmrt, _) = each(py, &c, n, |x| gain(x).map(|g| g.1))?;
     Ok((
         PyArray1::from_vec(py, erf),
         PyArray1::from_vec(py, dmrt),
@@ -503,6 +523,6 @@ pub(crate) fn f_svv<'py>(
     let (cols, n) = columns([&w, &h, &d], ["w", "h", "d"], &shape)?;
     let (out, (count, first)) = each(py, &cols, n, |x| {
         mrtmap_pipeline::comfort::f_svv(x[0], x[1], x[2])
-    });
+    })?;
     Ok((PyArray1::from_vec(py, out), count, first))
 }
