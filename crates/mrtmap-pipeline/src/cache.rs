@@ -11,7 +11,7 @@
 use std::path::{Path, PathBuf};
 use std::time::{Instant, UNIX_EPOCH};
 
-use mrtmap_io::write_atomic;
+use mrtmap_io::{Recording, StreamEntry, write_atomic};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
@@ -74,6 +74,25 @@ impl Fingerprint {
             self.inputs.push(FileStamp::of(p));
         }
         self
+    }
+
+    /// Adds the frames a list names, as one digest of each file's path, size and modification
+    /// time under `name` (thousands of frames make one entry, not thousands): a frame replaced
+    /// behind an unchanged list is a changed input (a run reused fusion over new thermal images).
+    pub fn frames(self, name: &str, rec: &Recording, frames: &[StreamEntry]) -> Self {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::hash::DefaultHasher::new();
+        for e in frames {
+            let p = rec.path_of(e);
+            let m = std::fs::metadata(&p).ok();
+            p.hash(&mut h);
+            m.as_ref().map(std::fs::Metadata::len).hash(&mut h);
+            m.and_then(|m| m.modified().ok()).hash(&mut h);
+        }
+        self.setting(
+            name,
+            &format!("{} frames, {:016x}", frames.len(), h.finish()),
+        )
     }
 
     /// Adds an optional input file.

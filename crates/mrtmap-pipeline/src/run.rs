@@ -441,6 +441,8 @@ fn track_stage(
     let fingerprint = ["rig.toml", "depth.txt", "rgb.txt", "imu.txt"]
         .iter()
         .fold(Fingerprint::new(), |f, n| f.file(&rec.dir.join(n)))
+        .frames("depth_frames", rec, &rec.depth)
+        .frames("rgb_frames", rec, &rec.rgb)
         .setting("track", &p.track);
     let stage = Stage {
         name: "track".into(),
@@ -477,6 +479,8 @@ fn fuse_stage(
         .iter()
         .fold(Fingerprint::new(), |f, n| f.file(&rec.dir.join(n)))
         .maybe_file(tracked.exists().then_some(tracked.as_path()))
+        .frames("depth_frames", rec, &rec.depth)
+        .frames("thermal_frames", rec, &rec.thermal)
         .setting("fuse", &p.fuse);
     let stage = Stage {
         name: "fuse".into(),
@@ -509,6 +513,7 @@ fn segment_stage(
                 .as_deref(),
         )
         .maybe_file(use_masks.then(|| rec.dir.join("masks.txt")).as_deref())
+        .frames("mask_frames", rec, if use_masks { &rec.masks } else { &[] })
         .setting("segment", &p.segment)
         .setting("room", &p.room)
         .maybe_file(

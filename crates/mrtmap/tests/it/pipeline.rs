@@ -64,6 +64,20 @@ fn assert_only(dir: &Path, known: &[PathBuf]) {
     }
 }
 
+/// `src` copied to `dst` with every file hard-linked.
+fn linked_copy(src: &Path, dst: &Path) {
+    std::fs::create_dir_all(dst).unwrap();
+    for e in std::fs::read_dir(src).unwrap() {
+        let e = e.unwrap();
+        let to = dst.join(e.file_name());
+        if e.file_type().unwrap().is_dir() {
+            linked_copy(&e.path(), &to);
+        } else {
+            std::fs::hard_link(e.path(), &to).unwrap();
+        }
+    }
+}
+
 fn stages_skipped(out: &Path) -> Vec<(String, bool)> {
     read_json(&out.join("run.json"))["stages"]
         .as_array()
@@ -80,8 +94,10 @@ fn stages_skipped(out: &Path) -> Vec<(String, bool)> {
 
 #[test]
 fn run_produces_every_output_and_reuses_unchanged_stages() {
-    let rec = recording();
     let dir = tempfile::tempdir().unwrap();
+    // Its own copy (files hard-linked): a frame is replaced below.
+    let rec = dir.path().join("scan");
+    linked_copy(recording(), &rec);
     let out = dir.path().join("run");
     let o = out.to_str().unwrap();
     let r = rec.to_str().unwrap();
@@ -199,6 +215,35 @@ fn run_produces_every_output_and_reuses_unchanged_stages() {
     ]);
     let st = stages_skipped(&out);
     assert!(st[0].1 && !st[1].1, "{st:?}");
+    // A thermal frame replaced behind an unchanged thermal.txt: fusion runs again (issue 54's
+    // campaign: fusion was reused over new images).
+    let rec_dir = rec.as_path();
+    let first = std::fs::read_to_string(rec_dir.join("thermal.txt"))
+        .unwrap()
+        .lines()
+        .find(|l| !l.starts_with('#') && !l.trim().is_empty())
+        .and_then(|l| l.split_whitespace().nth(1).map(str::to_string))
+        .unwrap();
+    let frame = rec_dir.join(&first);
+    let other = std::fs::read(&frame).unwrap();
+    std::fs::remove_file(&frame).unwrap();
+    std::fs::write(&frame, [other.as_slice(), b"\0"].concat()).unwrap();
+    ok(&[
+        "run",
+        r,
+        "--out",
+        o,
+        "--grid",
+        "8x6",
+        "--mark",
+        "P=0.2,0.5,1.0",
+        "--height",
+        "1.1",
+        "--height",
+        "1.7",
+    ]);
+    let st = stages_skipped(&out);
+    assert!(!st[0].1, "fusion reused over a replaced frame: {st:?}");
     // --force reruns all.
     ok(&["run", r, "--out", o, "--grid", "8x6", "--force"]);
     assert!(stages_skipped(&out).iter().all(|s| !s.1));
