@@ -91,8 +91,54 @@ pub fn fuse_into(
 ) -> Result<FusionReport> {
     progress.begin("fusing thermal frames");
     let fused = fuse(rec, params, &|d, t| progress.advance(d, t));
+    if let Some(problem) = nothing_fused(&fused.report) {
+        return Err(Error::source(&rec.dir, problem));
+    }
     write_fused(rec, params, &fused, out)?;
     Ok(fused.report)
+}
+
+/// Why a fusion that made no voxel made none, and what to check; `None` when it made some. Such
+/// a fusion is refused here, naming the frames' fate, rather than later as a room with no floor
+/// or walls (which blamed the scan for thermal stamps in milliseconds or a rig in millimetres).
+fn nothing_fused(r: &FusionReport) -> Option<String> {
+    if r.voxels > 0 {
+        return None;
+    }
+    if r.thermal_frames == 0 || r.depth_frames == 0 {
+        let list = if r.thermal_frames == 0 {
+            "thermal.txt"
+        } else {
+            "depth.txt"
+        };
+        return Some(format!(
+            "{list} lists no frames, so there is nothing to fuse: list the frames recorded (docs/recording.md)"
+        ));
+    }
+    let fate = {
+        let skipped: Vec<String> = r
+            .skipped
+            .iter()
+            .map(|(why, n)| format!("{n} {why}"))
+            .collect();
+        format!(
+            "{} of {} thermal frames fused{}{}",
+            r.used_frames,
+            r.thermal_frames,
+            if skipped.is_empty() {
+                String::new()
+            } else {
+                format!(" ({})", skipped.join(", "))
+            },
+            r.problems
+                .first()
+                .map(|p| format!("; the first: {p}"))
+                .unwrap_or_default()
+        )
+    };
+    Some(format!(
+        "fusion placed no thermal pixel on any depth point: {fate}. Check that thermal.txt's and depth.txt's timestamps are seconds on one clock, that rig.toml's [thermal] intrinsics match its images, and that depth_from_thermal is in metres"
+    ))
 }
 
 /// Writes a fusion into `out`: cloud.ply, fusion.json, poses.txt and frames.json.

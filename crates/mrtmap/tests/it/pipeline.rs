@@ -64,6 +64,51 @@ fn assert_only(dir: &Path, known: &[PathBuf]) {
     }
 }
 
+/// A fusion that places nothing is refused, saying what became of the frames (thermal stamps in
+/// milliseconds fused nothing, exited 0, and `run` then blamed the scan for finding no floor).
+#[test]
+fn a_fusion_that_places_nothing_says_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("scan");
+    linked_copy(recording(), &rec);
+    let list = std::fs::read_to_string(rec.join("thermal.txt")).unwrap();
+    let ms: String = list
+        .lines()
+        .map(|l| match l.split_once(' ') {
+            Some((t, p)) if !l.starts_with('#') => {
+                format!("{:.3} {p}\n", t.parse::<f64>().unwrap() * 1000.0)
+            }
+            _ => format!("{l}\n"),
+        })
+        .collect();
+    std::fs::remove_file(rec.join("thermal.txt")).unwrap();
+    std::fs::write(rec.join("thermal.txt"), ms).unwrap();
+    for cmd in ["fuse", "run"] {
+        let out = dir.path().join(cmd);
+        let o = mrtmap(&[cmd, rec.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{cmd}: {err}");
+        assert!(
+            err.contains("0 of") && err.contains("no depth frame within the sync tolerance"),
+            "{cmd}: {err}"
+        );
+        assert!(!out.join("fuse/stage.json").exists() && !out.join("stage.json").exists());
+    }
+    std::fs::remove_file(rec.join("thermal.txt")).unwrap();
+    std::fs::write(rec.join("thermal.txt"), "# no frames\n").unwrap();
+    let o = mrtmap(&[
+        "run",
+        rec.to_str().unwrap(),
+        "--out",
+        dir.path().join("e").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("thermal.txt lists no frames"),
+        "{err}"
+    );
+}
+
 /// `src` copied to `dst` with every file hard-linked.
 fn linked_copy(src: &Path, dst: &Path) {
     std::fs::create_dir_all(dst).unwrap();
