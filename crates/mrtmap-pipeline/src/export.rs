@@ -294,6 +294,19 @@ pub fn export_file(
     out: &Path,
     max_points: usize,
 ) -> Result<Vec<String>> {
+    // An extension that names another format than --to's would mislead whoever opens the file.
+    if let (Some(to), Some(named)) = (to, ExportFormat::from_path(out))
+        && to != named
+    {
+        return Err(Error::setting(
+            format!("--to {} --out {}", to.as_str(), out.display()),
+            format!(
+                "disagree: the file's extension names {}; name it for {} or leave --to out",
+                named.as_str(),
+                to.as_str()
+            ),
+        ));
+    }
     let Some(format) = to.or_else(|| ExportFormat::from_path(out)) else {
         return Err(Error::setting(
             format!("--out {}", out.display()),

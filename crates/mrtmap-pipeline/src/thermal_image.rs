@@ -29,7 +29,7 @@ pub struct ThermalReading {
     #[arg(long)]
     pub emissivity: Option<f64>,
     /// FLIR: object distance, m.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub distance: Option<f64>,
     /// FLIR: reflected apparent temperature, °C.
     #[arg(long, allow_negative_numbers = true)]
@@ -63,6 +63,21 @@ impl ThermalReading {
                 format!("--distance {d}"),
                 "must be a distance in metres, 0 or more",
             );
+        }
+        for (flag, t) in [
+            ("--reflected", self.reflected),
+            ("--atmospheric", self.atmospheric),
+        ] {
+            // FLIR's own range for these is −40…+150 °C or wider; below absolute zero is no
+            // temperature, and beyond 1000 °C no room's.
+            if let Some(t) = t
+                && !(-273.15..=1000.0).contains(&t)
+            {
+                return refuse(
+                    format!("{flag} {t}"),
+                    "is outside −273.15…1000 °C: give the temperature in °C",
+                );
+            }
         }
         if let Some(s) = self.scale
             && !(s > 0.0 && s.is_finite())

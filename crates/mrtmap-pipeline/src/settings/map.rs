@@ -9,6 +9,7 @@ use crate::error::{Error, Result};
 #[serde(default, deny_unknown_fields)]
 pub struct MapSection {
     /// Grid nodes across and along the floor's bounding rectangle.
+    #[serde(deserialize_with = "two_counts")]
     pub grid: [usize; 2],
     /// One map per height above the floor (m).
     pub heights_m: Vec<f64>,
@@ -16,6 +17,17 @@ pub struct MapSection {
     pub margin_m: f64,
     /// What to map: the sphere's MRT at each height, and a person's quantities.
     pub quantities: Vec<Quantity>,
+}
+
+/// Exactly two counts (`[20, 20, 20]` was read as 20 × 20, the third ignored).
+fn two_counts<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<[usize; 2], D::Error> {
+    let v = Vec::<usize>::deserialize(d)?;
+    <[usize; 2]>::try_from(v.as_slice()).map_err(|_| {
+        serde::de::Error::custom(format!(
+            "grid = {v:?} has {} values where it takes two, nodes across and along: [nx, ny]",
+            v.len()
+        ))
+    })
 }
 
 impl Default for MapSection {

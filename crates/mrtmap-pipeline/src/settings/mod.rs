@@ -222,6 +222,24 @@ impl Project {
         self.mrt.check()?;
         self.emissivity.check()?;
         self.sun.check()?;
+        if let Some(p) = self
+            .points
+            .iter()
+            .find(|p| p.xyz.iter().any(|v| !v.is_finite()))
+        {
+            return Err(Error::setting(
+                format!("[[points]] \"{}\" xyz = {:?}", p.name, p.xyz),
+                "is not a place: give three numbers in metres",
+            ));
+        }
+        // Two points of one name were both printed as that name: which is which?
+        let mut names = std::collections::HashSet::new();
+        if let Some(p) = self.points.iter().find(|p| !names.insert(p.name.as_str())) {
+            return Err(Error::setting(
+                format!("[[points]] name = \"{}\"", p.name),
+                "is given to two points: name each point once (--mark too)",
+            ));
+        }
         if self.map.quantities.contains(&Quantity::MrtSun) && !self.sun.is_given() {
             return Err(no_sun_error());
         }
@@ -300,6 +318,25 @@ mod tests {
         if let Ok(p) = huge {
             assert!(p.check().is_err());
         }
+        let twice = "[[points]]\nname = \"A\"\nxyz = [1.0, 1.0, 1.1]\n[[points]]\nname = \"A\"\nxyz = [2.0, 1.0, 1.1]\n";
+        let e = Project::parse(twice)
+            .unwrap()
+            .check()
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("name = \"A\"") && e.contains("two points"),
+            "{e}"
+        );
+        // Three values (the third was ignored) and one are refused, with the line.
+        for toml in ["[map]\ngrid = [20, 20, 20]\n", "[map]\ngrid = [20]\n"] {
+            let (line, e) = Project::parse(toml).unwrap_err();
+            assert!(line == 2 && e.contains("where it takes two"), "{line}: {e}");
+        }
+        assert_eq!(
+            Project::parse("[map]\ngrid = [8, 6]\n").unwrap().map.grid,
+            [8, 6]
+        );
     }
 
     #[test]

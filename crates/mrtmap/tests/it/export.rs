@@ -37,6 +37,11 @@ fn export_writes_each_format_and_a_honeybee_export_maps_back_the_same() {
         ],
         "is a folder: name the file to write in it",
     );
+    // gbXML into a file named .hbjson was written, and then read back as "not JSON".
+    fails_with(
+        &["export", "--to", "gbxml", "--out", hb.to_str().unwrap()],
+        "the file's extension names hbjson",
+    );
     let obj = dir.path().join("room.obj");
     fails_with(
         &["export", "--out", obj.to_str().unwrap()],

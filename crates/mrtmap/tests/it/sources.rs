@@ -128,6 +128,20 @@ fn thermal_prints_metadata_and_exports_a_flir_jpeg() {
     );
     let e = fails(&["thermal", f.to_str().unwrap(), "--emissivity", "1.5"]);
     assert!(e.contains("--emissivity 1.5"), "{e}");
+    // Below absolute zero is refused (it was read as a reflected temperature); a negative
+    // distance is named by its range, not taken for a flag.
+    let e = fails(&["thermal", f.to_str().unwrap(), "--reflected", "-300"]);
+    assert!(
+        e.contains("--reflected -300") && e.contains("−273.15"),
+        "{e}"
+    );
+    let e = fails(&["thermal", f.to_str().unwrap(), "--atmospheric", "-300"]);
+    assert!(e.contains("--atmospheric -300"), "{e}");
+    let e = fails(&["thermal", f.to_str().unwrap(), "--distance", "-5"]);
+    assert!(
+        e.contains("--distance -5") && e.contains("0 or more"),
+        "{e}"
+    );
     let e = fails(&["thermal", "no-such-file.jpg"]);
     assert!(e.contains("no-such-file.jpg"), "{e}");
 }
