@@ -829,6 +829,7 @@ impl ComfortAnswer {
 /// the line.
 pub fn comfort_csv(path: &Path) -> Result<Vec<String>> {
     let text = std::fs::read_to_string(path).map_err(|e| FileError::io(path, e))?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text); // Excel's "CSV UTF-8"
     let mut rows = text
         .lines()
         .enumerate()

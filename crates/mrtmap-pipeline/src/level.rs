@@ -52,6 +52,8 @@ pub(crate) fn read_references(path: &Path) -> Result<Vec<Reference>> {
 
 /// Parses references.csv text; errors name `path` and the line.
 pub fn parse_references(text: &str, path: &Path) -> Result<Vec<Reference>> {
+    // Excel's "CSV UTF-8" starts with a byte-order mark: read past it.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let bad = |line: usize, msg: String| Error::Config {
         path: path.to_path_buf(),
         line,
@@ -1081,6 +1083,9 @@ mod tests {
         std::fs::write(&p, "label,x,y,temperature_c\n").unwrap();
         let e = read_references(&p).unwrap_err().to_string();
         assert!(e.contains(":1: the header has no column 'z'"), "{e}");
+        // A byte-order mark before the header (Excel's "CSV UTF-8") is read past.
+        let bom = "\u{feff}label,x,y,z,temperature_c\nwall,1,2,1,20.5\n";
+        assert_eq!(parse_references(bom, Path::new("r.csv")).unwrap().len(), 1);
         std::fs::write(&p, "temperature_c,label,z,y,x,std_k\n20.5,w,3,2,1,0.05\n").unwrap();
         let r = read_references(&p).unwrap();
         assert_eq!(

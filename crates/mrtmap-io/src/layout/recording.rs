@@ -49,6 +49,16 @@ pub enum RecordingWarning {
     NoThermalFrames,
     /// trajectory.txt has no poses.
     NoPoses,
+    /// Lines that repeat the line before them (timestamp and file), left out: a frame listed
+    /// twice would count twice.
+    RepeatedLines {
+        /// The list.
+        list: &'static str,
+        /// Lines left out.
+        count: usize,
+        /// The first one (1-based).
+        first_line: usize,
+    },
     /// Thermal frames whose stamps lie outside the trajectory (as recorded: another clock's
     /// offset may cover them).
     ThermalWithoutPose {
@@ -73,12 +83,37 @@ impl std::fmt::Display for RecordingWarning {
             Self::NoDepthFrames => f.write_str("depth.txt lists no frames"),
             Self::NoThermalFrames => f.write_str("thermal.txt lists no frames"),
             Self::NoPoses => f.write_str("trajectory.txt has no poses"),
+            Self::RepeatedLines {
+                list,
+                count,
+                first_line,
+            } => write!(
+                f,
+                "{list}: {count} line{} repeat{} the line before (the first, line {first_line}) and {} left out",
+                if *count == 1 { "" } else { "s" },
+                if *count == 1 { "s" } else { "" },
+                if *count == 1 { "is" } else { "are" }
+            ),
             Self::ThermalWithoutPose { uncovered, total } => write!(
                 f,
                 "{uncovered} of {total} thermal frames have no pose within the trajectory"
             ),
         }
     }
+}
+
+/// The entries without those that repeat the one before (same time, same file), and the lines
+/// left out.
+fn without_repeats(entries: Vec<StreamEntry>) -> (Vec<StreamEntry>, Vec<usize>) {
+    let mut kept: Vec<StreamEntry> = Vec::with_capacity(entries.len());
+    let mut repeated = Vec::new();
+    for e in entries {
+        match kept.last() {
+            Some(prev) if prev.t == e.t && prev.path == e.path => repeated.push(e.line),
+            _ => kept.push(e),
+        }
+    }
+    (kept, repeated)
 }
 
 fn list(dir: &Path, name: &str, required: bool) -> Result<Vec<StreamEntry>, FileError> {
@@ -137,10 +172,21 @@ impl Recording {
         if !unknown.is_empty() {
             warnings.push(RecordingWarning::UnknownRigKeys(unknown));
         }
-        let depth = list(dir, "depth.txt", true)?;
-        let thermal = list(dir, "thermal.txt", true)?;
-        let rgb = list(dir, "rgb.txt", false)?;
-        let masks = list(dir, "masks.txt", false)?;
+        let mut once = |name: &'static str, entries: Vec<StreamEntry>| {
+            let (kept, repeated) = without_repeats(entries);
+            if let Some(&first_line) = repeated.first() {
+                warnings.push(RecordingWarning::RepeatedLines {
+                    list: name,
+                    count: repeated.len(),
+                    first_line,
+                });
+            }
+            kept
+        };
+        let depth = once("depth.txt", list(dir, "depth.txt", true)?);
+        let thermal = once("thermal.txt", list(dir, "thermal.txt", true)?);
+        let rgb = once("rgb.txt", list(dir, "rgb.txt", false)?);
+        let masks = once("masks.txt", list(dir, "masks.txt", false)?);
         let traj_path = dir.join("trajectory.txt");
         // Without poses, a recording with colour can still be tracked (`mrtmap track`).
         let trajectory = if traj_path.exists() {

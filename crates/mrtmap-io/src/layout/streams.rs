@@ -17,7 +17,10 @@ pub struct StreamEntry {
 }
 
 /// Parses a stream list. Timestamps must not go backwards.
+/// A byte-order mark at the start (Excel's "CSV UTF-8" and some Windows editors write one) is
+/// read past; text after the path is ignored.
 pub fn parse_stream_list(text: &str, list_path: &Path) -> Result<Vec<StreamEntry>, FileError> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut out: Vec<StreamEntry> = Vec::new();
     for (i, line) in text.lines().enumerate() {
         let n = i + 1;

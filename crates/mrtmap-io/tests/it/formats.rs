@@ -137,6 +137,12 @@ fn stream_lists_parse_and_refuse_backwards_time() {
             .contains("'zero' is not a timestamp")
     );
     assert!(parse_stream_list("0.1\n", p).is_err());
+    // A byte-order mark (Excel's "CSV UTF-8") is read past: it was "'\u{feff}#' is not a
+    // timestamp", the mark invisible in the message.
+    let l = parse_stream_list("\u{feff}# c\n0.1 depth/a.png\n", p).unwrap();
+    assert_eq!((l.len(), l[0].line), (1, 2));
+    let l = parse_stream_list("\u{feff}0.1 depth/a.png\n", p).unwrap();
+    assert_eq!(l[0].t, 0.1);
 }
 
 #[test]

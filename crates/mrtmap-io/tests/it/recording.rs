@@ -135,3 +135,31 @@ fn a_misspelt_rig_key_is_named() {
             .contains("[colour], [thermal] time_ofset_s")
     );
 }
+
+/// A line that repeats the one before (a recorder's retry, a copy-paste) is left out with a
+/// warning naming the list and line: a thermal frame listed twice was fused twice without a word.
+#[test]
+fn a_repeated_line_is_left_out_and_named() {
+    let dir = tempfile::tempdir().unwrap();
+    tiny(dir.path());
+    std::fs::write(
+        dir.path().join("thermal.txt"),
+        "# t path\n1.01 thermal/0.png\n1.01 thermal/0.png\n1.01 thermal/0.png\n",
+    )
+    .unwrap();
+    let r = Recording::open(dir.path()).unwrap();
+    assert_eq!(r.thermal.len(), 1);
+    assert_eq!(
+        r.warnings,
+        vec![mrtmap_io::RecordingWarning::RepeatedLines {
+            list: "thermal.txt",
+            count: 2,
+            first_line: 3
+        }]
+    );
+    let said = r.warnings[0].to_string();
+    assert!(
+        said.contains("thermal.txt: 2 lines repeat") && said.contains("line 3"),
+        "{said}"
+    );
+}
