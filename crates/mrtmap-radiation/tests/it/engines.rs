@@ -325,6 +325,20 @@ fn placement_uncertainty_is_the_mrts_gradient_times_the_placement() {
     // 1 cm from the wall the outer side is outside the room: a one-sided difference, larger still.
     let edge = placed.at(&Point3::new(3.99, 1.2, 1.1), 0).unwrap();
     assert!(edge.placement_std_error_k.is_finite() && edge.placement_std_error_k > expect);
+    // On the wall itself there is no MRT (a point on a window gave 16.4 °C by view factors and
+    // 11.5 °C by rays): refused by both methods, naming the surface.
+    for engine in [&plain, &placed] {
+        let e = engine
+            .at(&Point3::new(4.0, 1.2, 1.1), 0)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("from a wall, on it"), "{e}");
+        let e = engine
+            .at(&Point3::new(2.0, 1.2, 0.0), 0)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("from floor, on it"), "{e}");
+    }
     // At the centre of a uniform room nothing changes with the place.
     let uniform = scene(&box_room(4.0, 4.0, 2.6, [20.0; 6]));
     let c = MrtEngine::new(&uniform, Method::Exact)
