@@ -685,7 +685,14 @@ pub(crate) fn level_segmentation(
         .extend_from_slice(&seg.textured.temperature_std_k);
     seen.observations
         .extend_from_slice(&seg.textured.observations);
-    level.emissivity.apply(&mut seg.scene);
+    let unmatched = level.emissivity.apply(&mut seg.scene);
+    if !unmatched.is_empty() {
+        seg.report.warnings.push(format!(
+            "[emissivity] {} matched no surface, feature or furniture of the room found, so {} not used: check the ids and labels in segment/scene.json",
+            unmatched.join(", "),
+            if unmatched.len() == 1 { "it was" } else { "they were" }
+        ));
+    }
     let found = fit_grey_level(&seg.scene, &seen, &world_from_room, level);
     apply_level(&mut seg.scene, &found);
     // The surfaces' true temperatures, from the irradiance at the level found.

@@ -65,17 +65,67 @@ impl EmissivitySection {
     }
 
     /// Sets every surface's, feature's and occluder's emissivity in `scene` and marks its
-    /// temperatures as radiant (what the camera read).
-    pub fn apply(&self, scene: &mut RadiantScene) {
+    /// temperatures as radiant (what the camera read). Returns the entries that matched nothing
+    /// in the scene (`by_id.window-99`, `by_label.windw`), for a warning: a misspelt one changed
+    /// nothing without a word.
+    pub fn apply(&self, scene: &mut RadiantScene) -> Vec<String> {
+        let mut elements: Vec<(String, String)> = Vec::new();
         for s in &mut scene.surfaces {
             s.emissivity = self.of(&s.id, &s.label, Some(s.kind));
+            elements.push((s.id.clone(), s.label.to_lowercase()));
             for f in &mut s.features {
                 f.emissivity = self.of(&f.id, &f.label, None);
+                elements.push((f.id.clone(), f.label.to_lowercase()));
             }
         }
         for o in &mut scene.occluders {
             o.emissivity = self.of(&o.id, &o.label, None);
+            elements.push((o.id.clone(), o.label.to_lowercase()));
         }
         scene.temperatures = Some(mrtmap_radiation::TemperatureKind::Radiant);
+        let ids = self
+            .by_id
+            .keys()
+            .filter(|k| !elements.iter().any(|(id, _)| id == *k))
+            .map(|k| format!("by_id.{k}"));
+        let labels = self
+            .by_label
+            .keys()
+            .filter(|k| !elements.iter().any(|(_, l)| l.contains(&k.to_lowercase())))
+            .map(|k| format!("by_label.{k}"));
+        ids.chain(labels).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    /// Entries that match nothing are returned for a warning (a misspelt id or label changed
+    /// nothing without a word); those that match are used and not returned.
+    #[test]
+    fn entries_matching_nothing_are_named() {
+        let mut scene = mrtmap_radiation::example_office();
+        let window = scene
+            .surfaces
+            .iter()
+            .flat_map(|s| &s.features)
+            .find(|f| f.label.to_lowercase().contains("window"))
+            .map(|f| f.id.clone())
+            .unwrap();
+        let mut e = EmissivitySection::default();
+        e.by_id.insert(window.clone(), 0.5);
+        e.by_id.insert("window-99".into(), 0.9);
+        e.by_label.insert("windw".into(), 0.5);
+        e.by_label.insert("Wall".into(), 0.92);
+        let unmatched = e.apply(&mut scene);
+        assert_eq!(unmatched, vec!["by_id.window-99", "by_label.windw"]);
+        let w = scene
+            .surfaces
+            .iter()
+            .flat_map(|s| &s.features)
+            .find(|f| f.id == window);
+        assert_eq!(w.unwrap().emissivity, 0.5);
     }
 }
