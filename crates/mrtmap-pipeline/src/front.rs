@@ -367,6 +367,30 @@ impl<'p> Pipeline<'p> {
         )
     }
 
+    /// What [`Pipeline::live`] refuses before it follows anything: a front end calls it before
+    /// it opens its page, so that a bad request is not answered with an address first.
+    pub fn check_live(
+        &self,
+        recording: &Path,
+        target_k: f64,
+        exit_when_idle_s: Option<f64>,
+    ) -> Result<()> {
+        crate::coverage::check_target(target_k)?;
+        if let Some(s) = exit_when_idle_s.filter(|s| !(s.is_finite() && *s > 0.0)) {
+            return Err(crate::Error::setting(
+                format!("--exit-when-idle {s}"),
+                "give a positive number of seconds",
+            ));
+        }
+        if !recording.is_dir() {
+            return Err(crate::Error::source(
+                recording,
+                "is not a folder: start the recorder first (live follows the folder it writes), or give the recording's folder",
+            ));
+        }
+        self.project.check_heights_above_floor()
+    }
+
     /// `mrtmap live`: follows `recording` while a recorder writes it, sending what is known to
     /// `sink` (the state at least every second, a 3D view after each refresh, judged against
     /// ±`target_k`), until it has not grown for `exit_when_idle_s` or `stop` is set; then the
@@ -380,14 +404,7 @@ impl<'p> Pipeline<'p> {
         stop: &std::sync::atomic::AtomicBool,
         sink: &dyn crate::LiveSink,
     ) -> Result<RunDone> {
-        crate::coverage::check_target(target_k)?;
-        if let Some(s) = exit_when_idle_s.filter(|s| !(s.is_finite() && *s > 0.0)) {
-            return Err(crate::Error::setting(
-                format!("--exit-when-idle {s}"),
-                "give a positive number of seconds",
-            ));
-        }
-        self.project.check_heights_above_floor()?;
+        self.check_live(recording, target_k, exit_when_idle_s)?;
         let opts = crate::live::LiveOptions {
             target_k,
             exit_when_idle_s,

@@ -191,7 +191,13 @@ impl Project {
 
     /// Checks what can be checked before any stage runs.
     pub fn check(&self) -> Result<()> {
-        if self.map.heights_m.is_empty() || self.map.heights_m.iter().any(|h| !h.is_finite()) {
+        if self.map.heights_m.is_empty() {
+            return Err(Error::setting(
+                "[map] heights_m = []",
+                "asks for no map: give at least one height above the floor (1.1 m seated head, 1.7 m standing)",
+            ));
+        }
+        if self.map.heights_m.iter().any(|h| !h.is_finite()) {
             return Err(Error::setting(
                 format!("map heights {:?} m", self.map.heights_m),
                 "must be numbers (metres above the floor)",

@@ -392,3 +392,34 @@ fn ctrl_c_once_makes_the_full_run_and_twice_stops_at_once() {
         "the full run was not stopped"
     );
 }
+
+/// A folder that does not exist and a bad setting are refused before the page opens (the page's
+/// address and a promise of a full run were printed first).
+#[test]
+fn a_bad_live_request_is_refused_before_the_page_opens() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    for (rec, extra, says) in [
+        (dir.path().join("nope"), None, "start the recorder first"),
+        (recording().to_path_buf(), Some("0"), "--exit-when-idle 0"),
+    ] {
+        let mut args = vec![
+            "live".to_string(),
+            rec.display().to_string(),
+            "--serve".into(),
+            "127.0.0.1:0".into(),
+            "--out".into(),
+            out.display().to_string(),
+        ];
+        if let Some(s) = extra {
+            args.extend(["--exit-when-idle".into(), s.into()]);
+        }
+        let o = Command::new(env!("CARGO_BIN_EXE_mrtmap"))
+            .args(&args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.contains(says), "{err}");
+        assert!(!err.contains("live page:"), "{err}");
+    }
+}
