@@ -98,7 +98,11 @@ impl ComfortSection {
         }
         let v = self.air_speed(air);
         if !(0.0..=5.0).contains(&v) {
-            return Err(bad("air_speed_m_s", v, "0…5 m/s"));
+            // Named where it was given: [comfort]'s own speed, else [air]'s.
+            return Err(match self.air_speed_m_s {
+                Some(_) => bad("air_speed_m_s", v, "0…5 m/s"),
+                None => Error::setting(format!("[air] speed_m_s = {v}"), "is outside 0…5 m/s"),
+            });
         }
         if let Some(f) = self.facing_deg
             && !f.is_finite()

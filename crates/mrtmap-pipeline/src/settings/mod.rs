@@ -334,6 +334,13 @@ mod tests {
             e.contains("name = \"A\"") && e.contains("two points"),
             "{e}"
         );
+        // An air speed is named where it was given ([air] was named as [comfort]'s key).
+        let e = Project::parse("[air]\nspeed_m_s = -1.0\n")
+            .unwrap()
+            .check()
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("[air] speed_m_s = -1"), "{e}");
         // Three values (the third was ignored) and one are refused, with the line.
         for toml in ["[map]\ngrid = [20, 20, 20]\n", "[map]\ngrid = [20]\n"] {
             let (line, e) = Project::parse(toml).unwrap_err();
