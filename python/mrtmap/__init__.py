@@ -247,7 +247,7 @@ class Scene:
         """A scene from scene.json's content as a dict (``json.load`` of the file)."""
         if not isinstance(scene, dict):
             raise TypeError(f"scene must be a dict of scene.json's content; got {type(scene).__name__}")
-        return cls.from_json(json.dumps(scene), source)
+        return cls.from_json(json.dumps(scene, default=_plain), source)
 
     @classmethod
     def example(cls) -> "Scene":
@@ -450,6 +450,16 @@ def survey(recordings, out, client=None, config=None, n_workers=None, progress=N
 
 
 # ---- comfort formulas, vectorised, named and unitised as pythermalcomfort's ----
+
+def _plain(x):
+    """numpy's arrays and scalars as Python's lists and numbers, for ``json.dumps`` (a scene dict
+    built with numpy raised "Object of type ndarray is not JSON serializable")."""
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, np.generic):
+        return x.item()
+    raise TypeError(f"{type(x).__name__} is not a number, list or text a scene can hold")
+
 
 def _broadcast(*xs):
     """The inputs' broadcast shape and each input as a contiguous array in its own shape: the

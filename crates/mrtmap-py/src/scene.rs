@@ -13,8 +13,8 @@ use serde_json::Value;
 
 use crate::{MrtKeywords, MrtmapError, frame_of, must_exist, points_of, py_err, serde_py};
 
-/// The largest grid each way (nodes), as `mrtmap map --grid`.
-const MAX_GRID: i64 = 2000;
+/// The most nodes a map may have (the command line's limit: a 2000 × 2000 map).
+const MAX_GRID_NODES: usize = 4_000_000;
 
 /// A radiant scene (scene.json, format mrtmap-scene/1) and where it came from.
 #[pyclass(name = "Scene", module = "mrtmap._mrtmap", frozen)]
@@ -70,13 +70,13 @@ fn ids(scene: &RadiantScene) -> Vec<&str> {
     ids
 }
 
-/// The grid's node counts, each 2 to [`MAX_GRID`].
+/// The grid's node counts: at least one each way and at most [`MAX_GRID_NODES`] in all, as the
+/// command line's `--grid` (Python said 2 to 2000 each way).
 fn grid_counts(nx: i64, ny: i64) -> PyResult<(usize, usize)> {
-    let ok = |n: i64| (2..=MAX_GRID).contains(&n);
     match (usize::try_from(nx), usize::try_from(ny)) {
-        (Ok(x), Ok(y)) if ok(nx) && ok(ny) => Ok((x, y)),
+        (Ok(x), Ok(y)) if x >= 1 && y >= 1 && x.saturating_mul(y) <= MAX_GRID_NODES => Ok((x, y)),
         _ => Err(MrtmapError::new_err(format!(
-            "grid ({nx}, {ny}) must have 2 to {MAX_GRID} nodes each way"
+            "grid ({nx}, {ny}) must have at least 1 node each way and at most {MAX_GRID_NODES} in all"
         ))),
     }
 }
