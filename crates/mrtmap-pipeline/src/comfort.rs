@@ -88,6 +88,16 @@ pub(crate) fn thermal(
     tr_se_k: f64,
 ) -> std::result::Result<Thermal, PhysicsError> {
     let c = Temperature::from_celsius;
+    // The air speed as given is checked before the relative speed is made of it (`--v -0.1`
+    // was refused as a relative air speed of −0.04).
+    if !(0.0..=10.0).contains(&air.speed_m_s) {
+        return Err(PhysicsError::OutOfRange {
+            name: "air speed (m/s)",
+            value: air.speed_m_s,
+            min: 0.0,
+            max: 10.0,
+        });
+    }
     let vr = relative_air_speed(air.speed_m_s, air.met);
     let pmv_at = |tr: f64| {
         pmv_ppd(&PmvInputs {

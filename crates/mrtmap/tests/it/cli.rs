@@ -1138,6 +1138,11 @@ fn negative_values_are_judged_by_their_range() {
             &["map", "--height", "-1", "--out", "unused"][..],
             "-1.00 m above the floor",
         ),
+        // The speed as typed, not the relative speed made of it ("-0.04").
+        (
+            &["comfort", "--ta", "22", "--tr", "22", "--v", "-0.1"][..],
+            "air speed (m/s) = -0.1",
+        ),
     ] {
         fails_with(args, says);
     }
