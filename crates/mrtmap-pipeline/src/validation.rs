@@ -125,6 +125,18 @@ impl Validation {
 
 /// The scene of a `run` output folder or of a folder holding scene.json.
 fn scene_of(map: &Path) -> Result<PathBuf> {
+    if !map.exists() {
+        return Err(Error::source(
+            map,
+            "does not exist: give the output folder of `mrtmap run` (--map)",
+        ));
+    }
+    if map.is_file() {
+        return Err(Error::source(
+            map,
+            "is a file: --map takes the output folder of `mrtmap run` (or a folder holding scene.json), not a file",
+        ));
+    }
     [
         SegmentDir::new(map).scene_json(),
         RunLayout::new(map).scene_json(),

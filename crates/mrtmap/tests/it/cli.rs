@@ -729,6 +729,17 @@ fn validate_refuses_globes_outside_the_room_and_says_why_a_value_is_missing() {
         ],
         "none of its 1 globe readings could be judged",
     );
+    // A --map that does not exist, or a file, is named as such (both said "has no scene.json").
+    let nope = dir.path().join("nope");
+    fails_with(
+        &["validate", "--map", nope.to_str().unwrap(), "--globe", g],
+        "does not exist",
+    );
+    let sj = dir.path().join("scene.json");
+    fails_with(
+        &["validate", "--map", sj.to_str().unwrap(), "--globe", g],
+        "is a file: --map takes the output folder",
+    );
 }
 
 #[test]
