@@ -30,6 +30,20 @@ pub enum PhysicsError {
         /// Σ εF.
         sum: f64,
     },
+    /// A globe reading no surroundings could give: the globe loses more heat to the air than
+    /// surroundings above absolute zero could return (Tr⁴ ≤ 0).
+    #[error(
+        "the globe reading implies no radiant temperature: a globe at {} °C in air at {} °C moving at {} m/s would need surroundings below absolute zero; check the globe and air temperatures and the air speed",
+        short(*globe_c), short(*air_c), short(*air_speed_m_s)
+    )]
+    NoRadiantTemperature {
+        /// Globe temperature (°C).
+        globe_c: f64,
+        /// Air temperature (°C).
+        air_c: f64,
+        /// Air speed (m/s).
+        air_speed_m_s: f64,
+    },
     /// A numerical solution did not converge.
     #[error("{what} did not converge")]
     NoConvergence {

@@ -259,11 +259,10 @@ pub fn mrt_from_globe(
 ) -> Result<GlobeMrt, PhysicsError> {
     let (t4, h, formula) = mrt4_from_globe(globe, reading, method)?;
     if t4 <= 0.0 {
-        return Err(PhysicsError::OutOfRange {
-            name: "Tr⁴ (the reading implies no radiant temperature)",
-            value: t4,
-            min: 0.0,
-            max: f64::INFINITY,
+        return Err(PhysicsError::NoRadiantTemperature {
+            globe_c: reading.globe.celsius(),
+            air_c: reading.air.celsius(),
+            air_speed_m_s: reading.air_speed_m_s,
         });
     }
     Ok(GlobeMrt {

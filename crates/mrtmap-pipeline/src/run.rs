@@ -756,6 +756,12 @@ pub fn run(
     check_out_dir(out)?;
     check_out_apart(recording, out)?;
     let mut rec = Recording::open(recording)?;
+    // The contact readings are read again after segmentation; a bad row is refused now, not
+    // after fusion's seconds.
+    let references = rec.dir.join("references.csv");
+    if references.exists() {
+        read_references(&references)?;
+    }
     let layout = RunLayout::new(out);
     let on_depth_clock = |w: &RecordingWarning| {
         // The recording's count was of the stamps as recorded; on the depth clock they may have

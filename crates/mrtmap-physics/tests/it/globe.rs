@@ -213,3 +213,17 @@ proptest! {
         prop_assert!((back.mrt.celsius() - tr).abs() < 1e-4, "{} vs {}", back.mrt.celsius(), tr);
     }
 }
+
+/// A reading no surroundings could give (a cold globe in hot, fast air) says so in words, not as
+/// "Tr⁴ = -35259969917 is outside the valid range".
+#[test]
+fn a_reading_no_room_could_give_is_named_in_words() {
+    let e = mrt_from_globe(&Globe::STANDARD, &reading(-20.0, 40.0, 5.0), CLOSED_FORCED)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("a globe at -20 °C in air at 40 °C moving at 5 m/s")
+            && e.contains("below absolute zero"),
+        "{e}"
+    );
+}

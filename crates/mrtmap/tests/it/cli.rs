@@ -549,8 +549,15 @@ fn points_and_heights_outside_the_room_are_refused_with_where_the_room_is() {
         "cannot compute the MRT at far",
     );
     assert!(!out.exists(), "a refused map writes nothing");
-    // A point on a wall is still in the room.
-    let v = ok_json(&["mrt", "--at", "0,1.8,1.1", "--json"]);
+    // A point on a wall sees it over half its view and has no MRT: refused by both methods (they
+    // answered 16.4 and 11.5 °C on the window); 1 cm into the room is answered.
+    for method in ["exact", "montecarlo"] {
+        fails_with(
+            &["mrt", "--at", "0,1.8,1.1", "--method", method],
+            "0.0 cm from a wall, on it",
+        );
+    }
+    let v = ok_json(&["mrt", "--at", "0.01,1.8,1.1", "--json"]);
     assert!(v["points"][0]["mrt_c"].as_f64().unwrap() > 15.0);
 }
 

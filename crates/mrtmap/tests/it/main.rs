@@ -8,6 +8,7 @@ mod export;
 mod live;
 mod pipeline;
 mod readme;
+mod refusals;
 mod sources;
 mod sun;
 

@@ -38,7 +38,7 @@ pub fn recording() -> &'static Path {
     })
 }
 
-fn read_json(p: &Path) -> Value {
+pub(crate) fn read_json(p: &Path) -> Value {
     serde_json::from_str(
         &std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display())),
     )
@@ -64,65 +64,6 @@ fn assert_only(dir: &Path, known: &[PathBuf]) {
     }
 }
 
-/// A fusion that places nothing is refused, saying what became of the frames (thermal stamps in
-/// milliseconds fused nothing, exited 0, and `run` then blamed the scan for finding no floor).
-#[test]
-fn a_fusion_that_places_nothing_says_why() {
-    let dir = tempfile::tempdir().unwrap();
-    let rec = dir.path().join("scan");
-    linked_copy(recording(), &rec);
-    let list = std::fs::read_to_string(rec.join("thermal.txt")).unwrap();
-    let ms: String = list
-        .lines()
-        .map(|l| match l.split_once(' ') {
-            Some((t, p)) if !l.starts_with('#') => {
-                format!("{:.3} {p}\n", t.parse::<f64>().unwrap() * 1000.0)
-            }
-            _ => format!("{l}\n"),
-        })
-        .collect();
-    std::fs::remove_file(rec.join("thermal.txt")).unwrap();
-    std::fs::write(rec.join("thermal.txt"), ms).unwrap();
-    for cmd in ["fuse", "run"] {
-        let out = dir.path().join(cmd);
-        let o = mrtmap(&[cmd, rec.to_str().unwrap(), "--out", out.to_str().unwrap()]);
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert!(!o.status.success(), "{cmd}: {err}");
-        assert!(
-            err.contains("0 of") && err.contains("no depth frame within the sync tolerance"),
-            "{cmd}: {err}"
-        );
-        assert!(!out.join("fuse/stage.json").exists() && !out.join("stage.json").exists());
-    }
-    std::fs::remove_file(rec.join("thermal.txt")).unwrap();
-    std::fs::write(rec.join("thermal.txt"), "# no frames\n").unwrap();
-    let o = mrtmap(&[
-        "run",
-        rec.to_str().unwrap(),
-        "--out",
-        dir.path().join("e").to_str().unwrap(),
-    ]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(
-        !o.status.success() && err.contains("thermal.txt lists no frames"),
-        "{err}"
-    );
-}
-
-/// `src` copied to `dst` with every file hard-linked.
-fn linked_copy(src: &Path, dst: &Path) {
-    std::fs::create_dir_all(dst).unwrap();
-    for e in std::fs::read_dir(src).unwrap() {
-        let e = e.unwrap();
-        let to = dst.join(e.file_name());
-        if e.file_type().unwrap().is_dir() {
-            linked_copy(&e.path(), &to);
-        } else {
-            std::fs::hard_link(e.path(), &to).unwrap();
-        }
-    }
-}
-
 fn stages_skipped(out: &Path) -> Vec<(String, bool)> {
     read_json(&out.join("run.json"))["stages"]
         .as_array()
@@ -142,7 +83,7 @@ fn run_produces_every_output_and_reuses_unchanged_stages() {
     let dir = tempfile::tempdir().unwrap();
     // Its own copy (files hard-linked): a frame is replaced below.
     let rec = dir.path().join("scan");
-    linked_copy(recording(), &rec);
+    crate::refusals::linked_copy(recording(), &rec);
     let out = dir.path().join("run");
     let o = out.to_str().unwrap();
     let r = rec.to_str().unwrap();
@@ -1245,93 +1186,4 @@ fn coverage_says_whether_a_scan_is_good_enough_and_where_to_look() {
     ]);
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("--target-k -1"));
-}
-
-/// `simulate --sun`: truth.json gets SolarCal on its grid for a seated person facing the sun. The
-/// office's window is on the +x wall (y 0.9…2.7, z 0.9…2.2); with the sun 30° high due +x a
-/// person at (2.65, 1.8) sits in the beam (SolarCal by hand: 16.4 K with the whole body lit), one
-/// at y ≈ 0.3 beside it gets sky and floor only; a body centre inside the desk (x 2.5…3.8, y
-/// 0.25…1.05, up to 0.75 m) has no value.
-#[test]
-fn simulate_with_the_sun_writes_solarcal_into_the_truth() {
-    let dir = tempfile::tempdir().unwrap();
-    let rec = dir.path().join("sunny");
-    let args = |sun: &str, dni: &str, tau: &str| -> Vec<String> {
-        [
-            "simulate",
-            "--room",
-            "office",
-            "--out",
-            rec.to_str().unwrap(),
-            "--seconds",
-            "3",
-            "--depth-size",
-            "80x60",
-            "--noise",
-            "none",
-            "--truth-rays",
-            "500",
-            "--sun",
-            sun,
-            "--dni",
-            dni,
-            "--transmittance",
-            tau,
-        ]
-        .map(String::from)
-        .to_vec()
-    };
-    for (a, needle) in [
-        (args("30,0", "700", "1.6"), "--transmittance = 1.6"),
-        (args("-5,0", "700", "0.6"), "--sun altitude = -5"),
-    ] {
-        let a: Vec<&str> = a.iter().map(String::as_str).collect();
-        let out = mrtmap(&a);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert!(!out.status.success() && err.contains(needle), "{err}");
-        assert!(!err.contains("panicked"), "{err}");
-    }
-    let good = args("30,0", "700", "0.6");
-    let good: Vec<&str> = good.iter().map(String::as_str).collect();
-    ok(&good);
-    let truth = read_json(&rec.join("truth.json"));
-    let sun = &truth["sun"];
-    assert_eq!(sun["inputs"]["dni_w_m2"], 700.0);
-    assert_eq!(sun["posture"], "seated");
-    let nodes = sun["nodes"].as_array().unwrap();
-    assert_eq!(
-        nodes.len(),
-        truth["grid"]["nodes"].as_array().unwrap().len()
-    );
-    let nearest = |x: f64, y: f64| {
-        nodes
-            .iter()
-            .min_by(|a, b| {
-                let d = |n: &Value| {
-                    (n["xyz_room"][0].as_f64().unwrap() - x)
-                        .hypot(n["xyz_room"][1].as_f64().unwrap() - y)
-                };
-                d(a).total_cmp(&d(b))
-            })
-            .unwrap()
-    };
-    let lit = nearest(2.65, 1.8);
-    let d_lit = lit["delta_mrt_k"].as_f64().unwrap();
-    assert!((d_lit - 16.4).abs() < 1.64, "{lit}");
-    assert!(lit["f_bes"].as_f64().unwrap() > 0.9, "{lit}");
-    let in_desk = nearest(2.65, 0.3);
-    assert!(in_desk["delta_mrt_k"].is_null(), "{in_desk}");
-    assert_eq!(in_desk["note"], "inside desk");
-    let beside = nearest(2.0, 0.3);
-    assert!(
-        (beside["xyz_room"][1].as_f64().unwrap() - 0.3).abs() < 0.1,
-        "{beside}"
-    );
-    let d_beside = beside["delta_mrt_k"].as_f64().unwrap();
-    assert!(d_beside < d_lit / 4.0, "{beside}");
-    assert!(
-        beside["f_svv"].as_f64().unwrap() > 0.0,
-        "sky through the window: {beside}"
-    );
-    assert_eq!(beside["f_bes"], 0.0);
 }

@@ -4,7 +4,8 @@
 use serde_json::Value;
 
 use crate::cli::edited_example;
-use crate::{fails_with, mrtmap, ok_json};
+use crate::pipeline::read_json;
+use crate::{fails_with, mrtmap, ok, ok_json};
 
 #[test]
 fn solar_gain_equals_solarcal_and_names_a_bad_flag() {
@@ -39,7 +40,7 @@ fn solar_gain_equals_solarcal_and_names_a_bad_flag() {
     assert_eq!(v["asw"], 0.7);
     assert_eq!(v["floor_reflectance"], 0.6);
     assert_eq!(v["f_svv"], 0.04233);
-    let text = crate::ok(&args);
+    let text = ok(&args);
     assert!(text.contains("ΔMRT +16.41 K"), "{text}");
     // Out of range: one sentence naming the flag, exit code 1 as any refused input.
     let mut bad = args.to_vec();
@@ -148,7 +149,7 @@ fn validate_flags_a_globe_in_the_sun_and_does_not_judge_it() {
         globe.to_str().unwrap(),
         project.to_str().unwrap(),
     );
-    let text = crate::ok(&["validate", "--map", d, "--globe", g, "--config", p]);
+    let text = ok(&["validate", "--map", d, "--globe", g, "--config", p]);
     assert!(
         text.contains("in sun: its reading includes short-wave the long-wave map does not"),
         "{text}"
@@ -170,7 +171,7 @@ fn validate_flags_a_globe_in_the_sun_and_does_not_judge_it() {
     assert!(!lines[1].ends_with(','), "{csv}");
     assert!(lines[2].ends_with(','), "{csv}");
     // Without the project, the same globe is judged.
-    crate::ok(&["validate", "--map", d, "--globe", g]);
+    ok(&["validate", "--map", d, "--globe", g]);
     let v: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("validation.json")).unwrap())
             .unwrap();
@@ -202,7 +203,7 @@ fn map_draws_the_mrt_with_the_sun_from_the_projects_sun() {
     );
     let project = dir.path().join("project.toml");
     std::fs::write(&project, SUNNY_PROJECT).unwrap();
-    let text = crate::ok(&[
+    let text = ok(&[
         "map",
         "--grid",
         "4x3",
@@ -233,4 +234,93 @@ fn map_draws_the_mrt_with_the_sun_from_the_projects_sun() {
     let m = lit["mrt_sun"][0].as_f64().unwrap();
     let lw = lit["sun"]["mrt_long_wave_c"].as_f64().unwrap();
     assert!((m - lw - d).abs() < 1e-6, "{lit}");
+}
+
+/// `simulate --sun`: truth.json gets SolarCal on its grid for a seated person facing the sun. The
+/// office's window is on the +x wall (y 0.9…2.7, z 0.9…2.2); with the sun 30° high due +x a
+/// person at (2.65, 1.8) sits in the beam (SolarCal by hand: 16.4 K with the whole body lit), one
+/// at y ≈ 0.3 beside it gets sky and floor only; a body centre inside the desk (x 2.5…3.8, y
+/// 0.25…1.05, up to 0.75 m) has no value.
+#[test]
+fn simulate_with_the_sun_writes_solarcal_into_the_truth() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("sunny");
+    let args = |sun: &str, dni: &str, tau: &str| -> Vec<String> {
+        [
+            "simulate",
+            "--room",
+            "office",
+            "--out",
+            rec.to_str().unwrap(),
+            "--seconds",
+            "3",
+            "--depth-size",
+            "80x60",
+            "--noise",
+            "none",
+            "--truth-rays",
+            "500",
+            "--sun",
+            sun,
+            "--dni",
+            dni,
+            "--transmittance",
+            tau,
+        ]
+        .map(String::from)
+        .to_vec()
+    };
+    for (a, needle) in [
+        (args("30,0", "700", "1.6"), "--transmittance = 1.6"),
+        (args("-5,0", "700", "0.6"), "--sun altitude = -5"),
+    ] {
+        let a: Vec<&str> = a.iter().map(String::as_str).collect();
+        let out = mrtmap(&a);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && err.contains(needle), "{err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    let good = args("30,0", "700", "0.6");
+    let good: Vec<&str> = good.iter().map(String::as_str).collect();
+    ok(&good);
+    let truth = read_json(&rec.join("truth.json"));
+    let sun = &truth["sun"];
+    assert_eq!(sun["inputs"]["dni_w_m2"], 700.0);
+    assert_eq!(sun["posture"], "seated");
+    let nodes = sun["nodes"].as_array().unwrap();
+    assert_eq!(
+        nodes.len(),
+        truth["grid"]["nodes"].as_array().unwrap().len()
+    );
+    let nearest = |x: f64, y: f64| {
+        nodes
+            .iter()
+            .min_by(|a, b| {
+                let d = |n: &Value| {
+                    (n["xyz_room"][0].as_f64().unwrap() - x)
+                        .hypot(n["xyz_room"][1].as_f64().unwrap() - y)
+                };
+                d(a).total_cmp(&d(b))
+            })
+            .unwrap()
+    };
+    let lit = nearest(2.65, 1.8);
+    let d_lit = lit["delta_mrt_k"].as_f64().unwrap();
+    assert!((d_lit - 16.4).abs() < 1.64, "{lit}");
+    assert!(lit["f_bes"].as_f64().unwrap() > 0.9, "{lit}");
+    let in_desk = nearest(2.65, 0.3);
+    assert!(in_desk["delta_mrt_k"].is_null(), "{in_desk}");
+    assert_eq!(in_desk["note"], "inside desk");
+    let beside = nearest(2.0, 0.3);
+    assert!(
+        (beside["xyz_room"][1].as_f64().unwrap() - 0.3).abs() < 0.1,
+        "{beside}"
+    );
+    let d_beside = beside["delta_mrt_k"].as_f64().unwrap();
+    assert!(d_beside < d_lit / 4.0, "{beside}");
+    assert!(
+        beside["f_svv"].as_f64().unwrap() > 0.0,
+        "sky through the window: {beside}"
+    );
+    assert_eq!(beside["f_bes"], 0.0);
 }
