@@ -119,25 +119,34 @@ fn events(addr: &str, n: usize) -> Vec<Value> {
     got
 }
 
-/// Appends a thermal line whose file is a frame of another size, just after the newest line.
+/// Appends a thermal line whose file is a frame of another size, just after the newest line. The
+/// replay appends lines meanwhile: the line is written only while the list is as read (a replay
+/// line landing between the read and the append put the injected one back in time, and the final
+/// run refused the list).
 fn inject_wrong_size_frame(rec: &Path) {
-    let list = std::fs::read_to_string(rec.join("thermal.txt")).unwrap();
-    let last: f64 = list
-        .lines()
-        .rev()
-        .find(|l| !l.starts_with('#'))
-        .and_then(|l| l.split_whitespace().next())
-        .and_then(|t| t.parse().ok())
-        .unwrap();
     image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_pixel(40, 30, image::Luma([29315]))
         .save(rec.join("thermal/wrong_size.png"))
         .unwrap();
-    let mut f = std::fs::OpenOptions::new()
-        .append(true)
-        .open(rec.join("thermal.txt"))
-        .unwrap();
-    f.write_all(format!("{:.6} thermal/wrong_size.png\n", last + 0.001).as_bytes())
-        .unwrap();
+    loop {
+        let list = std::fs::read_to_string(rec.join("thermal.txt")).unwrap();
+        let last: f64 = list
+            .lines()
+            .rev()
+            .find(|l| !l.starts_with('#'))
+            .and_then(|l| l.split_whitespace().next())
+            .and_then(|t| t.parse().ok())
+            .unwrap();
+        let mut f = std::fs::OpenOptions::new()
+            .append(true)
+            .open(rec.join("thermal.txt"))
+            .unwrap();
+        if !list.ends_with('\n') || f.metadata().unwrap().len() != list.len() as u64 {
+            continue; // the replay is writing: read again
+        }
+        f.write_all(format!("{:.6} thermal/wrong_size.png\n", last + 0.001).as_bytes())
+            .unwrap();
+        return;
+    }
 }
 
 #[test]
