@@ -40,7 +40,7 @@ def test_bad_settings(scene):
     with pytest.raises(mrtmap.MrtmapError, match="world_from_room"):
         scene.mrt([[1, 1, 1]], frame="scan")  # the example was not written by segmentation
     with pytest.raises(mrtmap.MrtmapError, match="grid"):
-        scene.map(grid=(1, 20))
+        scene.map(grid=(0, 20))  # (1, 20) is a line of 20 nodes, as `--grid 1x20`
     with pytest.raises(mrtmap.MrtmapError, match="height"):
         scene.map(height=-1)
     with pytest.raises(mrtmap.MrtmapError, match="above the floor|height|ceiling"):
