@@ -177,14 +177,15 @@ fn columns<'a, const N: usize>(
 /// An output of `n` values, or a `MemoryError` when it does not fit (a broadcast of a 100,000
 /// column against a 100,000 row asks 80 GB; allocating it outright aborted the interpreter).
 fn zeros(n: usize) -> PyResult<Vec<f64>> {
-    let mut v = Vec::new();
-    v.try_reserve_exact(n).map_err(|_| {
+    // Asked first and given back (an address range, no page touched), then allocated zeroed:
+    // `vec!` takes zeroed pages from the system that the workers fill in parallel, where filling
+    // the reserved vector with zeros here would touch every page first, on one thread.
+    Vec::<f64>::new().try_reserve_exact(n).map_err(|_| {
         pyo3::exceptions::PyMemoryError::new_err(format!(
             "{n} results of 8 bytes do not fit in memory: compute the inputs in smaller pieces"
         ))
     })?;
-    v.resize(n, 0.0);
-    Ok(v)
+    Ok(vec![0.0; n])
 }
 
 /// Every column's values for the block of `len` elements from `start`.
