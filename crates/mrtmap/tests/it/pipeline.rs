@@ -158,7 +158,8 @@ fn run_produces_every_output_and_reuses_unchanged_stages() {
         stages_skipped(&out)
     );
     // A new height: only that map is computed.
-    ok(&[
+    // The same run at two heights, asked again below.
+    let two_heights = [
         "run",
         r,
         "--out",
@@ -171,7 +172,8 @@ fn run_produces_every_output_and_reuses_unchanged_stages() {
         "1.1",
         "--height",
         "1.7",
-    ]);
+    ];
+    ok(&two_heights);
     assert_exist(&RunLayout::new(&out).map(1.7).outputs());
     let st = stages_skipped(&out);
     assert_eq!(
@@ -185,49 +187,22 @@ fn run_produces_every_output_and_reuses_unchanged_stages() {
     );
     // An interrupted run resumes: remove segment's fingerprint, as if it stopped mid-stage.
     std::fs::remove_file(out.join("segment/stage.json")).unwrap();
-    ok(&[
-        "run",
-        r,
-        "--out",
-        o,
-        "--grid",
-        "8x6",
-        "--mark",
-        "P=0.2,0.5,1.0",
-        "--height",
-        "1.1",
-        "--height",
-        "1.7",
-    ]);
+    ok(&two_heights);
     let st = stages_skipped(&out);
     assert!(st[0].1 && !st[1].1, "{st:?}");
     // A thermal frame replaced behind an unchanged thermal.txt: fusion runs again (issue 54's
     // campaign: fusion was reused over new images).
-    let rec_dir = rec.as_path();
-    let first = std::fs::read_to_string(rec_dir.join("thermal.txt"))
+    let first = std::fs::read_to_string(rec.join("thermal.txt"))
         .unwrap()
         .lines()
         .find(|l| !l.starts_with('#') && !l.trim().is_empty())
         .and_then(|l| l.split_whitespace().nth(1).map(str::to_string))
         .unwrap();
-    let frame = rec_dir.join(&first);
+    let frame = rec.join(&first);
     let other = std::fs::read(&frame).unwrap();
     std::fs::remove_file(&frame).unwrap();
     std::fs::write(&frame, [other.as_slice(), b"\0"].concat()).unwrap();
-    ok(&[
-        "run",
-        r,
-        "--out",
-        o,
-        "--grid",
-        "8x6",
-        "--mark",
-        "P=0.2,0.5,1.0",
-        "--height",
-        "1.1",
-        "--height",
-        "1.7",
-    ]);
+    ok(&two_heights);
     let st = stages_skipped(&out);
     assert!(!st[0].1, "fusion reused over a replaced frame: {st:?}");
     // --force reruns all.
