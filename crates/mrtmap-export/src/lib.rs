@@ -18,6 +18,7 @@ pub mod gltf;
 pub mod hbjson;
 pub mod radiance;
 
+use mrtmap_radiation::ElementKind;
 use std::collections::HashSet;
 
 /// Errors of reading a Honeybee model or a temperatures table.
@@ -94,12 +95,14 @@ pub enum Opening {
     Door,
 }
 
-/// The opening a feature's label names, if any: a door when it says door, else a window when it
-/// names glazing; lights, paintings and radiators are no openings.
+/// The opening a feature's label names, if any ([`ElementKind`], the one vocabulary): a door when
+/// it is a door (a glazed door too), else a window when it is glazing; lights, paintings and
+/// radiators are no openings.
 pub fn opening(label: &str) -> Option<Opening> {
-    if is_door(label) {
+    let kind = ElementKind::of_label(label);
+    if kind.is_door() {
         Some(Opening::Door)
-    } else if is_glazing(label) {
+    } else if kind.is_glazing() {
         Some(Opening::Window)
     } else {
         None
@@ -108,15 +111,7 @@ pub fn opening(label: &str) -> Option<Opening> {
 
 /// Whether a feature's label names glazing (glass for Radiance; see [`opening`]).
 pub fn is_glazing(label: &str) -> bool {
-    let l = label.to_ascii_lowercase();
-    ["window", "glaz", "glass", "skylight"]
-        .iter()
-        .any(|w| l.contains(w))
-}
-
-/// Whether a feature's label names a door.
-fn is_door(label: &str) -> bool {
-    label.to_ascii_lowercase().contains("door")
+    ElementKind::of_label(label).is_glazing()
 }
 
 /// A number as text with at most `digits` decimals and no "-0".

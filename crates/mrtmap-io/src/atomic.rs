@@ -35,8 +35,17 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
 /// run may replace.
 pub const MADE: &str = ".mrtmap-made";
 
+/// Whether `name` is what mrtmap leaves while writing an entry that `made` lists: a temporary
+/// file of [`write_atomic`] or a folder `NAME.partial` of a listed `NAME`.
+fn is_in_progress(name: &str, made: &std::collections::HashSet<&str>) -> bool {
+    (name.starts_with(".mrtmap-") && name.ends_with(".tmp"))
+        || name
+            .strip_suffix(".partial")
+            .is_some_and(|stem| made.contains(stem))
+}
+
 /// Refuses `target` when it exists and is not empty, unless [`MADE`] lists all it holds.
-fn check_replaceable(target: &Path) -> Result<(), FileError> {
+pub fn check_replaceable(target: &Path) -> Result<(), FileError> {
     let Ok(entries) = std::fs::read_dir(target) else {
         return Ok(()); // absent (a file there fails later, named)
     };
@@ -44,7 +53,7 @@ fn check_replaceable(target: &Path) -> Result<(), FileError> {
     let made: std::collections::HashSet<&str> = made.lines().collect();
     let mut names: Vec<String> = entries
         .filter_map(|e| e.ok().map(|e| e.file_name().to_string_lossy().into_owned()))
-        .filter(|n| n != MADE)
+        .filter(|n| n != MADE && !is_in_progress(n, &made))
         .collect();
     names.sort();
     let Some(first) = names.iter().find(|n| !made.contains(n.as_str())) else {
@@ -66,6 +75,26 @@ fn check_replaceable(target: &Path) -> Result<(), FileError> {
             "{what}: give a new or empty folder, or move what is in it (mrtmap replaces only a folder it made)"
         )),
     ))
+}
+
+/// Claims the folder `dir` for outputs that mrtmap writes into it in place (a run folder): refuses
+/// it when it holds an entry that its [`MADE`] list does not name (a folder of the user's, or a
+/// file they put in one of mrtmap's), creates it when missing, and adds `names` (the entries the
+/// caller will write) to the list, so that a later run may write them again.
+pub fn claim_dir(dir: &Path, names: &[String]) -> Result<(), FileError> {
+    check_replaceable(dir)?;
+    std::fs::create_dir_all(dir).map_err(|e| FileError::io(dir, e))?;
+    let list = dir.join(MADE);
+    let old = std::fs::read_to_string(&list).unwrap_or_default();
+    let mut all: std::collections::BTreeSet<&str> = old.lines().filter(|l| !l.is_empty()).collect();
+    let before = all.len();
+    all.extend(names.iter().map(String::as_str));
+    if all.len() == before && list.exists() {
+        return Ok(());
+    }
+    let mut text = all.into_iter().collect::<Vec<_>>().join("\n");
+    text.push('\n');
+    write_atomic(&list, text.as_bytes())
 }
 
 /// A folder being built: files go into `FINAL.partial/`; [`PartialDir::finish`] renames it to

@@ -30,13 +30,14 @@
 mod atomic;
 pub mod bytes;
 pub mod depth;
+pub mod epw;
 mod error;
 mod image16;
 pub mod layout;
 mod ply;
 pub mod thermal;
 
-pub use atomic::{PartialDir, write_atomic};
+pub use atomic::{MADE, PartialDir, check_replaceable, claim_dir, write_atomic};
 pub use error::{EncodeError, FileError, FileErrorKind, io_words};
 pub use image16::{Image16, encode_png_rgb8, encode_png16, gaussian_blur, read_image16};
 pub use layout::masks;

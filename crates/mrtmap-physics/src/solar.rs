@@ -5,9 +5,10 @@
 //! radiant field ERF (W/m²) and the rise ΔMRT it causes in the mean radiant temperature:
 //!
 //! ```text
-//!  E_diff  = f_eff · f_svv · ½ · T_sol · I_diff                       (sky, I_diff = 0.2 I_dir)
+//!  E_diff  = f_eff · f_svv · ½ · T_sol · I_diff      (sky; I_diff = 0.2 I_dir, or a weather file's)
 //!  E_dir   = f_eff · f_p(β, SHARP) · T_sol · f_bes · I_dir             (the beam)
-//!  E_refl  = f_eff · f_svv · ½ · T_sol · (I_dir sin β + I_diff) · R_floor   (off the floor)
+//!  E_refl  = f_eff · f_svv · ½ · T_sol · (I_dir sin β + I_diff) · R_floor   (off the floor;
+//!            the beam's part only where the beam enters the room: [`SkyAndRoom`])
 //!  ERF     = (E_diff + E_dir + E_refl) · α_sw / α_lw                  (α_lw = 0.95)
 //!  ΔMRT    = ERF / (f_eff · h_r)                                      (h_r = 6 W/m²K)
 //! ```
@@ -153,6 +154,34 @@ pub struct SolarGain {
 /// assert!((g.delta_mrt_k - 16.41).abs() < 0.01);
 /// ```
 pub fn solar_gain(i: &SolarInputs) -> Result<SolarGain, PhysicsError> {
+    solar_gain_in(i, &SkyAndRoom::SOLARCAL)
+}
+
+/// What SolarCal's short form assumes about the sky and the room, made explicit: the diffuse sky
+/// irradiance (0.2 × the direct normal irradiance unless a weather file gives it) and whether the
+/// beam lands in the room at all (else the floor reflects no beam).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SkyAndRoom {
+    /// The diffuse horizontal irradiance outside (W/m²), when known (an EPW file's field 16);
+    /// `None`: SolarCal's 0.2 × I_dir.
+    pub diffuse_horizontal_w_m2: Option<f64>,
+    /// Whether the beam enters the room through some glazing: without it, the floor-reflected
+    /// beam term (I_dir sin β R_floor) is left out, as no floor patch is lit.
+    pub beam_enters: bool,
+}
+
+impl SkyAndRoom {
+    /// SolarCal's own assumptions (pythermalcomfort's `solar_gain`): I_diff = 0.2 I_dir, a beam
+    /// on the floor.
+    pub const SOLARCAL: Self = Self {
+        diffuse_horizontal_w_m2: None,
+        beam_enters: true,
+    };
+}
+
+/// SolarCal as [`solar_gain`], with the sky's diffuse irradiance and whether the beam enters the
+/// room given by `sky` (see [`SkyAndRoom`]).
+pub fn solar_gain_in(i: &SolarInputs, sky: &SkyAndRoom) -> Result<SolarGain, PhysicsError> {
     let beta = in_range("solar altitude (°)", i.altitude_deg, 0.0, 90.0)?;
     let sharp = in_range("SHARP (°)", i.sharp_deg, 0.0, 180.0)?;
     let i_dir = in_range(
@@ -166,14 +195,21 @@ pub fn solar_gain(i: &SolarInputs) -> Result<SolarGain, PhysicsError> {
     let f_bes = in_range("fraction of the body in the beam f_bes", i.f_bes, 0.0, 1.0)?;
     let asw = in_range("short-wave absorptivity", i.asw, 0.0, 1.0)?;
     let r_floor = in_range("floor reflectance", i.floor_reflectance, 0.0, 1.0)?;
+    let i_diff = match sky.diffuse_horizontal_w_m2 {
+        Some(d) => in_range("diffuse horizontal irradiance (W/m²)", d, 0.0, MAX_DNI_W_M2)?,
+        None => DIFFUSE_FRACTION * i_dir,
+    };
 
     let fp = solar_projected_area_factor(i.posture, beta, sharp);
     let f_eff = i.posture.f_eff();
-    let i_diff = DIFFUSE_FRACTION * i_dir;
+    let beam_on_floor = if sky.beam_enters {
+        i_dir * beta.to_radians().sin()
+    } else {
+        0.0
+    };
     let e_diff = f_eff * f_svv * 0.5 * t_sol * i_diff;
     let e_direct = f_eff * fp * t_sol * f_bes * i_dir;
-    let e_reflected =
-        f_eff * f_svv * 0.5 * t_sol * (i_dir * beta.to_radians().sin() + i_diff) * r_floor;
+    let e_reflected = f_eff * f_svv * 0.5 * t_sol * (beam_on_floor + i_diff) * r_floor;
     let erf = (e_diff + e_direct + e_reflected) * (asw / LONG_WAVE_ABSORPTIVITY);
     Ok(SolarGain {
         erf_w_m2: erf,

@@ -508,6 +508,7 @@ pub(crate) fn make_comfort_maps(
     sun: Option<&SunQuery>,
     marks: &[(String, [f64; 2])],
     out: &Path,
+    stop: &(dyn Fn() -> bool + Sync),
 ) -> Result<ComfortOutput> {
     if quantities.contains(&Quantity::MrtSun) && sun.is_none() {
         return Err(crate::settings::no_sun_error());
@@ -537,22 +538,27 @@ pub(crate) fn make_comfort_maps(
     let nodes: Vec<ComfortNode> = layout
         .places
         .par_iter()
-        .map(|&(i, j, uv)| ComfortNode {
-            i,
-            j,
-            point: comfort_at(
-                engine,
-                &frame,
-                uv,
-                c,
-                air,
-                &person,
-                sun_ctx,
-                (j * grid[0] + i) as u64,
-            )
-            .map_err(|e| e.to_string()),
+        .map(|&(i, j, uv)| {
+            (!stop()).then(|| ComfortNode {
+                i,
+                j,
+                point: comfort_at(
+                    engine,
+                    &frame,
+                    uv,
+                    c,
+                    air,
+                    &person,
+                    sun_ctx,
+                    (j * grid[0] + i) as u64,
+                )
+                .map_err(|e| e.to_string()),
+            })
         })
-        .collect();
+        .collect::<Option<Vec<_>>>()
+        .ok_or(Error::Stopped {
+            stage: "the comfort maps",
+        })?;
     let mark_values = marks
         .iter()
         .enumerate()

@@ -278,6 +278,31 @@ impl RunLayout {
     pub fn validation_json(&self) -> PathBuf {
         self.root.join("validation.json")
     }
+
+    /// The entries a run with maps at `heights_m` may write at the top of its folder: what it
+    /// claims there ([`mrtmap_io::claim_dir`]) before writing.
+    pub fn top_names(heights_m: &[f64]) -> Vec<String> {
+        let l = RunLayout::new("");
+        let mut paths = vec![
+            l.report_html(),
+            l.run_json(),
+            l.recording_dir(),
+            l.recording_stage_json(),
+            l.track_dir(),
+            l.fuse_dir(),
+            l.segment_dir(),
+            l.comfort_dir(),
+            l.export_dir(),
+            l.validation_csv(),
+            l.validation_json(),
+        ];
+        paths.extend(heights_m.iter().map(|&h| l.map_dir(h)));
+        paths
+            .iter()
+            .filter_map(|p| p.components().next())
+            .map(|c| c.as_os_str().to_string_lossy().into_owned())
+            .collect()
+    }
 }
 
 /// The track stage's folder (`track/` of a run, or `mrtmap track --out`).

@@ -94,9 +94,6 @@ pub fn parse_references(text: &str, path: &Path) -> Result<Vec<Reference>> {
             Some(s) if !s.is_empty() => num("std_k")?,
             _ => crate::settings::default_std(),
         };
-        if !(std_k > 0.0 && std_k < 50.0) {
-            return Err(bad(k + 1, format!("std_k {std_k} is outside 0…50 K")));
-        }
         let frame = match col("frame").map(|f| f.to_lowercase()).as_deref() {
             None | Some("") | Some("room") => PointFrame::Room,
             Some("scan") => PointFrame::Scan,
@@ -113,24 +110,21 @@ pub fn parse_references(text: &str, path: &Path) -> Result<Vec<Reference>> {
             Some(s) if !s.is_empty() => Some(num("emissivity")?),
             _ => None,
         };
-        if let Some(e) = emissivity
-            && !(e > 0.0 && e <= 1.0)
-        {
-            return Err(bad(
-                k + 1,
-                format!(
-                    "emissivity {e} is outside 0 < ε ≤ 1 (leave the cell empty for the emissivity of the surface under the point)"
-                ),
-            ));
-        }
-        out.push(Reference {
+        let reading = Reference {
             label: col("label").map_or(String::new(), |s| s.to_string()),
             xyz: [num("x")?, num("y")?, num("z")?],
             temperature_c: num("temperature_c")?,
             std_k,
             frame,
             emissivity,
-        });
+        };
+        reading.check().map_err(|b| {
+            bad(
+                k + 1,
+                format!("{} {} is outside {}", b.key, b.value, b.allowed),
+            )
+        })?;
+        out.push(reading);
     }
     Ok(out)
 }

@@ -217,7 +217,7 @@ pub(crate) fn map_scene(
     if person.contains(&Quantity::MrtSun) && sun.is_none() {
         return Err(crate::settings::no_sun_error());
     }
-    let map = make_map(scene, source, &project.mrt, spec, marks, out)?;
+    let map = make_map(scene, source, &project.mrt, spec, marks, out, &|| false)?;
     if person.is_empty() {
         return Ok(SceneMaps { map, comfort: None });
     }
@@ -250,6 +250,7 @@ pub(crate) fn map_scene(
         sun.as_ref(),
         &xy_marks,
         out,
+        &|| false,
     )?;
     Ok(SceneMaps {
         map,
@@ -280,9 +281,11 @@ fn compute_field(
     engine: &MrtEngine<'_>,
     frame: MapFrame,
     spec: GridSpec,
+    stop: &(dyn Fn() -> bool + Sync),
 ) -> Result<(MrtField, f64)> {
     let t0 = Instant::now();
-    let field = MrtField::compute(engine, frame, spec)?;
+    let field = MrtField::compute_until(engine, frame, spec, stop)?
+        .ok_or(Error::Stopped { stage: "a map" })?;
     let secs = t0.elapsed().as_secs_f64();
     if let Some(e) = field.nodes.iter().find_map(|n| match &n.result {
         Err(e @ MrtError::NotEnclosed { .. }) => Some(e.clone()),
@@ -334,7 +337,7 @@ pub fn map_arrays(
     let method = mrt.method(scene)?;
     let engine = mrt.engine(scene)?;
     let frame = map_frame(&engine, scene, source, spec)?;
-    let (field, secs) = compute_field(&engine, frame, spec)?;
+    let (field, secs) = compute_field(&engine, frame, spec, &|| false)?;
     let (nx, ny) = (spec.nx, spec.ny);
     let mut out = MapArrays {
         height_m: spec.height_m,
@@ -373,12 +376,13 @@ pub(crate) fn make_map(
     spec: GridSpec,
     marks: &[Mark],
     out: &Path,
+    stop: &(dyn Fn() -> bool + Sync),
 ) -> Result<MapOutput> {
     let method = mrt.method(scene)?;
     let engine = mrt.engine(scene)?;
     let frame = map_frame(&engine, scene, source, spec)?;
     let points = mark_points(&engine, &frame, &spec, marks)?;
-    let (field, secs) = compute_field(&engine, frame, spec)?;
+    let (field, secs) = compute_field(&engine, frame, spec, stop)?;
     let (records, map_marks) = mark_records(&engine, &field, &spec, marks, &points)?;
     let how = method.describe(engine.ray_engine());
     let input = MapInput {

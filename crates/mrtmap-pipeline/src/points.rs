@@ -9,7 +9,7 @@ use std::path::Path;
 
 use mrtmap_geometry::nalgebra::Point3;
 use mrtmap_physics::PhysicsError;
-use mrtmap_physics::{SolarInputs, sharp_deg, solar_gain};
+use mrtmap_physics::{SkyAndRoom, SolarInputs, sharp_deg, solar_gain_in};
 /// A sphere's MRT at a point with its view-factor table (mrtmap-radiation's).
 pub use mrtmap_radiation::PointRecord;
 /// The sun in the room's frame and a person's exposure to it (mrtmap-radiation's).
@@ -91,6 +91,10 @@ pub struct PointAnswers {
     /// The plane radiant temperatures at each point (empty unless asked for).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub planes: Vec<PlaneAnswer>,
+    /// What the answers leave out or rest on, in words (a sun asked for in a scene without
+    /// glazing).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 /// A person's MRT at a point.
@@ -194,17 +198,24 @@ pub(crate) fn solar_on(
 ) -> std::result::Result<(SunExposure, f64, mrtmap_physics::SolarGain), PhysicsError> {
     let exposure = tracer.exposure(at, posture, &sun.direction);
     let sharp = sharp_deg(facing_deg, sun.direction.azimuth_deg);
-    let g = solar_gain(&SolarInputs {
-        altitude_deg: sun.direction.altitude_deg,
-        sharp_deg: sharp,
-        dni_w_m2: sun.dni_w_m2,
-        transmittance: sun.transmittance,
-        f_svv: exposure.f_svv,
-        f_bes: exposure.f_bes,
-        asw: sun.asw,
-        posture: posture.into(),
-        floor_reflectance: sun.floor_reflectance,
-    })?;
+    let sky = SkyAndRoom {
+        diffuse_horizontal_w_m2: sun.diffuse_horizontal_w_m2,
+        beam_enters: tracer.beam_enters(&sun.direction),
+    };
+    let g = solar_gain_in(
+        &SolarInputs {
+            altitude_deg: sun.direction.altitude_deg,
+            sharp_deg: sharp,
+            dni_w_m2: sun.dni_w_m2,
+            transmittance: sun.transmittance,
+            f_svv: exposure.f_svv,
+            f_bes: exposure.f_bes,
+            asw: sun.asw,
+            posture: posture.into(),
+            floor_reflectance: sun.floor_reflectance,
+        },
+        &sky,
+    )?;
     Ok((exposure, sharp, g))
 }
 
@@ -251,6 +262,9 @@ fn plane_answer(a: &RadiantAsymmetry) -> PlaneAnswer {
     }
 }
 
+/// The warning for a sun asked for in a scene that has no glazing.
+pub(crate) const NO_GLAZING: &str = "the scene has no glazing (no feature labelled window, skylight, roof light, glazed door or curtain wall): the sun cannot reach anyone, so ΔMRT is 0 everywhere";
+
 /// Answers `q` on `scene` (read from `source`, which errors name) with the view-factor settings
 /// `mrt`. A point outside the room or inside its furniture is refused with an error naming it;
 /// the k-th point draws its rays from stream k, so answers do not depend on the other points.
@@ -272,7 +286,11 @@ pub fn mrt_at_points(
         points: Vec::new(),
         persons: Vec::new(),
         planes: Vec::new(),
+        warnings: Vec::new(),
     };
+    if tracer.as_ref().is_some_and(|t| !t.has_windows()) {
+        answers.warnings.push(NO_GLAZING.into());
+    }
     // In parallel: the k-th point draws from stream k, so the answers are those of a loop; the
     // first point refused (in order) is the one named.
     type One = (
@@ -336,6 +354,7 @@ impl PointAnswers {
         let mut lines = Vec::new();
         if !self.persons.is_empty() || !self.planes.is_empty() {
             lines.push(format!("scene: {}", self.scene));
+            lines.extend(self.warnings.iter().map(|w| format!("warning: {w}")));
             lines.extend(person_and_plane_lines(&self.persons, &self.planes));
             if self.points.is_empty() {
                 return lines;
@@ -599,7 +618,7 @@ mod tests {
             sun: Some(SunQuery::new(30.0, 0.0, 700.0, 0.6)),
         };
         let a = mrt_at_points(&scene, "example", &mrt, &q).unwrap();
-        let solarcal = solar_gain(&SolarInputs {
+        let solarcal = mrtmap_physics::solar_gain(&SolarInputs {
             altitude_deg: 30.0,
             sharp_deg: 0.0,
             dni_w_m2: 700.0,

@@ -772,6 +772,7 @@ pub fn run_recording(
     project.check_heights_above_floor()?;
     crate::run::check_out_dir(out)?;
     let _lock = crate::lock::OutLock::take(out)?;
+    mrtmap_io::claim_dir(out, &RunLayout::top_names(&project.map.heights_m))?;
     let t0 = std::time::Instant::now();
     let prepared = crate::source::prepare(recording, out, source)?;
     let outcome = crate::run::run(&prepared.dir, out, project, force, progress)?;

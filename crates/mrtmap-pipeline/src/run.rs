@@ -23,8 +23,8 @@ use mrtmap_scan::FusedFrame;
 use mrtmap_scan::segment::{MaskInput, SegmentParams, TextureInput, segment_textured};
 /// What segmentation reports, and the label votes (mrtmap-scan's).
 pub use mrtmap_scan::segment::{SegmentReport, Votes};
-use mrtmap_scan::{FuseParams, FusionReport, SkipReason, fuse, refined_poses};
-use mrtmap_track::{TrackParams, TrackReport, track};
+use mrtmap_scan::{FuseParams, FusionReport, SkipReason, refined_poses};
+use mrtmap_track::{TrackParams, TrackReport};
 
 use crate::cache::{Fingerprint, Stage, StageOutcome, read_json, run_or_reuse, write_json};
 use crate::comfort::{ComfortSummary, comfort_title, make_comfort_maps};
@@ -65,8 +65,14 @@ pub fn track_into(
     progress: &dyn Progress,
 ) -> Result<(Trajectory, TrackReport)> {
     progress.begin("tracking the camera (colour + depth)");
-    let (traj, report) = track(rec, params, &|d, t| progress.advance(d as u64, t as u64))
-        .map_err(|e| Error::source(&rec.dir, e.to_string()))?;
+    let (traj, report) = mrtmap_track::track_until(
+        rec,
+        params,
+        &|d, t| progress.advance(d as u64, t as u64),
+        &|| progress.stopped(),
+    )
+    .map_err(|e| Error::source(&rec.dir, e.to_string()))?
+    .ok_or(Error::Stopped { stage: "tracking" })?;
     let (traj, report) = without_outliers(traj, report, rec.groundtruth.as_ref());
     std::fs::create_dir_all(out).map_err(|e| mrtmap_io::FileError::io(out, e))?;
     let dir = TrackDir::new(out);
@@ -90,7 +96,10 @@ pub fn fuse_into(
     progress: &dyn Progress,
 ) -> Result<FusionReport> {
     progress.begin("fusing thermal frames");
-    let fused = fuse(rec, params, &|d, t| progress.advance(d, t));
+    let fused = mrtmap_scan::fuse_until(rec, params, &|d, t| progress.advance(d, t), &|| {
+        progress.stopped()
+    })
+    .ok_or(Error::Stopped { stage: "fusion" })?;
     if let Some(problem) = nothing_fused(&fused.report) {
         return Err(Error::source(&rec.dir, problem));
     }
@@ -366,6 +375,10 @@ fn comfort_stage(
         .setting("mrt", &p.mrt)
         .setting("sun", &p.sun)
         .setting("points", &p.points);
+    let fingerprint = p
+        .named_files()
+        .iter()
+        .fold(fingerprint, |f, path| f.file(path));
     let stage = Stage {
         name: "comfort maps".into(),
         stamp: dir.stage_json(),
@@ -388,6 +401,7 @@ fn comfort_stage(
             sun.as_ref(),
             &marks,
             dir.dir(),
+            &|| progress.stopped(),
         )?;
         made = Some(ComfortResult {
             summary: o.summary,
@@ -673,6 +687,7 @@ fn map_stage(
             spec,
             &marks,
             dir.dir(),
+            &|| progress.stopped(),
         )?);
         Ok(())
     })?;
@@ -831,6 +846,9 @@ pub fn run(
         }
         None => None,
     };
+    if p.sun.is_given() && !mrtmap_radiation::SunTracer::new(&scene).has_windows() {
+        warnings.push(format!("sun: {}", crate::points::NO_GLAZING));
+    }
     Ok(RunOutcome {
         stages,
         track,

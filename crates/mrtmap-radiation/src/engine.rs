@@ -231,6 +231,9 @@ pub enum MrtError {
         /// Crown above the body centre (m).
         head_m: f64,
     },
+    /// A scene in true surface temperatures whose radiosities could not be solved.
+    #[error("the scene's surface temperatures could not be turned into radiosities: {0}")]
+    EnclosureSolve(String),
     /// The point is not in the room.
     #[error("point ({:.2}, {:.2}, {:.2}) is {where_}: the room spans {room}", point[0], point[1], point[2])]
     OutsideRoom {
@@ -373,7 +376,9 @@ struct Tracer {
 
 /// A scene made ready for MRT queries with one method: patch list, and for Monte Carlo the BVH.
 pub struct MrtEngine<'a> {
-    scene: &'a RadiantScene,
+    /// The scene as given, or its radiosities when it gives true surface temperatures of grey
+    /// elements ([`crate::grey::solve_enclosure`]).
+    scene: std::borrow::Cow<'a, RadiantScene>,
     bounds: Option<RoomBounds>,
     /// Answer at points the scene does not enclose (ΣF short of 1) instead of refusing.
     open: bool,
@@ -443,6 +448,18 @@ fn arr(p: &Point3<f64>) -> [f64; 3] {
 impl<'a> MrtEngine<'a> {
     /// Prepares `scene` for `method`. Exact refuses scenes with occluders.
     pub fn new(scene: &'a RadiantScene, method: Method) -> Result<Self, MrtError> {
+        if crate::grey::needs_enclosure_solve(scene) {
+            let solved = crate::grey::solve_enclosure(scene, method)?;
+            return Self::build(std::borrow::Cow::Owned(solved), method);
+        }
+        Self::build(std::borrow::Cow::Borrowed(scene), method)
+    }
+
+    fn build(
+        scene_cow: std::borrow::Cow<'a, RadiantScene>,
+        method: Method,
+    ) -> Result<Self, MrtError> {
+        let scene: &RadiantScene = &scene_cow;
         let patches = patches(scene);
         let mut surface_patch = Vec::with_capacity(scene.surfaces.len());
         let mut k = 0;
@@ -492,9 +509,10 @@ impl<'a> MrtEngine<'a> {
             caster: caster(&tris, rays),
             owner,
         });
+        let bounds = RoomBounds::of_scene(scene);
         Ok(Self {
-            scene,
-            bounds: RoomBounds::of_scene(scene),
+            scene: scene_cow,
+            bounds,
             open: false,
             patches,
             surface_patch,
@@ -540,7 +558,7 @@ impl<'a> MrtEngine<'a> {
 
     /// The scene.
     pub fn scene(&self) -> &RadiantScene {
-        self.scene
+        &self.scene
     }
 
     /// The ray-casting engine's name, for Monte Carlo.

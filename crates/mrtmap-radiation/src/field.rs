@@ -260,31 +260,52 @@ impl MrtField {
         frame: MapFrame,
         spec: GridSpec,
     ) -> Result<Self, FieldError> {
+        match Self::compute_until(engine, frame, spec, &|| false)? {
+            Some(f) => Ok(f),
+            // `stop` never says so.
+            None => unreachable!("a map that is never asked to stop stopped"),
+        }
+    }
+
+    /// [`MrtField::compute`], asking `stop` before each node: `Ok(None)` once it says so (a
+    /// person pressed Ctrl-C).
+    pub fn compute_until(
+        engine: &MrtEngine<'_>,
+        frame: MapFrame,
+        spec: GridSpec,
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> Result<Option<Self>, FieldError> {
         let GridLayout { u, v, places } = Self::layout(&frame, &spec, engine.bounds())?;
         let nx = spec.nx;
         let nodes = places
             .into_par_iter()
             .map(|(i, j, uv)| {
+                if stop() {
+                    return None;
+                }
                 let point = frame.point(&uv, spec.height_m);
                 let result = engine.at(&point, (j * nx + i) as u64);
-                GridNode {
+                Some(GridNode {
                     i,
                     j,
                     uv,
                     point,
                     result,
-                }
+                })
             })
-            .collect::<Vec<GridNode>>();
+            .collect::<Option<Vec<GridNode>>>();
+        let Some(nodes) = nodes else {
+            return Ok(None);
+        };
         let unseen = unseen_impacts(engine, &nodes);
-        Ok(Self {
+        Ok(Some(Self {
             frame,
             spec,
             u,
             v,
             nodes,
             unseen,
-        })
+        }))
     }
 
     /// Extremes and mean, and the unseen patches that matter most; `None` when no node was

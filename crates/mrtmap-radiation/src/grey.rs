@@ -23,8 +23,9 @@ use mrtmap_geometry::nalgebra::{Point2, Point3, Vector3};
 use mrtmap_geometry::polygon::point_in_polygon_fast;
 use mrtmap_physics::Temperature;
 
-use crate::engine::MrtEngine;
-use crate::scene::{RadiantScene, SurfaceKind};
+use crate::engine::{Method, MrtEngine, MrtError};
+use crate::scene::{RadiantScene, SurfaceKind, TemperatureKind};
+use crate::vocabulary::ElementKind;
 
 /// The standard uncertainty of an emissivity taken from the table (or given without one).
 pub const EMISSIVITY_STD: f64 = 0.02;
@@ -37,43 +38,56 @@ const IRRADIANCE_OFFSET_M: f64 = 0.02;
 /// those on the element).
 const IRRADIANCE_GRID: usize = 3;
 
-/// Long-wave emissivities by label: the first entry whose keyword the label contains wins.
+/// Long-wave emissivities by what an element is made of: the first entry whose keyword the label
+/// contains wins, after glass (glazing and mirrors, [`GLASS_EMISSIVITY`]) and before the
+/// element's kind ([`KIND_EMISSIVITY`]), so that "aluminium radiator" is bare metal.
 /// Sources: ASHRAE Handbook — Fundamentals (2021), ch. 4, table 5 (emissivities of surfaces);
 /// ISO 18434-1 annex and thermography makers' tables (FLIR, Testo) for the ranges, of which the
 /// middle is taken.
 pub const EMISSIVITY_TABLE: &[(&str, f64, &str)] = &[
-    (
-        "mirror",
-        0.84,
-        "glass (silvered behind: the front pane emits)",
-    ),
-    (
-        "window",
-        0.84,
-        "soda-lime window glass, uncoated (0.84–0.92)",
-    ),
-    ("glass", 0.84, "soda-lime glass (0.84–0.92)"),
-    ("glazing", 0.84, "soda-lime glass (0.84–0.92)"),
-    ("skylight", 0.84, "soda-lime glass (0.84–0.92)"),
     ("polished", 0.10, "polished metal (0.03–0.2)"),
     ("aluminium", 0.10, "bare aluminium (0.03–0.2)"),
     ("aluminum", 0.10, "bare aluminium (0.03–0.2)"),
     ("stainless", 0.20, "stainless steel, unpainted (0.1–0.3)"),
     ("bare metal", 0.20, "bare metal (0.1–0.3)"),
     ("metal", 0.93, "painted metal (0.90–0.95)"),
-    ("radiator", 0.93, "painted steel radiator (0.90–0.95)"),
-    ("panel", 0.93, "painted metal radiant panel (0.90–0.95)"),
+];
+
+/// Glass's long-wave emissivity: soda-lime window glass, uncoated (0.84–0.92); a mirror's front
+/// pane emits as glass.
+pub const GLASS_EMISSIVITY: f64 = 0.84;
+
+/// Emissivities by element kind ([`ElementKind`], after glass and [`EMISSIVITY_TABLE`]'s
+/// materials).
+pub const KIND_EMISSIVITY: &[(ElementKind, f64, &str)] = &[
     (
-        "light",
-        0.90,
-        "recessed light: painted housing and diffuser (0.85–0.95)",
+        ElementKind::Radiator,
+        0.93,
+        "painted steel radiator (0.90–0.95)",
     ),
-    ("lamp", 0.90, "light fitting (0.85–0.95)"),
-    ("painting", 0.92, "paint on canvas or paper (0.90–0.95)"),
-    ("picture", 0.92, "paint on canvas or paper (0.90–0.95)"),
-    ("door", 0.90, "painted wood (0.85–0.95)"),
+    (
+        ElementKind::RadiantPanel,
+        0.93,
+        "painted metal radiant panel (0.90–0.95)",
+    ),
+    (
+        ElementKind::Light,
+        0.90,
+        "light fitting: painted housing and diffuser (0.85–0.95)",
+    ),
+    (
+        ElementKind::Painting,
+        0.92,
+        "paint on canvas or paper (0.90–0.95)",
+    ),
+    (ElementKind::Door, 0.90, "painted wood (0.85–0.95)"),
+    (ElementKind::Desk, 0.90, "wood or laminate (0.85–0.95)"),
+];
+
+/// Emissivities of building materials and of the surface kinds, the last word: the first entry
+/// whose keyword the label contains, else the surface kind's.
+pub const MATERIAL_EMISSIVITY: &[(&str, f64, &str)] = &[
     ("wood", 0.90, "wood (0.85–0.95)"),
-    ("desk", 0.90, "wood or laminate (0.85–0.95)"),
     ("carpet", 0.93, "carpet (0.90–0.95)"),
     ("tile", 0.93, "ceiling tile (0.90–0.95)"),
     ("brick", 0.90, "brick (0.85–0.95)"),
@@ -91,15 +105,27 @@ pub const EMISSIVITY_TABLE: &[(&str, f64, &str)] = &[
     ),
 ];
 
-/// The emissivity of an element from its label, else its surface kind's (painted plaster, floor
-/// covering), else 0.93 (most building materials lie within 0.90–0.95).
+/// The emissivity of an element from its label (glass by [`ElementKind`], then the materials of
+/// [`EMISSIVITY_TABLE`], then the element's kind, then [`MATERIAL_EMISSIVITY`]), else its surface
+/// kind's (painted plaster, floor covering), else 0.93 (most building materials lie within
+/// 0.90–0.95).
 pub fn default_emissivity(label: &str, kind: Option<SurfaceKind>) -> f64 {
+    let element = ElementKind::of_label(label);
+    if element.is_glass() {
+        return GLASS_EMISSIVITY;
+    }
     let l = label.to_lowercase();
     if let Some(e) = EMISSIVITY_TABLE.iter().find(|(k, _, _)| l.contains(k)) {
         return e.1;
     }
+    if let Some(e) = KIND_EMISSIVITY.iter().find(|(k, _, _)| *k == element) {
+        return e.1;
+    }
+    if let Some(e) = MATERIAL_EMISSIVITY.iter().find(|(k, _, _)| l.contains(k)) {
+        return e.1;
+    }
     let by_kind = kind.map(|k| k.as_str()).unwrap_or("wall");
-    EMISSIVITY_TABLE
+    MATERIAL_EMISSIVITY
         .iter()
         .find(|(k, _, _)| *k == by_kind)
         .map_or(0.93, |e| e.1)
@@ -342,6 +368,100 @@ pub fn derive_surface_temperatures<E>(
     Ok(set_surface_temperatures(scene, &elements, emissivity_std))
 }
 
+/// Rounds of the radiosity iteration of [`solve_enclosure`]: each shrinks the error by 1 − ε
+/// (0.16 at most, glass), as the simulator's grey truth takes them.
+pub const ENCLOSURE_ROUNDS: usize = 3;
+
+/// Whether `scene` gives the true surface temperatures ("temperatures": "surface") of elements
+/// that are not black: its MRT then needs the radiosities, which [`solve_enclosure`] finds.
+pub fn needs_enclosure_solve(scene: &RadiantScene) -> bool {
+    scene.temperatures == Some(TemperatureKind::Surface)
+        && scene
+            .surfaces
+            .iter()
+            .any(|s| s.emissivity < 1.0 || s.features.iter().any(|f| f.emissivity < 1.0))
+}
+
+/// A scene in true surface temperatures solved as the grey enclosure it is: each surface (its
+/// background) and feature leaves the radiosity J = εσT⁴ + (1 − ε)σT_irr⁴, its irradiance
+/// σT_irr⁴ coming from the others' radiosities ([`irradiances`] with `method`: the T⁴ mean of the
+/// plane radiant temperatures at up to nine points on it), iterated [`ENCLOSURE_ROUNDS`] times
+/// from J = σT⁴. The answer is a scene of radiant temperatures (what a camera would read), each
+/// element keeping its true temperature as its surface temperature, and its ± from the true
+/// temperature's (× ε(T/T_r)³) and the irradiance's sampling error (× (1 − ε)(T_irr/T_r)³).
+/// A raster's texels take their surface's irradiance. Furniture keeps its temperature (its
+/// emissivity weights it as before).
+///
+/// The weighted average Tr⁴ = ΣεFT⁴ / ΣεF is right only where every surface reflects the
+/// point's own MRT; near cold glass, which reflects the room, it reads low (0.2–0.4 K in the
+/// grey office).
+pub fn solve_enclosure(scene: &RadiantScene, method: Method) -> Result<RadiantScene, MrtError> {
+    let given = scene.to_file();
+    let to_radiant = |irr: Option<&[GreyElement]>| -> Result<RadiantScene, MrtError> {
+        let mut file = given.clone();
+        file.temperatures = Some(TemperatureKind::Radiant);
+        let mut k = 0;
+        for (si, s) in file.surfaces.iter_mut().enumerate() {
+            let src = &scene.surfaces[si];
+            let el = irr.and_then(|e| e.get(k));
+            k += 1;
+            let (t, std) = radiosity(src.temperature, src.temperature_std_k, src.emissivity, el);
+            s.temperature_c = t.celsius();
+            s.temperature_std_k = std;
+            s.surface_temperature_c = Some(src.temperature.celsius());
+            s.surface_temperature_std_k = Some(src.temperature_std_k.unwrap_or(0.0));
+            if let Some(r) = &mut s.raster {
+                for v in r.temperature_c.iter_mut().flatten() {
+                    let (t, _) = radiosity(Temperature::from_celsius(*v), None, src.emissivity, el);
+                    *v = t.celsius();
+                }
+            }
+            for (fi, f) in s.features.iter_mut().enumerate() {
+                let srcf = &src.features[fi];
+                let el = irr.and_then(|e| e.get(k));
+                k += 1;
+                let (t, std) = radiosity(
+                    srcf.temperature,
+                    srcf.temperature_std_k,
+                    srcf.emissivity,
+                    el,
+                );
+                f.temperature_c = t.celsius();
+                f.temperature_std_k = std;
+                f.surface_temperature_c = Some(srcf.temperature.celsius());
+                f.surface_temperature_std_k = Some(srcf.temperature_std_k.unwrap_or(0.0));
+            }
+        }
+        RadiantScene::new(&file).map_err(|e| MrtError::EnclosureSolve(e.to_string()))
+    };
+    let mut radiant = to_radiant(None)?;
+    for _ in 0..ENCLOSURE_ROUNDS {
+        let engine = MrtEngine::new(&radiant, method)?;
+        let elements = irradiances(&engine);
+        radiant = to_radiant(Some(&elements))?;
+    }
+    Ok(radiant)
+}
+
+/// The radiosity temperature of an element at `t` (± `std_k`) with emissivity `e` and the
+/// irradiance of `el` (none yet: `t` itself), with its ±.
+fn radiosity(
+    t: Temperature,
+    std_k: Option<f64>,
+    e: f64,
+    el: Option<&GreyElement>,
+) -> (Temperature, Option<f64>) {
+    let Some((irr, irr_std)) = el.and_then(|el| el.irradiance) else {
+        return (t, std_k);
+    };
+    let j = radiant_temperature(t, irr, e);
+    let (tk, ik, jk) = (t.kelvin(), irr.kelvin(), j.kelvin());
+    let from_t = std_k.map(|s| e * (tk / jk).powi(3) * s);
+    let from_irr = (1.0 - e) * (ik / jk).powi(3) * irr_std;
+    let std = from_t.map(|a| (a * a + from_irr * from_irr).sqrt());
+    (j, std)
+}
+
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used)]
@@ -422,7 +542,59 @@ mod tests {
             .at(&p, 0)
             .unwrap()
             .mrt;
-        assert!((surface.kelvin() - legacy.kelvin()).abs() < 1e-12);
+        // True surface temperatures are solved as the grey enclosure (no longer weighted by ε):
+        // the answer is the MRT of the radiosities, each between its element's own temperature
+        // and what it receives.
+        let solved = solve_enclosure(&scene, Method::Exact).unwrap();
+        assert_eq!(solved.temperatures, Some(TemperatureKind::Radiant));
+        let direct = MrtEngine::new(&solved, Method::Exact)
+            .unwrap()
+            .at(&p, 0)
+            .unwrap()
+            .mrt;
+        assert!((surface.kelvin() - direct.kelvin()).abs() < 1e-12);
+        let engine = MrtEngine::new(&solved, Method::Exact).unwrap();
+        let irr = irradiances(&engine);
+        for el in irr.iter().filter(|e| e.feature.is_some()) {
+            let (given, radiant) = (
+                &scene.surfaces[el.surface].features[el.feature.unwrap()],
+                &solved.surfaces[el.surface].features[el.feature.unwrap()],
+            );
+            let t_irr = el.irradiance.unwrap().0.kelvin();
+            let (t, j) = (given.temperature.kelvin(), radiant.temperature.kelvin());
+            assert!(
+                (j - t) * (t_irr - t) >= -1e-9 && (j - t).abs() <= (t_irr - t).abs() + 0.05,
+                "{}: T {t} J {j} T_irr {t_irr}",
+                given.id
+            );
+            assert_eq!(radiant.surface_temperature.unwrap().0, given.temperature);
+        }
+    }
+
+    /// In a room at one temperature the radiosities are that temperature whatever the
+    /// emissivities: the solved MRT is it.
+    #[test]
+    fn a_uniform_grey_enclosure_radiates_its_temperature() {
+        use crate::engine::{Method, MrtEngine};
+        use crate::scene::TemperatureKind;
+        use mrtmap_geometry::nalgebra::Point3;
+        let mut scene = crate::example_office();
+        scene.temperatures = Some(TemperatureKind::Surface);
+        for s in &mut scene.surfaces {
+            s.emissivity = 0.9;
+            s.temperature = c(21.0);
+            for f in &mut s.features {
+                f.emissivity = 0.84;
+                f.temperature = c(21.0);
+            }
+        }
+        assert!(needs_enclosure_solve(&scene));
+        let m = MrtEngine::new(&scene, Method::Exact)
+            .unwrap()
+            .at(&Point3::new(1.0, 1.0, 1.1), 0)
+            .unwrap()
+            .mrt;
+        assert!((m.celsius() - 21.0).abs() < 1e-6, "{}", m.celsius());
     }
 
     /// In a uniform room every surface receives the room's temperature: a grey surface's true

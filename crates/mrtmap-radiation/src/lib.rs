@@ -28,6 +28,7 @@ mod map_frame;
 mod person;
 mod scene;
 mod sun;
+mod vocabulary;
 
 pub use bounds::{Outside, ROOM_TOLERANCE_M, RoomBounds};
 pub use engine::{
@@ -47,7 +48,8 @@ pub use scene::{
     SurfaceFile, SurfaceKind, TEMPERATURE_RANGE_C, TemperatureKind, Texel, UnseenPatch,
     UnseenShare, slug,
 };
-pub use sun::{BODY_WIDTH_M, SunDirection, SunExposure, SunTracer, is_window_label};
+pub use sun::{BODY_WIDTH_M, BeamAudit, SunDirection, SunExposure, SunTracer, audit_the_beam};
+pub use vocabulary::{ElementKind, GlazingKind, LABEL_ALIASES};
 
 use serde::{Deserialize, Serialize};
 

@@ -1,21 +1,28 @@
-//! The sun on a person in a scene: how much of the sky the person sees through the windows
+//! The sun on a person in a scene: how much of the sky the person sees through the glazing
 //! (SolarCal's f_svv) and how much of the body the beam reaches (f_bes), by rays cast against the
 //! scene. SolarCal itself (ERF, ΔMRT) is `mrtmap_physics::solar_gain`.
 //!
-//! A window is a feature whose label contains "window" or "glass" (any case). A ray leaves
-//! through a window when the first thing it meets is a surface at a point inside a window
-//! feature; furniture, walls, the ceiling and other features stop it.
+//! Glazing is a feature whose label names glazing ([`ElementKind::is_glazing`]: a window, a
+//! skylight or roof light, a glazed door, a curtain wall). A ray from a point in the room leaves
+//! through the glazing when the first thing it meets is a surface at a point inside a glazing
+//! feature, and beyond the glass it meets nothing of the building (a wing of an L-shaped room, a
+//! wall): furniture, walls, the ceiling and other features stop it. Only points inside the room
+//! send rays, so a ray always meets the glass from the inside.
 //!
 //! - **f_svv**, the sky-vault view fraction, is counted as the CBE Comfort Tool's form counts it:
 //!   directions above the horizon taken uniformly in azimuth (0…360°) and altitude (0…90°), on a
-//!   2° grid from the body centre, and the share whose ray leaves through a window. For a window
+//!   2° grid from the body centre, and the share whose ray leaves through glazing. For a window
 //!   straight ahead this is what atan(h/2d)° · atan(w/2d)° / 16200 approximates (that form takes
 //!   the window's outline in angles as a rectangle, half of it above the horizon), but traced it
 //!   also sees where the window is (above or beside the person) and what stands in the way.
 //! - **f_bes**, the fraction of the body in the beam: the body as a vertical rectangle
 //!   [`BODY_WIDTH_M`] wide from the floor to the crown (1.3 m seated, 1.75 m standing) through the
 //!   body's axis, turned square to the sun, sampled on a 9 × 27 grid; the share of the samples
-//!   whose ray towards the sun leaves through a window.
+//!   inside the room whose ray towards the sun leaves through glazing (a body beside a wall is
+//!   not lit through the wall by the part of its rectangle that pokes out).
+//! - **Whether the beam enters the room at all** ([`SunTracer::beam_enters`]): from some point of
+//!   some glazing whose outside faces the sun, 1 mm inside the glass, a ray towards the sun leaves
+//!   through that glazing with nothing of the building in the way. Where it does not, SolarCal's floor-reflected beam has no floor patch to come from.
 
 use mrtmap_geometry::RayCaster;
 use mrtmap_geometry::nalgebra::{Point3, Vector3};
@@ -23,7 +30,9 @@ use mrtmap_geometry::polygon::point_in_polygon_fast;
 use mrtmap_physics::Posture;
 use serde::{Deserialize, Serialize};
 
+use crate::bounds::RoomBounds;
 use crate::scene::RadiantScene;
+use crate::vocabulary::ElementKind;
 
 /// The width of the rectangle that stands for the body in the beam (m): about a person's
 /// shoulder width.
@@ -70,20 +79,25 @@ enum Owner {
     Occluder,
 }
 
-/// The scene made ready for sun rays: its triangles in a BVH and which features are windows.
+/// The scene made ready for sun rays: its triangles in a BVH and which features are glazing.
 pub struct SunTracer<'a> {
     scene: &'a RadiantScene,
     caster: mrtmap_geometry::BvhRayCaster,
     owner: Vec<Owner>,
-    /// Per surface, the indices of its features that are windows.
+    /// Per surface, the indices of its features that are glazing.
     windows: Vec<Vec<usize>>,
+    /// Where the room is (None for a scene without a floor outline: every point counts).
+    bounds: Option<RoomBounds>,
 }
 
-/// Whether a feature's label makes it a window ("window", "glass", any case).
-pub fn is_window_label(label: &str) -> bool {
-    let l = label.to_lowercase();
-    l.contains("window") || l.contains("glass")
-}
+/// How far beyond the glass the ray is cast on (m), to see whether the building stands in the way.
+const BEYOND_GLASS_M: f64 = 1e-4;
+/// How far inside the glazing its sample points are taken for [`SunTracer::beam_enters`] (m).
+const INSIDE_GLASS_M: f64 = 1e-3;
+/// How far from a glazing's centre its sides are told apart (m): past the room's tolerance.
+const SIDE_TEST_M: f64 = 0.02;
+/// Sample points per side of a glazing's bounds for [`SunTracer::beam_enters`].
+const BEAM_GRID: usize = 6;
 
 impl<'a> SunTracer<'a> {
     /// Prepares `scene`.
@@ -105,7 +119,7 @@ impl<'a> SunTracer<'a> {
             .iter()
             .map(|s| {
                 (0..s.features.len())
-                    .filter(|&f| is_window_label(&s.features[f].label))
+                    .filter(|&f| ElementKind::of_label(&s.features[f].label).is_glazing())
                     .collect()
             })
             .collect();
@@ -114,18 +128,29 @@ impl<'a> SunTracer<'a> {
             caster: mrtmap_geometry::BvhRayCaster::new(&tris),
             owner,
             windows,
+            bounds: RoomBounds::of_scene(scene),
         }
     }
 
-    /// Whether the scene has any window.
+    /// Whether `p` lies in the room (always, for a scene without a floor outline).
+    fn inside(&self, p: &Point3<f64>) -> bool {
+        self.bounds.as_ref().is_none_or(|b| b.locate(p).is_none())
+    }
+
+    /// Whether the scene has any glazing.
     pub fn has_windows(&self) -> bool {
         self.windows.iter().any(|w| !w.is_empty())
     }
 
-    /// The window (surface index, feature index) the ray from `p` along the unit vector `d` leaves
-    /// through, or `None` when something else stops it first.
+    /// The glazing (surface index, feature index) the ray from `p` (in the room) along the unit
+    /// vector `d` leaves through, or `None` when something else stops it first, in the room or
+    /// beyond the glass.
     fn window_hit(&self, p: &Point3<f64>, d: &Vector3<f64>) -> Option<(usize, usize)> {
         let hit = self.caster.cast(p, d, f64::INFINITY)?;
+        let beyond = p + d * (hit.t + BEYOND_GLASS_M);
+        if self.caster.cast(&beyond, d, f64::INFINITY).is_some() {
+            return None;
+        }
         let Owner::Surface(si) = self.owner[hit.triangle as usize] else {
             return None;
         };
@@ -190,13 +215,17 @@ impl<'a> SunTracer<'a> {
         let feet = centre.z - posture.centre_height_m();
         let height = posture.head_height_m();
         let (nu, nz) = BODY_SAMPLES;
-        let mut lit = 0usize;
+        let (mut lit, mut body) = (0usize, 0usize);
         let mut through: Vec<(usize, usize)> = Vec::new();
         for i in 0..nu {
             let u = ((i as f64 + 0.5) / nu as f64 - 0.5) * BODY_WIDTH_M;
             for j in 0..nz {
                 let z = feet + (j as f64 + 0.5) / nz as f64 * height;
                 let p = Point3::new(centre.x, centre.y, z) + across * u;
+                if !self.inside(&p) {
+                    continue;
+                }
+                body += 1;
                 if let Some(w) = self.window_hit(&p, &d) {
                     lit += 1;
                     if !through.contains(&w) {
@@ -210,7 +239,52 @@ impl<'a> SunTracer<'a> {
             .iter()
             .map(|&(si, fi)| self.scene.surfaces[si].features[fi].id.clone())
             .collect();
-        (lit as f64 / (nu * nz) as f64, ids)
+        (lit as f64 / body.max(1) as f64, ids)
+    }
+
+    /// Whether the beam from `sun` enters the room through any glazing: from a point of a
+    /// glazing that faces the sun (a 6 × 6 grid over it), 1 mm inside the glass, a ray towards
+    /// the sun leaves through that glazing. False with the sun below the horizon.
+    pub fn beam_enters(&self, sun: &SunDirection) -> bool {
+        if sun.altitude_deg <= 0.0 {
+            return false;
+        }
+        let d = sun.towards_sun();
+        self.windows.iter().enumerate().any(|(si, fs)| {
+            let s = &self.scene.surfaces[si];
+            fs.iter().any(|&fi| {
+                let out = self.outward(si, fi);
+                if out.dot(&d) <= 0.0 {
+                    return false;
+                }
+                let f = &s.features[fi];
+                let (lo, hi) = f.bounds_2d;
+                (0..BEAM_GRID * BEAM_GRID).any(|k| {
+                    let q = mrtmap_geometry::nalgebra::Point2::new(
+                        lo.x + (hi.x - lo.x) * ((k % BEAM_GRID) as f64 + 0.5) / BEAM_GRID as f64,
+                        lo.y + (hi.y - lo.y) * ((k / BEAM_GRID) as f64 + 0.5) / BEAM_GRID as f64,
+                    );
+                    point_in_polygon_fast(&q, &f.polygon_2d)
+                        && self.window_hit(&(s.frame.to_3d(&q) - out * INSIDE_GLASS_M), &d)
+                            == Some((si, fi))
+                })
+            })
+        })
+    }
+
+    /// The outward normal (away from the room) of glazing `fi` on surface `si`: the side of its
+    /// plane that lies outside the room 2 cm from its centre.
+    fn outward(&self, si: usize, fi: usize) -> Vector3<f64> {
+        let s = &self.scene.surfaces[si];
+        let n = s.frame.normal.into_inner();
+        let f = &s.features[fi];
+        let c = f.polygon.iter().fold(Vector3::zeros(), |a, p| a + p.coords)
+            / f.polygon.len().max(1) as f64;
+        if self.inside(&Point3::from(c + n * SIDE_TEST_M)) {
+            -n
+        } else {
+            n
+        }
     }
 
     /// The window (its id) through which the beam from `sun` reaches the point `p` (a globe's
@@ -237,6 +311,99 @@ impl<'a> SunTracer<'a> {
             beam_windows,
         }
     }
+}
+
+impl SunTracer<'_> {
+    /// The ids of the glazing whose outside faces the sun (the beam can pass them inwards), with
+    /// the sun above the horizon.
+    pub fn glazing_facing(&self, sun: &SunDirection) -> Vec<String> {
+        if sun.altitude_deg <= 0.0 {
+            return Vec::new();
+        }
+        let d = sun.towards_sun();
+        let mut ids = Vec::new();
+        for (si, fs) in self.windows.iter().enumerate() {
+            for &fi in fs {
+                if self.outward(si, fi).dot(&d) > 0.0 {
+                    ids.push(self.scene.surfaces[si].features[fi].id.clone());
+                }
+            }
+        }
+        ids
+    }
+}
+
+/// What [`audit_the_beam`] found.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BeamAudit {
+    /// (sun, body) cases with part of the body in the beam.
+    pub lit: usize,
+    /// Cases where the beam came through a wall or glazing facing away from the sun, or entered
+    /// with no glazing facing it, in words.
+    pub violations: Vec<String>,
+}
+
+/// Sweeps the sun around the sky (azimuth every 10°, altitudes 5°, 30°, 60°, 85°) over a 7 × 7
+/// grid of bodies of `posture` covering the floor to 8 cm from its bounds (inside the room and
+/// out of furniture), and checks that every body lit is lit through glazing whose outside faces
+/// the sun, and that no beam enters when no glazing faces it: the beam never comes through a
+/// wall.
+pub fn audit_the_beam(scene: &RadiantScene, posture: Posture) -> BeamAudit {
+    let t = SunTracer::new(scene);
+    let mut audit = BeamAudit::default();
+    let Some(bounds) = RoomBounds::of_scene(scene) else {
+        return audit;
+    };
+    let (lo, hi) = bounds.frame.floor_bounds();
+    let mut centres = Vec::new();
+    for i in 0..7 {
+        for j in 0..7 {
+            let u = lo.x + 0.08 + (hi.x - lo.x - 0.16) * i as f64 / 6.0;
+            let v = lo.y + 0.08 + (hi.y - lo.y - 0.16) * j as f64 / 6.0;
+            let p = bounds.frame.point(
+                &mrtmap_geometry::nalgebra::Point2::new(u, v),
+                posture.centre_height_m(),
+            );
+            if bounds.locate(&p).is_none() && !scene.occluders.iter().any(|o| o.contains(&p)) {
+                centres.push(p);
+            }
+        }
+    }
+    for az in (0..360).step_by(10) {
+        for alt in [5.0, 30.0, 60.0, 85.0] {
+            let sun = SunDirection {
+                altitude_deg: alt,
+                azimuth_deg: f64::from(az),
+            };
+            let facing = t.glazing_facing(&sun);
+            let enters = t.beam_enters(&sun);
+            if facing.is_empty() && enters {
+                audit.violations.push(format!(
+                    "sun at {az}°, {alt}° high: the beam enters though no glazing faces it"
+                ));
+            }
+            for c in &centres {
+                let (f, ids) = t.f_bes(c, posture, &sun);
+                if f <= 0.0 {
+                    continue;
+                }
+                audit.lit += 1;
+                if !enters {
+                    audit.violations.push(format!(
+                        "sun at {az}°, {alt}° high: a body at ({:.2}, {:.2}) is lit though no beam enters",
+                        c.x, c.y
+                    ));
+                }
+                for id in ids.iter().filter(|id| !facing.contains(id)) {
+                    audit.violations.push(format!(
+                        "sun at {az}°, {alt}° high: a body at ({:.2}, {:.2}) is lit through {id}, whose outside faces away",
+                        c.x, c.y
+                    ));
+                }
+            }
+        }
+    }
+    audit
 }
 
 #[cfg(test)]
@@ -292,6 +459,100 @@ mod tests {
         // Half the body: a person standing so that the beam's lower edge crosses them.
         let (f, _) = t.f_bes(&Point3::new(1.0, 1.8, 1.0), Posture::Standing, &sun);
         assert!(f > 0.05 && f < 0.95, "{f}");
+    }
+
+    #[test]
+    fn no_sun_through_a_wall_in_the_example_office() {
+        for posture in [Posture::Seated, Posture::Standing] {
+            let audit = audit_the_beam(&example_office(), posture);
+            assert!(audit.violations.is_empty(), "{:?}", audit.violations);
+            assert!(audit.lit > 0, "the sweep never lit anyone");
+        }
+        // Issue 63's case: a seated person 0.1 m from the window's wall, the sun behind that wall
+        // (azimuth 100°: the beam would come from −x): the body's rectangle reaches past the wall,
+        // but no part of it outside the room is lit, and no beam enters the room.
+        let scene = example_office();
+        let t = SunTracer::new(&scene);
+        let sun = SunDirection {
+            altitude_deg: 30.0,
+            azimuth_deg: 100.0,
+        };
+        let (f, ids) = t.f_bes(&Point3::new(4.1, 1.8, 0.6), Posture::Seated, &sun);
+        assert_eq!((f, ids.len()), (0.0, 0));
+        assert!(!t.beam_enters(&sun));
+        assert!(t.beam_enters(&SunDirection {
+            altitude_deg: 30.0,
+            azimuth_deg: 0.0,
+        }));
+    }
+
+    /// A skylight, a roof light and a glazed door let in what a window of the same polygon lets
+    /// in (issue 61).
+    #[test]
+    fn every_glazing_lets_the_sun_in() {
+        let sun = SunDirection {
+            altitude_deg: 30.0,
+            azimuth_deg: 0.0,
+        };
+        let at = Point3::new(2.65, 1.8, 0.6);
+        let with_label = |label: &str| {
+            let mut file = example_office().to_file();
+            for s in &mut file.surfaces {
+                for f in &mut s.features {
+                    if f.label == "window" {
+                        f.label = label.into();
+                    }
+                }
+            }
+            let scene = RadiantScene::new(&file).unwrap();
+            let t = SunTracer::new(&scene);
+            (t.f_bes(&at, Posture::Seated, &sun).0, t.f_svv(&at))
+        };
+        let window = with_label("window");
+        assert!(window.0 > 0.9 && window.1 > 0.0, "{window:?}");
+        for label in [
+            "skylight",
+            "roof light",
+            "glazed door",
+            "Glass Door",
+            "curtain wall",
+        ] {
+            assert_eq!(with_label(label), window, "{label}");
+        }
+        assert_eq!(with_label("mirror"), (0.0, 0.0));
+
+        // A 0.6 m square in the ceiling (light-2's place) over a seated person, the sun 70° high:
+        // as a skylight or a roof light it lets in the beam a "window" there would, as a light
+        // none.
+        let high = SunDirection {
+            altitude_deg: 70.0,
+            azimuth_deg: 0.0,
+        };
+        let under = Point3::new(2.24, 1.0, 0.6);
+        let in_ceiling = |label: &str| {
+            let mut file = example_office().to_file();
+            for s in &mut file.surfaces {
+                for f in &mut s.features {
+                    if f.id == "light-2" {
+                        f.label = label.into();
+                    }
+                }
+            }
+            let scene = RadiantScene::new(&file).unwrap();
+            let t = SunTracer::new(&scene);
+            (
+                t.f_bes(&under, Posture::Seated, &high).0,
+                t.f_svv(&under),
+                t.beam_enters(&high),
+            )
+        };
+        let window = in_ceiling("window");
+        assert!(window.0 > 0.05 && window.1 > 0.0 && window.2, "{window:?}");
+        for label in ["skylight", "roof light", "rooflight", "roof window"] {
+            assert_eq!(in_ceiling(label), window, "{label}");
+        }
+        let light = in_ceiling("recessed light");
+        assert_eq!((light.0, light.2), (0.0, true), "{light:?}");
     }
 
     #[test]

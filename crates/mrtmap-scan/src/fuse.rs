@@ -902,6 +902,21 @@ fn thermal_clock(
 
 /// Fuses a recording. `progress(done, total)` is called after each frame.
 pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) + Sync)) -> Fused {
+    match fuse_until(rec, params, progress, &|| false) {
+        Some(f) => f,
+        // `stop` never says so.
+        None => unreachable!("a fusion that is never asked to stop stopped"),
+    }
+}
+
+/// [`fuse`], asking `stop` after the clock's estimate and after each chunk of frames (a few
+/// tenths of a second apart): `None` once it says so (a person pressed Ctrl-C).
+pub fn fuse_until(
+    rec: &Recording,
+    params: &FuseParams,
+    progress: &(dyn Fn(u64, u64) + Sync),
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Option<Fused> {
     let mut params = *params;
     if params.depth.stride == 0 {
         params.depth.stride = DepthSampling::auto_stride(&rec.rig.depth, &rec.rig.thermal);
@@ -923,6 +938,9 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
         rec
     };
     let clock = thermal_clock(rec, params, tolerance, &limits);
+    if stop() {
+        return None;
+    }
     let shifted;
     let rec = if clock.offset_s != 0.0 {
         let mut r = rec.clone();
@@ -970,8 +988,11 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
         let mut warm = Fuser::new(params, limits, report.clone(), Calibrator::default());
         let most = chunks.len().div_ceil(WARM_UP_SHARE);
         let done = warm.run(rec, &rays, &chunks[..most], total, &|_, _| {}, &|f| {
-            f.calibrator.vignetting_ready(WARM_UP_SPREAD)
+            stop() || f.calibrator.vignetting_ready(WARM_UP_SPREAD)
         });
+        if stop() {
+            return None;
+        }
         if warm.calibrator.vignetting_ready(1.0) && done < chunks.len() {
             let frames = chunks[..done].iter().map(|c| c.len()).sum();
             Calibrator::with_prior(warm.calibrator.vignetting(), frames)
@@ -987,8 +1008,11 @@ pub fn fuse(rec: &Recording, params: &FuseParams, progress: &(dyn Fn(u64, u64) +
     for r in dropped {
         fuser.drop_frame(r);
     }
-    fuser.run(rec, &rays, &chunks, total, progress, &|_| false);
-    fuser.finish(t_start)
+    fuser.run(rec, &rays, &chunks, total, progress, &|_| stop());
+    if stop() {
+        return None;
+    }
+    Some(fuser.finish(t_start))
 }
 
 #[cfg(test)]

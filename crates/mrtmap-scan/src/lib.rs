@@ -22,7 +22,7 @@ pub mod voxels;
 
 pub use fuse::{
     FuseParams, Fused, FusedFrame, FusionReport, IcpReport, IcpSettings, Timing, from_pose7, fuse,
-    pose7,
+    fuse_until, pose7,
 };
 pub use fuse_live::{Advance, LiveFusion};
 pub use sync::{Pairing, SkipReason, pair_frames, refined_poses};

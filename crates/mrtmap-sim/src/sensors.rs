@@ -416,19 +416,14 @@ pub fn instance_label(room: &Room, id: u16) -> Option<&str> {
 
 fn colour(room: &Room, hit: &Hit) -> [f64; 3] {
     let by_label = |l: &str| -> [f64; 3] {
-        let l = l.to_lowercase();
-        if l.contains("window") || l.contains("glass") {
-            [150.0, 200.0, 235.0]
-        } else if l.contains("light") || l.contains("lamp") || l.contains("panel") {
-            [255.0, 245.0, 190.0]
-        } else if l.contains("painting") || l.contains("picture") {
-            [170.0, 60.0, 50.0]
-        } else if l.contains("door") {
-            [120.0, 80.0, 50.0]
-        } else if l.contains("radiator") || l.contains("heater") {
-            [225.0, 225.0, 225.0]
-        } else {
-            [180.0, 180.0, 120.0]
+        use mrtmap_radiation::ElementKind as K;
+        match K::of_label(l) {
+            K::Glazing(_) => [150.0, 200.0, 235.0],
+            K::Light | K::RadiantPanel => [255.0, 245.0, 190.0],
+            K::Painting => [170.0, 60.0, 50.0],
+            K::Door => [120.0, 80.0, 50.0],
+            K::Radiator => [225.0, 225.0, 225.0],
+            K::Mirror | K::Desk | K::Other => [180.0, 180.0, 120.0],
         }
     };
     match hit.element {
@@ -505,21 +500,15 @@ pub fn texture(p: &Vector3<f64>, seed: u64) -> f64 {
 
 /// A label a detector might confuse with `label`.
 fn confusable(label: &str) -> &'static str {
-    let l = label.to_lowercase();
-    if l.contains("window") {
-        "mirror"
-    } else if l.contains("light") || l.contains("panel") {
-        "lamp"
-    } else if l.contains("painting") {
-        "poster"
-    } else if l.contains("door") {
-        "wardrobe"
-    } else if l.contains("radiator") {
-        "heater"
-    } else if l.contains("desk") {
-        "table"
-    } else {
-        "object"
+    use mrtmap_radiation::ElementKind as K;
+    match K::of_label(label) {
+        K::Glazing(_) => "mirror",
+        K::Light | K::RadiantPanel => "lamp",
+        K::Painting => "poster",
+        K::Door => "wardrobe",
+        K::Radiator => "heater",
+        K::Desk => "table",
+        K::Mirror | K::Other => "object",
     }
 }
 

@@ -190,7 +190,7 @@ pub struct TruthSunNode {
 /// f_svv and f_bes traced through the windows of `room`'s fine scene (room frame).
 pub fn sun_truth(room: &Room, grid: &TruthGrid, sun: &SimSun) -> Result<TruthSun, crate::SimError> {
     use mrtmap_physics::{
-        DEFAULT_ASW, DEFAULT_FLOOR_REFLECTANCE, Posture, SolarInputs, solar_gain,
+        DEFAULT_ASW, DEFAULT_FLOOR_REFLECTANCE, Posture, SkyAndRoom, SolarInputs, solar_gain_in,
     };
     sun.check()?;
     let fine = room.scene(&Isometry3::identity(), true)?;
@@ -201,6 +201,10 @@ pub fn sun_truth(room: &Room, grid: &TruthGrid, sun: &SimSun) -> Result<TruthSun
     };
     let posture = Posture::Seated;
     let centre = posture.centre_height_m();
+    let sky = SkyAndRoom {
+        beam_enters: tracer.beam_enters(&direction),
+        ..SkyAndRoom::SOLARCAL
+    };
     let nodes = grid
         .nodes
         .iter()
@@ -219,17 +223,20 @@ pub fn sun_truth(room: &Room, grid: &TruthGrid, sun: &SimSun) -> Result<TruthSun
                 });
             }
             let e = tracer.exposure(&p, posture, &direction);
-            let g = solar_gain(&SolarInputs {
-                altitude_deg: sun.altitude_deg,
-                sharp_deg: 0.0,
-                dni_w_m2: sun.dni_w_m2,
-                transmittance: sun.transmittance,
-                f_svv: e.f_svv,
-                f_bes: e.f_bes,
-                asw: DEFAULT_ASW,
-                posture: posture.into(),
-                floor_reflectance: DEFAULT_FLOOR_REFLECTANCE,
-            })
+            let g = solar_gain_in(
+                &SolarInputs {
+                    altitude_deg: sun.altitude_deg,
+                    sharp_deg: 0.0,
+                    dni_w_m2: sun.dni_w_m2,
+                    transmittance: sun.transmittance,
+                    f_svv: e.f_svv,
+                    f_bes: e.f_bes,
+                    asw: DEFAULT_ASW,
+                    posture: posture.into(),
+                    floor_reflectance: DEFAULT_FLOOR_REFLECTANCE,
+                },
+                &sky,
+            )
             .map_err(|err| crate::SimError::OutOfRange {
                 what: format!("SolarCal at ({:.2}, {:.2}): {err}", p.x, p.y),
                 value: f64::NAN,

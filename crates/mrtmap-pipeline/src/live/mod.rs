@@ -220,6 +220,7 @@ fn refresh(rec: &Recording, mut fused: Fused, p: &Project, work: &Path) -> Resul
         spec,
         &[],
         run.map(h).dir(),
+        &|| false,
     )?;
     let outcome = RunOutcome {
         stages: Vec::new(),
@@ -334,6 +335,9 @@ pub(crate) fn live(
     sink: &dyn LiveSink,
 ) -> Result<crate::report::RunDone> {
     check_live_out(recording, out)?;
+    // Held while following, so that a second `live` (or `run`) into the same folder is refused
+    // now; given back just before the final run, which takes it again.
+    let lock = crate::lock::OutLock::take(out)?;
     let p = coarse(pipeline.project());
     let params = p.fuse.params()?;
     let fixed_offset = match params.clock {
@@ -371,12 +375,15 @@ pub(crate) fn live(
             _ => 0.0,
         };
         if track_live.is_none() && listed_s >= DECIDE_POSES_AFTER_S {
-            let tracked = can_track && !recording.join("trajectory.txt").exists();
+            let has_poses = recording.join("trajectory.txt").exists();
+            let tracked = can_track && !has_poses;
             follower.ignore_trajectory = tracked;
             state.poses_from = if tracked {
                 "tracked live"
-            } else {
+            } else if has_poses {
                 "the recording"
+            } else {
+                "none: the recording has no trajectory.txt and no colour frames to track"
             }
             .into();
             track_live = Some(tracked);
@@ -408,6 +415,7 @@ pub(crate) fn live(
     r.finish();
     state.phase = "final run".into();
     sink.state(&state);
+    drop(lock);
     let done = pipeline.run(recording, out);
     state.phase = if done.is_ok() { "done" } else { "failed" }.into();
     sink.state(&state);
@@ -647,6 +655,8 @@ fn fusion_problems(fusion: &LiveFusion) -> Vec<String> {
 pub(crate) fn check_live_out(recording: &Path, out: &Path) -> Result<PathBuf> {
     crate::run::check_out_dir(out)?;
     crate::run::check_out_apart(recording, out)?;
+    // The final run writes in place: a folder of the user's is refused now, not after the scan.
+    mrtmap_io::check_replaceable(out)?;
     if !recording.join("rig.toml").is_file() {
         return Err(Error::source(
             &recording.join("rig.toml"),

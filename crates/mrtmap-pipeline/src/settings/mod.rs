@@ -104,7 +104,7 @@ std = 0.02                # the standard uncertainty of each emissivity
 # by_label = { window = 0.88, radiator = 0.2 }  # labels containing the key (longest key first)
 # by_id = { "wall-3" = 0.90 }                   # one surface or feature, by its id in scene.json
 
-[sun]                     # the sun through the windows (SolarCal), for mrt_sun and validate; unset: none
+[sun]                     # the sun through the glazing (SolarCal), for mrt_sun and validate; unset: none
 # altitude_deg = 30.0     # the sun in the room's frame: degrees above the horizon,
 # azimuth_deg = 0.0       # and from +x towards +y
 # date_time = "2026-01-15T10:30:00Z"  # or: a UTC time and a place (NOAA's sun position)
@@ -112,7 +112,8 @@ std = 0.02                # the standard uncertainty of each emissivity
 # longitude_deg = 13.4    # east positive
 # north_deg = 0.0         # compass bearing of the room's +y axis (0: +y north, +x east)
 # epw = "site.epw"        # with date_time: an EnergyPlus weather file gives the place and that
-                          # hour's direct normal irradiance (local standard time, hour ending)
+                          # hour's direct normal and diffuse irradiance (local standard time, hour
+                          # ending); a relative path is from this file's folder
 # dni_w_m2 = 700.0        # direct normal irradiance outside (needed with a sun)
 # transmittance = 0.6     # the windows' total solar transmittance with shades (needed with a sun)
 floor_reflectance = 0.6   # the floor's short-wave reflectance
@@ -159,11 +160,24 @@ impl Project {
     /// Reads project.toml; errors name the file and line.
     pub fn load(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|e| mrtmap_io::FileError::io(path, e))?;
-        Self::parse(&text).map_err(|(line, message)| Error::Config {
+        let mut p = Self::parse(&text).map_err(|(line, message)| Error::Config {
             path: path.to_path_buf(),
             line,
             message,
-        })
+        })?;
+        // A file the project names by a relative path is found beside the project.toml.
+        if let (Some(epw), Some(dir)) = (&mut p.sun.epw, path.parent())
+            && Path::new(epw.as_str()).is_relative()
+        {
+            *epw = dir.join(epw.as_str()).display().to_string();
+        }
+        Ok(p)
+    }
+
+    /// The files the settings name (the weather file): inputs of the stages that read them, so
+    /// that replacing one behind the same path re-runs those stages.
+    pub fn named_files(&self) -> Vec<std::path::PathBuf> {
+        self.sun.epw.iter().map(std::path::PathBuf::from).collect()
     }
 
     /// Parses project.toml text; an error gives the 1-based line (0 when unknown) and the message.
@@ -228,6 +242,14 @@ impl Project {
         self.mrt.check()?;
         self.emissivity.check()?;
         self.sun.check()?;
+        for r in &self.references {
+            r.check().map_err(|b| {
+                Error::setting(
+                    format!("[[references]] \"{}\" {} = {}", r.label, b.key, b.value),
+                    format!("is outside {}", b.allowed),
+                )
+            })?;
+        }
         if let Some(p) = self
             .points
             .iter()

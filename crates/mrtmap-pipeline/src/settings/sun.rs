@@ -32,8 +32,9 @@ pub struct SunSection {
     pub north_deg: f64,
     /// An EnergyPlus weather file (EPW), with `date_time`: its LOCATION gives the latitude and
     /// longitude (unless given) and its hour holding `date_time` (local standard time, hour ending)
-    /// the direct normal irradiance (unless `dni_w_m2` is given). A relative path is from the
-    /// folder mrtmap runs in.
+    /// the direct normal irradiance (unless `dni_w_m2` is given) and the diffuse horizontal
+    /// irradiance (SolarCal's sky term, else 0.2 × direct). A relative path is from the folder of
+    /// the project.toml that names it (from the folder mrtmap runs in for a flag or Python).
     pub epw: Option<String>,
     /// Direct normal irradiance outside (W/m²); needed with a sun.
     pub dni_w_m2: Option<f64>,
@@ -89,8 +90,8 @@ impl SunSection {
             Some(path) => Some(epw_at(Path::new(path), &time)?),
             None => None,
         };
-        let lat_given = self.latitude_deg.or(epw.map(|w| w.latitude_deg));
-        let lon_given = self.longitude_deg.or(epw.map(|w| w.longitude_deg));
+        let lat_given = self.latitude_deg.or(epw.as_ref().map(|w| w.latitude_deg));
+        let lon_given = self.longitude_deg.or(epw.as_ref().map(|w| w.longitude_deg));
         let need = |key: &str, v: Option<f64>| {
             v.ok_or_else(|| {
                 Error::setting(
@@ -203,12 +204,20 @@ impl SunSection {
                 ));
             }
         };
-        let dni = self.dni_w_m2.or(epw.map(|w| w.dni_w_m2)).ok_or_else(|| {
-            Error::setting(
-                "[sun] dni_w_m2",
-                "is needed with a sun: the direct normal irradiance outside (W/m²)",
-            )
-        })?;
+        let dni = match (self.dni_w_m2, &epw) {
+            (Some(v), _) => v,
+            (None, Some(w)) => w.dni_w_m2.ok_or_else(|| Error::Config {
+                path: w.path.clone(),
+                line: w.line,
+                message: "the direct normal irradiance (field 15) of this hour is missing (9999): give [sun] dni_w_m2".into(),
+            })?,
+            (None, None) => {
+                return Err(Error::setting(
+                    "[sun] dni_w_m2",
+                    "is needed with a sun: the direct normal irradiance outside (W/m²)",
+                ));
+            }
+        };
         let dni = within(
             "dni_w_m2",
             dni,
@@ -228,6 +237,7 @@ impl SunSection {
         let mut q = SunQuery::new(altitude, azimuth, dni, tau);
         q.floor_reflectance = floor;
         q.asw = asw;
+        q.diffuse_horizontal_w_m2 = epw.and_then(|w| w.dhi_w_m2);
         Ok(Some(q))
     }
 }
@@ -244,51 +254,33 @@ fn sun_within(key: &str, v: f64, lo: f64, hi: f64, allowed: &str) -> Result<f64>
     }
 }
 
-/// What an EPW weather file gives for one hour: its place and the direct normal irradiance.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// What an EPW weather file gives for one hour: its place and the hour's irradiances.
+#[derive(Clone, Debug, PartialEq)]
 pub struct EpwHour {
+    /// The file.
+    pub path: std::path::PathBuf,
+    /// The row's line in it.
+    pub line: usize,
     /// Latitude (degrees, north positive).
     pub latitude_deg: f64,
     /// Longitude (degrees, east positive).
     pub longitude_deg: f64,
-    /// Direct normal irradiance (W/m², the file's field 15).
-    pub dni_w_m2: f64,
+    /// Direct normal irradiance (W/m², the file's field 15); `None` where the file marks it
+    /// missing (9999).
+    pub dni_w_m2: Option<f64>,
+    /// Diffuse horizontal irradiance (W/m², field 16); `None` where missing.
+    pub dhi_w_m2: Option<f64>,
 }
 
 /// The hour of the EnergyPlus weather file `path` that holds the instant `time` (UTC): the file's
 /// LOCATION line (latitude, longitude, time zone in hours from UTC) and the data row whose month,
 /// day and hour (local standard time, hour ending: hour h covers h − 1 to h) hold it, any year
-/// (typical-year files mix them). Errors name the file and, for a row, the line.
+/// (typical-year files mix them). The file is read and checked by [`mrtmap_io::epw::Epw`]; errors
+/// name the file and, for a row or a field, the line.
 pub fn epw_at(path: &Path, time: &mrtmap_physics::UtcTime) -> Result<EpwHour> {
-    let text = std::fs::read_to_string(path).map_err(|e| mrtmap_io::FileError::io(path, e))?;
-    let bad = |line: usize, message: String| Error::Config {
-        path: path.to_path_buf(),
-        line,
-        message,
-    };
-    let loc = text
-        .lines()
-        .position(|l| l.starts_with("LOCATION"))
-        .ok_or_else(|| bad(1, "no LOCATION line: is it an EPW weather file?".into()))?;
-    let cells: Vec<&str> = text.lines().nth(loc).unwrap_or("").split(',').collect();
-    let num = |k: usize, what: &str, line: usize| -> Result<f64> {
-        cells
-            .get(k)
-            .and_then(|c| c.trim().parse::<f64>().ok())
-            .filter(|v| v.is_finite())
-            .ok_or_else(|| {
-                bad(
-                    line,
-                    format!("LOCATION's {what} (field {}) is not a number", k + 1),
-                )
-            })
-    };
-    let (lat, lon, tz) = (
-        num(6, "latitude", loc + 1)?,
-        num(7, "longitude", loc + 1)?,
-        num(8, "time zone", loc + 1)?,
-    );
-    // The local standard time, by whole days and hours from the UTC instant.
+    let epw = mrtmap_io::epw::Epw::read(path)?;
+    let tz = epw.location.time_zone_h;
+    // The local standard time: the time zone is within −12…+14 h, so the day moves by one at most.
     let days_in = |y: i32, m: u32| match m {
         2 if (y % 4 == 0 && y % 100 != 0) || y % 400 == 0 => 29,
         2 => 28,
@@ -296,67 +288,46 @@ pub fn epw_at(path: &Path, time: &mrtmap_physics::UtcTime) -> Result<EpwHour> {
         _ => 31,
     };
     let minutes = f64::from(time.hour * 60 + time.minute) + time.second / 60.0 + tz * 60.0;
-    let (mut y, mut m, mut d) = (time.year, time.month, time.day as i64);
-    let mut day_shift = (minutes / 1440.0).floor() as i64;
+    let day_shift = (minutes / 1440.0).floor() as i64;
     let local_min = minutes - 1440.0 * day_shift as f64;
-    while day_shift > 0 {
-        d += 1;
-        if d > i64::from(days_in(y, m)) {
-            d = 1;
-            m += 1;
-            if m > 12 {
-                m = 1;
-                y += 1;
+    // Typical-year files mix years: the row is found by month, day and hour alone.
+    let (mut y, mut m, mut d) = (time.year, time.month, i64::from(time.day));
+    match day_shift {
+        1.. => {
+            d += 1;
+            if d > i64::from(days_in(y, m)) {
+                d = 1;
+                m = m % 12 + 1;
             }
         }
-        day_shift -= 1;
-    }
-    while day_shift < 0 {
-        d -= 1;
-        if d < 1 {
-            m = if m == 1 { 12 } else { m - 1 };
-            if m == 12 {
-                y -= 1;
+        ..0 => {
+            d -= 1;
+            if d < 1 {
+                m = if m == 1 { 12 } else { m - 1 };
+                if m == 12 {
+                    y -= 1;
+                }
+                d = i64::from(days_in(y, m));
             }
-            d = i64::from(days_in(y, m));
         }
-        day_shift += 1;
+        0 => {}
     }
-    let hour = (local_min / 60.0).floor() as i64 + 1;
-    for (k, line) in text.lines().enumerate().skip(loc + 1) {
-        let c: Vec<&str> = line.split(',').collect();
-        if c.len() < 15 {
-            continue;
-        }
-        let int = |i: usize| c[i].trim().parse::<i64>().ok();
-        if int(1) == Some(i64::from(m)) && int(2) == Some(d) && int(3) == Some(hour) {
-            let dni = c[14]
-                .trim()
-                .parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite() && *v >= 0.0)
-                .ok_or_else(|| {
-                    bad(
-                        k + 1,
-                        format!(
-                            "direct normal irradiance (field 15) '{}' is not a number",
-                            c[14].trim()
-                        ),
-                    )
-                })?;
-            return Ok(EpwHour {
-                latitude_deg: lat,
-                longitude_deg: lon,
-                dni_w_m2: dni,
-            });
-        }
-    }
-    Err(bad(
-        0,
-        format!(
+    let hour = ((local_min / 60.0).floor() as i64 + 1).clamp(1, 24) as u32;
+    let row = epw.row(m, d as u32, hour).ok_or_else(|| Error::Config {
+        path: path.to_path_buf(),
+        line: 0,
+        message: format!(
             "no row for {m:02}-{d:02}, hour {hour} (local standard time, UTC{tz:+}): the file holds no such hour"
         ),
-    ))
+    })?;
+    Ok(EpwHour {
+        path: path.to_path_buf(),
+        line: row.line,
+        latitude_deg: epw.location.latitude_deg,
+        longitude_deg: epw.location.longitude_deg,
+        dni_w_m2: row.dni_w_m2,
+        dhi_w_m2: row.dhi_w_m2,
+    })
 }
 
 /// An ISO 8601 time in UTC: `YYYY-MM-DDTHH:MM[:SS[.fff]]` with `Z` or `+00:00` (a space for the
@@ -403,6 +374,9 @@ pub struct SunQuery {
     pub asw: f64,
     /// The floor's short-wave reflectance.
     pub floor_reflectance: f64,
+    /// The diffuse horizontal irradiance outside (W/m²), when a weather file gives it; `None`:
+    /// SolarCal's 0.2 × the direct normal irradiance.
+    pub diffuse_horizontal_w_m2: Option<f64>,
 }
 
 impl SunQuery {
@@ -418,6 +392,7 @@ impl SunQuery {
             transmittance,
             asw: DEFAULT_ASW,
             floor_reflectance: DEFAULT_FLOOR_REFLECTANCE,
+            diffuse_horizontal_w_m2: None,
         }
     }
 }
@@ -446,8 +421,8 @@ mod tests {
         let t = parse_utc("2026-01-15T11:00:00Z").unwrap();
         let h = epw_at(&epw, &t).unwrap();
         assert_eq!(
-            (h.latitude_deg, h.longitude_deg, h.dni_w_m2),
-            (52.47, 13.40, 345.0)
+            (h.latitude_deg, h.longitude_deg, h.dni_w_m2, h.dhi_w_m2),
+            (52.47, 13.40, Some(345.0), Some(60.0))
         );
         let sun = SunSection {
             date_time: Some("2026-01-15T11:00:00Z".into()),
@@ -457,6 +432,7 @@ mod tests {
         };
         let q = sun.query().unwrap().unwrap();
         assert_eq!(q.dni_w_m2, 345.0);
+        assert_eq!(q.diffuse_horizontal_w_m2, Some(60.0));
         let direct = SunSection {
             epw: None,
             latitude_deg: Some(52.47),
@@ -482,6 +458,58 @@ mod tests {
         .unwrap_err()
         .to_string();
         assert!(e.contains("[sun] epw"), "{e}");
+    }
+
+    /// Issue 63: a relative `epw` is found beside the project.toml that names it (not in the
+    /// folder mrtmap runs in); the hour's missing DNI (9999) is named by file, line and field, not
+    /// read as 9999 W/m² and blamed on a key the user never wrote; a time zone of 1e13 is refused
+    /// at once (it made `map` spin).
+    #[test]
+    fn a_weather_file_is_found_beside_its_project_and_read_strictly() {
+        let dir = tempfile::tempdir().unwrap();
+        let row = |h: u32, dni: &str| {
+            format!("1989,1,15,{h},60,?9?9?9?9E0,1.0,-2.0,80,101000,0,0,250,150,{dni},60,0,0,0,0\n")
+        };
+        let loc = "LOCATION,Berlin,,DEU,IWEC Data,103840,52.47,13.40,1.0,49.0\n";
+        std::fs::write(
+            dir.path().join("site.epw"),
+            format!("{loc}{}{}", row(12, "100"), row(13, "9999")),
+        )
+        .unwrap();
+        let toml = |when: &str| {
+            format!("[sun]\ndate_time = \"{when}\"\nepw = \"site.epw\"\ntransmittance = 0.6\n")
+        };
+        std::fs::write(dir.path().join("p.toml"), toml("2026-01-15T10:30:00Z")).unwrap();
+        let p = Project::load(&dir.path().join("p.toml")).unwrap();
+        assert_eq!(
+            Path::new(p.sun.epw.as_deref().unwrap()),
+            dir.path().join("site.epw")
+        );
+        let q = p.sun.query().unwrap().unwrap();
+        assert_eq!((q.dni_w_m2, q.diffuse_horizontal_w_m2), (100.0, Some(60.0)));
+        assert_eq!(p.named_files(), vec![dir.path().join("site.epw")]);
+        // 11:30 UTC is in the local hour ending at 13:00, whose DNI is missing.
+        std::fs::write(dir.path().join("p.toml"), toml("2026-01-15T11:30:00Z")).unwrap();
+        let e = Project::load(&dir.path().join("p.toml"))
+            .unwrap()
+            .sun
+            .query()
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("site.epw:3:") && e.contains("field 15"), "{e}");
+        assert!(!e.contains("dni_w_m2 = 9999"), "{e}");
+        std::fs::write(
+            dir.path().join("site.epw"),
+            format!("{}{}", loc.replace(",1.0,", ",1e13,"), row(12, "100")),
+        )
+        .unwrap();
+        let e = Project::load(&dir.path().join("p.toml"))
+            .unwrap()
+            .sun
+            .check()
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("time zone (field 9) 1e13"), "{e}");
     }
 
     #[test]

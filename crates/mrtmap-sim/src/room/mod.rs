@@ -960,12 +960,10 @@ pub fn preset(name: &str) -> Option<Result<Room, RoomError>> {
         .map(|(_, t)| Room::from_toml(t))
 }
 
-/// Whether a feature's label names glass: windows, glazing, glass doors, mirrors. Near-infrared
-/// light passes through (or is mirrored by) them, so an active-stereo depth camera gets no depth
-/// there; a thermal camera sees the pane itself, which is opaque at 8–14 µm.
+/// Whether a feature's label names glass: glazing of every kind and mirrors
+/// ([`mrtmap_radiation::ElementKind::is_glass`]). Near-infrared light passes through (or is
+/// mirrored by) them, so an active-stereo depth camera gets no depth there; a thermal camera sees
+/// the pane itself, which is opaque at 8–14 µm.
 pub fn is_glass(label: &str) -> bool {
-    let l = label.to_lowercase();
-    ["window", "glass", "glazing", "mirror", "skylight"]
-        .iter()
-        .any(|w| l.contains(w))
+    mrtmap_radiation::ElementKind::of_label(label).is_glass()
 }

@@ -305,6 +305,21 @@ pub fn track(
     params: &TrackParams,
     progress: &dyn Fn(usize, usize),
 ) -> Result<(Trajectory, TrackReport), TrackError> {
+    match track_until(rec, params, progress, &|| false)? {
+        Some(t) => Ok(t),
+        // `stop` never says so.
+        None => unreachable!("tracking that is never asked to stop stopped"),
+    }
+}
+
+/// [`track`], asking `stop` after each chunk of frames: `Ok(None)` once it says so (a person
+/// pressed Ctrl-C).
+pub fn track_until(
+    rec: &Recording,
+    params: &TrackParams,
+    progress: &dyn Fn(usize, usize),
+    stop: &dyn Fn() -> bool,
+) -> Result<Option<(Trajectory, TrackReport)>, TrackError> {
     let t0 = Instant::now();
     let mut tracker = Tracker::new(rec, params)?;
     let reader = FrameReader::new(params, tracker.cams);
@@ -320,10 +335,13 @@ pub fn track(
             progress(i + 1, n);
             tracker.step(rec, i, f);
         }
+        if stop() {
+            return Ok(None);
+        }
         start = end;
     }
     tracker.optimise_graph();
-    tracker.finish(rec, t0)
+    tracker.finish(rec, t0).map(Some)
 }
 
 /// How a frame was placed.
