@@ -20,7 +20,7 @@ use mrtmap_io::{
 };
 use mrtmap_radiation::{GridSpec, RadiantScene};
 use mrtmap_scan::FusedFrame;
-use mrtmap_scan::segment::{MaskInput, SegmentParams, TextureInput, segment_textured};
+use mrtmap_scan::segment::{MaskInput, SegmentParams, TextureInput, segment_textured_until};
 /// What segmentation reports, and the label votes (mrtmap-scan's).
 pub use mrtmap_scan::segment::{SegmentReport, Votes};
 use mrtmap_scan::{FuseParams, FusionReport, SkipReason, refined_poses};
@@ -259,6 +259,19 @@ pub fn segment_into(
     level: &LevelInputs,
     out: &Path,
 ) -> Result<SegmentReport> {
+    segment_into_until(fused, inputs, params, level, out, &|| false)
+}
+
+/// [`segment_into`], asking `stop` between segmentation's steps ([`Error::Stopped`] once it says
+/// so).
+pub(crate) fn segment_into_until(
+    fused: &Path,
+    inputs: &SegmentInputs<'_>,
+    params: &SegmentParams,
+    level: &LevelInputs,
+    out: &Path,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Result<SegmentReport> {
     let fused = FuseDir::new(fused);
     let cloud_path = fused.cloud_ply();
     let cloud = read_cloud_ply(&cloud_path)?.cloud;
@@ -285,18 +298,27 @@ pub fn segment_into(
             frames,
             vignetting_k: *a,
         });
-    let mut seg = segment_textured(
+    let mut seg = segment_textured_until(
         &cloud,
         &poses.poses,
         mask_input.as_ref(),
         texture_input.as_ref(),
         params,
+        stop,
     )
     .map_err(|source| Error::Segment {
         cloud: cloud_path.clone(),
         source,
+    })?
+    .ok_or(Error::Stopped {
+        stage: "segmentation",
     })?;
     let found = crate::level::level_segmentation(&mut seg, &cloud, level);
+    if stop() {
+        return Err(Error::Stopped {
+            stage: "segmentation",
+        });
+    }
     let dir = SegmentDir::new(out);
     write_json(&dir.level_json(), &found)?;
     write_atomic(&dir.scene_json(), (seg.scene.to_json() + "\n").as_bytes())?;
@@ -599,12 +621,13 @@ fn segment_stage(
             texture: p.segment.texture,
         };
         let level = LevelInputs::of(rec, p)?;
-        segment_into(
+        segment_into_until(
             fused.dir(),
             &inputs,
             &p.segment.params(&p.room),
             &level,
             dir.dir(),
+            &|| progress.stopped(),
         )
         .map(|_| ())
     })?;

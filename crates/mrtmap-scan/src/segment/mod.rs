@@ -383,10 +383,30 @@ pub fn segment_textured(
     texture: Option<&TextureInput<'_>>,
     p: &SegmentParams,
 ) -> Result<Segmentation, SegmentError> {
+    match segment_textured_until(cloud, camera_poses, masks, texture, p, &|| false)? {
+        Some(s) => Ok(s),
+        // `stop` never says so.
+        None => unreachable!("a segmentation that is never asked to stop stopped"),
+    }
+}
+
+/// [`segment_textured`], asking `stop` between its steps: `Ok(None)` once it says so (a person
+/// pressed Ctrl-C).
+pub fn segment_textured_until(
+    cloud: &ThermalCloud,
+    camera_poses: &[Isometry3<f64>],
+    masks: Option<&MaskInput<'_>>,
+    texture: Option<&TextureInput<'_>>,
+    p: &SegmentParams,
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Result<Option<Segmentation>, SegmentError> {
     let mut pts = Points::of(cloud);
     let cloud_points = pts.pos.len();
     let up0 = up_from_poses(camera_poses).ok_or(SegmentError::NoPoses)?;
     let planes = envelope::find_planes(&pts.pos, &pts.nrm, p);
+    if stop() {
+        return Ok(None);
+    }
     let mut weights: Vec<f64> = pts.obs.iter().map(|&o| o.max(1) as f64).collect();
     let cloud_in = envelope::Cloud {
         points: &pts.pos,
@@ -394,6 +414,9 @@ pub fn segment_textured(
         weights: &weights,
     };
     let env = envelope::envelope(cloud_in, planes, up0, p)?;
+    if stop() {
+        return Ok(None);
+    }
     let up = env.up;
     let height_m = env.planes[env.floor]
         .plane
@@ -407,9 +430,15 @@ pub fn segment_textured(
         .collect();
     let bands = surface_bands(&geoms, &polys2, &pts, p);
     let (mut surface_id, mut members) = assign_points(&geoms, &polys2, &bands, &pts, p);
+    if stop() {
+        return Ok(None);
+    }
     let unassigned = surface_id.iter().filter(|s| **s < 0).count();
     let furniture = furniture_of(&env, &longest, &bands, &pts, &surface_id, height_m, p);
     release_under_furniture(&geoms, &furniture, &pts, &mut surface_id, &mut members);
+    if stop() {
+        return Ok(None);
+    }
     let texture_report = texture.map(|t| {
         fill_from_texture(
             t,
@@ -424,6 +453,9 @@ pub fn segment_textured(
         )
     });
     let analyses = analyse_surfaces(&geoms, &polys2, &members, (&pts, &weights), p);
+    if stop() {
+        return Ok(None);
+    }
     let all_features: Vec<(usize, &features::FoundFeature)> = analyses
         .iter()
         .enumerate()
@@ -434,6 +466,9 @@ pub fn segment_textured(
     number_walls(&mut geoms, &frame);
     let (feature_votes, furniture_votes, mask_summary) =
         vote_labels(masks, &all_features, &furniture, &pts.pos);
+    if stop() {
+        return Ok(None);
+    }
     let mut ids = Ids::default();
     let mut warnings = Vec::new();
     let found = build_features(
@@ -486,13 +521,13 @@ pub fn segment_textured(
         texture: texture_report,
     };
     let textured = pts.cloud_from(cloud_points);
-    Ok(Segmentation {
+    Ok(Some(Segmentation {
         scene,
         surface_id,
         feature_id,
         textured,
         report,
-    })
+    }))
 }
 
 /// Each surface's temperatures and features from its member points ([`features::analyse_surface`]).
