@@ -205,6 +205,31 @@ def test_ctrl_c_during_a_run_raises_keyboard_interrupt(scans, tmp_path):
     assert not (tmp_path / "out" / "report.html").exists()
 
 
+@pytest.mark.parametrize("stage", ["fusing", "segmenting", "mapping MRT", "comfort"])
+def test_ctrl_c_stops_a_run_within_a_second_in_every_stage(scans, tmp_path, stage):
+    """Issue 63: Ctrl-C is looked at inside every long stage (fusion's frames, segmentation's
+    steps, a map's and the comfort maps' nodes), not only between stages: the run stops within a
+    second of it, whichever stage it falls in, and what was finished is reused."""
+    sent = []
+
+    def progress(name, done, total):
+        if not sent and stage in name:
+            sent.append(time.perf_counter())
+            _thread.interrupt_main()
+
+    out = tmp_path / "out"
+    config = {"map": {"quantities": ["mrt", "mrt_seated"], "grid": [20, 20]}}
+    with pytest.raises(KeyboardInterrupt):
+        mrtmap.run(scans[2], out, config=config, progress=progress)
+    assert sent, f"no stage named {stage!r}"
+    took = time.perf_counter() - sent[0]
+    assert took < 1.0, f"stopped {took:.2f} s after Ctrl-C in {stage}"
+    assert not (out / "report.html").exists()
+    # The run folder is resumable: the next run finishes it.
+    done = mrtmap.run(scans[2], out, config=config)
+    assert (out / "report.html").exists() and done["maps"]
+
+
 # ---- 4. typed keywords ----
 
 def test_settings_are_typed_keywords():

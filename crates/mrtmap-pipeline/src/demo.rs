@@ -274,7 +274,7 @@ fn demo_project(truth: &Truth, s: &DemoSettings) -> Project {
 
 /// An engine with Monte Carlo of `rays` where needed.
 fn engine(scene: &RadiantScene, rays: usize) -> Result<MrtEngine<'_>> {
-    Ok(MrtEngine::new(
+    Ok(mrtmap_radiation::enclosure::engine(
         scene,
         Method::Auto(MonteCarlo {
             rays,

@@ -9,6 +9,7 @@
 //! OUT/
 //!   report.html             the report: maps, tables, the room in 3D; one file, nothing linked
 //!   run.json                the source, each stage's time and reuse, the warnings, the settings
+//!   .mrtmap-made            the entries mrtmap wrote here (a later run writes only into those)
 //!   recording/              a bag, MCAP file or database converted (docs/recording.md)
 //!   recording.stage.json    the conversion's fingerprint (a recording folder is read where it is)
 //!   track/                  the built-in tracker, when the recording has no poses
@@ -277,6 +278,12 @@ impl RunLayout {
     /// `validation.json` (`mrtmap validate`; the report shows its globes).
     pub fn validation_json(&self) -> PathBuf {
         self.root.join("validation.json")
+    }
+
+    /// `.mrtmap-made`: the entries mrtmap wrote here, which a later run may write again
+    /// ([`mrtmap_io::claim_dir`]).
+    pub fn made_list(&self) -> PathBuf {
+        self.root.join(mrtmap_io::MADE)
     }
 
     /// The entries a run with maps at `heights_m` may write at the top of its folder: what it

@@ -153,7 +153,7 @@ fn scene_of(map: &Path) -> Result<PathBuf> {
 
 /// The engine MRTs are compared with globes by: exact where valid, else Monte Carlo of `RAYS`.
 fn globe_engine(scene: &RadiantScene) -> Result<MrtEngine<'_>> {
-    Ok(MrtEngine::new(
+    Ok(mrtmap_radiation::enclosure::engine(
         scene,
         Method::Auto(MonteCarlo {
             rays: RAYS,

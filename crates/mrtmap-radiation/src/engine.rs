@@ -234,6 +234,11 @@ pub enum MrtError {
     /// A scene in true surface temperatures whose radiosities could not be solved.
     #[error("the scene's surface temperatures could not be turned into radiosities: {0}")]
     EnclosureSolve(String),
+    /// A scene in true surface temperatures of grey elements handed to the engine unsolved.
+    #[error(
+        "the scene gives true surface temperatures of grey elements, whose radiosities must be solved before an MRT (mrtmap_radiation::enclosure::engine)"
+    )]
+    UnsolvedSurfaceTemperatures,
     /// The point is not in the room.
     #[error("point ({:.2}, {:.2}, {:.2}) is {where_}: the room spans {room}", point[0], point[1], point[2])]
     OutsideRoom {
@@ -447,12 +452,21 @@ fn arr(p: &Point3<f64>) -> [f64; 3] {
 
 impl<'a> MrtEngine<'a> {
     /// Prepares `scene` for `method`. Exact refuses scenes with occluders.
+    /// A scene in true surface temperatures of grey elements is refused: its radiosities must be
+    /// solved first ([`crate::enclosure::engine`] does both).
     pub fn new(scene: &'a RadiantScene, method: Method) -> Result<Self, MrtError> {
-        if crate::grey::needs_enclosure_solve(scene) {
-            let solved = crate::grey::solve_enclosure(scene, method)?;
-            return Self::build(std::borrow::Cow::Owned(solved), method);
+        if scene.gives_grey_surface_temperatures() {
+            return Err(MrtError::UnsolvedSurfaceTemperatures);
         }
         Self::build(std::borrow::Cow::Borrowed(scene), method)
+    }
+
+    /// [`MrtEngine::new`] on a scene it keeps.
+    pub fn new_owned(scene: RadiantScene, method: Method) -> Result<Self, MrtError> {
+        if scene.gives_grey_surface_temperatures() {
+            return Err(MrtError::UnsolvedSurfaceTemperatures);
+        }
+        Self::build(std::borrow::Cow::Owned(scene), method)
     }
 
     fn build(

@@ -21,6 +21,7 @@
 //! ```
 
 mod bounds;
+pub mod enclosure;
 mod engine;
 mod field;
 pub mod grey;

@@ -4,7 +4,7 @@
 use mrtmap_geometry::PlaneFrame;
 use mrtmap_geometry::nalgebra::{Point2, Point3};
 use mrtmap_geometry::polygon::{self, signed_area};
-use mrtmap_radiation::{Method, MonteCarlo, MrtEngine, RadiantScene, Surface, SurfaceKind};
+use mrtmap_radiation::{Method, MonteCarlo, RadiantScene, Surface, SurfaceKind};
 use serde::{Deserialize, Serialize};
 
 use crate::truth::Truth;
@@ -192,7 +192,7 @@ fn corner_error(found: &RadiantScene, truth: &RadiantScene) -> f64 {
 
 /// The found scene's MRT at the truth's validation points.
 fn point_scores(found: &RadiantScene, truth: &Truth) -> Result<Vec<PointScore>, crate::SimError> {
-    let engine = MrtEngine::new(
+    let engine = mrtmap_radiation::enclosure::engine(
         found,
         Method::Auto(MonteCarlo {
             rays: 200_000,

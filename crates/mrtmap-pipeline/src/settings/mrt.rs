@@ -147,9 +147,11 @@ impl MrtSection {
     /// answered).
     pub fn engine<'a>(&self, scene: &'a RadiantScene) -> Result<MrtEngine<'a>> {
         self.check()?;
-        Ok(MrtEngine::new(scene, self.method(scene)?)?
-            .allow_open(self.allow_open)
-            .with_placement_std(self.placement_std_m))
+        Ok(
+            mrtmap_radiation::enclosure::engine(scene, self.method(scene)?)?
+                .allow_open(self.allow_open)
+                .with_placement_std(self.placement_std_m),
+        )
     }
 }
 

@@ -251,6 +251,17 @@ pub struct RadiantScene {
 }
 
 impl RadiantScene {
+    /// Whether the scene gives true surface temperatures ("temperatures": "surface") of elements
+    /// that are not black: their radiosities must be solved before an MRT
+    /// ([`crate::enclosure::solve_enclosure`]).
+    pub fn gives_grey_surface_temperatures(&self) -> bool {
+        self.temperatures == Some(TemperatureKind::Surface)
+            && self
+                .surfaces
+                .iter()
+                .any(|s| s.emissivity < 1.0 || s.features.iter().any(|f| f.emissivity < 1.0))
+    }
+
     /// The weight of an element of emissivity `emissivity` in a radiant average: 1 when the
     /// temperatures are radiant (the camera's reading already holds what the surface reflects),
     /// the emissivity when they are true surface temperatures (or the file does not say: the

@@ -385,7 +385,7 @@ fn true_surface_temperatures_give_the_grey_truth() {
         margin_m: 0.3,
     };
     let grid = |scene: &RadiantScene| {
-        let engine = MrtEngine::new(scene, method).unwrap();
+        let engine = mrtmap_radiation::enclosure::engine(scene, method).unwrap();
         let frame = MapFrame::of_scene(scene).unwrap();
         MrtField::compute(&engine, frame, spec)
             .unwrap()

@@ -133,6 +133,7 @@ fn run_produces_every_output_and_reuses_unchanged_stages() {
         l.map_dir(1.1),
         l.report_html(),
         l.run_json(),
+        l.made_list(),
     ];
     assert_exist(&top);
     assert_only(&out, &top);
