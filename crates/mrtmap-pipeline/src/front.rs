@@ -372,6 +372,7 @@ impl<'p> Pipeline<'p> {
     pub fn check_live(
         &self,
         recording: &Path,
+        out: &Path,
         target_k: f64,
         exit_when_idle_s: Option<f64>,
     ) -> Result<()> {
@@ -388,6 +389,9 @@ impl<'p> Pipeline<'p> {
                 "is not a folder: start the recorder first (live follows the folder it writes), or give the recording's folder",
             ));
         }
+        crate::run::check_out_dir(out)?;
+        crate::run::check_out_apart(recording, out)?;
+        mrtmap_io::check_replaceable(out)?;
         self.project.check_heights_above_floor()
     }
 
@@ -404,7 +408,7 @@ impl<'p> Pipeline<'p> {
         stop: &std::sync::atomic::AtomicBool,
         sink: &dyn crate::LiveSink,
     ) -> Result<RunDone> {
-        self.check_live(recording, target_k, exit_when_idle_s)?;
+        self.check_live(recording, out, target_k, exit_when_idle_s)?;
         let opts = crate::live::LiveOptions {
             target_k,
             exit_when_idle_s,

@@ -31,7 +31,7 @@ fn fixed_mmap_threshold() {}
 pub fn run(a: &LiveArgs) -> anyhow::Result<()> {
     fixed_mmap_threshold();
     let pipeline = Pipeline::new(Project::resolve(a.config.as_deref(), &Overrides::new())?);
-    pipeline.check_live(&a.recording, a.target_k, a.exit_when_idle)?;
+    pipeline.check_live(&a.recording, &a.out, a.target_k, a.exit_when_idle)?;
     let server = mrtmap_live::Server::start(&a.serve)?;
     eprintln!(
         "live page: http://{} (state: /state.json); following {}; Ctrl-C stops following and makes the full run into {}",

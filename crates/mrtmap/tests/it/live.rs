@@ -408,9 +408,36 @@ fn ctrl_c_once_makes_the_full_run_and_twice_stops_at_once() {
 fn a_bad_live_request_is_refused_before_the_page_opens() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    for (rec, extra, says) in [
-        (dir.path().join("nope"), None, "start the recorder first"),
-        (recording().to_path_buf(), Some("0"), "--exit-when-idle 0"),
+    // Issue 63: a folder of the user's (their own report.html in it) and the recording itself
+    // are refused before following, not after the whole scan.
+    let users = dir.path().join("mine");
+    std::fs::create_dir_all(&users).unwrap();
+    std::fs::write(users.join("report.html"), "my notes").unwrap();
+    for (rec, extra, says, out) in [
+        (
+            dir.path().join("nope"),
+            None,
+            "start the recorder first",
+            &out,
+        ),
+        (
+            recording().to_path_buf(),
+            Some("0"),
+            "--exit-when-idle 0",
+            &out,
+        ),
+        (
+            recording().to_path_buf(),
+            None,
+            "mrtmap did not write there",
+            &users,
+        ),
+        (
+            recording().to_path_buf(),
+            None,
+            "is the recording folder itself",
+            &recording().to_path_buf(),
+        ),
     ] {
         let mut args = vec![
             "live".to_string(),
@@ -431,4 +458,8 @@ fn a_bad_live_request_is_refused_before_the_page_opens() {
         assert!(!o.status.success() && err.contains(says), "{err}");
         assert!(!err.contains("live page:"), "{err}");
     }
+    assert_eq!(
+        std::fs::read_to_string(users.join("report.html")).unwrap(),
+        "my notes"
+    );
 }

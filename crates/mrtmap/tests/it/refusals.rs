@@ -74,6 +74,33 @@ fn a_bad_reference_row_is_refused_before_fusion() {
     assert!(!out.join("fuse").exists(), "fusion ran first");
 }
 
+/// Issue 63: `run --out` into a folder holding the user's own report.html and run.json is refused
+/// (they were overwritten), before any stage; a folder a run made is run into again.
+#[test]
+fn run_keeps_out_of_a_folder_it_did_not_make() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("mine");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("report.html"), "my report").unwrap();
+    std::fs::write(out.join("run.json"), "{}").unwrap();
+    let o = mrtmap(&[
+        "run",
+        recording().to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("mrtmap did not write there"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(out.join("report.html")).unwrap(),
+        "my report"
+    );
+    assert!(!out.join("fuse").exists());
+}
+
 /// `src` copied to `dst` with every file hard-linked.
 pub(crate) fn linked_copy(src: &Path, dst: &Path) {
     std::fs::create_dir_all(dst).unwrap();

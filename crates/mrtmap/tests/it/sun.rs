@@ -125,6 +125,85 @@ fn mrt_adds_the_sun_through_the_window_for_a_person() {
     );
 }
 
+/// Issue 63: a seated person 0.1 m from the window's wall with the sun behind that wall (azimuth
+/// 100°) was lit "through window-1" (+3.07 K): the body's rectangle reached out through the wall.
+/// Now no beam: f_bes 0, no window, and only the sky and its floor reflection (no floor-reflected
+/// beam, as none enters the room) — well under the 3 K. A skylight in the ceiling lets the sun in
+/// as a window there would (issue 61), and a scene without glazing says so.
+#[test]
+fn no_sun_through_a_wall_and_every_glazing_lets_it_in() {
+    let sun_at = |scene: Option<&str>, at: &str, sun: &str| {
+        let mut args = vec![
+            "mrt",
+            "--at",
+            at,
+            "--person",
+            "seated",
+            "--facing",
+            "0",
+            "--sun",
+            sun,
+            "--dni",
+            "700",
+            "--transmittance",
+            "0.6",
+            "--json",
+        ];
+        if let Some(s) = scene {
+            args.extend(["--scene", s]);
+        }
+        ok_json(&args)
+    };
+    let v = sun_at(None, "4.1,1.8,0.6", "30,100");
+    let p = &v["persons"][0];
+    assert_eq!(p["f_bes"], 0.0, "{p}");
+    assert_eq!(p["beam_windows"].as_array().map(Vec::len), Some(0), "{p}");
+    // SolarCal's sky and its floor reflection alone: no beam on the body, none on the floor.
+    let f_svv = p["f_svv"].as_f64().unwrap();
+    let (f_eff, i_diff) = (0.696, 0.2 * 700.0);
+    let erf = f_eff * f_svv * 0.5 * 0.6 * (i_diff + i_diff * 0.6) * (0.7 / 0.95);
+    let d = p["delta_mrt_k"].as_f64().unwrap();
+    assert!((d - erf / (6.0 * f_eff)).abs() < 1e-9, "{p}");
+    assert!(d < 1.5, "{p}");
+    let dir = tempfile::tempdir().unwrap();
+    let sky = edited_example(dir.path(), "skylight.json", |v| {
+        v["surfaces"][1]["features"][1]["label"] = Value::from("skylight");
+    });
+    let win = edited_example(dir.path(), "ceiling-window.json", |v| {
+        v["surfaces"][1]["features"][1]["label"] = Value::from("window");
+    });
+    let (a, b) = (
+        sun_at(Some(&sky), "2.24,1.0,0.6", "70,0"),
+        sun_at(Some(&win), "2.24,1.0,0.6", "70,0"),
+    );
+    let (a, b) = (&a["persons"][0], &b["persons"][0]);
+    assert!(a["f_bes"].as_f64().unwrap() > 0.05, "{a}");
+    assert_eq!(a["f_bes"], b["f_bes"]);
+    assert_eq!(a["delta_mrt_k"], b["delta_mrt_k"]);
+    assert_eq!(a["beam_windows"][0], "light-2");
+    let closed = edited_example(dir.path(), "closed.json", |v| {
+        v["surfaces"][2]["features"][0]["label"] = Value::from("painting");
+    });
+    let text = ok(&[
+        "mrt",
+        "--at",
+        "2.65,1.8,0.6",
+        "--person",
+        "seated",
+        "--facing",
+        "0",
+        "--sun",
+        "30,0",
+        "--dni",
+        "700",
+        "--transmittance",
+        "0.6",
+        "--scene",
+        &closed,
+    ]);
+    assert!(text.contains("warning: the scene has no glazing"), "{text}");
+}
+
 /// The example office's window is on the +x wall; `[sun]` 30° high due +x puts a globe in front
 /// of it (2.65, 1.8, 1.1) in the beam and one at y = 0.3 in the shade.
 const SUNNY_PROJECT: &str =
