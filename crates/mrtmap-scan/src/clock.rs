@@ -275,6 +275,21 @@ pub fn estimate_offset(
     tolerance_s: f64,
     limits: &InterpolationLimits,
 ) -> ClockReport {
+    match estimate_offset_until(rec, search, tolerance_s, limits, &|| false) {
+        Some(r) => r,
+        // `stop` never says so.
+        None => unreachable!("an estimate that is never asked to stop stopped"),
+    }
+}
+
+/// [`estimate_offset`], asking `stop` before each offset it tries: `None` once it says so.
+pub fn estimate_offset_until(
+    rec: &Recording,
+    search: &ClockSearch,
+    tolerance_s: f64,
+    limits: &InterpolationLimits,
+    stop: &dyn Fn() -> bool,
+) -> Option<ClockReport> {
     let mut samples = samples(rec, search, tolerance_s, limits);
     let voxels = number_voxels(&mut samples, search.voxel_m);
     let mut report = ClockReport {
@@ -284,12 +299,17 @@ pub fn estimate_offset(
         ..Default::default()
     };
     if samples.len() < 3 {
-        return report;
+        return Some(report);
     }
     let mut curve: Vec<[f64; 2]> = Vec::new();
+    let stopped = std::cell::Cell::new(false);
     let eval = |d: f64, curve: &mut Vec<[f64; 2]>| -> f64 {
         if let Some(c) = curve.iter().find(|c| (c[0] - d).abs() < 1e-9) {
             return c[1];
+        }
+        if stopped.get() || stop() {
+            stopped.set(true);
+            return f64::NAN;
         }
         let m = mismatch(rec, &samples, voxels, d, limits);
         curve.push([d, m]);
@@ -304,8 +324,11 @@ pub fn estimate_offset(
             best = (d, m);
         }
     }
+    if stopped.get() {
+        return None;
+    }
     if !best.1.is_finite() {
-        return report;
+        return Some(report);
     }
     let fine = (search.coarse_step_s / search.fine_step_s).round() as i64;
     let centre = best.0;
@@ -381,7 +404,7 @@ pub fn estimate_offset(
     // A weak minimum is no estimate: the stamps are left as they are, and the report says so.
     report.offset_s = if report.weak { 0.0 } else { offset };
     report.unapplied_s = report.weak.then_some(offset);
-    report
+    (!stopped.get()).then_some(report)
 }
 
 /// The x0 (within `h` of `centre`, on a grid of h/20) of the V y = a + b·|x − x0|, b > 0, that

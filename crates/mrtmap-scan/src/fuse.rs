@@ -20,7 +20,7 @@ use mrtmap_io::{InterpolationLimits, Recording, ThermalCloud};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::clock::{ClockOffset, ClockReport, ClockSearch, OffsetSource, estimate_offset};
+use crate::clock::{ClockOffset, ClockReport, ClockSearch, OffsetSource, estimate_offset_until};
 use crate::frame::{DepthPoints, DepthSampling, RayTable, ThermalImage, depth_points};
 use crate::observe::{ObservationCounts, ObservationParams, observe};
 use crate::pose_check::{PoseCheck, drop_outlier_poses};
@@ -884,18 +884,19 @@ fn thermal_clock(
     params: &FuseParams,
     tolerance_s: f64,
     limits: &InterpolationLimits,
-) -> ClockReport {
+    stop: &dyn Fn() -> bool,
+) -> Option<ClockReport> {
     let fixed = |offset_s, source| ClockReport {
         offset_s,
         source,
         ..Default::default()
     };
     match (params.clock, rec.rig.thermal_time_offset_s) {
-        (ClockOffset::Off, _) => fixed(0.0, OffsetSource::None),
-        (ClockOffset::Fixed(o), _) => fixed(o, OffsetSource::Given),
-        (ClockOffset::Auto, Some(o)) => fixed(o, OffsetSource::RigToml),
+        (ClockOffset::Off, _) => Some(fixed(0.0, OffsetSource::None)),
+        (ClockOffset::Fixed(o), _) => Some(fixed(o, OffsetSource::Given)),
+        (ClockOffset::Auto, Some(o)) => Some(fixed(o, OffsetSource::RigToml)),
         (ClockOffset::Auto, None) | (ClockOffset::Estimate, _) => {
-            estimate_offset(rec, &params.clock_search, tolerance_s, limits)
+            estimate_offset_until(rec, &params.clock_search, tolerance_s, limits, stop)
         }
     }
 }
@@ -937,10 +938,7 @@ pub fn fuse_until(
     } else {
         rec
     };
-    let clock = thermal_clock(rec, params, tolerance, &limits);
-    if stop() {
-        return None;
-    }
+    let clock = thermal_clock(rec, params, tolerance, &limits, &|| stop())?;
     let shifted;
     let rec = if clock.offset_s != 0.0 {
         let mut r = rec.clone();
