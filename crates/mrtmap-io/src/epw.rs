@@ -178,7 +178,7 @@ impl Epw {
                         format!("the {what} (field {}) '{}' is not a number", i + 1, c[i]),
                     )
                 })?;
-                if v == EPW_MISSING_IRRADIANCE {
+                if v >= EPW_MISSING_IRRADIANCE {
                     return Ok(None);
                 }
                 if v.is_finite() && (0.0..=EPW_MAX_IRRADIANCE_W_M2).contains(&v) {
