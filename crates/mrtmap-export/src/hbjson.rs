@@ -12,6 +12,7 @@
 //! temperatures from a table by identifier (or the model's own `user_data["mrtmap"]`), shades
 //! that mrtmap wrote come back as furniture.
 
+use mrtmap_radiation::ElementKind;
 use std::collections::{BTreeMap, HashMap, HashSet};
 
 use mrtmap_geometry::PlaneFrame;
@@ -144,7 +145,7 @@ fn face_json(scene: &RadiantScene, s: &Surface, ids: &mut Identifiers) -> Value 
                 continue;
             }
         };
-        list.push(json!({
+        let mut opening_json = json!({
             "type": kind,
             "identifier": ids.make(&f.id),
             "display_name": f.label,
@@ -152,7 +153,12 @@ fn face_json(scene: &RadiantScene, s: &Surface, ids: &mut Identifiers) -> Value 
             "boundary_condition": outdoors(),
             "properties": { "type": format!("{kind}PropertiesAbridged") },
             "user_data": { "mrtmap": m },
-        }));
+        });
+        // A glazed door is a Honeybee Door with glass: it keeps letting the sun in when read back.
+        if kind == "Door" && ElementKind::of_label(&f.label).is_glazing() {
+            opening_json["is_glass"] = json!(true);
+        }
+        list.push(opening_json);
     }
     let mut m = measured(
         &s.id,
@@ -590,12 +596,14 @@ fn read_face(
             let s_at = format!("{sat}.geometry");
             let raw = polygon(sub.get("geometry").unwrap_or(&Value::Null), &s_at, scale)?;
             let (sp, _) = flatten(raw, plane.as_ref(), tol, &s_at)?;
+            // A Honeybee door with glass is a glazed door (the sun comes through it).
+            let glass_door = key == "doors" && sub.get("is_glass") == Some(&Value::Bool(true));
             let label = sub
                 .get("user_data")
                 .and_then(|u| u.get("mrtmap"))
                 .and_then(|d| d.get("label"))
                 .and_then(Value::as_str)
-                .unwrap_or(label);
+                .unwrap_or(if glass_door { "glazed door" } else { label });
             if let Some((t, s, e)) = look.get(&sid, sub) {
                 let (st, ss) = surface_of(sub);
                 features.push(FeatureFile {

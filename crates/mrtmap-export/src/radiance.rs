@@ -33,12 +33,20 @@ fn polygon(o: &mut String, material: &str, id: &str, p: &[Point3<f64>]) {
     o.push('\n');
 }
 
+/// `text` on one line: a line break in a label would end the comment and leave the rest of the
+/// label where Radiance reads primitives.
+fn one_line(text: &str) -> String {
+    text.chars()
+        .map(|c| if c.is_control() { ' ' } else { c })
+        .collect()
+}
+
 /// The comment above an object: its id, what it is, its radiant temperature, ± and area, and its
 /// emissivity and surface temperature where the scene gives one.
 fn comment(p: &MeshPart) -> String {
-    let mut what = format!("# {} ({}", p.id, p.role.as_str());
+    let mut what = format!("# {} ({}", one_line(&p.id), p.role.as_str());
     if !p.label.is_empty() {
-        let _ = write!(what, ", {}", p.label);
+        let _ = write!(what, ", {}", one_line(&p.label));
     }
     let _ = write!(what, "): {} °C", num(p.temperature_c, 2));
     if let Some(s) = p.temperature_std_k {
@@ -61,8 +69,9 @@ fn comment(p: &MeshPart) -> String {
 pub fn write(scene: &RadiantScene, name: &str) -> String {
     let mut ids = Identifiers::default();
     let mut o = format!(
-        "# {name}: a room measured by mrtmap ({} surfaces, {} furniture); metres, the scene's frame (z up)\n\
+        "# {}: a room measured by mrtmap ({} surfaces, {} furniture); metres, the scene's frame (z up)\n\
          # materials are default reflectances by kind (a scan measures temperatures, not reflectances)\n\n",
+        one_line(name),
         scene.surfaces.len(),
         scene.occluders.len()
     );

@@ -31,32 +31,63 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
     Ok(())
 }
 
-/// The file in a finished [`PartialDir`] listing the entries it was finished with: what a later
-/// run may replace.
+/// The file in a folder mrtmap made listing what it wrote there: what a later run may replace.
+/// A finished [`PartialDir`] lists every file by its path inside the folder (`thermal/0001.png`);
+/// [`claim_dir`] lists whole entries with a trailing `/` (`fuse/`: that name and all under it).
 pub const MADE: &str = ".mrtmap-made";
 
-/// Whether `name` is what mrtmap leaves while writing an entry that `made` lists: a temporary
-/// file of [`write_atomic`] or a folder `NAME.partial` of a listed `NAME`.
-fn is_in_progress(name: &str, made: &std::collections::HashSet<&str>) -> bool {
-    (name.starts_with(".mrtmap-") && name.ends_with(".tmp"))
-        || name
-            .strip_suffix(".partial")
-            .is_some_and(|stem| made.contains(stem))
+/// Whether `path` (inside the folder, `/`-separated) is what mrtmap leaves while writing: a
+/// temporary file of [`write_atomic`] or a folder `NAME.partial`.
+fn is_in_progress(path: &str) -> bool {
+    let name = path.rsplit('/').next().unwrap_or(path);
+    (name.starts_with(".mrtmap-") && name.ends_with(".tmp")) || name.ends_with(".partial")
 }
 
-/// Refuses `target` when it exists and is not empty, unless [`MADE`] lists all it holds.
-pub fn check_replaceable(target: &Path) -> Result<(), FileError> {
-    let Ok(entries) = std::fs::read_dir(target) else {
-        return Ok(()); // absent (a file there fails later, named)
+/// Whether the list `made` covers `path`: named exactly, or under an entry ending in `/`.
+fn covered(path: &str, made: &std::collections::HashSet<&str>) -> bool {
+    made.contains(path)
+        || made.iter().any(|e| {
+            e.strip_suffix('/')
+                .is_some_and(|stem| path == stem || path.starts_with(*e))
+        })
+}
+
+/// Every file under `dir`, by its path inside it (`/`-separated), in name order; folders
+/// `NAME.partial` and temporary files are passed over.
+fn files_under(dir: &Path, prefix: &str, out: &mut Vec<String>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
     };
+    let mut entries: Vec<_> = entries.filter_map(Result::ok).collect();
+    entries.sort_by_key(|e| e.file_name());
+    for e in entries {
+        let path = format!("{prefix}{}", e.file_name().to_string_lossy());
+        if is_in_progress(&path) || path == MADE {
+            continue;
+        }
+        if e.file_type().is_ok_and(|t| t.is_dir()) {
+            let before = out.len();
+            files_under(&e.path(), &format!("{path}/"), out);
+            if out.len() == before {
+                out.push(format!("{path}/")); // an empty folder is an entry too
+            }
+        } else {
+            out.push(path);
+        }
+    }
+}
+
+/// Refuses `target` when it exists and is not empty, unless [`MADE`] covers every file in it,
+/// in its subfolders too (a file a person added inside a folder mrtmap made is theirs).
+pub fn check_replaceable(target: &Path) -> Result<(), FileError> {
+    if !target.is_dir() {
+        return Ok(()); // absent (a file there fails later, named)
+    }
     let made = std::fs::read_to_string(target.join(MADE)).unwrap_or_default();
-    let made: std::collections::HashSet<&str> = made.lines().collect();
-    let mut names: Vec<String> = entries
-        .filter_map(|e| e.ok().map(|e| e.file_name().to_string_lossy().into_owned()))
-        .filter(|n| n != MADE && !is_in_progress(n, &made))
-        .collect();
-    names.sort();
-    let Some(first) = names.iter().find(|n| !made.contains(n.as_str())) else {
+    let made: std::collections::HashSet<&str> = made.lines().filter(|l| !l.is_empty()).collect();
+    let mut names = Vec::new();
+    files_under(target, "", &mut names);
+    let Some(first) = names.iter().find(|n| !covered(n, &made)) else {
         return Ok(());
     };
     let what = if made.is_empty() {
@@ -88,10 +119,30 @@ pub fn claim_dir(dir: &Path, names: &[String]) -> Result<(), FileError> {
     let old = std::fs::read_to_string(&list).unwrap_or_default();
     let mut all: std::collections::BTreeSet<&str> = old.lines().filter(|l| !l.is_empty()).collect();
     let before = all.len();
-    all.extend(names.iter().map(String::as_str));
+    let claimed: Vec<String> = names.iter().map(|n| format!("{n}/")).collect();
+    all.extend(claimed.iter().map(String::as_str));
     if all.len() == before && list.exists() {
         return Ok(());
     }
+    let mut text = all.into_iter().collect::<Vec<_>>().join("\n");
+    text.push('\n');
+    write_atomic(&list, text.as_bytes())
+}
+
+/// Adds every file now in `dir` (in its subfolders too) to its [`MADE`] list: for a command that
+/// wrote its outputs into a folder [`check_replaceable`] let it use, so that it may write them
+/// again next time while a file a person adds later is still theirs.
+pub fn record_made(dir: &Path) -> Result<(), FileError> {
+    let list = dir.join(MADE);
+    let old = std::fs::read_to_string(&list).unwrap_or_default();
+    let mut all: std::collections::BTreeSet<String> = old
+        .lines()
+        .filter(|l| !l.is_empty())
+        .map(str::to_string)
+        .collect();
+    let mut now = Vec::new();
+    files_under(dir, "", &mut now);
+    all.extend(now);
     let mut text = all.into_iter().collect::<Vec<_>>().join("\n");
     text.push('\n');
     write_atomic(&list, text.as_bytes())
@@ -134,11 +185,8 @@ impl PartialDir {
 
     /// Moves the folder to its final name, listing what it holds in [`MADE`].
     pub fn finish(self) -> Result<PathBuf, FileError> {
-        let mut names: Vec<String> = std::fs::read_dir(&self.partial)
-            .map_err(|e| FileError::io(&self.partial, e))?
-            .filter_map(|e| e.ok().map(|e| e.file_name().to_string_lossy().into_owned()))
-            .collect();
-        names.sort();
+        let mut names = Vec::new();
+        files_under(&self.partial, "", &mut names);
         names.push(String::new());
         let made = self.partial.join(MADE);
         std::fs::write(&made, names.join("\n")).map_err(|e| FileError::io(&made, e))?;
@@ -189,6 +237,44 @@ mod tests {
             "{err:?}"
         );
         assert!(user.join("sub").is_dir());
+        // A file added inside a subfolder of a folder mrtmap made is the user's too (it was
+        // deleted with the folder: the outside campaign of issue 63).
+        let nested = tmp.path().join("nested");
+        let dir = PartialDir::create(&nested)?;
+        std::fs::create_dir_all(dir.path().join("thermal")).map_err(|e| FileError::io(&out, e))?;
+        std::fs::write(dir.path().join("thermal/0.png"), b"x")
+            .map_err(|e| FileError::io(&out, e))?;
+        dir.finish()?;
+        finish_with(&nested, &["e.txt"])?; // all its own: replaced
+        let dir = PartialDir::create(&nested)?;
+        std::fs::create_dir_all(dir.path().join("thermal")).map_err(|e| FileError::io(&out, e))?;
+        dir.finish()?;
+        std::fs::write(nested.join("thermal/notes.txt"), b"mine")
+            .map_err(|e| FileError::io(&out, e))?;
+        let err = finish_with(&nested, &["f.txt"])
+            .err()
+            .map(|e| e.to_string());
+        assert!(
+            err.as_deref()
+                .is_some_and(|e| e.contains("thermal/notes.txt") && e.contains("did not write")),
+            "{err:?}"
+        );
+        assert!(nested.join("thermal/notes.txt").exists());
+        // A folder claimed for writing in place covers what is under the names it claimed.
+        let run = tmp.path().join("run");
+        claim_dir(&run, &["fuse".to_string(), "report.html".to_string()])?;
+        std::fs::create_dir_all(run.join("fuse")).map_err(|e| FileError::io(&run, e))?;
+        std::fs::write(run.join("fuse/cloud.ply"), b"x").map_err(|e| FileError::io(&run, e))?;
+        std::fs::write(run.join("report.html"), b"x").map_err(|e| FileError::io(&run, e))?;
+        claim_dir(&run, &["segment".to_string()])?;
+        std::fs::write(run.join("mine.txt"), b"x").map_err(|e| FileError::io(&run, e))?;
+        let err = claim_dir(&run, &["fuse".to_string()])
+            .err()
+            .map(|e| e.to_string());
+        assert!(
+            err.as_deref().is_some_and(|e| e.contains("mine.txt")),
+            "{err:?}"
+        );
         Ok(())
     }
 }

@@ -15,6 +15,8 @@ use crate::error::FileError;
 
 /// EnergyPlus's missing-value code for the irradiance fields.
 pub const EPW_MISSING_IRRADIANCE: f64 = 9999.0;
+/// Fields in an hourly row, as EnergyPlus writes them.
+pub const EPW_ROW_FIELDS: usize = 35;
 /// The largest irradiance accepted (W/m²): above the solar constant (about 1361 W/m²), generously.
 pub const EPW_MAX_IRRADIANCE_W_M2: f64 = 1500.0;
 
@@ -127,6 +129,7 @@ impl Epw {
             elevation_m: field(9, "elevation", -1000.0, 9999.9, "-1000…9999.9 m")?,
         };
         let mut rows = Vec::new();
+        let mut seen = std::collections::HashMap::new();
         for (k, l) in lines {
             let line = k + 1;
             let c: Vec<&str> = l.split(',').map(str::trim).collect();
@@ -144,12 +147,12 @@ impl Epw {
                     format!("'{}' among the hourly rows is not a row of numbers", c[0]),
                 ));
             }
-            if c.len() < 16 {
+            if c.len() != EPW_ROW_FIELDS {
                 return Err(FileError::syntax(
                     path,
                     line,
                     format!(
-                        "the hourly row has {} fields where EnergyPlus writes 35 (the irradiances are fields 15 and 16)",
+                        "the hourly row has {} fields where EnergyPlus writes {EPW_ROW_FIELDS}: a field missing or added would shift the irradiances (fields 15 and 16)",
                         c.len()
                     ),
                 ));
@@ -195,11 +198,25 @@ impl Epw {
                     ))
                 }
             };
+            let (month, day, hour) = (
+                int(1, "month", 1, 12)?,
+                int(2, "day", 1, 31)?,
+                int(3, "hour", 1, 24)?,
+            );
+            if let Some(first) = seen.insert((month, day, hour), line) {
+                return Err(FileError::syntax(
+                    path,
+                    line,
+                    format!(
+                        "repeats the hour of line {first} (month {month}, day {day}, hour {hour}): which one holds that hour?"
+                    ),
+                ));
+            }
             rows.push(EpwRow {
                 line,
-                month: int(1, "month", 1, 12)?,
-                day: int(2, "day", 1, 31)?,
-                hour: int(3, "hour", 1, 24)?,
+                month,
+                day,
+                hour,
                 dni_w_m2: irradiance(14, "direct normal irradiance")?,
                 dhi_w_m2: irradiance(15, "diffuse horizontal irradiance")?,
             });
@@ -300,6 +317,20 @@ mod tests {
         assert!(e.contains("hour (field 4) '25'"), "{e}");
         let e = parse(&format!("{LOC}\n1989,1,15,12,60,x,1.0\n")).unwrap_err();
         assert!(e.contains("site.epw:2:") && e.contains("7 fields"), "{e}");
+        // One field short anywhere would read the diffuse column as the direct one.
+        let short = row(12, "100", "40").replacen(",1.0,", ",", 1);
+        let e = parse(&format!("{LOC}\n{short}")).unwrap_err();
+        assert!(e.contains("34 fields"), "{e}");
+        let e = parse(&format!(
+            "{LOC}\n{}{}",
+            row(12, "100", "40"),
+            row(12, "90", "40")
+        ))
+        .unwrap_err();
+        assert!(
+            e.contains("site.epw:3:") && e.contains("repeats the hour of line 2"),
+            "{e}"
+        );
         let e = parse("not a weather file\n").unwrap_err();
         assert!(e.contains("LOCATION"), "{e}");
         let e = parse(&format!("{LOC}\n")).unwrap_err();

@@ -37,7 +37,7 @@ pub mod layout;
 mod ply;
 pub mod thermal;
 
-pub use atomic::{MADE, PartialDir, check_replaceable, claim_dir, write_atomic};
+pub use atomic::{MADE, PartialDir, check_replaceable, claim_dir, record_made, write_atomic};
 pub use error::{EncodeError, FileError, FileErrorKind, io_words};
 pub use image16::{Image16, encode_png_rgb8, encode_png16, gaussian_blur, read_image16};
 pub use layout::masks;

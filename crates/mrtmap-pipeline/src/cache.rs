@@ -95,6 +95,16 @@ impl Fingerprint {
         )
     }
 
+    /// Adds a small input file by its content (a digest of its bytes) as well as its stamp: a
+    /// settings' file (a weather file) rewritten with the same size and time is still a change.
+    pub fn file_content(self, p: &Path) -> Self {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::hash::DefaultHasher::new();
+        std::fs::read(p).ok().hash(&mut h);
+        let name = format!("content of {}", FileStamp::of(p).path);
+        self.file(p).setting(&name, &format!("{:016x}", h.finish()))
+    }
+
     /// Adds an optional input file.
     pub fn maybe_file(self, p: Option<&Path>) -> Self {
         match p {

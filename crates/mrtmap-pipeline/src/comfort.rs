@@ -513,6 +513,9 @@ pub(crate) fn make_comfort_maps(
     if quantities.contains(&Quantity::MrtSun) && sun.is_none() {
         return Err(crate::settings::no_sun_error());
     }
+    if sun.is_some() {
+        crate::points::check_sun_frame(scene, "[sun]")?;
+    }
     let tracer = sun.map(|_| SunTracer::new(scene));
     let sun_ctx = tracer.as_ref().zip(sun);
     let frame = MapFrame::of_scene(scene).map_err(|e| Error::Map {

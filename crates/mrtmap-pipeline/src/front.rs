@@ -268,9 +268,11 @@ impl<'p> Pipeline<'p> {
     pub fn fuse(&self, recording: &Path, out: &Path) -> Result<FuseDone> {
         let params = self.project.fuse.params()?;
         crate::run::check_out_apart(recording, out)?;
+        mrtmap_io::check_replaceable(out)?;
         let prepared = crate::source::prepare(recording, out, &self.source)?;
         let rec = Recording::open(&prepared.dir)?;
         let report = crate::run::fuse_into(&rec, &params, out, self.progress)?;
+        mrtmap_io::record_made(out)?;
         Ok(FuseDone {
             prepared,
             warnings: rec.warnings,
@@ -283,9 +285,11 @@ impl<'p> Pipeline<'p> {
     /// (trajectory.txt, track.json).
     pub fn track(&self, recording: &Path, out: &Path) -> Result<TrackDone> {
         crate::run::check_out_apart(recording, out)?;
+        mrtmap_io::check_replaceable(out)?;
         let rec = Recording::open(recording)?;
         let (trajectory, report) =
             crate::run::track_into(&rec, &self.project.track.params(), out, self.progress)?;
+        mrtmap_io::record_made(out)?;
         Ok(TrackDone {
             warnings: rec.warnings,
             trajectory,
@@ -306,6 +310,7 @@ impl<'p> Pipeline<'p> {
         references: Option<&Path>,
         out: &Path,
     ) -> Result<SegmentDone> {
+        mrtmap_io::check_replaceable(out)?;
         let report = crate::run::segment_folder(&SegmentJob {
             fused,
             masks,
@@ -315,6 +320,7 @@ impl<'p> Pipeline<'p> {
             references,
             out,
         })?;
+        mrtmap_io::record_made(out)?;
         Ok(SegmentDone { report })
     }
 
@@ -335,7 +341,10 @@ impl<'p> Pipeline<'p> {
             height_m: m.heights_m.first().copied().unwrap_or(1.1),
             margin_m: m.margin_m,
         };
-        crate::maps::map_scene(scene, source, &self.project, spec, marks, out)
+        mrtmap_io::check_replaceable(out)?;
+        let maps = crate::maps::map_scene(scene, source, &self.project, spec, marks, out)?;
+        mrtmap_io::record_made(out)?;
+        Ok(maps)
     }
 
     /// `mrtmap mrt`: the MRT (of a sphere or a person, with the sun when asked) at the query's

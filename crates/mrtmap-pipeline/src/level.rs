@@ -322,8 +322,17 @@ fn judge_readings(
         let implausible = seen.and_then(|(c, _)| {
             let off = (c - ex.radiant_c).abs();
             (off > allowed + 3.0 * r.std_k).then(|| {
+                // Grey: what the camera should read is not the reading itself; say so.
+                let grey = if ex.emissivity < 1.0 {
+                    format!(
+                        ", whose surface at emissivity {:.2} should look {:.1} °C to the camera",
+                        ex.emissivity, ex.radiant_c
+                    )
+                } else {
+                    String::new()
+                };
                 format!(
-                    "disagrees with what the camera saw there ({c:.1} °C) by {off:.1} K, more than the camera can be off ({allowed} K): left out; check the reading (a typo?) and its coordinates"
+                    "disagrees with what the camera saw there ({c:.1} °C) by {off:.1} K{grey}, more than the camera can be off ({allowed} K): left out; check the reading (a typo?), its coordinates and the emissivity taken for it ([emissivity], or the reading's own)"
                 )
             })
         });

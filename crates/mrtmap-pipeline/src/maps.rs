@@ -138,10 +138,15 @@ impl SceneMaps {
         let person = Quantity::person(quantities);
         let s = &c.summary;
         lines.push(String::new());
+        // With the sun and no facing given the person faces the sun (docs/comfort.md).
+        let facing = if s.sun.is_some() && s.comfort.facing_deg.is_none() {
+            "facing the sun (SHARP 0)".to_string()
+        } else {
+            s.comfort.facing().describe()
+        };
         lines.push(format!(
-            "a {} person, {}: {} nodes in {:.1} s",
+            "a {} person, {facing}: {} nodes in {:.1} s",
             s.comfort.posture.as_str(),
-            s.comfort.facing().describe(),
             s.nodes,
             s.compute_secs
         ));

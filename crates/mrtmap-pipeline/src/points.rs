@@ -262,6 +262,18 @@ fn plane_answer(a: &RadiantAsymmetry) -> PlaneAnswer {
     }
 }
 
+/// Refuses the sun (asked for by `what`) in a scene whose up is not +z: its altitude and azimuth
+/// are in the room's frame, z up.
+pub(crate) fn check_sun_frame(scene: &RadiantScene, what: &str) -> Result<()> {
+    if mrtmap_radiation::sun_frame_is_z_up(scene) {
+        return Ok(());
+    }
+    Err(Error::setting(
+        what,
+        "needs a scene whose up is +z: the sun's altitude and azimuth are in the room's frame (z up, the floor at z = 0); write the scene with z up",
+    ))
+}
+
 /// The warning for a sun asked for in a scene that has no glazing.
 pub(crate) const NO_GLAZING: &str = "the scene has no glazing (no feature labelled window, skylight, roof light, glazed door or curtain wall): the sun cannot reach anyone, so ΔMRT is 0 everywhere";
 
@@ -276,6 +288,9 @@ pub fn mrt_at_points(
     q: &PointQuery,
 ) -> Result<PointAnswers> {
     check_sun(q)?;
+    if q.sun.is_some() {
+        check_sun_frame(scene, "--sun")?;
+    }
     let method = mrt.method(scene)?;
     let engine = mrt.engine(scene)?;
     let tracer = q.sun.as_ref().map(|_| SunTracer::new(scene));

@@ -400,7 +400,7 @@ fn comfort_stage(
     let fingerprint = p
         .named_files()
         .iter()
-        .fold(fingerprint, |f, path| f.file(path));
+        .fold(fingerprint, |f, path| f.file_content(path));
     let stage = Stage {
         name: "comfort maps".into(),
         stamp: dir.stage_json(),

@@ -49,7 +49,10 @@ pub use scene::{
     SurfaceFile, SurfaceKind, TEMPERATURE_RANGE_C, TemperatureKind, Texel, UnseenPatch,
     UnseenShare, slug,
 };
-pub use sun::{BODY_WIDTH_M, BeamAudit, SunDirection, SunExposure, SunTracer, audit_the_beam};
+pub use sun::{
+    BODY_WIDTH_M, BeamAudit, SunDirection, SunExposure, SunTracer, audit_the_beam,
+    sun_frame_is_z_up,
+};
 pub use vocabulary::{ElementKind, GlazingKind, LABEL_ALIASES};
 
 use serde::{Deserialize, Serialize};

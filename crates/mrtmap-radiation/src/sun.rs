@@ -146,7 +146,13 @@ impl<'a> SunTracer<'a> {
     /// vector `d` leaves through, or `None` when something else stops it first, in the room or
     /// beyond the glass.
     fn window_hit(&self, p: &Point3<f64>, d: &Vector3<f64>) -> Option<(usize, usize)> {
-        let hit = self.caster.cast(p, d, f64::INFINITY)?;
+        // From inside a closed room a ray always meets something; one that meets nothing slipped
+        // through the seam between two triangles (a vertical ray onto a ceiling's diagonal): it is
+        // cast again turned by a few microradians (micrometres at a room's distances).
+        let hit = self.caster.cast(p, d, f64::INFINITY).or_else(|| {
+            let nudged = (d + Vector3::new(3e-6, -2e-6, 1e-6)).normalize();
+            self.caster.cast(p, &nudged, f64::INFINITY)
+        })?;
         let beyond = p + d * (hit.t + BEYOND_GLASS_M);
         if self.caster.cast(&beyond, d, f64::INFINITY).is_some() {
             return None;
@@ -206,7 +212,7 @@ impl<'a> SunTracer<'a> {
         posture: Posture,
         sun: &SunDirection,
     ) -> (f64, Vec<String>) {
-        if !self.has_windows() || sun.altitude_deg <= 0.0 {
+        if !self.has_windows() || sun.altitude_deg < 0.0 {
             return (0.0, Vec::new());
         }
         let d = sun.towards_sun();
@@ -246,7 +252,7 @@ impl<'a> SunTracer<'a> {
     /// glazing that faces the sun (a 6 × 6 grid over it), 1 mm inside the glass, a ray towards
     /// the sun leaves through that glazing. False with the sun below the horizon.
     pub fn beam_enters(&self, sun: &SunDirection) -> bool {
-        if sun.altitude_deg <= 0.0 {
+        if sun.altitude_deg < 0.0 {
             return false;
         }
         let d = sun.towards_sun();
@@ -290,7 +296,7 @@ impl<'a> SunTracer<'a> {
     /// The window (its id) through which the beam from `sun` reaches the point `p` (a globe's
     /// centre), or `None` when the point is in shade or the sun below the horizon.
     pub fn beam_at(&self, p: &Point3<f64>, sun: &SunDirection) -> Option<String> {
-        if sun.altitude_deg <= 0.0 {
+        if sun.altitude_deg < 0.0 {
             return None;
         }
         let (si, fi) = self.window_hit(p, &sun.towards_sun())?;
@@ -313,11 +319,18 @@ impl<'a> SunTracer<'a> {
     }
 }
 
+/// Whether `scene`'s up is +z: the frame the sun's altitude and azimuth are given in (a
+/// scene with another up, a hand-written y-up one, is refused by the sun's callers rather than
+/// lit from the wrong side).
+pub fn sun_frame_is_z_up(scene: &RadiantScene) -> bool {
+    RoomBounds::of_scene(scene).is_none_or(|b| b.frame.plane.normal.z > 1.0 - 1e-9)
+}
+
 impl SunTracer<'_> {
     /// The ids of the glazing whose outside faces the sun (the beam can pass them inwards), with
-    /// the sun above the horizon.
+    /// the sun not below the horizon.
     pub fn glazing_facing(&self, sun: &SunDirection) -> Vec<String> {
-        if sun.altitude_deg <= 0.0 {
+        if sun.altitude_deg < 0.0 {
             return Vec::new();
         }
         let d = sun.towards_sun();
@@ -553,6 +566,31 @@ mod tests {
         }
         let light = in_ceiling("recessed light");
         assert_eq!((light.0, light.2), (0.0, true), "{light:?}");
+
+        // A skylight over the room's centre, which lies on the ceiling's diagonal (the seam of
+        // its two triangles): the sun straight overhead lights the whole body, as at 89.999°
+        // (rays exactly on the seam slipped through: f_bes 0.89).
+        let mut file = example_office().to_file();
+        file.surfaces[1].features[0].polygon = vec![
+            [1.8, 1.5, 2.7],
+            [2.4, 1.5, 2.7],
+            [2.4, 2.1, 2.7],
+            [1.8, 2.1, 2.7],
+        ];
+        file.surfaces[1].features[0].label = "skylight".into();
+        let scene = RadiantScene::new(&file).unwrap();
+        let t = SunTracer::new(&scene);
+        for alt in [90.0, 89.999] {
+            let (f, _) = t.f_bes(
+                &Point3::new(2.1, 1.8, 0.6),
+                Posture::Seated,
+                &SunDirection {
+                    altitude_deg: alt,
+                    azimuth_deg: 0.0,
+                },
+            );
+            assert_eq!(f, 1.0, "{alt}");
+        }
     }
 
     #[test]

@@ -542,8 +542,8 @@ pub struct MrtArgs {
     /// asymmetries (vertical, and the worst horizontal pair every 15°) with ISO 7730's PD and category.
     #[arg(long)]
     pub plane: bool,
-    /// The sun on the person through the scene's windows (features labelled "window" or
-    /// "glass"): its altitude and its azimuth in the room's frame like --facing (0 = the sun
+    /// The sun on the person through the scene's glazing (features labelled window, skylight,
+    /// roof light, glazed or glass door, curtain wall, glazing or glass): its altitude and its azimuth in the room's frame like --facing (0 = the sun
     /// beyond the +x side), degrees. Adds SolarCal's ΔMRT beside the MRT, with the sky-vault view
     /// fraction and the share of the body in the beam traced in the scene. Needs --facing, --dni
     /// and --transmittance.

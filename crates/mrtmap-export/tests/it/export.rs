@@ -484,3 +484,58 @@ fn exports_name_the_radiant_and_the_surface_temperature() {
         .unwrap();
     assert_eq!((f.surface_temperature_c, f.emissivity), (Some(11.5), 0.84));
 }
+
+/// The outside campaign of issue 63: a glazed door keeps its glass through Honeybee (a Door with
+/// `is_glass`, read back as a glazed door that lets the sun in), and a label with a line break
+/// stays inside its Radiance comment.
+#[test]
+fn a_glazed_door_keeps_its_glass_and_a_label_cannot_break_a_comment() {
+    let mut f = example_office().to_file();
+    for s in &mut f.surfaces {
+        for ft in &mut s.features {
+            if ft.id == "window-1" {
+                ft.label = "glazed door".into();
+            }
+            if ft.id == "painting-1" {
+                ft.label = "painting\nvoid plastic evil 0 0 5 1 1 1 0 0".into();
+            }
+        }
+    }
+    let s = RadiantScene::new(&f).unwrap();
+    let text = hbjson::write(&s, "office");
+    let model: Value = serde_json::from_str(&text).unwrap();
+    let doors: Vec<&Value> = model["rooms"][0]["faces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|f| f["doors"].as_array().into_iter().flatten())
+        .collect();
+    let glazed: Vec<&&Value> = doors.iter().filter(|d| d["is_glass"] == true).collect();
+    assert_eq!(glazed.len(), 1, "{doors:?}");
+    // Read back without mrtmap's user_data (as another tool writes it): still glazing.
+    let mut bare = model.clone();
+    for face in bare["rooms"][0]["faces"].as_array_mut().unwrap() {
+        for d in face["doors"].as_array_mut().into_iter().flatten() {
+            d.as_object_mut().unwrap().remove("user_data");
+        }
+    }
+    let table = parse_temperatures("identifier,temperature_c\n*,20\n").unwrap();
+    let back = read(&bare.to_string(), None, Some(&table)).unwrap();
+    let labels: Vec<String> = back
+        .scene
+        .surfaces
+        .iter()
+        .flat_map(|s| s.features.iter().map(|f| f.label.clone()))
+        .collect();
+    assert!(
+        labels
+            .iter()
+            .any(|l| mrtmap_radiation::ElementKind::of_label(l).is_glazing()),
+        "{labels:?}"
+    );
+    let rad = radiance::write(&s, "office\nvoid plastic evil2 0 0 5 1 1 1 0 0");
+    for line in rad.lines().filter(|l| l.contains("evil")) {
+        assert!(line.starts_with('#'), "{line}");
+    }
+    parse_rad(&rad);
+}

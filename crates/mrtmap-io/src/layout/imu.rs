@@ -24,6 +24,7 @@ pub struct ImuSample {
 
 /// Parses `imu.txt`; errors name the file and line.
 pub fn parse_imu(text: &str, path: &Path) -> Result<Vec<ImuSample>, FileError> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut out: Vec<ImuSample> = Vec::new();
     for (i, line) in text.lines().enumerate() {
         let n = i + 1;

@@ -57,6 +57,8 @@ impl Trajectory {
     /// Parses TUM trajectory text. Lines starting with `#` and blank lines are skipped; a
     /// duplicate timestamp keeps the first pose.
     pub fn parse(text: &str, path: &Path) -> Result<Self, FileError> {
+        // A byte-order mark (Windows editors) is read past, as in every list mrtmap reads.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let mut t = Trajectory::default();
         for (i, line) in text.lines().enumerate() {
             let line_no = i + 1;

@@ -214,8 +214,13 @@ impl Follower {
         let Some(end) = bytes.iter().rposition(|&b| b == b'\n') else {
             return false;
         };
+        let at_start = self.tails[k].offset == 0;
         self.tails[k].offset += end as u64 + 1;
-        let text = String::from_utf8_lossy(&bytes[..=end]).into_owned();
+        let mut text = String::from_utf8_lossy(&bytes[..=end]).into_owned();
+        // A byte-order mark at the list's start is read past, as the batch reader does.
+        if at_start && text.starts_with('\u{feff}') {
+            text.drain(..'\u{feff}'.len_utf8());
+        }
         for raw in text.lines() {
             self.tails[k].lines += 1;
             let n = self.tails[k].lines;
@@ -371,6 +376,27 @@ mod tests {
     }
 
     use std::fs::OpenOptions;
+
+    /// A list that starts with a byte-order mark (a Windows editor's) gives its first line to
+    /// live as to `run` (live dropped it as "expected 'timestamp path'": issue 61).
+    #[test]
+    fn a_byte_order_mark_is_read_past_as_the_batch_reader_does() {
+        let d = tempfile::tempdir().unwrap();
+        let dir = d.path();
+        std::fs::write(dir.join("rig.toml"), RIG).unwrap();
+        let mut f = Follower::new(dir, None).unwrap();
+        png(dir, "thermal/0.png");
+        png(dir, "thermal/1.png");
+        let text = "\u{feff}10.0 thermal/0.png\n10.1 thermal/1.png\n";
+        append(dir, "thermal.txt", text);
+        f.poll();
+        assert!(f.warnings.is_empty(), "{:?}", f.warnings);
+        let batch = mrtmap_io::parse_stream_list(text, Path::new("thermal.txt")).unwrap();
+        assert_eq!(f.rec.thermal.len(), batch.len());
+        for (a, b) in f.rec.thermal.iter().zip(&batch) {
+            assert_eq!((a.line, &a.path), (b.line, &b.path));
+        }
+    }
 
     /// A line still being written is left for the next poll; a file that has not appeared holds
     /// its list for MISSING_WAIT_S, then is skipped with a warning naming the line and the file;

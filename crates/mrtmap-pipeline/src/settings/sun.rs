@@ -169,6 +169,16 @@ impl SunSection {
             self.azimuth_deg,
             self.date_time.as_deref(),
         ) {
+            (Some(_), Some(_), None)
+                if self.north_deg != 0.0
+                    || self.latitude_deg.is_some()
+                    || self.longitude_deg.is_some() =>
+            {
+                return Err(Error::setting(
+                    "[sun] north_deg, latitude_deg and longitude_deg",
+                    "place a sun given by date_time; with altitude_deg and azimuth_deg (already in the room's frame) they would be ignored: leave them out, or give date_time instead",
+                ));
+            }
             (Some(alt), Some(az), None) => {
                 let alt = within(
                     "altitude_deg",
@@ -313,12 +323,13 @@ pub fn epw_at(path: &Path, time: &mrtmap_physics::UtcTime) -> Result<EpwHour> {
         0 => {}
     }
     let hour = ((local_min / 60.0).floor() as i64 + 1).clamp(1, 24) as u32;
-    let row = epw.row(m, d as u32, hour).ok_or_else(|| Error::Config {
-        path: path.to_path_buf(),
-        line: 0,
-        message: format!(
-            "no row for {m:02}-{d:02}, hour {hour} (local standard time, UTC{tz:+}): the file holds no such hour"
-        ),
+    let row = epw.row(m, d as u32, hour).ok_or_else(|| {
+        Error::source(
+            path,
+            format!(
+                "has no row for {m:02}-{d:02}, hour {hour} (local standard time, UTC{tz:+}): the file holds no such hour"
+            ),
+        )
     })?;
     Ok(EpwHour {
         path: path.to_path_buf(),
@@ -410,7 +421,9 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let epw = dir.path().join("berlin.epw");
         let row = |h: u32, dni: f64| {
-            format!("1989,1,15,{h},60,?9?9?9?9E0,1.0,-2.0,80,101000,0,0,250,150,{dni},60,0,0,0,0\n")
+            format!(
+                "1989,1,15,{h},60,?9?9?9?9E0,1.0,-2.0,80,101000,0,0,250,150,{dni},60,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0\n"
+            )
         };
         let text = format!(
             "LOCATION,Berlin,,DEU,IWEC Data,103840,52.47,13.40,1.0,49.0\nDESIGN CONDITIONS,0\nDATA PERIODS,1,1,Data,Sunday, 1/ 1,12/31\n{}{}",
@@ -468,7 +481,9 @@ mod tests {
     fn a_weather_file_is_found_beside_its_project_and_read_strictly() {
         let dir = tempfile::tempdir().unwrap();
         let row = |h: u32, dni: &str| {
-            format!("1989,1,15,{h},60,?9?9?9?9E0,1.0,-2.0,80,101000,0,0,250,150,{dni},60,0,0,0,0\n")
+            format!(
+                "1989,1,15,{h},60,?9?9?9?9E0,1.0,-2.0,80,101000,0,0,250,150,{dni},60,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0\n"
+            )
         };
         let loc = "LOCATION,Berlin,,DEU,IWEC Data,103840,52.47,13.40,1.0,49.0\n";
         std::fs::write(

@@ -42,6 +42,9 @@ fn element_named(text: &str, path: &serde_path_to_error::Path) -> Option<String>
 impl RadiantScene {
     /// Parses and validates JSON text.
     pub fn from_json(text: &str) -> Result<Self, SceneError> {
+        // A byte-order mark (Windows editors, Excel's exports) is read past, as in every text
+        // file mrtmap reads.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let mut de = serde_json::Deserializer::from_str(text);
         let file: SceneFile = serde_path_to_error::deserialize(&mut de).map_err(|e| {
             let element = element_named(text, e.path());

@@ -134,12 +134,13 @@ fn connection(r: &Record<'_>) -> Result<(u32, Connection), Corrupt> {
     Ok((id, Connection { topic, datatype }))
 }
 
-/// Buffers reused from chunk to chunk: allocating (and zeroing) them afresh for each chunk cost
-/// more than decompressing it.
+/// The output buffer, reused from chunk to chunk: allocating (and zeroing) it afresh for each
+/// chunk cost more than decompressing it. Each LZ4 chunk gets a decoder of its own: one reused
+/// across frames of different block sizes broke lz4_flex's own assertion (a bag whose chunks
+/// came out with 4 MB and 256 KB blocks panicked in a debug build).
 #[derive(Default)]
 struct Buffers {
     out: Vec<u8>,
-    lz4: Option<lz4_flex::frame::FrameDecoder<std::io::Cursor<Vec<u8>>>>,
 }
 
 /// Decompresses a chunk into `bufs.out`.
@@ -166,21 +167,9 @@ fn decompress(r: &Record<'_>, bufs: &mut Buffers) -> Result<(), Corrupt> {
         "bz2" => bzip2::read::BzDecoder::new(src)
             .take(size as u64 + 1)
             .read_to_end(out),
-        "lz4" => {
-            let dec = bufs.lz4.get_or_insert_with(|| {
-                lz4_flex::frame::FrameDecoder::new(std::io::Cursor::new(Vec::new()))
-            });
-            let cur = dec.get_mut();
-            cur.get_mut().clear();
-            cur.get_mut().extend_from_slice(src);
-            cur.set_position(0);
-            let r = dec.take(size as u64 + 1).read_to_end(out);
-            if r.is_err() {
-                // A broken frame may leave the decoder mid-frame: start afresh next time.
-                bufs.lz4 = None;
-            }
-            r
-        }
+        "lz4" => lz4_flex::frame::FrameDecoder::new(src)
+            .take(size as u64 + 1)
+            .read_to_end(out),
         other => {
             return Err(Corrupt::new(
                 r.at,
