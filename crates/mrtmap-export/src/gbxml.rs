@@ -80,6 +80,15 @@ fn describe(
 /// The room's volume (m³) from its surfaces wound outward (divergence theorem); a scene that is not
 /// closed gives a meaningless number.
 pub fn room_volume(scene: &RadiantScene) -> f64 {
+    // The divergence theorem needs a closed room: one without a floor or a ceiling (an open scene
+    // file) is taken as the prism of its floor outline up to its highest point instead (the
+    // theorem gave 27.2 m³ for the example office without its ceiling, which holds 40.8).
+    let has = |k: SurfaceKind| scene.surfaces.iter().any(|s| s.kind == k);
+    if !(has(SurfaceKind::Floor) && has(SurfaceKind::Ceiling)) {
+        return mrtmap_radiation::RoomBounds::of_scene(scene).map_or(0.0, |b| {
+            mrtmap_geometry::polygon::signed_area(&b.frame.floor_uv).abs() * b.ceiling_m
+        });
+    }
     scene
         .surfaces
         .iter()

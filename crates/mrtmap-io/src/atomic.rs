@@ -33,7 +33,8 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FileError> {
 
 /// The file in a folder mrtmap made listing what it wrote there: what a later run may replace.
 /// A finished [`PartialDir`] lists every file by its path inside the folder (`thermal/0001.png`);
-/// [`claim_dir`] lists whole entries with a trailing `/` (`fuse/`: that name and all under it).
+/// [`claim_dir`] lists whole entries as `name/**` (`fuse/**`: that name and all under it); an
+/// empty folder is listed as `name/`.
 pub const MADE: &str = ".mrtmap-made";
 
 /// Whether `path` (inside the folder, `/`-separated) is what mrtmap leaves while writing: a
@@ -43,12 +44,17 @@ fn is_in_progress(path: &str) -> bool {
     (name.starts_with(".mrtmap-") && name.ends_with(".tmp")) || name.ends_with(".partial")
 }
 
-/// Whether the list `made` covers `path`: named exactly, or under an entry ending in `/`.
+/// Whether the list `made` covers `path`: named exactly (an empty folder as `name/`), or under an
+/// entry `name/**` (the name and all under it).
 fn covered(path: &str, made: &std::collections::HashSet<&str>) -> bool {
     made.contains(path)
         || made.iter().any(|e| {
-            e.strip_suffix('/')
-                .is_some_and(|stem| path == stem || path.starts_with(*e))
+            e.strip_suffix("/**").is_some_and(|stem| {
+                path == stem
+                    || path
+                        .strip_prefix(stem)
+                        .is_some_and(|rest| rest.starts_with('/'))
+            })
         })
 }
 
@@ -119,7 +125,7 @@ pub fn claim_dir(dir: &Path, names: &[String]) -> Result<(), FileError> {
     let old = std::fs::read_to_string(&list).unwrap_or_default();
     let mut all: std::collections::BTreeSet<&str> = old.lines().filter(|l| !l.is_empty()).collect();
     let before = all.len();
-    let claimed: Vec<String> = names.iter().map(|n| format!("{n}/")).collect();
+    let claimed: Vec<String> = names.iter().map(|n| format!("{n}/**")).collect();
     all.extend(claimed.iter().map(String::as_str));
     if all.len() == before && list.exists() {
         return Ok(());

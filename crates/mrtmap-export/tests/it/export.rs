@@ -38,6 +38,16 @@ fn office_volume_and_floor_area_are_the_boxs() {
         room_volume(&s)
     );
     assert!((floor_area(&s) - 4.2 * 3.6).abs() < 1e-9);
+    // Without its ceiling (an open scene file) the room still holds its volume (the divergence
+    // theorem on the open shell gave 27.2 m³: the outside campaign of issue 63).
+    let mut f = s.to_file();
+    f.surfaces.retain(|x| x.kind != "ceiling");
+    let open = RadiantScene::new(&f).unwrap();
+    assert!(
+        (room_volume(&open) - 4.2 * 3.6 * 2.7).abs() < 1e-6,
+        "{}",
+        room_volume(&open)
+    );
 }
 
 #[test]

@@ -307,12 +307,16 @@ fn map_writes_csv_png_svg_and_a_summary_that_agree() {
         svg.contains("\nwindow 11.5 °C\n") && svg.contains("\nA\n"),
         "features and marks are named"
     );
-    // No temporary files are left behind.
+    // No temporary files are left behind; the list of what mrtmap wrote there is beside them
+    // (so that a later map may write them again, and a file of the user's is refused).
     let names: Vec<String> = std::fs::read_dir(&out)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n != ".mrtmap-made")
         .collect();
     assert_eq!(names.len(), 4, "{names:?}");
+    let made = std::fs::read_to_string(out.join(".mrtmap-made")).unwrap();
+    assert_eq!(made.lines().count(), 4, "{made}");
 }
 
 #[test]
