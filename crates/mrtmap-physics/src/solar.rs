@@ -256,7 +256,8 @@ pub fn f_svv(width_m: f64, height_m: f64, distance_m: f64) -> Result<f64, Physic
 /// SHARP (degrees, 0…180) of a sun at `sun_azimuth_deg` for a person facing `facing_deg`, both
 /// measured the same way in one horizontal frame (a room's: from +x towards +y).
 pub fn sharp_deg(facing_deg: f64, sun_azimuth_deg: f64) -> f64 {
-    let d = (sun_azimuth_deg - facing_deg).rem_euclid(360.0);
+    // + 0.0: a whole turn's −0 reads as 0.
+    let d = (sun_azimuth_deg - facing_deg).rem_euclid(360.0) + 0.0;
     if d > 180.0 { 360.0 - d } else { d }
 }
 

@@ -118,6 +118,8 @@ pub struct SceneMaps {
     pub map: MapOutput,
     /// The person's comfort maps.
     pub comfort: Option<crate::comfort::ComfortOutput>,
+    /// What the maps leave out, in words (a sun in a scene without glazing).
+    pub warnings: Vec<String>,
 }
 
 impl SceneMaps {
@@ -126,6 +128,7 @@ impl SceneMaps {
     pub fn lines(&self, source: &str, quantities: &[Quantity], out: &Path) -> Vec<String> {
         let m = &self.map;
         let mut lines = vec![format!("scene: {source}"), format!("method: {}", m.method)];
+        lines.extend(self.warnings.iter().map(|w| format!("warning: {w}")));
         lines.extend(m.summary.lines());
         lines.push(format!(
             "computed in {:.3} s; wrote mrt_grid.csv, mrt_map.png, mrt_map.svg, summary.json in {}",
@@ -224,7 +227,11 @@ pub(crate) fn map_scene(
     }
     let map = make_map(scene, source, &project.mrt, spec, marks, out, &|| false)?;
     if person.is_empty() {
-        return Ok(SceneMaps { map, comfort: None });
+        return Ok(SceneMaps {
+            map,
+            comfort: None,
+            warnings: Vec::new(),
+        });
     }
     let engine = project.mrt.engine(scene)?;
     let frame = MapFrame::of_scene(scene).map_err(|e| Error::Map {
@@ -257,9 +264,15 @@ pub(crate) fn map_scene(
         out,
         &|| false,
     )?;
+    let warnings = if sun.is_some() && !mrtmap_radiation::SunTracer::new(scene).has_windows() {
+        vec![crate::points::NO_GLAZING.to_string()]
+    } else {
+        Vec::new()
+    };
     Ok(SceneMaps {
         map,
         comfort: Some(comfort),
+        warnings,
     })
 }
 

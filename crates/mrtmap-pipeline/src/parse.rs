@@ -47,7 +47,11 @@ pub fn parse_sun(s: &str) -> Result<[f64; 2], ParseError> {
         &[2],
         "ALT,AZ: the sun's altitude and its azimuth from +x towards +y, in degrees",
     )?;
-    Ok([v[0], v[1].rem_euclid(360.0)])
+    // The azimuth as [sun] azimuth_deg takes it: one turn either way, read as 0…360.
+    if !(-360.0..=360.0).contains(&v[1]) {
+        return Err(format!("the azimuth in '{s}' is outside -360…360°").into());
+    }
+    Ok([v[0], v[1].rem_euclid(360.0) + 0.0])
 }
 
 /// "AxB" (also "A×B") as two numbers; `bad` says what was expected.

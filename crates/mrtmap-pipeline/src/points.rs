@@ -183,6 +183,11 @@ fn check_sun(q: &PointQuery) -> Result<()> {
             format!("--sun {alt},{az}"),
             "has its altitude outside 0…90°: no sun above the horizon, no beam",
         )),
+        // As [sun] azimuth_deg: one turn either way.
+        Some(_) if !(-360.0..=360.0).contains(&az) => Err(Error::setting(
+            format!("--sun {alt},{az}"),
+            "has its azimuth outside -360…360°",
+        )),
         Some(_) => Ok(()),
     }
 }
@@ -234,7 +239,7 @@ fn sun_on(
         solar_on(tracer, at, p.posture, facing, sun).map_err(solar_flag_error)?;
     Ok(SunAnswer {
         sun_altitude_deg: sun.direction.altitude_deg,
-        sun_azimuth_deg: sun.direction.azimuth_deg,
+        sun_azimuth_deg: sun.direction.azimuth_deg.rem_euclid(360.0) + 0.0,
         sharp_deg: sharp,
         f_svv: exposure.f_svv,
         f_bes: exposure.f_bes,

@@ -202,6 +202,23 @@ fn no_sun_through_a_wall_and_every_glazing_lets_it_in() {
         &closed,
     ]);
     assert!(text.contains("warning: the scene has no glazing"), "{text}");
+    // A map with the sun says so too.
+    let project = dir.path().join("sun.toml");
+    std::fs::write(&project, SUNNY_PROJECT).unwrap();
+    let text = ok(&[
+        "map",
+        "--scene",
+        &closed,
+        "--config",
+        project.to_str().unwrap(),
+        "--quantity",
+        "mrt_sun",
+        "--grid",
+        "3x3",
+        "--out",
+        dir.path().join("m").to_str().unwrap(),
+    ]);
+    assert!(text.contains("warning: the scene has no glazing"), "{text}");
 }
 
 /// The example office's window is on the +x wall; `[sun]` 30° high due +x puts a globe in front
