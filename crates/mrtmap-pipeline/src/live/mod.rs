@@ -376,7 +376,9 @@ pub(crate) fn live(
         };
         if track_live.is_none() && listed_s >= DECIDE_POSES_AFTER_S {
             let has_poses = recording.join("trajectory.txt").exists();
-            let tracked = can_track && !has_poses;
+            // A rig with a colour camera whose recording lists no colour frame has nothing to
+            // track: it was shown as "tracked live" while nothing fused.
+            let tracked = can_track && !has_poses && !follower.rec.rgb.is_empty();
             follower.ignore_trajectory = tracked;
             state.poses_from = if tracked {
                 "tracked live"
