@@ -147,79 +147,18 @@ impl Epw {
                     format!("'{}' among the hourly rows is not a row of numbers", c[0]),
                 ));
             }
-            if c.len() != EPW_ROW_FIELDS {
+            let row = parse_row(path, line, &c)?;
+            if let Some(first) = seen.insert((row.month, row.day, row.hour), line) {
                 return Err(FileError::syntax(
                     path,
                     line,
                     format!(
-                        "the hourly row has {} fields where EnergyPlus writes {EPW_ROW_FIELDS}: a field missing or added would shift the irradiances (fields 15 and 16)",
-                        c.len()
+                        "repeats the hour of line {first} (month {}, day {}, hour {}): which one holds that hour?",
+                        row.month, row.day, row.hour
                     ),
                 ));
             }
-            let int = |i: usize, what: &str, lo: u32, hi: u32| {
-                c[i].parse::<u32>()
-                    .ok()
-                    .filter(|v| (lo..=hi).contains(v))
-                    .ok_or_else(|| {
-                        FileError::syntax(
-                            path,
-                            line,
-                            format!(
-                                "the {what} (field {}) '{}' is not a whole number within {lo}…{hi}",
-                                i + 1,
-                                c[i]
-                            ),
-                        )
-                    })
-            };
-            let irradiance = |i: usize, what: &str| -> Result<Option<f64>, FileError> {
-                let v: f64 = c[i].parse().map_err(|_| {
-                    FileError::syntax(
-                        path,
-                        line,
-                        format!("the {what} (field {}) '{}' is not a number", i + 1, c[i]),
-                    )
-                })?;
-                if v >= EPW_MISSING_IRRADIANCE {
-                    return Ok(None);
-                }
-                if v.is_finite() && (0.0..=EPW_MAX_IRRADIANCE_W_M2).contains(&v) {
-                    Ok(Some(v))
-                } else {
-                    Err(FileError::syntax(
-                        path,
-                        line,
-                        format!(
-                            "the {what} (field {}) {} is outside 0…1500 W/m² (9999 marks a missing value)",
-                            i + 1,
-                            c[i]
-                        ),
-                    ))
-                }
-            };
-            let (month, day, hour) = (
-                int(1, "month", 1, 12)?,
-                int(2, "day", 1, 31)?,
-                int(3, "hour", 1, 24)?,
-            );
-            if let Some(first) = seen.insert((month, day, hour), line) {
-                return Err(FileError::syntax(
-                    path,
-                    line,
-                    format!(
-                        "repeats the hour of line {first} (month {month}, day {day}, hour {hour}): which one holds that hour?"
-                    ),
-                ));
-            }
-            rows.push(EpwRow {
-                line,
-                month,
-                day,
-                hour,
-                dni_w_m2: irradiance(14, "direct normal irradiance")?,
-                dhi_w_m2: irradiance(15, "diffuse horizontal irradiance")?,
-            });
+            rows.push(row);
         }
         if rows.is_empty() {
             return Err(FileError::syntax(
@@ -238,6 +177,75 @@ impl Epw {
             .iter()
             .find(|r| r.month == month && r.day == day && r.hour == hour)
     }
+}
+
+/// One hourly row (`c`, its fields, at `line`): exactly 35 fields, the month, day and hour in
+/// range, the irradiances in range or missing (9999).
+fn parse_row(path: &Path, line: usize, c: &[&str]) -> Result<EpwRow, FileError> {
+    if c.len() != EPW_ROW_FIELDS {
+        return Err(FileError::syntax(
+            path,
+            line,
+            format!(
+                "the hourly row has {} fields where EnergyPlus writes {EPW_ROW_FIELDS}: a field missing or added would shift the irradiances (fields 15 and 16)",
+                c.len()
+            ),
+        ));
+    }
+    let int = |i: usize, what: &str, lo: u32, hi: u32| {
+        c[i].parse::<u32>()
+            .ok()
+            .filter(|v| (lo..=hi).contains(v))
+            .ok_or_else(|| {
+                FileError::syntax(
+                    path,
+                    line,
+                    format!(
+                        "the {what} (field {}) '{}' is not a whole number within {lo}…{hi}",
+                        i + 1,
+                        c[i]
+                    ),
+                )
+            })
+    };
+    let irradiance = |i: usize, what: &str| -> Result<Option<f64>, FileError> {
+        let v: f64 = c[i].parse().map_err(|_| {
+            FileError::syntax(
+                path,
+                line,
+                format!("the {what} (field {}) '{}' is not a number", i + 1, c[i]),
+            )
+        })?;
+        if v >= EPW_MISSING_IRRADIANCE {
+            return Ok(None);
+        }
+        if v.is_finite() && (0.0..=EPW_MAX_IRRADIANCE_W_M2).contains(&v) {
+            Ok(Some(v))
+        } else {
+            Err(FileError::syntax(
+                path,
+                line,
+                format!(
+                    "the {what} (field {}) {} is outside 0…1500 W/m² (9999 marks a missing value)",
+                    i + 1,
+                    c[i]
+                ),
+            ))
+        }
+    };
+    let (month, day, hour) = (
+        int(1, "month", 1, 12)?,
+        int(2, "day", 1, 31)?,
+        int(3, "hour", 1, 24)?,
+    );
+    Ok(EpwRow {
+        line,
+        month,
+        day,
+        hour,
+        dni_w_m2: irradiance(14, "direct normal irradiance")?,
+        dhi_w_m2: irradiance(15, "diffuse horizontal irradiance")?,
+    })
 }
 
 #[cfg(test)]

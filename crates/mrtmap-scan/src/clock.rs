@@ -282,7 +282,9 @@ pub fn estimate_offset(
     }
 }
 
-/// [`estimate_offset`], asking `stop` before each offset it tries: `None` once it says so.
+/// [`estimate_offset`], asking `stop` before each offset it tries: `None` once it says so. One
+/// function for the search's three passes (coarse, fine, the V's neighbourhood) and the verdict:
+/// they share the curve of offsets tried and the best so far.
 pub fn estimate_offset_until(
     rec: &Recording,
     search: &ClockSearch,

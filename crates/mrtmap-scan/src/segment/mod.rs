@@ -391,7 +391,8 @@ pub fn segment_textured(
 }
 
 /// [`segment_textured`], asking `stop` between its steps: `Ok(None)` once it says so (a person
-/// pressed Ctrl-C).
+/// pressed Ctrl-C). Long on purpose: one call per step of docs/segmentation.md, in that order, so
+/// that the method reads top to bottom here; each step is its own function.
 pub fn segment_textured_until(
     cloud: &ThermalCloud,
     camera_poses: &[Isometry3<f64>],

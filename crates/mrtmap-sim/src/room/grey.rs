@@ -50,8 +50,8 @@ pub enum Surfaces {
     Grey,
 }
 
-/// Window glass's emissivity in grey rooms (uncoated soda-lime glass).
-pub const GLASS_EMISSIVITY: f64 = 0.84;
+/// Window glass's emissivity in grey rooms: the emissivity table's glass (one value, one place).
+pub use mrtmap_radiation::grey::GLASS_EMISSIVITY;
 /// Where the other surfaces' emissivities are drawn from in grey rooms (paint, plaster, tiles).
 pub const GREY_EMISSIVITY: std::ops::Range<f64> = 0.90..0.95;
 
