@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use super::rig::Rig;
-use super::streams::{StreamEntry, parse_stream_list};
+use super::streams::{LineSkip, MAX_SKIPPED_SHARE, SkippedLine, StreamEntry, read_stream_list};
 use super::trajectory::{InterpolationLimits, Trajectory};
 use crate::error::{FileError, FileErrorKind};
 use crate::image16::{Image16, read_image16};
@@ -35,7 +35,7 @@ pub struct Recording {
 }
 
 /// Something worth knowing about a recording that does not stop it from being used.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub enum RecordingWarning {
     /// rig.toml has keys or sections mrtmap does not read (`[section] key`): a misspelt optional
@@ -58,6 +58,16 @@ pub enum RecordingWarning {
         count: usize,
         /// The first one (1-based).
         first_line: usize,
+    },
+    /// Lines left out of a list by the list rules (see [`super::streams`]): not "timestamp
+    /// path", back in time, or their file not there; at most a tenth of the list's frame lines.
+    SkippedLines {
+        /// The list.
+        list: &'static str,
+        /// Lines left out.
+        count: usize,
+        /// The first one, and why.
+        first: SkippedLine,
     },
     /// Thermal frames whose stamps lie outside the trajectory (as recorded: another clock's
     /// offset may cover them).
@@ -94,6 +104,13 @@ impl std::fmt::Display for RecordingWarning {
                 if *count == 1 { "s" } else { "" },
                 if *count == 1 { "is" } else { "are" }
             ),
+            Self::SkippedLines { list, count, first } => write!(
+                f,
+                "{list}: {count} line{} left out (the first, line {}: {})",
+                if *count == 1 { "" } else { "s" },
+                first.line,
+                first.why
+            ),
             Self::ThermalWithoutPose { uncovered, total } => write!(
                 f,
                 "{uncovered} of {total} thermal frames have no pose within the trajectory"
@@ -102,21 +119,15 @@ impl std::fmt::Display for RecordingWarning {
     }
 }
 
-/// The entries without those that repeat the one before (same time, same file), and the lines
-/// left out.
-fn without_repeats(entries: Vec<StreamEntry>) -> (Vec<StreamEntry>, Vec<usize>) {
-    let mut kept: Vec<StreamEntry> = Vec::with_capacity(entries.len());
-    let mut repeated = Vec::new();
-    for e in entries {
-        match kept.last() {
-            Some(prev) if prev.t == e.t && prev.path == e.path => repeated.push(e.line),
-            _ => kept.push(e),
-        }
-    }
-    (kept, repeated)
-}
-
-fn list(dir: &Path, name: &str, required: bool) -> Result<Vec<StreamEntry>, FileError> {
+/// A list's frames by the list rules, its files checked; the lines left out go to the warnings
+/// (repeats and the rest apart). More than [`MAX_SKIPPED_SHARE`] of its frame lines left out
+/// (repeats not counted) and the list is refused, naming the first.
+fn list(
+    dir: &Path,
+    name: &'static str,
+    required: bool,
+    warnings: &mut Vec<RecordingWarning>,
+) -> Result<Vec<StreamEntry>, FileError> {
     let p = dir.join(name);
     if !p.exists() {
         return if required {
@@ -130,15 +141,40 @@ fn list(dir: &Path, name: &str, required: bool) -> Result<Vec<StreamEntry>, File
         };
     }
     let text = std::fs::read_to_string(&p).map_err(|e| FileError::io(&p, e))?;
-    let entries = parse_stream_list(&text, &p)?;
-    for e in &entries {
-        if !dir.join(&e.path).is_file() {
-            return Err(FileError::new(
-                &p,
-                Some(e.line),
-                FileErrorKind::Missing(e.path.display().to_string()),
-            ));
+    let (listed, mut skipped) = read_stream_list(&text);
+    let mut entries = Vec::with_capacity(listed.len());
+    for e in listed {
+        if dir.join(&e.path).is_file() {
+            entries.push(e);
+        } else {
+            skipped.push(SkippedLine {
+                line: e.line,
+                why: LineSkip::Missing(e.path),
+            });
         }
+    }
+    skipped.sort_by_key(|s| s.line);
+    let (repeated, skipped): (Vec<_>, Vec<_>) =
+        skipped.into_iter().partition(|s| s.why == LineSkip::Repeated);
+    let frame_lines = entries.len() + skipped.len();
+    if let Some(first) = skipped.first()
+        && skipped.len() as f64 > MAX_SKIPPED_SHARE * frame_lines as f64
+    {
+        return Err(first.to_error(&p));
+    }
+    if let Some(first) = repeated.first() {
+        warnings.push(RecordingWarning::RepeatedLines {
+            list: name,
+            count: repeated.len(),
+            first_line: first.line,
+        });
+    }
+    if let Some(first) = skipped.first() {
+        warnings.push(RecordingWarning::SkippedLines {
+            list: name,
+            count: skipped.len(),
+            first: first.clone(),
+        });
     }
     Ok(entries)
 }
@@ -172,21 +208,10 @@ impl Recording {
         if !unknown.is_empty() {
             warnings.push(RecordingWarning::UnknownRigKeys(unknown));
         }
-        let mut once = |name: &'static str, entries: Vec<StreamEntry>| {
-            let (kept, repeated) = without_repeats(entries);
-            if let Some(&first_line) = repeated.first() {
-                warnings.push(RecordingWarning::RepeatedLines {
-                    list: name,
-                    count: repeated.len(),
-                    first_line,
-                });
-            }
-            kept
-        };
-        let depth = once("depth.txt", list(dir, "depth.txt", true)?);
-        let thermal = once("thermal.txt", list(dir, "thermal.txt", true)?);
-        let rgb = once("rgb.txt", list(dir, "rgb.txt", false)?);
-        let masks = once("masks.txt", list(dir, "masks.txt", false)?);
+        let depth = list(dir, "depth.txt", true, &mut warnings)?;
+        let thermal = list(dir, "thermal.txt", true, &mut warnings)?;
+        let rgb = list(dir, "rgb.txt", false, &mut warnings)?;
+        let masks = list(dir, "masks.txt", false, &mut warnings)?;
         let traj_path = dir.join("trajectory.txt");
         // Without poses, a recording with colour can still be tracked (`mrtmap track`).
         let trajectory = if traj_path.exists() {

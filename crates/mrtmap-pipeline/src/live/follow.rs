@@ -22,7 +22,7 @@ use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 use std::time::{Instant, SystemTime};
 
-use mrtmap_io::{Recording, StreamEntry, Trajectory};
+use mrtmap_io::{LineSkip, ListLine, Recording, SkippedLine, StreamEntry, StreamLines, Trajectory};
 
 /// How long a listed file may take to appear before its line is skipped (s).
 pub(crate) const MISSING_WAIT_S: f64 = 2.0;
@@ -66,9 +66,12 @@ struct Tail {
     list: List,
     /// Bytes read so far.
     offset: u64,
-    /// Lines read so far.
-    lines: usize,
+    /// The list's rules (mrtmap-io's, as the batch reader's), fed every line read so far.
+    rules: StreamLines,
     pending: VecDeque<Pending>,
+    /// Lines read so far (trajectory.txt).
+    pose_lines: usize,
+    /// The last pose's time (trajectory.txt).
     last_t: f64,
 }
 
@@ -139,7 +142,8 @@ impl Follower {
         .map(|list| Tail {
             list,
             offset: 0,
-            lines: 0,
+            rules: StreamLines::new(),
+            pose_lines: 0,
             pending: VecDeque::new(),
             last_t: f64::NEG_INFINITY,
         })
@@ -214,56 +218,48 @@ impl Follower {
         let Some(end) = bytes.iter().rposition(|&b| b == b'\n') else {
             return false;
         };
-        let at_start = self.tails[k].offset == 0;
         self.tails[k].offset += end as u64 + 1;
-        let mut text = String::from_utf8_lossy(&bytes[..=end]).into_owned();
-        // A byte-order mark at the list's start is read past, as the batch reader does.
-        if at_start && text.starts_with('\u{feff}') {
-            text.drain(..'\u{feff}'.len_utf8());
-        }
+        let text = String::from_utf8_lossy(&bytes[..=end]).into_owned();
         for raw in text.lines() {
-            self.tails[k].lines += 1;
-            let n = self.tails[k].lines;
-            let s = raw.trim();
-            if s.is_empty() || s.starts_with('#') {
-                continue;
-            }
             if list == List::Trajectory {
-                if !self.ignore_trajectory {
+                // The byte-order mark and comment rules are the stream lists' (and
+                // Trajectory::parse's, which reads each line).
+                self.tails[k].pose_lines += 1;
+                let n = self.tails[k].pose_lines;
+                let raw = if n == 1 {
+                    raw.strip_prefix('\u{feff}').unwrap_or(raw)
+                } else {
+                    raw
+                };
+                let s = raw.trim();
+                if !s.is_empty() && !s.starts_with('#') && !self.ignore_trajectory {
                     self.take_pose(k, n, s, &path);
                 }
                 continue;
             }
-            let mut it = s.split_whitespace();
-            let parsed = match (it.next().map(str::parse::<f64>), it.next()) {
-                (Some(Ok(t)), Some(p)) if t.is_finite() => Some((t, p)),
-                _ => None,
-            };
-            let Some((t, p)) = parsed else {
-                self.warn(format!(
-                    "{} line {n}: expected 'timestamp path', got '{s}': skipped",
-                    list.file()
-                ));
-                continue;
-            };
-            let tail = &mut self.tails[k];
-            let last = tail.pending.back().map_or(tail.last_t, |q| q.t);
-            if t < last {
-                self.warn(format!(
-                    "{} line {n}: its time {t:.6} goes back before the line above ({last:.6}): skipped; the recorder's clock or its lists are out of order",
-                    list.file()
-                ));
-                continue;
+            match self.tails[k].rules.next_line(raw) {
+                ListLine::Nothing => {}
+                ListLine::Skipped(skip) => self.skip(list, &skip),
+                ListLine::Entry(e) => self.tails[k].pending.push_back(Pending {
+                    line: e.line,
+                    t: e.t,
+                    path: e.path,
+                    since: Instant::now(),
+                    size: None,
+                }),
             }
-            tail.pending.push_back(Pending {
-                line: n,
-                t,
-                path: PathBuf::from(p),
-                since: Instant::now(),
-                size: None,
-            });
         }
         true
+    }
+
+    /// A line left out, in the batch reader's words.
+    fn skip(&mut self, list: List, skip: &SkippedLine) {
+        self.warn(format!(
+            "{} line {}: {}: skipped",
+            list.file(),
+            skip.line,
+            skip.why
+        ));
     }
 
     /// One trajectory line.
@@ -285,13 +281,7 @@ impl Follower {
                 }
             }
             Ok(_) => {}
-            Err(e) => self.warn(format!(
-                "trajectory.txt line {n}: {}: skipped",
-                e.to_string()
-                    .rsplit(": ")
-                    .next()
-                    .unwrap_or("cannot be read")
-            )),
+            Err(e) => self.warn(format!("trajectory.txt line {n}: {}: skipped", e.kind)),
         }
     }
 
@@ -306,15 +296,16 @@ impl Follower {
                 if head.since.elapsed().as_secs_f64() < MISSING_WAIT_S {
                     return;
                 }
-                let (line, p) = (head.line, head.path.display().to_string());
+                let (line, p) = (head.line, head.path.clone());
                 self.tails[k].pending.pop_front();
                 let what = if size.is_some() {
                     "is still incomplete"
                 } else {
                     "has not appeared"
                 };
+                let why = LineSkip::Missing(p);
                 self.warn(format!(
-                    "{} line {line} points to {p}, which {what} after {MISSING_WAIT_S} s: skipped",
+                    "{} line {line}: {why} (it {what} after {MISSING_WAIT_S} s): skipped",
                     list.file()
                 ));
                 continue;
@@ -322,7 +313,6 @@ impl Follower {
             let Some(head) = self.tails[k].pending.pop_front() else {
                 return;
             };
-            self.tails[k].last_t = head.t;
             let mut entry = StreamEntry {
                 t: head.t,
                 path: head.path,
@@ -398,6 +388,81 @@ mod tests {
         }
     }
 
+    /// The same damaged lists, read by `run`'s reader (Recording::open) and followed live, give
+    /// the same frames (issue 61): a byte-order mark, a repeated line, a line back in time, one
+    /// that is not "timestamp path", a timestamp that is not a number and a file that never
+    /// appears, in a list of 40 frames, fed to live in two pieces cut mid-line.
+    #[test]
+    fn live_and_run_take_the_same_frames_from_the_same_damaged_lists() {
+        let d = tempfile::tempdir().unwrap();
+        let dir = d.path();
+        std::fs::write(dir.join("rig.toml"), RIG).unwrap();
+        let mut thermal = String::from("\u{feff}# t path\n");
+        let mut depth = String::new();
+        let mut poses = String::new();
+        for i in 0..40 {
+            let t = 10.0 + 0.1 * f64::from(i);
+            if i != 17 {
+                png(dir, &format!("thermal/{i}.png"));
+            }
+            png(dir, &format!("depth/{i}.png"));
+            thermal.push_str(&format!("{t:.3} thermal/{i}.png\n"));
+            depth.push_str(&format!("{t:.3} depth/{i}.png\n"));
+            poses.push_str(&format!("{t:.3} 0 0 0 0 0 0 1\n"));
+            match i {
+                5 => thermal.push_str(&format!("{t:.3} thermal/{i}.png\n")),
+                9 => thermal.push_str("10.1 thermal/1.png\n"),
+                12 => thermal.push_str("garbage\n"),
+                30 => thermal.push_str("ten thermal/3.png\n"),
+                _ => {}
+            }
+        }
+        std::fs::write(dir.join("depth.txt"), &depth).unwrap();
+        std::fs::write(dir.join("trajectory.txt"), &poses).unwrap();
+        std::fs::write(dir.join("thermal.txt"), &thermal).unwrap();
+        let batch = Recording::open(dir).unwrap();
+        std::fs::remove_file(dir.join("thermal.txt")).unwrap();
+
+        let mut f = Follower::new(dir, None).unwrap();
+        let cut = thermal.len() / 2 + 3;
+        let cut = (cut..).find(|&c| thermal.is_char_boundary(c)).unwrap();
+        append(dir, "thermal.txt", &thermal[..cut]);
+        f.poll();
+        append(dir, "thermal.txt", &thermal[cut..]);
+        f.poll();
+        std::thread::sleep(std::time::Duration::from_secs_f64(MISSING_WAIT_S + 0.1));
+        f.poll();
+        let frames = |v: &[StreamEntry]| -> Vec<(usize, PathBuf, i64)> {
+            v.iter()
+                .map(|e| (e.line, e.path.clone(), (e.t * 1e6).round() as i64))
+                .collect()
+        };
+        assert_eq!(batch.thermal.len(), 39, "40 frames, one never written");
+        assert_eq!(frames(&f.rec.thermal), frames(&batch.thermal));
+        assert_eq!(frames(&f.rec.depth), frames(&batch.depth));
+        // Both name the five lines left out: batch in its warnings, live one by one.
+        let skipped = batch
+            .warnings
+            .iter()
+            .find_map(|w| match w {
+                mrtmap_io::RecordingWarning::SkippedLines { list, count, .. } => {
+                    Some((*list, *count))
+                }
+                _ => None,
+            })
+            .unwrap();
+        assert_eq!(skipped, ("thermal.txt", 4));
+        assert!(
+            batch.warnings.iter().any(|w| matches!(
+                w,
+                mrtmap_io::RecordingWarning::RepeatedLines { count: 1, .. }
+            )),
+            "{:?}",
+            batch.warnings
+        );
+        assert_eq!(f.warning_count, 5, "{:?}", f.warnings);
+    }
+
     /// A line still being written is left for the next poll; a file that has not appeared holds
     /// its list for MISSING_WAIT_S, then is skipped with a warning naming the line and the file;
     /// a line that goes back in time is skipped and named; the stream goes on after each.
@@ -438,7 +503,7 @@ mod tests {
         assert_eq!(f.warnings.len(), 1, "{:?}", f.warnings);
         assert!(
             f.warnings[0]
-                .contains("thermal.txt line 4 points to thermal/2.png, which has not appeared"),
+                .contains("thermal.txt line 4: its file thermal/2.png is not there (it has not appeared"),
             "{}",
             f.warnings[0]
         );
