@@ -22,7 +22,7 @@ use mrtmap_scan::segment::SegmentReport;
 use mrtmap_track::TrackReport;
 
 use crate::coverage::Coverage;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::layout::TrackDir;
 use crate::maps::{GridSpec, Mark, SceneMaps};
 use crate::points::{PointAnswers, PointQuery};
@@ -298,10 +298,11 @@ impl<'p> Pipeline<'p> {
     }
 
     /// `mrtmap segment`: the fusion in `fused` (cloud.ply, poses.txt) segmented into `out`
-    /// (scene.json, segments.ply, segment.json) with `[segment]` and `[room]`; the features
-    /// labelled by the instance masks of the recording `masks`, what the cloud missed textured from
-    /// the thermal frames of `recording` (the masks' when not given), the temperature level fixed
-    /// by the contact readings in `references`.
+    /// (scene.json, segments.ply, segment.json) with `[segment]`, `[room]`, `[emissivity]`,
+    /// `[[references]]` and `[mrt]`; the features labelled by the instance masks of the recording
+    /// `masks` (or of `recording`, as `run` does), what the cloud missed textured from the
+    /// thermal frames of `recording` (the masks' when not given), the temperature level fixed by
+    /// the contact readings of the recording's references.csv, `references` and the project's.
     pub fn segment(
         &self,
         fused: &Path,
@@ -315,8 +316,7 @@ impl<'p> Pipeline<'p> {
             fused,
             masks,
             recording,
-            section: self.project.segment.clone(),
-            origin_corner: self.project.room.origin_corner,
+            project: &self.project,
             references,
             out,
         })?;
@@ -341,6 +341,14 @@ impl<'p> Pipeline<'p> {
             height_m: m.heights_m.first().copied().unwrap_or(1.1),
             margin_m: m.margin_m,
         };
+        if let Some((id, in_scene, want)) = self.project.emissivity.disagrees_with(scene) {
+            return Err(Error::setting(
+                format!("[emissivity] of {id} = {want}"),
+                format!(
+                    "differs from the {in_scene} the scene {source} was segmented with: the emissivities are applied where the camera's temperatures become surface temperatures, so segment again with this project (`mrtmap segment --config` or `mrtmap run`)"
+                ),
+            ));
+        }
         mrtmap_io::check_replaceable(out)?;
         let maps = crate::maps::map_scene(scene, source, &self.project, spec, marks, out)?;
         mrtmap_io::record_made(out)?;
@@ -387,13 +395,13 @@ impl<'p> Pipeline<'p> {
     ) -> Result<()> {
         crate::coverage::check_target(target_k)?;
         if let Some(s) = exit_when_idle_s.filter(|s| !(s.is_finite() && *s > 0.0)) {
-            return Err(crate::Error::setting(
+            return Err(Error::setting(
                 format!("--exit-when-idle {s}"),
                 "give a positive number of seconds",
             ));
         }
         if !recording.is_dir() {
-            return Err(crate::Error::source(
+            return Err(Error::source(
                 recording,
                 "is not a folder: start the recorder first (live follows the folder it writes), or give the recording's folder",
             ));

@@ -558,20 +558,28 @@ pub(crate) fn merge_same_spot(refs: Vec<Reference>) -> (Vec<Reference>, Vec<Stri
 impl LevelInputs {
     /// The recording's references.csv (when present) and the project's `[[references]]`.
     pub fn of(rec: &Recording, p: &Project) -> Result<Self> {
-        let csv = rec.dir.join("references.csv");
-        let mut references = if csv.exists() {
-            read_references(&csv)?
-        } else {
-            Vec::new()
-        };
+        Self::gathered(Some(rec), None, p)
+    }
+
+    /// What every path gives the level: the readings of `csv` (by default the recording's
+    /// references.csv, when a recording is given and has one) and the project's
+    /// `[[references]]`, same spots merged; the camera's accuracy from the recording's rig (the
+    /// default without one); the project's emissivities and `[mrt]`.
+    pub fn gathered(rec: Option<&Recording>, csv: Option<&Path>, p: &Project) -> Result<Self> {
+        let mut references = Vec::new();
+        let own = rec
+            .map(|r| r.dir.join("references.csv"))
+            .filter(|f| f.exists());
+        if let Some(csv) = csv.or(own.as_deref()) {
+            references.extend(read_references(csv)?);
+        }
         references.extend(p.references.iter().cloned());
         let (references, warnings) = merge_same_spot(references);
         Ok(Self {
             references,
             warnings,
             camera_accuracy_k: rec
-                .rig
-                .thermal_accuracy_k
+                .and_then(|r| r.rig.thermal_accuracy_k)
                 .unwrap_or(DEFAULT_CAMERA_ACCURACY_K),
             emissivity: p.emissivity.clone(),
             mrt: p.mrt,

@@ -80,7 +80,7 @@ pub use live::replay::ReplayDone;
 pub use live::{LiveSink, LiveState};
 pub use progress::{Progress, Silent};
 pub use report::RunDone;
-pub use resolve::{MrtFlags, Overrides};
+pub use resolve::{FuseFlags, MrtFlags, Overrides, SegmentFlags, TrackFlags};
 pub use run::RunOutcome;
 pub use settings::Project;
 pub use settings::mrt::MrtSection;

@@ -216,6 +216,140 @@ impl MrtFlags {
     }
 }
 
+/// `[fuse]`'s flags (`run`, `fuse`, `coverage`): each overrides its key of project.toml when
+/// given; the defaults are [`crate::settings::FuseSection`]'s.
+#[derive(Clone, Debug, Default, PartialEq, clap::Args)]
+pub struct FuseFlags {
+    /// Voxel size (m) ([fuse] voxel_m).
+    #[arg(long = "voxel-m")]
+    pub voxel_m: Option<f64>,
+    /// Refine poses by point-to-plane ICP against the map built so far ([fuse] icp).
+    #[arg(long, value_name = "on|off", value_parser = crate::parse::parse_on_off)]
+    pub icp: Option<bool>,
+    /// Largest time between a thermal frame and the depth frame it takes (ms); at least 0.55 of
+    /// the depth frames' interval is used, so every thermal frame finds one at any depth rate
+    /// ([fuse] sync_tolerance_ms).
+    #[arg(long = "sync-tolerance-ms")]
+    pub sync_tolerance_ms: Option<f64>,
+    /// Use every N-th depth pixel in each direction; 0: about one depth point per thermal pixel
+    /// (the cameras' focal lengths' ratio, rounded: 3 for a 640×480 D435 beside a Lepton)
+    /// ([fuse] depth_stride).
+    #[arg(long)]
+    pub depth_stride: Option<u32>,
+    /// Radiometric self-calibration: estimate and remove each frame's offset (flat-field
+    /// corrections, drift) and the vignetting from the frames' overlaps ([fuse] self_calibrate).
+    #[arg(long, value_name = "on|off", value_parser = crate::parse::parse_on_off)]
+    pub self_calibrate: Option<bool>,
+    /// What to add to the thermal stamps to put them on the depth camera's clock: auto (rig.toml's
+    /// `[thermal] time_offset_s`, else estimated from the scan), estimate, off, or milliseconds
+    /// (-70: frames stamped 70 ms after their exposure) ([fuse] time_offset).
+    #[arg(long, allow_hyphen_values = true)]
+    pub time_offset: Option<String>,
+}
+
+impl FuseFlags {
+    /// The flags given, as overrides.
+    pub fn add_to(&self, o: &mut Overrides) {
+        o.set_some("fuse.voxel_m", "--voxel-m", self.voxel_m.as_ref())
+            .set_some("fuse.icp", "--icp", self.icp.as_ref())
+            .set_some(
+                "fuse.sync_tolerance_ms",
+                "--sync-tolerance-ms",
+                self.sync_tolerance_ms.as_ref(),
+            )
+            .set_some(
+                "fuse.depth_stride",
+                "--depth-stride",
+                self.depth_stride.as_ref(),
+            )
+            .set_some(
+                "fuse.self_calibrate",
+                "--self-calibrate",
+                self.self_calibrate.as_ref(),
+            )
+            .set_some(
+                "fuse.time_offset",
+                "--time-offset",
+                self.time_offset.as_ref(),
+            );
+    }
+}
+
+/// `[segment]`'s flags (`run`, `segment`): each overrides its key of project.toml when given;
+/// the defaults are [`crate::settings::SegmentSection`]'s.
+#[derive(Clone, Debug, Default, PartialEq, clap::Args)]
+pub struct SegmentFlags {
+    /// A texel belongs to a feature when it differs from its surface's background by more (K)
+    /// ([segment] feature_threshold_k).
+    #[arg(long)]
+    pub feature_threshold_k: Option<f64>,
+    /// Smallest feature (m²) ([segment] feature_min_area_m2).
+    #[arg(long = "feature-min-area-m2")]
+    pub feature_min_area_m2: Option<f64>,
+    /// Texel of each surface's temperature raster in scene.json (m), so that a stratified wall
+    /// radiates as it is; 0 for one temperature per surface ([segment] raster_m).
+    #[arg(long = "raster-m")]
+    pub raster_m: Option<f64>,
+    /// Do not label features by the recording's instance masks ([segment] masks = false).
+    #[arg(long)]
+    pub no_masks: bool,
+}
+
+impl SegmentFlags {
+    /// The flags given, as overrides.
+    pub fn add_to(&self, o: &mut Overrides) {
+        o.set_some(
+            "segment.feature_threshold_k",
+            "--feature-threshold-k",
+            self.feature_threshold_k.as_ref(),
+        )
+        .set_some(
+            "segment.feature_min_area_m2",
+            "--feature-min-area-m2",
+            self.feature_min_area_m2.as_ref(),
+        )
+        .set_some("segment.raster_m", "--raster-m", self.raster_m.as_ref())
+        .set_some(
+            "segment.masks",
+            "--no-masks",
+            self.no_masks.then_some(&false),
+        );
+    }
+}
+
+/// `[track]`'s flags (`run`, `track`): each overrides its key of project.toml when given; the
+/// defaults are [`crate::settings::TrackSection`]'s.
+#[derive(Clone, Debug, Default, PartialEq, clap::Args)]
+pub struct TrackFlags {
+    /// Do not look for loop closures ([track] loop_closure = false).
+    #[arg(long)]
+    pub no_loops: bool,
+    /// Leave the recording's gyro (imu.txt) out of the prediction ([track] use_imu = false).
+    #[arg(long)]
+    pub no_imu: bool,
+    /// FAST corner threshold (grey levels); lower finds more corners on weak texture ([track]
+    /// fast_threshold).
+    #[arg(long)]
+    pub fast_threshold: Option<u8>,
+}
+
+impl TrackFlags {
+    /// The flags given, as overrides.
+    pub fn add_to(&self, o: &mut Overrides) {
+        o.set_some(
+            "track.loop_closure",
+            "--no-loops",
+            self.no_loops.then_some(&false),
+        )
+        .set_some("track.use_imu", "--no-imu", self.no_imu.then_some(&false))
+        .set_some(
+            "track.fast_threshold",
+            "--fast-threshold",
+            self.fast_threshold.as_ref(),
+        );
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use serde_json::Value;

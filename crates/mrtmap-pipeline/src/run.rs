@@ -30,12 +30,10 @@ use crate::cache::{Fingerprint, Stage, StageOutcome, read_json, run_or_reuse, wr
 use crate::comfort::{ComfortSummary, comfort_title, make_comfort_maps};
 use crate::error::{Error, Result};
 use crate::layout::{FuseDir, RunLayout, SegmentDir, TrackDir};
-use crate::level::{DEFAULT_CAMERA_ACCURACY_K, Level, LevelInputs, read_references};
+use crate::level::{Level, LevelInputs, read_references};
 use crate::maps::{Mark, MarkAt, Summary, make_map};
 use crate::progress::Progress;
-use crate::settings::{
-    PointEntry, PointFrame, Project, Quantity, RoomSection, SegmentSection, TrackMode,
-};
+use crate::settings::{PointEntry, PointFrame, Project, Quantity, TrackMode};
 
 /// The tracked trajectory without the poses that jump away from their neighbours' motion and
 /// back (issue 54: the frame after a lost one was written 54 cm off); the report counts them and
@@ -185,21 +183,20 @@ pub struct SegmentJob<'a> {
     /// A recording with instance masks (masks.txt) to label the features by.
     pub masks: Option<&'a Path>,
     /// The recording that was fused, whose thermal frames texture the room model (the masks'
-    /// recording when not given).
+    /// recording when not given); its masks, references.csv and camera accuracy are used as
+    /// `run` uses them.
     pub recording: Option<&'a Path>,
-    /// Feature threshold, smallest feature, raster texel (its `masks` and `texture` are set from
-    /// the recordings given).
-    pub section: SegmentSection,
-    /// The floor corner at the room frame's origin.
-    pub origin_corner: Option<usize>,
-    /// Contact readings (references.csv).
+    /// The settings (`[segment]`, `[room]`, `[emissivity]`, `[[references]]`, `[mrt]`).
+    pub project: &'a Project,
+    /// Contact readings (a references.csv besides the recording's).
     pub references: Option<&'a Path>,
     /// Where scene.json, segments.ply and segment.json go.
     pub out: &'a Path,
 }
 
 /// Segments a fusion's folder as [`SegmentJob`] says, after checking its inputs; one call for
-/// `mrtmap segment`.
+/// `mrtmap segment`. With the recording given, its inputs are gathered as the segment stage of
+/// `run` gathers them, so the two give the same scene.
 pub fn segment_folder(job: &SegmentJob<'_>) -> Result<SegmentReport> {
     if !FuseDir::new(job.fused).cloud_ply().exists() {
         return Err(Error::source(
@@ -221,32 +218,22 @@ pub fn segment_folder(job: &SegmentJob<'_>) -> Result<SegmentReport> {
         (Some(dir), _) => Some(Recording::open(dir)?),
         (None, m) => m,
     };
-    let section = SegmentSection {
-        masks: job.masks.is_some(),
-        texture: recording.is_some(),
-        ..job.section.clone()
-    };
-    section.check()?;
-    let room = RoomSection {
-        origin_corner: job.origin_corner,
-    };
-    room.check()?;
+    let p = job.project;
+    let use_masks = job.masks.is_some()
+        || (p.segment.masks && recording.as_ref().is_some_and(|r| !r.masks.is_empty()));
     let inputs = SegmentInputs {
         recording: recording.as_ref(),
-        masks: section.masks,
-        texture: section.texture,
+        masks: use_masks,
+        texture: p.segment.texture && recording.is_some(),
     };
-    let (references, warnings) = crate::level::merge_same_spot(match job.references {
-        Some(f) => read_references(f)?,
-        None => Vec::new(),
-    });
-    let level = LevelInputs {
-        references,
-        camera_accuracy_k: DEFAULT_CAMERA_ACCURACY_K,
-        warnings,
-        ..LevelInputs::default()
-    };
-    segment_into(job.fused, &inputs, &section.params(&room), &level, job.out)
+    let level = LevelInputs::gathered(recording.as_ref(), job.references, p)?;
+    segment_into(
+        job.fused,
+        &inputs,
+        &p.segment.params(&p.room),
+        &level,
+        job.out,
+    )
 }
 
 /// Segments the fusion in `fused` (cloud.ply, poses.txt) into `out`: scene.json, segments.ply,

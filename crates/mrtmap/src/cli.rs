@@ -3,20 +3,17 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use mrtmap_pipeline::MrtFlags;
 use mrtmap_pipeline::calibration::CalibrateArgs;
 use mrtmap_pipeline::demo::DemoArgs;
 use mrtmap_pipeline::export::{DEFAULT_MAX_POINTS, ExportFormat, ExportSource};
 use mrtmap_pipeline::maps::SceneSource;
-use mrtmap_pipeline::parse::{
-    parse_facing, parse_grid, parse_mark, parse_on_off, parse_point, parse_sun,
-};
-use mrtmap_pipeline::settings::{FuseSection, SegmentSection};
+use mrtmap_pipeline::parse::{parse_facing, parse_grid, parse_mark, parse_point, parse_sun};
 use mrtmap_pipeline::settings::{PointFrame, Quantity};
 use mrtmap_pipeline::simulation::SimulateArgs;
 use mrtmap_pipeline::source::SourceOptions;
 use mrtmap_pipeline::thermal_image::ThermalReading;
 use mrtmap_pipeline::validation::GlobeFormulaChoice;
+use mrtmap_pipeline::{FuseFlags, MrtFlags, SegmentFlags, TrackFlags};
 
 /// Map the mean radiant temperature (MRT) of a room.
 ///
@@ -275,18 +272,15 @@ pub struct RunArgs {
     /// origin_corner); by default the start of the longest wall with the room at x, y ≥ 0.
     #[arg(long, value_name = "N")]
     pub origin_corner: Option<usize>,
-    /// Voxel size (m) ([fuse] voxel_m).
-    #[arg(long = "voxel-m")]
-    pub voxel_m: Option<f64>,
-    /// ICP refinement ([fuse] icp).
-    #[arg(long, value_name = "on|off", value_parser = parse_on_off)]
-    pub icp: Option<bool>,
-    /// Radiometric self-calibration of the frames ([fuse] self_calibrate).
-    #[arg(long, value_name = "on|off", value_parser = parse_on_off)]
-    pub self_calibrate: Option<bool>,
-    /// Do not use the recording's instance masks ([segment] masks = false).
-    #[arg(long)]
-    pub no_masks: bool,
+    /// `[track]`'s flags.
+    #[command(flatten)]
+    pub track: TrackFlags,
+    /// `[fuse]`'s flags.
+    #[command(flatten)]
+    pub fuse: FuseFlags,
+    /// `[segment]`'s flags.
+    #[command(flatten)]
+    pub segment: SegmentFlags,
     /// Air temperature for the report (°C) ([air] temperature_c).
     #[arg(long, allow_negative_numbers = true)]
     pub air_c: Option<f64>,
@@ -412,17 +406,22 @@ pub struct SegmentArgs {
     /// Output folder for scene.json, segments.ply and segment.json.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-    /// Feature and raster settings.
+    /// A project file (TOML): its [segment], [room], [emissivity], [[references]] and [mrt]
+    /// apply, as in `mrtmap run`; flags override it.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// `[segment]`'s flags.
     #[command(flatten)]
-    pub section: SegmentSection,
+    pub section: SegmentFlags,
     /// The floor corner at the room frame's origin, as numbered in segment.json's floor_corners;
-    /// by default the start of the longest wall with the room at x, y ≥ 0.
+    /// by default the start of the longest wall with the room at x, y ≥ 0 ([room] origin_corner).
     #[arg(long, value_name = "N")]
     pub origin_corner: Option<usize>,
     /// Contact-thermometer readings (label,x,y,z,temperature_c[,std_k][,frame]; x, y, z in the
     /// room frame unless the frame column says scan, the frame of trajectory.txt) that fix the
     /// temperatures' absolute level (one: offset; two or more on different temperatures: gain
-    /// too).
+    /// too). Default: the recording's references.csv, as in `mrtmap run`; --config's
+    /// [[references]] are added either way.
     #[arg(long, value_name = "CSV")]
     pub references: Option<PathBuf>,
 }
@@ -440,9 +439,12 @@ pub struct FuseArgs {
     /// Output folder for cloud.ply, fusion.json and the refined trajectory.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-    /// The fusion's settings.
+    /// A project file (TOML): its [fuse] applies, as in `mrtmap run`; flags override it.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// `[fuse]`'s flags.
     #[command(flatten)]
-    pub fuse: FuseSection,
+    pub fuse: FuseFlags,
 }
 
 /// `mrtmap track`.
@@ -453,15 +455,12 @@ pub struct TrackArgs {
     /// Output folder for trajectory.txt and track.json.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
-    /// Do not look for loop closures.
-    #[arg(long)]
-    pub no_loops: bool,
-    /// Leave the recording's gyro (imu.txt) out of the prediction.
-    #[arg(long)]
-    pub no_imu: bool,
-    /// FAST corner threshold (grey levels); lower finds more corners on weak texture.
-    #[arg(long, default_value_t = 12)]
-    pub fast_threshold: u8,
+    /// A project file (TOML): its [track] applies, as in `mrtmap run`; flags override it.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// `[track]`'s flags.
+    #[command(flatten)]
+    pub track: TrackFlags,
 }
 
 /// `mrtmap rooms`.
@@ -568,6 +567,10 @@ pub struct MrtArgs {
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// A project file (TOML): its [mrt] applies, and its [sun] when --sun is not given; flags
+    /// override it.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
 }
 
 /// `mrtmap comfort`.

@@ -13,8 +13,8 @@ pub use imu::{ImuSample, imu_text, parse_imu, read_imu};
 pub use recording::{Recording, RecordingWarning};
 pub use rig::{PoseFile, RgbCamera, Rig, ThermalEncoding};
 pub use streams::{
-    LineSkip, ListLine, MAX_SKIPPED_SHARE, SkippedLine, StreamEntry, StreamLines, parse_stream_list,
-    read_stream_list, stream_list_text,
+    LineSkip, ListLine, MAX_SKIPPED_SHARE, SkippedLine, StreamEntry, StreamLines,
+    parse_stream_list, read_stream_list, stream_list_text,
 };
 pub use trajectory::{
     InterpolationLimits, QUATERNION_NORM_TOLERANCE, Trajectory, quaternion_xyzw, unit_quaternion,

@@ -154,8 +154,9 @@ fn list(
         }
     }
     skipped.sort_by_key(|s| s.line);
-    let (repeated, skipped): (Vec<_>, Vec<_>) =
-        skipped.into_iter().partition(|s| s.why == LineSkip::Repeated);
+    let (repeated, skipped): (Vec<_>, Vec<_>) = skipped
+        .into_iter()
+        .partition(|s| s.why == LineSkip::Repeated);
     let frame_lines = entries.len() + skipped.len();
     if let Some(first) = skipped.first()
         && skipped.len() as f64 > MAX_SKIPPED_SHARE * frame_lines as f64

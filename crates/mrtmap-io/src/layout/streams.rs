@@ -68,7 +68,9 @@ impl SkippedLine {
             LineSkip::NotAnEntry(s) => {
                 FileErrorKind::Syntax(format!("expected 'timestamp path', got '{s}'"))
             }
-            LineSkip::NotATimestamp(s) => FileErrorKind::Syntax(format!("'{s}' is not a timestamp")),
+            LineSkip::NotATimestamp(s) => {
+                FileErrorKind::Syntax(format!("'{s}' is not a timestamp"))
+            }
             LineSkip::Backwards { t, previous } => FileErrorKind::TimestampBackwards {
                 t: *t,
                 previous: *previous,

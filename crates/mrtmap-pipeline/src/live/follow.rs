@@ -502,8 +502,9 @@ mod tests {
         assert!((f.rec.thermal[2].t - 10.3).abs() < 1e-12);
         assert_eq!(f.warnings.len(), 1, "{:?}", f.warnings);
         assert!(
-            f.warnings[0]
-                .contains("thermal.txt line 4: its file thermal/2.png is not there (it has not appeared"),
+            f.warnings[0].contains(
+                "thermal.txt line 4: its file thermal/2.png is not there (it has not appeared"
+            ),
             "{}",
             f.warnings[0]
         );

@@ -64,6 +64,34 @@ impl EmissivitySection {
             )
     }
 
+    /// The first element of `scene` that one of this section's entries names (by id or label)
+    /// whose emissivity in the scene is another: (its id, the scene's, this section's). The
+    /// emissivities are applied when the room is segmented, where the camera's radiant
+    /// temperatures become surface temperatures; a scene segmented without them cannot take them
+    /// afterwards.
+    pub fn disagrees_with(&self, scene: &RadiantScene) -> Option<(String, f64, f64)> {
+        let named = |id: &str, label: &str| {
+            let l = label.to_lowercase();
+            self.by_id.contains_key(id)
+                || self.by_label.keys().any(|k| l.contains(&k.to_lowercase()))
+        };
+        let mut elements: Vec<(&str, &str, Option<mrtmap_radiation::SurfaceKind>, f64)> =
+            Vec::new();
+        for s in &scene.surfaces {
+            elements.push((&s.id, &s.label, Some(s.kind), s.emissivity));
+            for f in &s.features {
+                elements.push((&f.id, &f.label, None, f.emissivity));
+            }
+        }
+        for o in &scene.occluders {
+            elements.push((&o.id, &o.label, None, o.emissivity));
+        }
+        elements.into_iter().find_map(|(id, label, kind, e)| {
+            let want = self.of(id, label, kind);
+            (named(id, label) && (want - e).abs() > 1e-9).then(|| (id.to_string(), e, want))
+        })
+    }
+
     /// Sets every surface's, feature's and occluder's emissivity in `scene` and marks its
     /// temperatures as radiant (what the camera read). Returns the entries that matched nothing
     /// in the scene (`by_id.window-99`, `by_label.windw`), for a warning: a misspelt one changed

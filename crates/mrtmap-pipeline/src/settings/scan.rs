@@ -59,35 +59,26 @@ impl TrackSection {
     }
 }
 
-/// `[fuse]`, and the flags of `mrtmap fuse` (the doc comments are their `--help`, the defaults
-/// those of [`Default`]).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, clap::Args)]
+/// `[fuse]` (its flags: [`crate::FuseFlags`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct FuseSection {
     /// Voxel size (m).
-    #[arg(long = "voxel-m", default_value_t = 0.03)]
     pub voxel_m: f64,
     /// Refine poses by point-to-plane ICP against the map built so far (on or off).
-    #[arg(long, default_value = "on", value_name = "on|off", action = clap::ArgAction::Set,
-          value_parser = crate::parse::parse_on_off)]
     pub icp: bool,
     /// Largest time between a thermal frame and the depth frame it takes (ms); at least 0.55 of
     /// the depth frames' interval is used, so every thermal frame finds one at any depth rate.
-    #[arg(long = "sync-tolerance-ms", default_value_t = 20.0)]
     pub sync_tolerance_ms: f64,
     /// Use every N-th depth pixel in each direction; 0: about one depth point per thermal pixel
     /// (the cameras' focal lengths' ratio, rounded: 3 for a 640×480 D435 beside a Lepton).
-    #[arg(long, default_value_t = 0)]
     pub depth_stride: u32,
     /// Radiometric self-calibration (on or off): estimate and remove each frame's offset
     /// (flat-field corrections, drift) and the vignetting from the frames' overlaps.
-    #[arg(long, default_value = "on", value_name = "on|off", action = clap::ArgAction::Set,
-          value_parser = crate::parse::parse_on_off)]
     pub self_calibrate: bool,
     /// What to add to the thermal stamps to put them on the depth camera's clock: auto (rig.toml's
     /// `[thermal] time_offset_s`, else estimated from the scan), estimate, off, or milliseconds
     /// (-70: frames stamped 70 ms after their exposure).
-    #[arg(long, default_value = "auto", allow_hyphen_values = true)]
     pub time_offset: String,
 }
 
@@ -162,28 +153,22 @@ impl FuseSection {
     }
 }
 
-/// `[segment]`, and the flags of `mrtmap segment` (the doc comments are their `--help`, the
-/// defaults those of [`Default`]).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, clap::Args)]
+/// `[segment]` (its flags: [`crate::SegmentFlags`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SegmentSection {
     /// A texel belongs to a feature when it differs from its surface's background by more (K).
-    #[arg(long, default_value_t = 0.3)]
     pub feature_threshold_k: f64,
     /// Smallest feature (m²).
-    #[arg(long = "feature-min-area-m2", default_value_t = 0.04)]
     pub feature_min_area_m2: f64,
     /// Texel of each surface's temperature raster in scene.json (m), so that a stratified wall
     /// radiates as it is; 0 for one temperature per surface.
-    #[arg(long = "raster-m", default_value_t = 0.15)]
     pub raster_m: f64,
     /// Label features by the recording's instance masks when it has them.
-    #[arg(skip = true)]
     pub masks: bool,
     /// Cast the fused thermal frames onto the room model found, so that what the depth camera
     /// did not see (glass, dark or shiny surfaces, dropouts) takes the thermal camera's
     /// temperatures.
-    #[arg(skip = true)]
     pub texture: bool,
 }
 

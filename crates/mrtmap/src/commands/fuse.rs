@@ -5,16 +5,16 @@ use mrtmap_pipeline::{Overrides, Pipeline, Project};
 use crate::cli::FuseArgs;
 use crate::output::{Bar, print_lines};
 
+/// The project: the defaults, then the file, then the flags given.
+pub(crate) fn settings(a: &FuseArgs) -> anyhow::Result<Project> {
+    let mut o = Overrides::new();
+    a.fuse.add_to(&mut o);
+    Ok(Project::resolve(a.config.as_deref(), &o)?)
+}
+
 pub fn run(a: &FuseArgs) -> anyhow::Result<()> {
-    let project = Project::resolve_over(
-        Project {
-            fuse: a.fuse.clone(),
-            ..Project::default()
-        },
-        &Overrides::new(),
-    )?;
     let bar = Bar::new("");
-    let done = Pipeline::new(project)
+    let done = Pipeline::new(settings(a)?)
         .source(a.src.clone())
         .progress(&bar)
         .fuse(&a.recording, &a.out)?;

@@ -7,7 +7,8 @@ use mrtmap_pipeline::{Overrides, Pipeline, Project};
 use crate::cli::MapArgs;
 use crate::output::print_lines;
 
-pub fn run(a: &MapArgs) -> anyhow::Result<()> {
+/// The project: the defaults, then the file, then the flags given.
+pub(crate) fn settings(a: &MapArgs) -> anyhow::Result<Project> {
     let mut o = Overrides::new();
     o.set_some("map.grid", "--grid", a.grid.map(|(x, y)| [x, y]).as_ref())
         .set_some(
@@ -23,7 +24,11 @@ pub fn run(a: &MapArgs) -> anyhow::Result<()> {
         )
         .set_some("air.temperature_c", "--air-c", a.air_c.as_ref());
     a.method.add_to(&mut o);
-    let project = Project::resolve(a.config.as_deref(), &o)?;
+    Ok(Project::resolve(a.config.as_deref(), &o)?)
+}
+
+pub fn run(a: &MapArgs) -> anyhow::Result<()> {
+    let project = settings(a)?;
     let (scene, source) = load_scene(&a.scene)?;
     let marks: Vec<Mark> = a
         .marks

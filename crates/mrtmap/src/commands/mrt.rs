@@ -7,8 +7,26 @@ use mrtmap_pipeline::{Overrides, Pipeline, Project};
 use crate::cli::MrtArgs;
 use crate::output::{json, print_lines};
 
+/// The project: the defaults, then the file, then the flags given.
+pub(crate) fn settings(a: &MrtArgs) -> anyhow::Result<Project> {
+    let mut flags = Overrides::new();
+    a.method.add_to(&mut flags);
+    Ok(Project::resolve(a.config.as_deref(), &flags)?)
+}
+
 pub fn run(a: &MrtArgs) -> anyhow::Result<()> {
+    let project = settings(a)?;
     let (scene, source) = load_scene(&a.scene)?;
+    // --sun (with its --dni and --transmittance) overrides the project's [sun] as a whole.
+    let sun = match a.sun {
+        Some([alt, az]) => Some(SunQuery::new(
+            alt,
+            az,
+            a.dni.unwrap_or_default(),
+            a.transmittance.unwrap_or_default(),
+        )),
+        None => project.sun.query()?,
+    };
     let query = PointQuery {
         at: a.at.clone(),
         frame: a.frame,
@@ -16,18 +34,9 @@ pub fn run(a: &MrtArgs) -> anyhow::Result<()> {
             .person
             .map(|p| (p, a.facing.map_or(Facing::Any, Facing::Azimuth))),
         planes: a.plane,
-        sun: a.sun.map(|[alt, az]| {
-            SunQuery::new(
-                alt,
-                az,
-                a.dni.unwrap_or_default(),
-                a.transmittance.unwrap_or_default(),
-            )
-        }),
+        sun,
     };
-    let mut flags = Overrides::new();
-    a.method.add_to(&mut flags);
-    let answers = Pipeline::new(Project::resolve(None, &flags)?).mrt(&scene, &source, &query)?;
+    let answers = Pipeline::new(project).mrt(&scene, &source, &query)?;
     if a.json {
         out!("{}", json(&answers)?);
     } else {

@@ -8,7 +8,7 @@ use crate::cli::RunArgs;
 use crate::output::{Bar, print_lines};
 
 /// The project: the defaults, then the file, then the flags given.
-fn settings(a: &RunArgs) -> anyhow::Result<Project> {
+pub(crate) fn settings(a: &RunArgs) -> anyhow::Result<Project> {
     let mut o = Overrides::new();
     o.set_some("map.grid", "--grid", a.grid.map(|(x, y)| [x, y]).as_ref())
         .set_some(
@@ -22,20 +22,15 @@ fn settings(a: &RunArgs) -> anyhow::Result<Project> {
             "--quantity",
             (!a.quantities.is_empty()).then_some(&a.quantities),
         )
-        .set_some("fuse.voxel_m", "--voxel-m", a.voxel_m.as_ref())
-        .set_some("fuse.icp", "--icp", a.icp.as_ref())
-        .set_some(
-            "fuse.self_calibrate",
-            "--self-calibrate",
-            a.self_calibrate.as_ref(),
-        )
-        .set_some("segment.masks", "--no-masks", a.no_masks.then_some(&false))
         .set_some(
             "room.origin_corner",
             "--origin-corner",
             a.origin_corner.as_ref(),
         )
         .set_some("air.temperature_c", "--air-c", a.air_c.as_ref());
+    a.track.add_to(&mut o);
+    a.fuse.add_to(&mut o);
+    a.segment.add_to(&mut o);
     for (name, c) in &a.marks {
         let &[x, y, z] = c.as_slice() else {
             bail!(
