@@ -51,7 +51,7 @@ pub(crate) fn read_references(path: &Path) -> Result<Vec<Reference>> {
 }
 
 /// Parses references.csv text; errors name `path` and the line.
-pub fn parse_references(text: &str, path: &Path) -> Result<Vec<Reference>> {
+pub(crate) fn parse_references(text: &str, path: &Path) -> Result<Vec<Reference>> {
     // Excel's "CSV UTF-8" starts with a byte-order mark: read past it.
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let bad = |line: usize, msg: String| Error::Config {

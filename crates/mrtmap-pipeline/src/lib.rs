@@ -25,8 +25,7 @@
 //! - Commands that need no project: [`source`] (inspect, convert), [`demo`], [`calibration`],
 //!   [`simulation`], [`export`], [`points`] and [`maps`] (scenes, their points and grids),
 //!   [`comfort`], [`validation`] (also globe ↔ MRT), [`thermal_image`] (one thermal file);
-//!   [`parse`]: the text forms flags share (`20x20`, `X,Y,Z`, `on|off`); [`parse_references`]:
-//!   contact readings as text.
+//!   [`parse`]: the text forms flags share (`20x20`, `X,Y,Z`).
 //! - On site, live: [`Pipeline::live`] follows a recording as it is written and sends a
 //!   [`LiveState`] to a [`LiveSink`] (the live page's server, `mrtmap-live`);
 //!   [`Pipeline::replay`] writes a recording again at its own pace.
@@ -72,10 +71,10 @@ pub mod source;
 pub mod thermal_image;
 pub mod validation;
 
-pub use error::{Error, Result};
+pub use error::Error;
+pub(crate) use error::Result;
 pub use front::{FuseDone, Pipeline, SegmentDone, TrackDone};
 pub use layout::{DemoLayout, RunLayout};
-pub use level::parse_references;
 pub use live::replay::ReplayDone;
 pub use live::{LiveSink, LiveState};
 pub use progress::{Progress, Silent};

@@ -114,7 +114,7 @@ pub(crate) fn parse_interval(s: &str) -> Result<[f64; 2], ParseError> {
 }
 
 /// A switch: on or off.
-pub fn parse_on_off(s: &str) -> Result<bool, ParseError> {
+pub(crate) fn parse_on_off(s: &str) -> Result<bool, ParseError> {
     match s.trim() {
         "on" => Ok(true),
         "off" => Ok(false),

@@ -22,8 +22,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::clock::{ClockOffset, ClockReport, ClockSearch, OffsetSource, estimate_offset_until};
 use crate::frame::{DepthPoints, DepthSampling, RayTable, ThermalImage, depth_points};
+use crate::jump_judge::DepthJudge;
 use crate::observe::{ObservationCounts, ObservationParams, observe};
-use crate::pose_check::{PoseCheck, drop_outlier_poses};
+use crate::pose_check::{PoseCheck, check_poses};
 use crate::radiometric::{
     Calibrator, FrameResiduals, RadiometricReport, SelfCalibration, frame_residuals,
 };
@@ -926,11 +927,12 @@ pub fn fuse_until(
     let t_start = Instant::now();
     let limits = InterpolationLimits::default();
     let tolerance = sync_tolerance(rec, params.sync_tolerance_s);
-    // Poses that jump away from their neighbours' motion and back are dropped first, then the
-    // thermal clock is set.
-    let (checked, pose_check) = drop_outlier_poses(&rec.trajectory);
+    // Poses that jump away from their neighbours' motion and back are dropped first (and jumps
+    // that stay judged by the depth), then the thermal clock is set.
+    let judge = DepthJudge::new(rec, &params.depth);
+    let (checked, pose_check) = check_poses(&rec.trajectory, Some(&judge));
     let cleaned;
-    let rec = if pose_check.dropped > 0 || pose_check.left_out > 0 {
+    let rec = if pose_check.dropped > 0 || !pose_check.jumps.is_empty() {
         let mut r = rec.clone();
         r.trajectory = checked;
         cleaned = r;

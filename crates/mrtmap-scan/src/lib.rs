@@ -13,6 +13,7 @@ pub mod clock;
 pub mod frame;
 mod fuse;
 mod fuse_live;
+mod jump_judge;
 pub mod observe;
 pub mod pose_check;
 pub mod radiometric;

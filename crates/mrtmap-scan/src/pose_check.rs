@@ -13,11 +13,17 @@
 //! source's frame correcting itself.
 //!
 //! A jump that stays and is larger than a correction ([`JUMP_MIN_M`] beyond what a hand moves the
-//! camera in that interval, or [`JUMP_MIN_DEG`]) is a relocalisation into another frame: the poses
-//! either side of it are in two frames that no longer agree. The trajectory is cut there first;
-//! the piece with the most poses is kept and the others are left out (their frames are not fused),
-//! each jump listed with its time and size so that a run says which part of the scan it lost.
-//! Re-registering a piece to the map is not attempted.
+//! camera in that interval, or [`JUMP_MIN_DEG`]; with the depth to judge by, [`JUDGED_STEP_M`] or
+//! [`JUDGED_STEP_DEG`]) splits the trajectory into pieces. What it was is
+//! for the depth to say ([`JumpJudge`], given by fusion): the largest piece is the reference, and
+//! each other piece, from the nearest outwards, is compared with the depth seen by the pieces kept
+//! so far: if its frames agree with them at its own poses, the jump was motion (a pose stream
+//! with a gap, a tracker that caught up) and the piece is kept as it is; if they agree once the
+//! piece is moved by one rigid correction (first guessed by joining the poses either side of the
+//! jump, then refined by ICP), the pose source relocalised into another frame and the piece is
+//! re-anchored; if neither, the piece is left out (its frames are not fused). Without a judge (or
+//! when it cannot tell), every jump cuts, and the largest piece is kept. Each jump is listed with
+//! its time, size and outcome, so that a run says which part of the scan it moved or lost.
 
 use mrtmap_geometry::nalgebra::{Isometry3, Vector3};
 use mrtmap_io::Trajectory;
@@ -32,8 +38,32 @@ const HALF_WINDOW: usize = 3;
 pub const JUMP_MIN_M: f64 = 1.0;
 /// The same for the rotation (degrees, beyond 400°/s times the interval).
 pub const JUMP_MIN_DEG: f64 = 45.0;
+/// With the depth to judge by, the smallest step judged (m, degrees, beyond the same motion): a
+/// relocalisation by half a metre or ten degrees mapped half the scan that far off, and a step
+/// that was motion or a pose source's own correction costs nothing when the depth agrees.
+pub const JUDGED_STEP_M: f64 = 0.25;
+/// See [`JUDGED_STEP_M`].
+pub const JUDGED_STEP_DEG: f64 = 5.0;
 
-/// A jump that stayed: the trajectory was cut there.
+/// What a jump that stayed was, by the depth.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "kind")]
+pub enum JumpOutcome {
+    /// The frames after it agree with the map at their poses: the camera moved.
+    Motion,
+    /// They agree after one rigid correction of the piece (a relocalisation): re-anchored.
+    Reanchored {
+        /// How far the piece was moved (m).
+        correction_m: f64,
+        /// How far it was turned (degrees).
+        correction_deg: f64,
+    },
+    /// Neither (or nothing to judge by): the piece is left out.
+    #[default]
+    Cut,
+}
+
+/// A jump that stayed, and what became of the piece beyond it.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PoseJump {
     /// The time of the first pose after it (s).
@@ -42,7 +72,41 @@ pub struct PoseJump {
     pub jump_m: f64,
     /// How far it turned (degrees).
     pub jump_deg: f64,
+    /// What it was.
+    #[serde(default)]
+    pub outcome: JumpOutcome,
+    /// The share of the piece's depth points that lie on the map kept so far at its own poses,
+    /// and after the rigid correction (0…1), when the depth judged it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub agreement: Option<[f64; 2]>,
 }
+
+/// How well a piece of trajectory's depth agrees with the pieces kept so far.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Agreement {
+    /// The share of its depth points on the kept map at its own poses (0…1).
+    pub as_is: f64,
+    /// The share after the best rigid correction near the guess (0…1).
+    pub corrected: f64,
+    /// That correction (applied on the left of the piece's poses).
+    pub correction: Isometry3<f64>,
+}
+
+/// Judges a piece of trajectory beyond a jump by the depth frames in its time.
+pub trait JumpJudge {
+    /// How well the depth seen from `piece` agrees with that seen from `kept`, as it is and after
+    /// a rigid correction of `piece` near `guess`; `None` when there is too little to judge by
+    /// (no depth frames in its time).
+    fn judge(
+        &self,
+        kept: &Trajectory,
+        piece: &Trajectory,
+        guess: &Isometry3<f64>,
+    ) -> Option<Agreement>;
+}
+
+/// A piece agrees with the map when at least this share of its depth points lie on it.
+pub const AGREE_SHARE: f64 = 0.5;
 
 /// A pose dropped.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -79,38 +143,53 @@ pub struct PoseCheck {
 }
 
 impl PoseCheck {
-    /// A sentence per jump that cut the trajectory: when, how far, and what was left out.
+    /// A sentence per jump that stayed: when, how far, and what became of the piece beyond it.
     pub fn jump_lines(&self) -> Vec<String> {
         let t0 = self.start_s;
         let kept = self.kept_span_s.map_or(String::new(), |[a, b]| {
-            format!("only {:.2}–{:.2} s of it kept", a - t0, b - t0)
+            format!("{:.2}–{:.2} s of it kept", a - t0, b - t0)
         });
         self.jumps
             .iter()
             .map(|j| {
-                format!(
-                    "the poses jumped {:.2} m ({:.0}°) {:.2} s into the trajectory and stayed there (the pose source relocalising into another frame): the trajectory was cut there, {kept}; {} poses and the frames in their time left out",
+                let head = format!(
+                    "the poses jumped {:.2} m ({:.0}°) {:.2} s into the trajectory and stayed there",
                     j.jump_m,
                     j.jump_deg,
                     j.t - t0,
-                    self.left_out
-                )
+                );
+                match j.outcome {
+                    JumpOutcome::Motion => format!(
+                        "{head}; the depth after it agrees with the map at those poses, so the step was motion (a gap in the pose stream) or the pose source's own correction: kept"
+                    ),
+                    JumpOutcome::Reanchored {
+                        correction_m,
+                        correction_deg,
+                    } => format!(
+                        "{head}; the depth after it agrees with the map once moved {correction_m:.2} m ({correction_deg:.1}°): the pose source relocalised into another frame, and the poses were re-anchored"
+                    ),
+                    JumpOutcome::Cut => format!(
+                        "{head} (the pose source relocalising into another frame the depth cannot match): the trajectory was cut there, {kept}; {} poses and the frames in their time left out",
+                        self.left_out
+                    ),
+                }
             })
             .collect()
     }
 }
 
 /// Whether pose `b` is farther from pose `a` than a hand moves a camera in `dt` by more than
-/// [`JUMP_MIN_M`] or [`JUMP_MIN_DEG`]; (metres, degrees).
-fn jumped(a: &Isometry3<f64>, b: &Isometry3<f64>, dt: f64) -> Option<(f64, f64)> {
+/// `min` (metres, degrees); (metres, degrees).
+fn jumped(a: &Isometry3<f64>, b: &Isometry3<f64>, dt: f64, min: (f64, f64)) -> Option<(f64, f64)> {
     let m = (b.translation.vector - a.translation.vector).norm();
     let deg = a.rotation.angle_to(&b.rotation).to_degrees();
-    (m > JUMP_MIN_M + 3.0 * dt.abs() || deg > JUMP_MIN_DEG + 400.0 * dt.abs()).then_some((m, deg))
+    (m > min.0 + 3.0 * dt.abs() || deg > min.1 + 400.0 * dt.abs()).then_some((m, deg))
 }
 
-/// Cuts `traj` at the jumps that stay (the next [`HALF_WINDOW`] poses do not come back) and keeps
-/// the piece with the most poses: (that piece, the jumps, the poses left out).
-fn keep_largest_piece(traj: &Trajectory) -> (Trajectory, Vec<PoseJump>, usize) {
+/// The pieces of `traj` between the jumps that stay (the next [`HALF_WINDOW`] poses do not come
+/// back) larger than `min` (metres, degrees), as index ranges in time order, and the jumps (each
+/// judged a cut for now).
+fn pieces(traj: &Trajectory, min: (f64, f64)) -> (Vec<std::ops::Range<usize>>, Vec<PoseJump>) {
     let n = traj.stamps.len();
     let mut cuts = Vec::new();
     let mut jumps = Vec::new();
@@ -119,43 +198,149 @@ fn keep_largest_piece(traj: &Trajectory) -> (Trajectory, Vec<PoseJump>, usize) {
             &traj.poses[k],
             &traj.poses[k + 1],
             traj.stamps[k + 1] - traj.stamps[k],
+            min,
         ) else {
             continue;
         };
-        let stays = (k + 2..n.min(k + 2 + HALF_WINDOW)).all(|j| {
-            jumped(
-                &traj.poses[k],
-                &traj.poses[j],
-                traj.stamps[j] - traj.stamps[k],
-            )
-            .is_some()
-        });
+        // It stays when the poses after it are nearer the pose after the jump than the one
+        // before (a pose that jumps away and back is not).
+        let apart = |a: usize, b: usize| {
+            let m = (traj.poses[b].translation.vector - traj.poses[a].translation.vector).norm();
+            let deg = traj.poses[a]
+                .rotation
+                .angle_to(&traj.poses[b].rotation)
+                .to_degrees();
+            m / min.0 + deg / min.1
+        };
+        let after = k + 2..n.min(k + 2 + HALF_WINDOW);
+        let stays = !after.is_empty() && after.into_iter().all(|j| apart(k + 1, j) < apart(k, j));
         if stays {
             cuts.push(k + 1);
             jumps.push(PoseJump {
                 t: traj.stamps[k + 1],
                 jump_m: m,
                 jump_deg: deg,
+                outcome: JumpOutcome::Cut,
+                agreement: None,
             });
         }
-    }
-    if cuts.is_empty() {
-        return (traj.clone(), jumps, 0);
     }
     let bounds: Vec<usize> = std::iter::once(0)
         .chain(cuts)
         .chain(std::iter::once(n))
         .collect();
-    let (a, b) = bounds
-        .windows(2)
-        .map(|w| (w[0], w[1]))
-        .max_by_key(|(a, b)| (b - a, std::cmp::Reverse(*a)))
-        .unwrap_or((0, n));
-    let piece = Trajectory {
-        stamps: traj.stamps[a..b].to_vec(),
-        poses: traj.poses[a..b].to_vec(),
+    (bounds.windows(2).map(|w| w[0]..w[1]).collect(), jumps)
+}
+
+/// The poses of `range` in `traj`, each moved by `c` (on the left).
+fn moved(traj: &Trajectory, range: std::ops::Range<usize>, c: &Isometry3<f64>) -> Trajectory {
+    Trajectory {
+        stamps: traj.stamps[range.clone()].to_vec(),
+        poses: traj.poses[range].iter().map(|p| c * p).collect(),
+    }
+}
+
+/// The pieces kept (`kept[i]`: piece i's correction), joined in time order.
+fn joined(
+    traj: &Trajectory,
+    ranges: &[std::ops::Range<usize>],
+    kept: &[Option<Isometry3<f64>>],
+) -> Trajectory {
+    let mut out = Trajectory::default();
+    for (r, c) in ranges.iter().zip(kept) {
+        if let Some(c) = c {
+            let m = moved(traj, r.clone(), c);
+            out.stamps.extend(m.stamps);
+            out.poses.extend(m.poses);
+        }
+    }
+    out
+}
+
+/// Splits `traj` at the jumps that stay and keeps its pieces as `judge` finds them (see the
+/// module docs; without a judge the largest piece): (each piece kept, moved by its correction;
+/// the jumps with their outcomes; the poses left out).
+fn judge_pieces(
+    traj: &Trajectory,
+    judge: Option<&dyn JumpJudge>,
+) -> (Vec<Trajectory>, Vec<PoseJump>, usize) {
+    let n = traj.stamps.len();
+    let min = if judge.is_some() {
+        (JUDGED_STEP_M, JUDGED_STEP_DEG)
+    } else {
+        (JUMP_MIN_M, JUMP_MIN_DEG)
     };
-    (piece, jumps, n - (b - a))
+    let (ranges, mut jumps) = pieces(traj, min);
+    if ranges.len() <= 1 {
+        return (vec![traj.clone()], jumps, 0);
+    }
+    let reference = ranges
+        .iter()
+        .enumerate()
+        .max_by_key(|(i, r)| (r.len(), std::cmp::Reverse(*i)))
+        .map_or(0, |(i, _)| i);
+    let mut kept: Vec<Option<Isometry3<f64>>> = vec![None; ranges.len()];
+    kept[reference] = Some(Isometry3::identity());
+    if let Some(judge) = judge {
+        // Outwards from the reference, nearest first: before it, then after it, alternately.
+        let mut order: Vec<usize> = (0..ranges.len()).filter(|&i| i != reference).collect();
+        order.sort_by_key(|&i| (i.abs_diff(reference), i));
+        for i in order {
+            // The neighbour towards the reference, and the jump between them.
+            let (j, jump) = if i < reference {
+                (i + 1, i)
+            } else {
+                (i - 1, i - 1)
+            };
+            let piece = moved(traj, ranges[i].clone(), &Isometry3::identity());
+            // The guess: the piece joined to its neighbour where the poses jumped (the camera
+            // barely moves in one pose interval).
+            let guess = match kept[j] {
+                Some(cj) if i > reference => {
+                    cj * traj.poses[ranges[j].end - 1] * traj.poses[ranges[i].start].inverse()
+                }
+                Some(cj) => {
+                    cj * traj.poses[ranges[j].start] * traj.poses[ranges[i].end - 1].inverse()
+                }
+                None => Isometry3::identity(),
+            };
+            let map = joined(traj, &ranges, &kept);
+            let Some(a) = judge.judge(&map, &piece, &guess) else {
+                continue;
+            };
+            jumps[jump].agreement = Some([a.as_is, a.corrected]);
+            if a.as_is >= AGREE_SHARE && a.as_is + 0.05 >= a.corrected {
+                kept[i] = Some(Isometry3::identity());
+                jumps[jump].outcome = JumpOutcome::Motion;
+            } else if a.corrected >= AGREE_SHARE && kept[j].is_some() {
+                kept[i] = Some(a.correction);
+                jumps[jump].outcome = JumpOutcome::Reanchored {
+                    correction_m: a.correction.translation.vector.norm(),
+                    correction_deg: a.correction.rotation.angle().to_degrees(),
+                };
+            }
+        }
+    }
+    // The pieces kept are put in the frame of the first of them (the pose source's frame at the
+    // start, which a reading or a point given in the scan's frame is in).
+    if let Some(first) = kept.iter().flatten().next().map(Isometry3::inverse) {
+        for c in kept.iter_mut().flatten() {
+            *c = first * *c;
+        }
+    }
+    let mut out = Vec::new();
+    let mut left_out = 0;
+    for (r, c) in ranges.iter().zip(&kept) {
+        match c {
+            Some(c) => out.push(moved(traj, r.clone(), c)),
+            None => left_out += r.len(),
+        }
+    }
+    debug_assert_eq!(
+        out.iter().map(|t| t.stamps.len()).sum::<usize>() + left_out,
+        n
+    );
+    (out, jumps, left_out)
 }
 
 fn median(v: &mut [f64]) -> f64 {
@@ -244,14 +429,28 @@ fn limits(span_s: f64) -> (f64, f64) {
 /// that jump away from their neighbours' motion and back; returns the trajectory without them and
 /// what was found.
 pub fn drop_outlier_poses(traj: &Trajectory) -> (Trajectory, PoseCheck) {
-    let (piece, jumps, left_out) = keep_largest_piece(traj);
-    let kept_span_s =
-        (left_out > 0).then(|| [piece.stamps[0], piece.stamps[piece.stamps.len() - 1]]);
-    let (out, mut check) = drop_outliers(&piece);
+    check_poses(traj, None)
+}
+
+/// [`drop_outlier_poses`], the jumps that stay judged by `judge` (the depth): each piece beyond
+/// one kept as it is, re-anchored or left out (see the module docs).
+pub fn check_poses(traj: &Trajectory, judge: Option<&dyn JumpJudge>) -> (Trajectory, PoseCheck) {
+    let (pieces, jumps, left_out) = judge_pieces(traj, judge);
+    let mut out = Trajectory::default();
+    let mut check = PoseCheck::default();
+    for piece in &pieces {
+        let (clean, c) = drop_outliers(piece);
+        out.stamps.extend(clean.stamps);
+        out.poses.extend(clean.poses);
+        check.dropped += c.dropped;
+        check.examples.extend(c.examples);
+    }
+    check.examples.truncate(20);
     check.poses = traj.stamps.len();
     check.jumps = jumps;
     check.left_out = left_out;
-    check.kept_span_s = kept_span_s;
+    check.kept_span_s = (left_out > 0 && !out.stamps.is_empty())
+        .then(|| [out.stamps[0], out.stamps[out.stamps.len() - 1]]);
     check.start_s = traj.stamps.first().copied().unwrap_or(0.0);
     (out, check)
 }
@@ -380,7 +579,7 @@ mod tests {
         let said = check.jump_lines();
         assert!(
             said[0].contains("jumped 50.02 m (1°) 6.67 s into the trajectory")
-                && said[0].contains("only 0.00–6.63 s of it kept; 100 poses"),
+                && said[0].contains("0.00–6.63 s of it kept; 100 poses"),
             "{said:?}"
         );
         // The later piece kept when it is the larger.

@@ -41,6 +41,12 @@ pub(crate) struct BadReading {
 }
 
 impl Reference {
+    /// The readings of references.csv text (see docs/project.md); errors name `path` and the
+    /// line.
+    pub fn parse_csv(text: &str, path: &std::path::Path) -> crate::Result<Vec<Self>> {
+        crate::level::parse_references(text, path)
+    }
+
     /// The one check of a reading, for references.csv's rows and `[[references]]` alike: a place
     /// (finite coordinates), a temperature within the scene's range, 0 < std_k < 50 K and
     /// 0 < emissivity ≤ 1.

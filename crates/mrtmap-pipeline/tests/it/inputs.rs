@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use mrtmap_pipeline::Project;
-use mrtmap_pipeline::parse_references;
+use mrtmap_pipeline::settings::Reference;
 use proptest::prelude::*;
 
 fn cell() -> impl Strategy<Value = String> {
@@ -51,7 +51,7 @@ proptest! {
     fn references_csv_answers_or_names_the_line(
         text in csv_text(&["label", "x", "y", "z", "temperature_c", "std_k", "frame", "notes"])
     ) {
-        match parse_references(&text, Path::new("references.csv")) {
+        match Reference::parse_csv(&text, Path::new("references.csv")) {
             Ok(refs) => {
                 for r in refs {
                     prop_assert!(r.xyz.iter().all(|v| v.is_finite()));

@@ -11,7 +11,7 @@ fn run(
     out: &Path,
     p: &Project,
     progress: &dyn Progress,
-) -> mrtmap_pipeline::Result<RunOutcome> {
+) -> Result<RunOutcome, mrtmap_pipeline::Error> {
     Pipeline::new(p.clone())
         .progress(progress)
         .run(rec, out)

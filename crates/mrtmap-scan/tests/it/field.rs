@@ -230,3 +230,131 @@ fn a_window_without_depth_is_found_by_thermal_texturing() {
             .all(|s| s.textured_fraction == 0.0)
     );
 }
+
+/// Issue 61: a jump in the poses that stays is judged by the depth. A real gap (the frames and
+/// poses of 1.2 m of walk taken out, the rest brought forward in time: the camera moved 1.2 m
+/// between two pose samples) keeps both halves; the second half moved by a rigid 0.5 m / 10° (a
+/// relocalisation) is re-anchored onto the first and the cloud is as good as the unshifted walk's;
+/// the second half's poses replaced by a walk backwards (a jump to nowhere the depth can match)
+/// is cut, as before.
+#[test]
+fn a_jump_that_stays_is_judged_by_the_depth() {
+    use mrtmap_scan::pose_check::JumpOutcome;
+    let dir = tempfile::tempdir().unwrap();
+    let rec_dir = dir.path().join("scan");
+    let room = office(10.0, &rec_dir, |_| {});
+    let clean = Recording::open(&rec_dir).unwrap();
+    let mut p = params(false);
+    p.depth.stride = 2;
+    p.clock = ClockOffset::Off;
+    let base = fuse(&clean, &p, &|_, _| {});
+    let s_base = score(&room, &rec_dir, &base);
+    assert!(base.report.pose_check.jumps.is_empty());
+    let traj = &clean.trajectory;
+    let t0 = traj.stamps[0];
+    let at = |t: f64| traj.interpolate(t, &Default::default()).unwrap();
+
+    // A real gap: from 4 s, the first moment the camera is 1.2 m away; that stretch taken out.
+    let ta = t0 + 4.0;
+    let tb = traj
+        .stamps
+        .iter()
+        .copied()
+        .find(|&t| t > ta && (at(t).translation.vector - at(ta).translation.vector).norm() > 1.2)
+        .expect("the walk goes 1.2 m");
+    let dt = tb - ta - 0.005;
+    let mut gap = clean.clone();
+    let cut = |v: &mut Vec<mrtmap_io::StreamEntry>| {
+        v.retain(|e| e.t <= ta || e.t >= tb);
+        for e in v.iter_mut().filter(|e| e.t >= tb) {
+            e.t -= dt;
+        }
+    };
+    cut(&mut gap.depth);
+    cut(&mut gap.thermal);
+    cut(&mut gap.rgb);
+    cut(&mut gap.masks);
+    let (mut stamps, mut poses) = (Vec::new(), Vec::new());
+    for (t, q) in traj.stamps.iter().zip(&traj.poses) {
+        if *t <= ta {
+            stamps.push(*t);
+            poses.push(*q);
+        } else if *t >= tb {
+            stamps.push(*t - dt);
+            poses.push(*q);
+        }
+    }
+    gap.trajectory = Trajectory { stamps, poses };
+    let f = fuse(&gap, &p, &|_, _| {});
+    let c = &f.report.pose_check;
+    assert_eq!(c.jumps.len(), 1, "{c:?}");
+    assert_eq!(c.jumps[0].outcome, JumpOutcome::Motion, "{c:?}");
+    assert_eq!(c.left_out, 0, "{c:?}");
+    let s_gap = score(&room, &rec_dir, &f);
+    assert!(
+        s_gap.distance_p95_m < s_base.distance_p95_m + 0.005,
+        "{s_gap:?} vs {s_base:?}"
+    );
+
+    // A relocalisation: every pose after 5 s moved by 0.5 m and turned 10°.
+    let tm = t0 + 5.0;
+    let shift = Isometry3::from_parts(
+        Translation3::new(0.3, -0.4, 0.0),
+        UnitQuaternion::from_euler_angles(0.0, 0.0, 10f64.to_radians()),
+    );
+    let mut moved = clean.clone();
+    for (t, q) in moved
+        .trajectory
+        .stamps
+        .iter()
+        .zip(moved.trajectory.poses.iter_mut())
+    {
+        if *t > tm {
+            *q = shift * *q;
+        }
+    }
+    let f = fuse(&moved, &p, &|_, _| {});
+    let c = &f.report.pose_check;
+    assert_eq!(c.jumps.len(), 1, "{c:?}");
+    let JumpOutcome::Reanchored {
+        correction_m,
+        correction_deg,
+    } = c.jumps[0].outcome
+    else {
+        panic!("not re-anchored: {c:?}");
+    };
+    assert!((correction_deg - 10.0).abs() < 0.5, "{c:?}");
+    assert!((correction_m - 0.5).abs() < 0.05, "{c:?}");
+    assert_eq!(c.left_out, 0);
+    let s_moved = score(&room, &rec_dir, &f);
+    assert!(
+        s_moved.distance_p95_m < s_base.distance_p95_m + 0.005
+            && s_moved.abs_error_p95_k < s_base.abs_error_p95_k + 0.05,
+        "{s_moved:?} vs {s_base:?}"
+    );
+    let said = c.jump_lines();
+    assert!(said[0].contains("re-anchored"), "{said:?}");
+
+    // A jump to nowhere: after 6 s the poses walk the path backwards, 2 m away.
+    let tn = t0 + 6.0;
+    let t_end = *traj.stamps.last().unwrap();
+    let away = Isometry3::translation(2.0, 0.0, 0.0);
+    let mut lost = clean.clone();
+    for (t, q) in lost
+        .trajectory
+        .stamps
+        .iter()
+        .zip(lost.trajectory.poses.iter_mut())
+    {
+        if *t > tn {
+            *q = away * at(t_end - (*t - tn));
+        }
+    }
+    let f = fuse(&lost, &p, &|_, _| {});
+    let c = &f.report.pose_check;
+    assert_eq!(c.jumps.len(), 1, "{c:?}");
+    assert_eq!(c.jumps[0].outcome, JumpOutcome::Cut, "{c:?}");
+    assert!(c.left_out > 0 && c.kept_span_s.is_some(), "{c:?}");
+    let [a, c_] = c.jumps[0].agreement.unwrap();
+    assert!(a < 0.5 && c_ < 0.5, "{c:?}");
+}

@@ -10,6 +10,7 @@ mod pipeline;
 mod readme;
 mod refusals;
 mod sources;
+mod stages;
 mod sun;
 
 /// Runs the built binary.
