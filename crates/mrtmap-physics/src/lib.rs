@@ -57,7 +57,8 @@ pub use person::{
 };
 pub use solar::{
     DEFAULT_ASW, DEFAULT_FLOOR_REFLECTANCE, MAX_DNI_W_M2, SOLAR_HR_W_M2K, SkyAndRoom, SolarGain,
-    SolarInputs, SolarPosture, SunPosition, UtcTime, f_svv, room_azimuth_deg, sharp_deg,
-    solar_gain, solar_gain_in, solar_projected_area_factor, sun_position,
+    SolarInput, SolarInputError, SolarInputs, SolarPosture, SunPosition, UtcTime, f_svv,
+    room_azimuth_deg, sharp_deg, solar_gain, solar_gain_checked, solar_gain_in,
+    solar_projected_area_factor, sun_position,
 };
 pub use units::{Temperature, TemperatureDelta, ZERO_CELSIUS_K};

@@ -179,24 +179,84 @@ impl SkyAndRoom {
     };
 }
 
+/// SolarCal's inputs, each by what it is: which one an input error is about (a front end names
+/// its own flag or key for it by this, not by the error's words).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SolarInput {
+    /// The solar altitude (°).
+    Altitude,
+    /// SHARP, the sun's angle from the person's front (°).
+    Sharp,
+    /// The direct normal irradiance (W/m²).
+    Dni,
+    /// The glazing's solar transmittance.
+    Transmittance,
+    /// The sky-vault view fraction f_svv.
+    FSvv,
+    /// The fraction of the body in the beam f_bes.
+    FBes,
+    /// The person's short-wave absorptivity.
+    Asw,
+    /// The floor's reflectance.
+    FloorReflectance,
+    /// The diffuse horizontal irradiance (W/m²).
+    DiffuseHorizontal,
+}
+
+impl SolarInput {
+    /// Its name in an error.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Altitude => "solar altitude (°)",
+            Self::Sharp => "SHARP (°)",
+            Self::Dni => "direct normal irradiance (W/m²)",
+            Self::Transmittance => "solar transmittance",
+            Self::FSvv => "sky-vault view fraction f_svv",
+            Self::FBes => "fraction of the body in the beam f_bes",
+            Self::Asw => "short-wave absorptivity",
+            Self::FloorReflectance => "floor reflectance",
+            Self::DiffuseHorizontal => "diffuse horizontal irradiance (W/m²)",
+        }
+    }
+}
+
+/// A SolarCal input refused: which one, and why.
+#[derive(Debug, thiserror::Error)]
+#[error("{error}")]
+pub struct SolarInputError {
+    /// The input.
+    pub input: SolarInput,
+    /// Why (out of its range, or not a number).
+    pub error: PhysicsError,
+}
+
+impl From<SolarInputError> for PhysicsError {
+    fn from(e: SolarInputError) -> Self {
+        e.error
+    }
+}
+
 /// SolarCal as [`solar_gain`], with the sky's diffuse irradiance and whether the beam enters the
 /// room given by `sky` (see [`SkyAndRoom`]).
 pub fn solar_gain_in(i: &SolarInputs, sky: &SkyAndRoom) -> Result<SolarGain, PhysicsError> {
-    let beta = in_range("solar altitude (°)", i.altitude_deg, 0.0, 90.0)?;
-    let sharp = in_range("SHARP (°)", i.sharp_deg, 0.0, 180.0)?;
-    let i_dir = in_range(
-        "direct normal irradiance (W/m²)",
-        i.dni_w_m2,
-        0.0,
-        MAX_DNI_W_M2,
-    )?;
-    let t_sol = in_range("solar transmittance", i.transmittance, 0.0, 1.0)?;
-    let f_svv = in_range("sky-vault view fraction f_svv", i.f_svv, 0.0, 1.0)?;
-    let f_bes = in_range("fraction of the body in the beam f_bes", i.f_bes, 0.0, 1.0)?;
-    let asw = in_range("short-wave absorptivity", i.asw, 0.0, 1.0)?;
-    let r_floor = in_range("floor reflectance", i.floor_reflectance, 0.0, 1.0)?;
+    Ok(solar_gain_checked(i, sky)?)
+}
+
+/// [`solar_gain_in`], an input refused with which one it is.
+pub fn solar_gain_checked(i: &SolarInputs, sky: &SkyAndRoom) -> Result<SolarGain, SolarInputError> {
+    let within = |input: SolarInput, v: f64, min: f64, max: f64| {
+        in_range(input.name(), v, min, max).map_err(|error| SolarInputError { input, error })
+    };
+    let beta = within(SolarInput::Altitude, i.altitude_deg, 0.0, 90.0)?;
+    let sharp = within(SolarInput::Sharp, i.sharp_deg, 0.0, 180.0)?;
+    let i_dir = within(SolarInput::Dni, i.dni_w_m2, 0.0, MAX_DNI_W_M2)?;
+    let t_sol = within(SolarInput::Transmittance, i.transmittance, 0.0, 1.0)?;
+    let f_svv = within(SolarInput::FSvv, i.f_svv, 0.0, 1.0)?;
+    let f_bes = within(SolarInput::FBes, i.f_bes, 0.0, 1.0)?;
+    let asw = within(SolarInput::Asw, i.asw, 0.0, 1.0)?;
+    let r_floor = within(SolarInput::FloorReflectance, i.floor_reflectance, 0.0, 1.0)?;
     let i_diff = match sky.diffuse_horizontal_w_m2 {
-        Some(d) => in_range("diffuse horizontal irradiance (W/m²)", d, 0.0, MAX_DNI_W_M2)?,
+        Some(d) => within(SolarInput::DiffuseHorizontal, d, 0.0, MAX_DNI_W_M2)?,
         None => DIFFUSE_FRACTION * i_dir,
     };
 

@@ -120,7 +120,7 @@ impl<'a> Namer<'a> {
     fn main_feature(s: &Surface) -> Option<&str> {
         s.features
             .iter()
-            .filter(|f| !f.label.trim().is_empty() && f.label != "unlabelled")
+            .filter(|f| !mrtmap_radiation::says_nothing(&f.label))
             .max_by(|a, b| {
                 mrtmap_geometry::polygon::area_3d(&a.polygon)
                     .total_cmp(&mrtmap_geometry::polygon::area_3d(&b.polygon))

@@ -14,7 +14,7 @@ use std::path::Path;
 use mrtmap_geometry::nalgebra::Point2;
 use mrtmap_io::FileError;
 use mrtmap_physics::PhysicsError;
-use mrtmap_physics::{Category, Posture, Temperature, pmv_ppd};
+use mrtmap_physics::{Category, Posture, SkyAndRoom, Temperature, pmv_ppd, solar_gain_checked};
 /// The sun on a person (SolarCal), for callers with their own inputs
 /// (mrtmap-physics').
 pub use mrtmap_physics::{
@@ -953,7 +953,8 @@ impl SolarAnswer {
 /// SolarCal for one person ([`solar_gain`]); an input out of its range is refused naming its
 /// `mrtmap solar-gain` flag.
 pub fn solar_gain_of(inputs: SolarInputs) -> Result<SolarAnswer> {
-    let g = solar_gain(&inputs).map_err(crate::points::solar_flag_error)?;
+    let g = solar_gain_checked(&inputs, &SkyAndRoom::SOLARCAL)
+        .map_err(crate::points::solar_flag_error)?;
     Ok(SolarAnswer {
         model: SOLAR_MODEL,
         inputs,

@@ -17,6 +17,7 @@ use crate::advice::{Advice, Namer, Target, advise};
 use serde::Serialize;
 
 use crate::error::{Error, Result};
+use crate::level::LevelBasis;
 use crate::progress::Progress;
 use crate::run::{RunOutcome, run};
 use crate::settings::Project;
@@ -162,10 +163,13 @@ pub(crate) fn judge(
     let field = o.maps.first().and_then(|m| m.summary.map.field.as_ref());
     let unseen_patches = field.map_or(Vec::new(), |f| f.unseen_patches.clone());
     let max_unseen_k = field.map_or(0.0, |f| f.max_std_error_parts.unseen_k);
-    let (level_basis, level_std_k) = o.level.as_ref().map_or_else(
-        || ("camera".to_string(), o.scene.temperature_level_std_k),
-        |l| (l.basis.to_string(), l.std_k),
-    );
+    let (basis, level_std_k) = o
+        .level
+        .as_ref()
+        .map_or((LevelBasis::Camera, o.scene.temperature_level_std_k), |l| {
+            (l.basis, l.std_k)
+        });
+    let level_basis = basis.to_string();
     let namer = Namer::new(&o.scene, start.copied());
     let mut reasons = Vec::new();
     let mut targets = Vec::new();
@@ -195,7 +199,7 @@ pub(crate) fn judge(
     // (2σ) however well the room was scanned. It is a reason only when no reading was usable or
     // the readings leave over twice the target (one reading, far from the room's temperature).
     let mut notes = Vec::new();
-    if level_basis == "camera" {
+    if basis == LevelBasis::Camera {
         reasons.push(format!(
             "no contact reading was usable: the temperatures' level is the camera's (±{level_std_k:.1} K); read a wall and the coldest surface (references.csv)"
         ));

@@ -9,7 +9,9 @@ use std::path::Path;
 
 use mrtmap_geometry::nalgebra::Point3;
 use mrtmap_physics::PhysicsError;
-use mrtmap_physics::{SkyAndRoom, SolarInputs, sharp_deg, solar_gain_in};
+use mrtmap_physics::{
+    SkyAndRoom, SolarInput, SolarInputError, SolarInputs, sharp_deg, solar_gain_checked,
+};
 /// A sphere's MRT at a point with its view-factor table (mrtmap-radiation's).
 pub use mrtmap_radiation::PointRecord;
 /// The sun in the room's frame and a person's exposure to it (mrtmap-radiation's).
@@ -200,14 +202,14 @@ pub(crate) fn solar_on(
     posture: Posture,
     facing_deg: f64,
     sun: &SunQuery,
-) -> std::result::Result<(SunExposure, f64, mrtmap_physics::SolarGain), PhysicsError> {
+) -> std::result::Result<(SunExposure, f64, mrtmap_physics::SolarGain), SolarInputError> {
     let exposure = tracer.exposure(at, posture, &sun.direction);
     let sharp = sharp_deg(facing_deg, sun.direction.azimuth_deg);
     let sky = SkyAndRoom {
         diffuse_horizontal_w_m2: sun.diffuse_horizontal_w_m2,
         beam_enters: tracer.beam_enters(&sun.direction),
     };
-    let g = solar_gain_in(
+    let g = solar_gain_checked(
         &SolarInputs {
             altitude_deg: sun.direction.altitude_deg,
             sharp_deg: sharp,
@@ -517,75 +519,42 @@ pub(crate) fn to_scene_frame(
     }
 }
 
-/// The command line's flag for each SolarCal input, by the name mrtmap-physics gives it, and
-/// what the flag is.
-const SOLAR_FLAGS: [(&str, &str, &str); 8] = [
-    (
-        "solar altitude (°)",
-        "--altitude",
-        "the solar altitude in degrees",
-    ),
-    (
-        "SHARP (°)",
-        "--sharp",
-        "the sun's angle from the person's front in degrees",
-    ),
-    (
-        "direct normal irradiance (W/m²)",
-        "--dni",
-        "the direct normal irradiance in W/m²",
-    ),
-    (
-        "solar transmittance",
-        "--transmittance",
-        "the glazing's solar transmittance",
-    ),
-    (
-        "sky-vault view fraction f_svv",
-        "--f-svv",
-        "the sky-vault view fraction",
-    ),
-    (
-        "fraction of the body in the beam f_bes",
-        "--f-bes",
-        "the fraction of the body in the beam",
-    ),
-    (
-        "short-wave absorptivity",
-        "--asw",
-        "the person's short-wave absorptivity",
-    ),
-    (
-        "floor reflectance",
-        "--floor-reflectance",
-        "the floor's reflectance",
-    ),
-];
+/// The command line's flag for each SolarCal input, and what the input is.
+fn solar_flag(input: SolarInput) -> (&'static str, &'static str) {
+    match input {
+        SolarInput::Altitude => ("--altitude", "the solar altitude in degrees"),
+        SolarInput::Sharp => (
+            "--sharp",
+            "the sun's angle from the person's front in degrees",
+        ),
+        SolarInput::Dni => ("--dni", "the direct normal irradiance in W/m²"),
+        SolarInput::Transmittance => ("--transmittance", "the glazing's solar transmittance"),
+        SolarInput::FSvv => ("--f-svv", "the sky-vault view fraction"),
+        SolarInput::FBes => ("--f-bes", "the fraction of the body in the beam"),
+        SolarInput::Asw => ("--asw", "the person's short-wave absorptivity"),
+        SolarInput::FloorReflectance => ("--floor-reflectance", "the floor's reflectance"),
+        SolarInput::DiffuseHorizontal => (
+            "[sun] epw",
+            "the weather file's diffuse horizontal irradiance in W/m²",
+        ),
+    }
+}
 
 /// A SolarCal input refused, as its flag with the value given.
-pub(crate) fn solar_flag_error(e: PhysicsError) -> Error {
-    let flag = |name: &str| SOLAR_FLAGS.iter().find(|f| f.0 == name).map(|f| (f.1, f.2));
-    match e {
+pub(crate) fn solar_flag_error(e: SolarInputError) -> Error {
+    let (f, what) = solar_flag(e.input);
+    match e.error {
         PhysicsError::OutOfRange {
-            name,
-            value,
-            min,
-            max,
-        } => match flag(name) {
-            Some((f, what)) => Error::setting(
-                format!("{f} {value}"),
-                format!("is outside {min}…{max} ({what})"),
-            ),
-            None => e.into(),
-        },
-        PhysicsError::NotFinite { name, value } => match flag(name) {
-            Some((f, what)) => Error::setting(
-                format!("{f} {value}"),
-                format!("is not a finite number ({what})"),
-            ),
-            None => e.into(),
-        },
-        e => e.into(),
+            value, min, max, ..
+        } => Error::setting(
+            format!("{f} {value}"),
+            format!("is outside {min}…{max} ({what})"),
+        ),
+        PhysicsError::NotFinite { value, .. } => Error::setting(
+            format!("{f} {value}"),
+            format!("is not a finite number ({what})"),
+        ),
+        other => other.into(),
     }
 }
 

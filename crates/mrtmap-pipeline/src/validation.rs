@@ -361,6 +361,9 @@ pub struct GlobeConversion {
     pub h_w_m2k: f64,
     /// "mrt_from_globe" or "globe_from_mrt".
     pub direction: &'static str,
+    /// Whether the globe's reading was given (and the MRT found).
+    #[serde(skip)]
+    from_globe: bool,
 }
 
 /// What a globe reads: its temperature `globe_c` (°C) to convert to MRT, or an MRT `mrt_c` to
@@ -416,6 +419,7 @@ pub fn convert_globe(
         formula_description: r.formula.describe(),
         h_w_m2k: r.h_w_m2k,
         direction,
+        from_globe: matches!(input, GlobeInput::Globe(_)),
     })
 }
 
@@ -426,7 +430,7 @@ impl GlobeConversion {
             "air {:.2} °C, air speed {} m/s, globe {} m, ε {}",
             self.air_c, self.air_speed_m_s, self.diameter_m, self.emissivity
         );
-        if self.direction == "mrt_from_globe" {
+        if self.from_globe {
             vec![
                 format!("MRT {:.2} °C", self.mrt_c),
                 format!("  from globe {:.2} °C, {conditions}", self.globe_c),

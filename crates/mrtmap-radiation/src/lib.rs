@@ -53,7 +53,7 @@ pub use sun::{
     BODY_WIDTH_M, BeamAudit, SunDirection, SunExposure, SunTracer, audit_the_beam,
     sun_frame_is_z_up,
 };
-pub use vocabulary::{ElementKind, GlazingKind, LABEL_ALIASES};
+pub use vocabulary::{ElementKind, GlazingKind, LABEL_ALIASES, UNLABELLED, says_nothing};
 
 use serde::{Deserialize, Serialize};
 

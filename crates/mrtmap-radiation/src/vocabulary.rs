@@ -49,6 +49,15 @@ pub enum ElementKind {
     Other,
 }
 
+/// The label segmentation gives a feature that neither a rule nor a mask names.
+pub const UNLABELLED: &str = "unlabelled";
+
+/// Whether a label says nothing of what its element is (blank, or [`UNLABELLED`]).
+pub fn says_nothing(label: &str) -> bool {
+    let t = label.trim();
+    t.is_empty() || t.eq_ignore_ascii_case(UNLABELLED)
+}
+
 /// The aliases of each kind, looked for in a label (lower case) in this order: the first one the
 /// label contains decides.
 pub const LABEL_ALIASES: &[(&str, ElementKind)] = &[

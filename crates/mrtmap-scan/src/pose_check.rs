@@ -202,8 +202,9 @@ fn pieces(traj: &Trajectory, min: (f64, f64)) -> (Vec<std::ops::Range<usize>>, V
         ) else {
             continue;
         };
-        // It stays when the poses after it are nearer the pose after the jump than the one
-        // before (a pose that jumps away and back is not).
+        // It stays when the poses after it stay with the pose after the step and the poses
+        // before it were with the pose before (each within half the step): a pose that jumps
+        // away and back is neither, and neither is the step back from one.
         let apart = |a: usize, b: usize| {
             let m = (traj.poses[b].translation.vector - traj.poses[a].translation.vector).norm();
             let deg = traj.poses[a]
@@ -212,8 +213,12 @@ fn pieces(traj: &Trajectory, min: (f64, f64)) -> (Vec<std::ops::Range<usize>>, V
                 .to_degrees();
             m / min.0 + deg / min.1
         };
+        let half = 0.5 * apart(k, k + 1);
         let after = k + 2..n.min(k + 2 + HALF_WINDOW);
-        let stays = !after.is_empty() && after.into_iter().all(|j| apart(k + 1, j) < apart(k, j));
+        let before = k.saturating_sub(HALF_WINDOW)..k;
+        let stays = !after.is_empty()
+            && after.into_iter().all(|j| apart(k + 1, j) < half)
+            && before.into_iter().all(|i| apart(i, k) < half);
         if stays {
             cuts.push(k + 1);
             jumps.push(PoseJump {

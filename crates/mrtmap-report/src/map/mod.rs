@@ -760,7 +760,8 @@ fn draw_corners<DB: DrawingBackend>(
 ) -> Result<(), ReportError> {
     let frame = &field.frame;
     let floor = &frame.floor_uv;
-    let room_frame = axis_name(&frame.plane.u, "u") == "x" && axis_name(&frame.plane.v, "v") == "y";
+    // The map's axes are the room's x and y (the origin corner is the room frame's origin).
+    let room_frame = frame.plane.u.x > 1.0 - 1e-9 && frame.plane.v.y > 1.0 - 1e-9;
     let origin = floor
         .iter()
         .position(|p| room_frame && p.coords.norm() < 0.02);

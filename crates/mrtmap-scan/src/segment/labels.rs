@@ -76,7 +76,7 @@ pub fn rule_label(host: SurfaceKind, contrast_k: f64, area_m2: f64) -> &'static 
         }
         SurfaceKind::Wall if contrast_k < -2.0 => "window",
         SurfaceKind::Wall if contrast_k > 8.0 => "radiator",
-        _ => "unlabelled",
+        _ => mrtmap_radiation::UNLABELLED,
     }
 }
 
