@@ -43,9 +43,10 @@ pub use image16::{Image16, encode_png_rgb8, encode_png16, gaussian_blur, read_im
 pub use layout::masks;
 pub use layout::{
     ImuSample, InterpolationLimits, LayoutWriter, LineSkip, ListLine, MAX_SKIPPED_SHARE, PoseFile,
-    QUATERNION_NORM_TOLERANCE, Recording, RecordingWarning, RgbCamera, Rig, SkippedLine,
-    StreamEntry, StreamLines, ThermalEncoding, Trajectory, imu_text, parse_imu, parse_stream_list,
-    quaternion_xyzw, read_imu, read_stream_list, stream_list_text, unit_quaternion,
+    QUATERNION_NORM_TOLERANCE, Recording, RecordingFile, RecordingWarning, RgbCamera, Rig,
+    SkippedLine, StreamEntry, StreamLines, ThermalEncoding, Trajectory, imu_text, parse_imu,
+    parse_stream_list, quaternion_xyzw, read_imu, read_stream_list, stream_list_text,
+    unit_quaternion,
 };
 pub use ply::{ReadCloud, ThermalCloud, cloud_ply_bytes, iron, read_cloud_ply, write_cloud_ply};
 pub use thermal::{

@@ -693,7 +693,7 @@ pub struct CalibrateArgs {
     pub(crate) common_corners: bool,
 }
 
-/// The images searched for the board, before the fit ([`detect`]).
+/// The images searched for the board, before the fit ([`CalibrateArgs::detect`]).
 pub struct Detected {
     board: Board,
     images: Images,
@@ -705,9 +705,16 @@ enum Images {
     Stereo(PairDetections),
 }
 
-/// `mrtmap calibrate`, first step: the board checked, and the images of `--images` or the pairs
-/// of `--pairs` read and searched for it.
-pub fn detect(a: &CalibrateArgs) -> Result<Detected> {
+impl CalibrateArgs {
+    /// `mrtmap calibrate`, first step: the board checked, and the images of `--images` or the
+    /// pairs of `--pairs` read and searched for it.
+    pub fn detect(&self) -> Result<Detected> {
+        detect(self)
+    }
+}
+
+/// [`CalibrateArgs::detect`].
+fn detect(a: &CalibrateArgs) -> Result<Detected> {
     let board = board(a.board.cols, a.board.rows, a.square_m)?;
     let images = match (&a.pairs, &a.images) {
         (Some(dir), None) => Images::Stereo(detect_pairs(dir, &board, a.max_dt)?),

@@ -331,7 +331,7 @@ impl TrackDir {
 
     /// `trajectory.txt`: world_from_depth at the colour frames' times (TUM).
     pub fn trajectory_txt(&self) -> PathBuf {
-        self.dir.join("trajectory.txt")
+        mrtmap_io::RecordingFile::Trajectory.path_in(&self.dir)
     }
 
     /// `track.json`: what the tracker did.

@@ -76,7 +76,7 @@ pub(crate) use error::Result;
 pub use front::{FuseDone, Pipeline, SegmentDone, TrackDone};
 pub use layout::{DemoLayout, RunLayout};
 pub use live::replay::ReplayDone;
-pub use live::{LiveSink, LiveState};
+pub use live::{LivePhase, LiveSink, LiveState};
 pub use progress::{Progress, Silent};
 pub use report::RunDone;
 pub use resolve::{FuseFlags, MrtFlags, Overrides, SegmentFlags, TrackFlags};

@@ -16,7 +16,8 @@ use std::path::Path;
 
 use mrtmap_geometry::nalgebra::Point3;
 use mrtmap_io::{
-    Recording, RecordingWarning, Trajectory, read_cloud_ply, write_atomic, write_cloud_ply,
+    Recording, RecordingFile, RecordingWarning, Trajectory, read_cloud_ply, write_atomic,
+    write_cloud_ply,
 };
 use mrtmap_radiation::{GridSpec, RadiantScene};
 use mrtmap_scan::FusedFrame;
@@ -114,9 +115,9 @@ fn nothing_fused(r: &FusionReport) -> Option<String> {
     }
     if r.thermal_frames == 0 || r.depth_frames == 0 {
         let list = if r.thermal_frames == 0 {
-            "thermal.txt"
+            RecordingFile::Thermal
         } else {
-            "depth.txt"
+            RecordingFile::Depth
         };
         return Some(format!(
             "{list} lists no frames, so there is nothing to fuse: list the frames recorded (docs/recording.md)"
@@ -496,7 +497,7 @@ fn track_stage(
         TrackMode::Never => {
             if !has_poses {
                 return Err(Error::source(
-                    &rec.dir.join("trajectory.txt"),
+                    &RecordingFile::Trajectory.path_in(&rec.dir),
                     "the recording has no poses and [track] mode = \"never\": record poses, or set mode = \"auto\" to track the colour and depth frames",
                 ));
             }
@@ -507,12 +508,17 @@ fn track_stage(
         return Ok(None);
     }
     let dir = run.track();
-    let fingerprint = ["rig.toml", "depth.txt", "rgb.txt", "imu.txt"]
-        .iter()
-        .fold(Fingerprint::new(), |f, n| f.file(&rec.dir.join(n)))
-        .frames("depth_frames", rec, &rec.depth)
-        .frames("rgb_frames", rec, &rec.rgb)
-        .setting("track", &p.track);
+    let fingerprint = [
+        RecordingFile::Rig,
+        RecordingFile::Depth,
+        RecordingFile::Rgb,
+        RecordingFile::Imu,
+    ]
+    .iter()
+    .fold(Fingerprint::new(), |f, n| f.file(&n.path_in(&rec.dir)))
+    .frames("depth_frames", rec, &rec.depth)
+    .frames("rgb_frames", rec, &rec.rgb)
+    .setting("track", &p.track);
     let stage = Stage {
         name: "track".into(),
         stamp: dir.stage_json(),
@@ -544,13 +550,18 @@ fn fuse_stage(
     let dir = run.fuse();
     let params = p.fuse.params()?;
     let tracked = run.trajectory_txt();
-    let fingerprint = ["rig.toml", "depth.txt", "thermal.txt", "trajectory.txt"]
-        .iter()
-        .fold(Fingerprint::new(), |f, n| f.file(&rec.dir.join(n)))
-        .maybe_file(tracked.exists().then_some(tracked.as_path()))
-        .frames("depth_frames", rec, &rec.depth)
-        .frames("thermal_frames", rec, &rec.thermal)
-        .setting("fuse", &p.fuse);
+    let fingerprint = [
+        RecordingFile::Rig,
+        RecordingFile::Depth,
+        RecordingFile::Thermal,
+        RecordingFile::Trajectory,
+    ]
+    .iter()
+    .fold(Fingerprint::new(), |f, n| f.file(&n.path_in(&rec.dir)))
+    .maybe_file(tracked.exists().then_some(tracked.as_path()))
+    .frames("depth_frames", rec, &rec.depth)
+    .frames("thermal_frames", rec, &rec.thermal)
+    .setting("fuse", &p.fuse);
     let stage = Stage {
         name: "fuse".into(),
         stamp: dir.stage_json(),
@@ -581,12 +592,16 @@ fn segment_stage(
                 .filter(|f| p.segment.texture && f.exists())
                 .as_deref(),
         )
-        .maybe_file(use_masks.then(|| rec.dir.join("masks.txt")).as_deref())
+        .maybe_file(
+            use_masks
+                .then(|| RecordingFile::Masks.path_in(&rec.dir))
+                .as_deref(),
+        )
         .frames("mask_frames", rec, if use_masks { &rec.masks } else { &[] })
         .setting("segment", &p.segment)
         .setting("room", &p.room)
         .maybe_file(
-            Some(rec.dir.join("references.csv"))
+            Some(RecordingFile::References.path_in(&rec.dir))
                 .filter(|f| f.exists())
                 .as_deref(),
         )
@@ -783,7 +798,7 @@ pub fn run(
     let mut rec = Recording::open(recording)?;
     // The contact readings are read again after segmentation; a bad row is refused now, not
     // after fusion's seconds.
-    let references = rec.dir.join("references.csv");
+    let references = RecordingFile::References.path_in(&rec.dir);
     if references.exists() {
         read_references(&references)?;
     }

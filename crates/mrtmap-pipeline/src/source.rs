@@ -589,7 +589,7 @@ pub(crate) fn prepare(source: &Path, out: &Path, o: &SourceOptions) -> Result<Pr
     let stage = Stage {
         name: "convert".into(),
         stamp: layout.recording_stage_json(),
-        outputs: vec![dir.join("rig.toml")],
+        outputs: vec![mrtmap_io::RecordingFile::Rig.path_in(&dir)],
     };
     let fingerprint = Fingerprint::new()
         .file(source)

@@ -8,8 +8,8 @@ use mrtmap_geometry::camera::{BrownConrady, PinholeCamera};
 use mrtmap_geometry::nalgebra::{Isometry3, Point3, Translation3, Unit, UnitQuaternion, Vector3};
 use mrtmap_io::masks::{labels_path, mask_labels_json};
 use mrtmap_io::{
-    EncodeError, FileError, ImuSample, PartialDir, RgbCamera, Rig, ThermalEncoding, Trajectory,
-    encode_png_rgb8, encode_png16, imu_text, stream_list_text,
+    EncodeError, FileError, ImuSample, PartialDir, RecordingFile, RgbCamera, Rig, ThermalEncoding,
+    Trajectory, encode_png_rgb8, encode_png16, imu_text, stream_list_text,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -355,7 +355,7 @@ fn write_poses(
         poses: slam_poses,
     };
     out.write(
-        "groundtruth.txt",
+        RecordingFile::Groundtruth.name(),
         gt.to_tum(&format!(
             "{header}\ntrue poses: timestamp tx ty tz qx qy qz qw (world_from_depth)"
         ))
@@ -365,7 +365,7 @@ fn write_poses(
         return Ok(n_poses);
     }
     out.write(
-        "trajectory.txt",
+        RecordingFile::Trajectory.name(),
         slam.to_tum(&format!("{header}\nSLAM poses (drift {:?})", cfg.drift))
             .as_bytes(),
     )?;
@@ -430,7 +430,7 @@ fn write_imu(
         })
         .collect();
     out.write(
-        "imu.txt",
+        RecordingFile::Imu.name(),
         imu_text(&samples, &format!("{header}\ninertial unit (BMI055 model)")).as_bytes(),
     )
 }
@@ -592,17 +592,29 @@ fn write_lists(
         lag_s * 1e3
     );
     for (file, what, ts, dir, lag) in [
-        ("depth.txt", "depth frames", depth_t, "depth", 0.0),
         (
-            "thermal.txt",
+            RecordingFile::Depth.name(),
+            "depth frames",
+            depth_t,
+            "depth",
+            0.0,
+        ),
+        (
+            RecordingFile::Thermal.name(),
             thermal_what.as_str(),
             thermal_t,
             "thermal",
             lag_s,
         ),
-        ("rgb.txt", "colour frames", rgb_t, "rgb", 0.0),
         (
-            "masks.txt",
+            RecordingFile::Rgb.name(),
+            "colour frames",
+            rgb_t,
+            "rgb",
+            0.0,
+        ),
+        (
+            RecordingFile::Masks.name(),
             "instance masks (16-bit ids, labels in the .json beside each)",
             rgb_t,
             "masks",
@@ -643,7 +655,7 @@ fn write_camera_truth(
                 r.label, p.x, p.y, p.z, r.temperature_c, r.std_k
             ));
         }
-        files.write("references.csv", csv.as_bytes())?;
+        files.write(RecordingFile::References.name(), csv.as_bytes())?;
     }
     #[derive(Serialize)]
     struct CameraTruth<'a> {
@@ -710,7 +722,7 @@ pub fn simulate(
     let total = (depth_t.len() + thermal_t.len() + rgb_t.len()) as u64;
     let done = AtomicU64::new(0);
     let tick = || progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
-    files.write("rig.toml", rig(cfg).to_toml().as_bytes())?;
+    files.write(RecordingFile::Rig.name(), rig(cfg).to_toml().as_bytes())?;
     let camera = (!cfg.radiometric.is_perfect()).then(|| {
         CameraErrors::draw(
             cfg.radiometric,

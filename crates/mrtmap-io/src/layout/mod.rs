@@ -1,6 +1,7 @@
 //! The recording layout: one folder per scan, read by [`Recording`] and written frame by frame by
 //! [`LayoutWriter`] (see the crate docs for the files and what is accepted beyond them).
 
+mod files;
 mod imu;
 pub mod masks;
 mod recording;
@@ -9,6 +10,7 @@ mod streams;
 mod trajectory;
 mod writer;
 
+pub use files::RecordingFile;
 pub use imu::{ImuSample, imu_text, parse_imu, read_imu};
 pub use recording::{Recording, RecordingWarning};
 pub use rig::{PoseFile, RgbCamera, Rig, ThermalEncoding};

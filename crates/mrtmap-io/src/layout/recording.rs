@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use super::files::RecordingFile;
 use super::rig::Rig;
 use super::streams::{LineSkip, MAX_SKIPPED_SHARE, SkippedLine, StreamEntry, read_stream_list};
 use super::trajectory::{InterpolationLimits, Trajectory};
@@ -124,11 +125,12 @@ impl std::fmt::Display for RecordingWarning {
 /// (repeats not counted) and the list is refused, naming the first.
 fn list(
     dir: &Path,
-    name: &'static str,
+    file: RecordingFile,
     required: bool,
     warnings: &mut Vec<RecordingWarning>,
 ) -> Result<Vec<StreamEntry>, FileError> {
-    let p = dir.join(name);
+    let name = file.name();
+    let p = file.path_in(dir);
     if !p.exists() {
         return if required {
             Err(FileError::new(
@@ -193,7 +195,7 @@ impl Recording {
                 )),
             ));
         }
-        let rig_path = dir.join("rig.toml");
+        let rig_path = RecordingFile::Rig.path_in(dir);
         if !rig_path.exists() {
             return Err(FileError::new(
                 &rig_path,
@@ -209,11 +211,11 @@ impl Recording {
         if !unknown.is_empty() {
             warnings.push(RecordingWarning::UnknownRigKeys(unknown));
         }
-        let depth = list(dir, "depth.txt", true, &mut warnings)?;
-        let thermal = list(dir, "thermal.txt", true, &mut warnings)?;
-        let rgb = list(dir, "rgb.txt", false, &mut warnings)?;
-        let masks = list(dir, "masks.txt", false, &mut warnings)?;
-        let traj_path = dir.join("trajectory.txt");
+        let depth = list(dir, RecordingFile::Depth, true, &mut warnings)?;
+        let thermal = list(dir, RecordingFile::Thermal, true, &mut warnings)?;
+        let rgb = list(dir, RecordingFile::Rgb, false, &mut warnings)?;
+        let masks = list(dir, RecordingFile::Masks, false, &mut warnings)?;
+        let traj_path = RecordingFile::Trajectory.path_in(dir);
         // Without poses, a recording with colour can still be tracked (`mrtmap track`).
         let trajectory = if traj_path.exists() {
             Trajectory::read(&traj_path)?
@@ -230,13 +232,13 @@ impl Recording {
                 ),
             ));
         };
-        let gt_path = dir.join("groundtruth.txt");
+        let gt_path = RecordingFile::Groundtruth.path_in(dir);
         let groundtruth = if gt_path.exists() {
             Some(Trajectory::read(&gt_path)?)
         } else {
             None
         };
-        let imu_path = dir.join("imu.txt");
+        let imu_path = RecordingFile::Imu.path_in(dir);
         let imu = if imu_path.exists() {
             super::read_imu(&imu_path)?
         } else {

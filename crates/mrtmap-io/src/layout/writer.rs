@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use nalgebra::Isometry3;
 
+use super::files::RecordingFile;
 use super::imu::{ImuSample, imu_text};
 use super::rig::Rig;
 use super::streams::stream_list_text;
@@ -113,18 +114,18 @@ impl LayoutWriter {
         sort(&mut self.rgb);
         write(
             &d,
-            "depth.txt",
+            RecordingFile::Depth.name(),
             stream_list_text(&self.header, &self.depth).as_bytes(),
         )?;
         write(
             &d,
-            "thermal.txt",
+            RecordingFile::Thermal.name(),
             stream_list_text(&self.header, &self.thermal).as_bytes(),
         )?;
         if !self.rgb.is_empty() {
             write(
                 &d,
-                "rgb.txt",
+                RecordingFile::Rgb.name(),
                 stream_list_text(&self.header, &self.rgb).as_bytes(),
             )?;
         }
@@ -138,7 +139,7 @@ impl LayoutWriter {
         if !traj.is_empty() {
             write(
                 &d,
-                "trajectory.txt",
+                RecordingFile::Trajectory.name(),
                 traj.to_tum(&format!(
                     "{}\nworld_from_depth: timestamp tx ty tz qx qy qz qw",
                     self.header
@@ -149,9 +150,13 @@ impl LayoutWriter {
         if !self.imu.is_empty() {
             self.imu.sort_by(|a, b| a.t.total_cmp(&b.t));
             self.imu.dedup_by(|b, a| b.t <= a.t);
-            write(&d, "imu.txt", imu_text(&self.imu, &self.header).as_bytes())?;
+            write(
+                &d,
+                RecordingFile::Imu.name(),
+                imu_text(&self.imu, &self.header).as_bytes(),
+            )?;
         }
-        write(&d, "rig.toml", rig.to_toml().as_bytes())?;
+        write(&d, RecordingFile::Rig.name(), rig.to_toml().as_bytes())?;
         write(&d, "source.json", source_json.as_bytes())?;
         self.dir.finish()
     }

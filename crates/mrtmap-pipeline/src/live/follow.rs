@@ -22,7 +22,9 @@ use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 use std::time::{Instant, SystemTime};
 
-use mrtmap_io::{LineSkip, ListLine, Recording, SkippedLine, StreamEntry, StreamLines, Trajectory};
+use mrtmap_io::{
+    LineSkip, ListLine, Recording, RecordingFile, SkippedLine, StreamEntry, StreamLines, Trajectory,
+};
 
 /// How long a listed file may take to appear before its line is skipped (s).
 pub(crate) const MISSING_WAIT_S: f64 = 2.0;
@@ -30,27 +32,8 @@ pub(crate) const MISSING_WAIT_S: f64 = 2.0;
 /// Warnings kept (the first ones; the count goes on).
 const MAX_WARNINGS: usize = 50;
 
-/// Which list.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum List {
-    Depth,
-    Thermal,
-    Rgb,
-    Masks,
-    Trajectory,
-}
-
-impl List {
-    fn file(self) -> &'static str {
-        match self {
-            List::Depth => "depth.txt",
-            List::Thermal => "thermal.txt",
-            List::Rgb => "rgb.txt",
-            List::Masks => "masks.txt",
-            List::Trajectory => "trajectory.txt",
-        }
-    }
-}
+/// Which list: a file of the recording layout.
+type List = RecordingFile;
 
 /// A line waiting for its file.
 struct Pending {
@@ -127,7 +110,7 @@ fn whole(path: &Path, size_before: Option<u64>) -> (bool, Option<u64>) {
 impl Follower {
     /// Starts following `dir`, whose rig.toml must be readable.
     pub(crate) fn new(dir: &Path, thermal_offset_s: Option<f64>) -> crate::Result<Self> {
-        let rig = mrtmap_io::Rig::read(&dir.join("rig.toml"))?;
+        let rig = mrtmap_io::Rig::read(&RecordingFile::Rig.path_in(dir))?;
         let offset = thermal_offset_s
             .or(rig.thermal_time_offset_s)
             .unwrap_or(0.0);
@@ -205,7 +188,7 @@ impl Follower {
     /// Reads the complete lines appended to list `k` since the last poll.
     fn read_new_lines(&mut self, k: usize) -> bool {
         let list = self.tails[k].list;
-        let path = self.rec.dir.join(list.file());
+        let path = list.path_in(&self.rec.dir);
         let Ok(mut f) = File::open(&path) else {
             return false;
         };
@@ -256,7 +239,7 @@ impl Follower {
     fn skip(&mut self, list: List, skip: &SkippedLine) {
         self.warn(format!(
             "{} line {}: {}: skipped",
-            list.file(),
+            list.name(),
             skip.line,
             skip.why
         ));
@@ -306,7 +289,7 @@ impl Follower {
                 let why = LineSkip::Missing(p);
                 self.warn(format!(
                     "{} line {line}: {why} (it {what} after {MISSING_WAIT_S} s): skipped",
-                    list.file()
+                    list.name()
                 ));
                 continue;
             }
@@ -333,7 +316,7 @@ impl Follower {
                 }
                 List::Rgb => self.rec.rgb.push(entry),
                 List::Masks => self.rec.masks.push(entry),
-                List::Trajectory => {}
+                _ => {}
             }
         }
     }

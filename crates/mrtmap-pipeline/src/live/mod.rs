@@ -23,7 +23,7 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant, SystemTime};
 
 use mrtmap_geometry::nalgebra::Isometry3;
-use mrtmap_io::{Recording, Trajectory};
+use mrtmap_io::{Recording, RecordingFile, Trajectory};
 use mrtmap_radiation::RadiantScene;
 use mrtmap_scan::{Fused, LiveFusion};
 use serde::Serialize;
@@ -99,11 +99,41 @@ pub struct CameraNow {
     pub position_room: Option<[f64; 3]>,
 }
 
+/// Where `mrtmap live` is.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub enum LivePhase {
+    /// Following the recording as it grows.
+    #[default]
+    #[serde(rename = "following")]
+    Following,
+    /// Making the full run on the finished recording.
+    #[serde(rename = "final run")]
+    FinalRun,
+    /// The full run is written.
+    #[serde(rename = "done")]
+    Done,
+    /// The full run failed.
+    #[serde(rename = "failed")]
+    Failed,
+}
+
+impl std::fmt::Display for LivePhase {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::Following => "following",
+            Self::FinalRun => "final run",
+            Self::Done => "done",
+            Self::Failed => "failed",
+        })
+    }
+}
+
 /// What `mrtmap live` knows now (`GET /state.json`).
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct LiveState {
-    /// "following", "final run", "done" or "failed".
-    pub phase: String,
+    /// Where it is: following, the final run, done or failed (in the JSON "following",
+    /// "final run", "done", "failed").
+    pub phase: LivePhase,
     /// Where the poses come from: "the recording" (trajectory.txt) or "tracked live" (the
     /// built-in tracker, on a recording without poses).
     pub poses_from: String,
@@ -359,7 +389,7 @@ pub(crate) fn live(
     let mut tracker: Option<mrtmap_track::LiveTracker> = None;
     let t0 = Instant::now();
     let mut state = LiveState {
-        phase: "following".into(),
+        phase: LivePhase::Following,
         poses_from: "not known yet".into(),
         verdict: "keep scanning".into(),
         ..LiveState::default()
@@ -375,7 +405,7 @@ pub(crate) fn live(
             _ => 0.0,
         };
         if track_live.is_none() && listed_s >= DECIDE_POSES_AFTER_S {
-            let has_poses = recording.join("trajectory.txt").exists();
+            let has_poses = RecordingFile::Trajectory.path_in(recording).exists();
             // A rig with a colour camera whose recording lists no colour frame has nothing to
             // track: it was shown as "tracked live" while nothing fused.
             let tracked = can_track && !has_poses && !follower.rec.rgb.is_empty();
@@ -415,11 +445,15 @@ pub(crate) fn live(
         std::thread::sleep(Duration::from_secs_f64((POLL_S - spent).max(0.005)));
     }
     r.finish();
-    state.phase = "final run".into();
+    state.phase = LivePhase::FinalRun;
     sink.state(&state);
     drop(lock);
     let done = pipeline.run(recording, out);
-    state.phase = if done.is_ok() { "done" } else { "failed" }.into();
+    state.phase = if done.is_ok() {
+        LivePhase::Done
+    } else {
+        LivePhase::Failed
+    };
     sink.state(&state);
     done
 }
@@ -659,9 +693,9 @@ pub(crate) fn check_live_out(recording: &Path, out: &Path) -> Result<PathBuf> {
     crate::run::check_out_apart(recording, out)?;
     // The final run writes in place: a folder of the user's is refused now, not after the scan.
     mrtmap_io::check_replaceable(out)?;
-    if !recording.join("rig.toml").is_file() {
+    if !RecordingFile::Rig.path_in(recording).is_file() {
         return Err(Error::source(
-            &recording.join("rig.toml"),
+            &RecordingFile::Rig.path_in(recording),
             "is missing: a recording followed live must have its rig.toml from the start (the recorder writes it first)",
         ));
     }

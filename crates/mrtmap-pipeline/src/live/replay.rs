@@ -12,14 +12,14 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use mrtmap_io::{FileError, Recording};
+use mrtmap_io::{FileError, Recording, RecordingFile};
 
 use crate::error::{Error, Result};
 
 /// One thing to write: at scan time `t`, `line` into the list `list`, after copying `file`.
 struct Event {
     t: f64,
-    list: &'static str,
+    list: RecordingFile,
     line: String,
     file: Option<PathBuf>,
 }
@@ -42,10 +42,10 @@ pub struct ReplayDone {
 fn events(rec: &Recording) -> Vec<Event> {
     let mut ev = Vec::new();
     for (list, entries) in [
-        ("depth.txt", &rec.depth),
-        ("thermal.txt", &rec.thermal),
-        ("rgb.txt", &rec.rgb),
-        ("masks.txt", &rec.masks),
+        (RecordingFile::Depth, &rec.depth),
+        (RecordingFile::Thermal, &rec.thermal),
+        (RecordingFile::Rgb, &rec.rgb),
+        (RecordingFile::Masks, &rec.masks),
     ] {
         for e in entries {
             ev.push(Event {
@@ -60,7 +60,7 @@ fn events(rec: &Recording) -> Vec<Event> {
         let (v, q) = (p.translation.vector, p.rotation.coords);
         ev.push(Event {
             t: *t,
-            list: "trajectory.txt",
+            list: RecordingFile::Trajectory,
             line: format!(
                 "{t:.6} {:.9} {:.9} {:.9} {:.9} {:.9} {:.9} {:.9}",
                 v.x, v.y, v.z, q.x, q.y, q.z, q.w
@@ -77,7 +77,7 @@ fn events(rec: &Recording) -> Vec<Event> {
             .to_string();
         ev.push(Event {
             t: s.t,
-            list: "imu.txt",
+            list: RecordingFile::Imu,
             line,
             file: None,
         });
@@ -121,7 +121,7 @@ pub fn replay(
         ));
     }
     std::fs::create_dir_all(into).map_err(|e| FileError::io(into, e))?;
-    for name in ["rig.toml", "references.csv"] {
+    for name in [RecordingFile::Rig, RecordingFile::References].map(RecordingFile::name) {
         if from.join(name).is_file() {
             copy(&from.join(name), &into.join(name))?;
         }
@@ -158,11 +158,11 @@ pub fn replay(
             copy(&from.join(f), &into.join(f))?;
             done.files += 1;
             let labels = mrtmap_io::masks::labels_path(&from.join(f));
-            if e.list == "masks.txt" && labels.is_file() {
+            if e.list == RecordingFile::Masks && labels.is_file() {
                 copy(&labels, &mrtmap_io::masks::labels_path(&into.join(f)))?;
             }
         }
-        let list = into.join(e.list);
+        let list = e.list.path_in(into);
         let mut out = OpenOptions::new()
             .create(true)
             .append(true)

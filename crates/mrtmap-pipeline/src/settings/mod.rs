@@ -29,7 +29,6 @@ pub use scan::{FuseSection, SegmentSection, TrackMode, TrackSection};
 pub use sun::SunSection;
 
 pub(crate) use comfort::*;
-pub(crate) use references::default_std;
 
 /// The documented example, shown by `mrtmap run --help`.
 pub const PROJECT_EXAMPLE: &str = r#"# project.toml: every key is optional (defaults shown); flags override them.

@@ -1,7 +1,11 @@
 //! `[[references]]`: contact-thermometer readings of surface points (also references.csv's
 //! rows).
 
+use std::path::Path;
+
 use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result};
 
 use crate::settings::PointFrame;
 
@@ -43,8 +47,13 @@ pub(crate) struct BadReading {
 impl Reference {
     /// The readings of references.csv text (see docs/project.md); errors name `path` and the
     /// line.
-    pub fn parse_csv(text: &str, path: &std::path::Path) -> crate::Result<Vec<Self>> {
-        crate::level::parse_references(text, path)
+    pub fn parse_csv(text: &str, path: &Path) -> Result<Vec<Self>> {
+        parse_references(text, path)
+    }
+
+    /// Reads references.csv; errors name the file and the line.
+    pub(crate) fn read_csv(path: &Path) -> Result<Vec<Self>> {
+        read_references(path)
     }
 
     /// The one check of a reading, for references.csv's rows and `[[references]]` alike: a place
@@ -83,6 +92,91 @@ impl Reference {
         }
         Ok(())
     }
+}
+
+/// Reads `references.csv`; errors name the file and line.
+pub(crate) fn read_references(path: &Path) -> Result<Vec<Reference>> {
+    let text = std::fs::read_to_string(path).map_err(|e| mrtmap_io::FileError::io(path, e))?;
+    parse_references(&text, path)
+}
+
+/// Parses references.csv text; errors name `path` and the line.
+pub(crate) fn parse_references(text: &str, path: &Path) -> Result<Vec<Reference>> {
+    // Excel's "CSV UTF-8" starts with a byte-order mark: read past it.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let bad = |line: usize, msg: String| Error::Config {
+        path: path.to_path_buf(),
+        line,
+        message: msg,
+    };
+    let mut out = Vec::new();
+    let mut header: Option<Vec<String>> = None;
+    for (k, raw) in text.lines().enumerate() {
+        let line = raw.trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+        let Some(h) = &header else {
+            let names: Vec<String> = cells.iter().map(|c| c.to_lowercase()).collect();
+            for need in ["label", "x", "y", "z", "temperature_c"] {
+                if !names.iter().any(|n| n == need) {
+                    return Err(bad(
+                        k + 1,
+                        format!(
+                            "the header has no column '{need}' (needs label,x,y,z,temperature_c and optionally std_k, frame and emissivity)"
+                        ),
+                    ));
+                }
+            }
+            header = Some(names);
+            continue;
+        };
+        let col = |name: &str| h.iter().position(|n| n == name).and_then(|i| cells.get(i));
+        let num = |name: &str| -> Result<f64> {
+            let v = col(name).copied().unwrap_or("");
+            v.parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| bad(k + 1, format!("{name} '{v}' is not a number")))
+        };
+        let std_k = match col("std_k") {
+            Some(s) if !s.is_empty() => num("std_k")?,
+            _ => default_std(),
+        };
+        let frame = match col("frame").map(|f| f.to_lowercase()).as_deref() {
+            None | Some("") | Some("room") => PointFrame::Room,
+            Some("scan") => PointFrame::Scan,
+            Some(other) => {
+                return Err(bad(
+                    k + 1,
+                    format!(
+                        "frame '{other}' is neither room (x, y along the floor from the room frame's origin corner, z above the floor) nor scan (the frame of trajectory.txt)"
+                    ),
+                ));
+            }
+        };
+        let emissivity = match col("emissivity") {
+            Some(s) if !s.is_empty() => Some(num("emissivity")?),
+            _ => None,
+        };
+        let reading = Reference {
+            label: col("label").map_or(String::new(), |s| s.to_string()),
+            xyz: [num("x")?, num("y")?, num("z")?],
+            temperature_c: num("temperature_c")?,
+            std_k,
+            frame,
+            emissivity,
+        };
+        reading.check().map_err(|b| {
+            bad(
+                k + 1,
+                format!("{} {} is outside {}", b.key, b.value, b.allowed),
+            )
+        })?;
+        out.push(reading);
+    }
+    Ok(out)
 }
 
 #[cfg(test)]
@@ -130,7 +224,7 @@ mod tests {
                     ""
                 }
             );
-            let csv_err = crate::level::parse_references(&csv, Path::new("references.csv"));
+            let csv_err = parse_references(&csv, Path::new("references.csv"));
             assert!(csv_err.is_err(), "{csv}");
         }
         let nan = Project::parse(

@@ -163,7 +163,8 @@ fn image_folder(src: &Path) -> Result<ThermalFrames> {
 fn thermal_frames(src: &Path, o: &SourceOptions) -> Result<ThermalFrames> {
     match resolve_source(src)? {
         (SourceKind::Folder, _)
-            if src.join("thermal.txt").is_file() && src.join("rig.toml").is_file() =>
+            if mrtmap_io::RecordingFile::Thermal.path_in(src).is_file()
+                && mrtmap_io::RecordingFile::Rig.path_in(src).is_file() =>
         {
             let rec = Recording::open(src)?;
             let frames = rec

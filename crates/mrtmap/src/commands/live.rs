@@ -4,7 +4,7 @@
 use std::sync::Mutex;
 use std::sync::atomic::Ordering;
 
-use mrtmap_pipeline::{LiveSink, LiveState, Overrides, Pipeline, Project};
+use mrtmap_pipeline::{LivePhase, LiveSink, LiveState, Overrides, Pipeline, Project};
 
 use crate::cli::{LiveArgs, ReplayArgs};
 use crate::output::print_lines;
@@ -78,7 +78,7 @@ impl LiveSink for Terminal<'_> {
             "{} ({} of {} thermal frames fused)",
             s.verdict, s.frames_fused, s.frames_received
         );
-        if s.verdict != said.1 || s.phase != "following" {
+        if s.verdict != said.1 || s.phase != LivePhase::Following {
             eprintln!("{}: {verdict}", s.phase);
             said.1 = s.verdict.clone();
         }
