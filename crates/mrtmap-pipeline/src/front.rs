@@ -431,7 +431,8 @@ impl<'p> Pipeline<'p> {
             exit_when_idle_s,
             ..crate::live::LiveOptions::default()
         };
-        crate::live::live(self, recording, out, &opts, stop, sink)
+        let final_run = || self.run(recording, out);
+        crate::live::live(&self.project, &final_run, recording, out, &opts, stop, sink)
     }
 
     /// `mrtmap replay`: the finished recording `from` written into the new folder `into` at

@@ -15,6 +15,7 @@
 
 mod evaluate;
 mod evaluate_scene;
+mod operator;
 mod radiometric;
 mod render;
 mod room;
@@ -25,13 +26,13 @@ mod walk;
 
 pub use evaluate::{CloudScore, score_cloud, truth_at};
 pub use evaluate_scene::{FeatureScore, PointScore, SceneScore, SurfaceScore, score_scene};
+pub use operator::{OPERATOR_C, Operator};
 pub use radiometric::{
     CameraErrors, FfcPeriod, RadiometricModel, ReferenceReading, reference_readings,
 };
 pub use render::{Element, Hit, RoomRenderer, temperature_at};
 pub use room::grey::{
-    GLASS_EMISSIVITY, GREY_EMISSIVITY, Grey, IRRADIANCE_RAYS, OPERATOR_C, Operator, Surfaces,
-    radiant_c, room_as_simulated,
+    GLASS_EMISSIVITY, GREY_EMISSIVITY, Grey, IRRADIANCE_RAYS, Surfaces, radiant_c,
 };
 pub use room::is_glass;
 pub use room::{
@@ -42,7 +43,9 @@ pub use sensors::{
     DepthNoise, ThermalNoise, camera_rays, instance_label, instance_of, render_depth,
     render_rgb_and_mask, render_thermal,
 };
-pub use simulate::{Drift, NoiseLevel, Progress, SimConfig, SimSummary, TIME_ORIGIN_S, simulate};
+pub use simulate::{
+    Drift, NoiseLevel, Progress, SimConfig, SimSummary, TIME_ORIGIN_S, room_as_simulated, simulate,
+};
 pub use truth::{
     SimSun, TRUTH_FORMAT, Truth, TruthGrid, TruthNode, TruthPoint, TruthSun, TruthSunNode,
     compute_truth, sun_truth,

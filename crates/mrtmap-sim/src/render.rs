@@ -368,7 +368,7 @@ pub fn specular_t4(
     p: &Point3<f64>,
     d: &Vector3<f64>,
     normal: &Vector3<f64>,
-    operator: &crate::room::grey::Operator,
+    operator: &crate::operator::Operator,
 ) -> f64 {
     let r = d - normal * (2.0 * d.dot(normal));
     let start = p + r * 1e-6;
@@ -377,7 +377,7 @@ pub fn specular_t4(
         .hit(&start, &r)
         .filter(|t| hit.is_none_or(|h| *t < h.t));
     let reflected_c = match (by_operator, hit) {
-        (Some(_), _) => crate::room::grey::OPERATOR_C,
+        (Some(_), _) => crate::operator::OPERATOR_C,
         (None, Some(h)) => temperature_at(room, &h, &(start + r * h.t)),
         (None, None) => room.file.air_temperature_c,
     };

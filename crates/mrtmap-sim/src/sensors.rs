@@ -314,7 +314,7 @@ pub fn render_thermal<R: Rng>(
                 o,
                 renderer.view(p),
                 p.rotation.to_rotation_matrix(),
-                crate::room::grey::Operator::behind(p),
+                crate::operator::Operator::behind(p),
             )
         })
         .collect();

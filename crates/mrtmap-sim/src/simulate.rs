@@ -780,3 +780,13 @@ pub fn simulate(
         truth_method: truth.method,
     })
 }
+/// `room` with its surfaces as `cfg` asks (see [`crate::SimConfig::surfaces`]): what
+/// [`crate::simulate`] renders and computes the truth of. A room already grey, or one whose file
+/// gives the emissivities simulated (a recording's room.toml), keeps them.
+pub fn room_as_simulated(room: &Room, cfg: &SimConfig) -> Result<Room, SimError> {
+    if room.grey.is_some() {
+        return Ok(room.clone());
+    }
+    room.clone()
+        .with_surfaces(cfg.surfaces(), cfg.seed, crate::room::grey::IRRADIANCE_RAYS)
+}

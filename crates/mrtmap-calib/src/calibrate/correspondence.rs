@@ -17,8 +17,8 @@
 use mrtmap_geometry::camera::PinholeCamera;
 use mrtmap_geometry::nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
+use super::joint::PairStatus;
 use super::mono::MonoResult;
-use super::stereo::PairStatus;
 use super::view_error;
 use crate::CalibError;
 use crate::board::Board;

@@ -34,6 +34,7 @@
 
 mod correspondence;
 mod intrinsics;
+mod joint;
 mod mono;
 mod resample;
 mod stereo;
@@ -46,10 +47,9 @@ use crate::board::Board;
 use crate::detect::{Corner, Detection};
 
 pub use intrinsics::{DistortionModel, Intrinsics, camera_from};
+pub use joint::PairStatus;
 pub use mono::{MonoResult, PrincipalPoint, calibrate_mono, calibrate_mono_with};
-pub use stereo::{
-    PairInput, PairResult, PairStatus, StereoOptions, StereoResult, calibrate_stereo,
-};
+pub use stereo::{PairInput, PairResult, StereoOptions, StereoResult, calibrate_stereo};
 
 /// Isometry from (axis-angle, translation).
 pub fn iso(p: &[f64]) -> Isometry3<f64> {

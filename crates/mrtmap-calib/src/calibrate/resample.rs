@@ -11,8 +11,8 @@
 use rayon::prelude::*;
 
 use super::intrinsics::{DistortionModel, Intrinsics};
+use super::joint::{EXTRINSIC_PARAMS, Joint, Stereo, both_alone, stereo_cameras, stereo_params};
 use super::mono::{Mono, PrincipalPoint};
-use super::stereo::{EXTRINSIC_PARAMS, Joint, Stereo, both_alone, stereo_cameras, stereo_params};
 use super::{iso, push_residuals};
 use crate::board::Board;
 use crate::detect::Detection;

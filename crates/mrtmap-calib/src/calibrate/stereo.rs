@@ -1,6 +1,6 @@
 //! Two cameras' calibration: each camera alone, then the extrinsic between them.
 //!
-//! 1. Each camera calibrated alone from all of its own images ([`both_alone`]).
+//! 1. Each camera calibrated alone from all of its own images ([`both_alone`](super::joint::both_alone)).
 //! 2. The thermal corners' numbering tied to the colour image's, and a first extrinsic from the
 //!    pairs that show the whole board in both images ([`correspondence`](super::correspondence)).
 //! 3. Levenberg–Marquardt over the extrinsic and every board pose with the intrinsics fixed (as
@@ -11,70 +11,23 @@
 //! 5. The extrinsic's spread: the larger of the fit's and a bootstrap over the image pairs.
 //! 6. Each pair's result and errors, and how the fit was made, in words.
 
-use std::ops::Range;
-
 use mrtmap_geometry::camera::PinholeCamera;
 use mrtmap_geometry::nalgebra::{Isometry3, Translation3};
 use serde::{Deserialize, Serialize};
 
 use super::correspondence::{full, mean_whole_rotation, median_offset, quarter_turns, tie_shifts};
-use super::intrinsics::{DistortionModel, Intrinsics, camera_from};
-use super::mono::{MonoResult, PrincipalPoint, calibrate_mono_with};
+use super::intrinsics::{DistortionModel, Intrinsics};
+use super::joint::{
+    EXTRINSIC_PARAMS, Joint, PairStatus, RGB_PARAMS, Stereo, THERMAL_PARAMS, both_alone,
+    stereo_cameras, stereo_params,
+};
+use super::mono::{MonoResult, PrincipalPoint};
 use super::resample::Resample;
-use super::{ViewError, corners_of, iso, keep_flags, pooled, push_residuals, vec6, view_error};
+use super::{ViewError, corners_of, pooled, vec6};
 use crate::CalibError;
 use crate::board::Board;
 use crate::detect::{Corner, Detection};
-use crate::lm::{Problem, solve};
-
-/// Where the colour camera's intrinsics sit in the stereo problem's global parameters (flat, as
-/// the solver holds them: the colour camera's intrinsics, the thermal camera's, then
-/// thermal_from_rgb as axis-angle and translation).
-pub(super) const RGB_PARAMS: Range<usize> = 0..Intrinsics::LEN;
-
-/// Where the thermal camera's intrinsics sit in the stereo problem's global parameters.
-pub(super) const THERMAL_PARAMS: Range<usize> = Intrinsics::LEN..2 * Intrinsics::LEN;
-
-/// Where thermal_from_rgb (axis-angle, translation) sits in the stereo problem's global
-/// parameters.
-pub(super) const EXTRINSIC_PARAMS: Range<usize> = 2 * Intrinsics::LEN..2 * Intrinsics::LEN + 6;
-
-/// The stereo problem's global parameters: both cameras' intrinsics and thermal_from_rgb
-/// (axis-angle, translation).
-pub(super) fn stereo_params(
-    rgb: &Intrinsics,
-    thermal: &Intrinsics,
-    thermal_from_rgb: &[f64],
-) -> Vec<f64> {
-    let mut g: Vec<f64> = rgb.params().to_vec();
-    g.extend(thermal.params());
-    g.extend(thermal_from_rgb);
-    g
-}
-
-/// The colour and thermal cameras (of these image sizes) and thermal_from_rgb in the stereo
-/// problem's global parameters.
-pub(super) fn stereo_cameras(
-    g: &[f64],
-    rgb_size: (u32, u32),
-    th_size: (u32, u32),
-) -> (PinholeCamera, PinholeCamera, Isometry3<f64>) {
-    (
-        camera_from(rgb_size.0, rgb_size.1, &g[RGB_PARAMS]),
-        camera_from(th_size.0, th_size.1, &g[THERMAL_PARAMS]),
-        iso(&g[EXTRINSIC_PARAMS]),
-    )
-}
-
-/// What became of one pair.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case", tag = "status", content = "reason")]
-pub enum PairStatus {
-    /// Used in the stereo fit.
-    Used,
-    /// Not used, and why.
-    Rejected(String),
-}
+use crate::lm::solve;
 
 /// One pair in the stereo result.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -122,32 +75,6 @@ pub struct StereoResult {
     pub model_choice: String,
 }
 
-/// The extrinsic problem for the solver: the board in each pair's colour and thermal images.
-pub(super) struct Stereo<'a> {
-    /// The board.
-    pub(super) board: &'a Board,
-    /// Colour image size (px).
-    pub(super) rgb_size: (u32, u32),
-    /// Thermal image size (px).
-    pub(super) th_size: (u32, u32),
-    /// Each pair's colour corners.
-    pub(super) rgb: Vec<&'a [Corner]>,
-    /// Each pair's thermal corners, in the colour image's numbering.
-    pub(super) th: Vec<Vec<Corner>>,
-}
-
-impl Problem for Stereo<'_> {
-    fn views(&self) -> usize {
-        self.rgb.len()
-    }
-    fn residuals(&self, v: usize, g: &[f64], p: &[f64; 6], out: &mut Vec<f64>) {
-        let (cr, ct, e) = stereo_cameras(g, self.rgb_size, self.th_size);
-        let pose = iso(p);
-        push_residuals(&cr, &pose, self.board, self.rgb[v], out);
-        push_residuals(&ct, &(e * pose), self.board, &self.th[v], out);
-    }
-}
-
 /// A pair of detections (`None` where the board was not found) with image sizes.
 pub struct PairInput<'a> {
     /// Colour detection.
@@ -166,28 +93,6 @@ pub struct StereoOptions {
     /// Use only the corners found in both images of a pair in the joint fit (as OpenCV's
     /// `stereoCalibrate` requires); by default every corner of either image counts.
     pub common_corners: bool,
-}
-
-/// Each camera alone, from every image of it; `principal` (colour, thermal) says how each
-/// principal point is found.
-pub(super) fn both_alone(
-    board: &Board,
-    rgb_size: (u32, u32),
-    thermal_size: (u32, u32),
-    dets: (&[Option<Detection>], &[Option<Detection>]),
-    models: (DistortionModel, DistortionModel),
-    principal: (PrincipalPoint, PrincipalPoint),
-) -> Result<(MonoResult, MonoResult), CalibError> {
-    let alone = |camera: &'static str, (w, h): (u32, u32), d, model, pp| {
-        calibrate_mono_with(board, w, h, d, model, pp).map_err(|e| CalibError::Camera {
-            camera,
-            source: Box::new(e),
-        })
-    };
-    Ok((
-        alone("colour", rgb_size, dets.0, models.0, principal.0)?,
-        alone("thermal", thermal_size, dets.1, models.1, principal.1)?,
-    ))
 }
 
 /// How a recalibration keeps a camera's principal point: as the full calibration chose it.
@@ -212,66 +117,6 @@ fn initial_status(rgb: &[Option<Detection>], th: &[Option<Detection>]) -> Vec<Pa
             })
         })
         .collect()
-}
-
-/// The extrinsic problem's global parameters and each pair's errors.
-pub(super) struct Joint<'a> {
-    /// The problem.
-    pub(super) prob: Stereo<'a>,
-    /// Which global parameters are fitted.
-    pub(super) free: Vec<bool>,
-}
-
-impl Joint<'_> {
-    /// (colour, thermal) reprojection errors of view `v` under `s`.
-    fn errors(&self, s: &crate::lm::Solved, v: usize) -> (ViewError, ViewError) {
-        let (rgb_size, th_size) = (self.prob.rgb_size, self.prob.th_size);
-        let (cr, ct, e) = stereo_cameras(&s.global, rgb_size, th_size);
-        let pose = iso(&s.views[v]);
-        (
-            view_error(&cr, &pose, self.prob.board, self.prob.rgb[v]),
-            view_error(&ct, &(e * pose), self.prob.board, &self.prob.th[v]),
-        )
-    }
-
-    /// Refits without the pairs whose error is far above the others', twice at most and keeping
-    /// at least three; `status` says why a pair was dropped.
-    fn reject_outliers(
-        &self,
-        mut s: crate::lm::Solved,
-        active: &mut [bool],
-        idx: &[usize],
-        status: &mut [PairStatus],
-    ) -> crate::lm::Solved {
-        for _ in 0..2 {
-            let errs: Vec<Option<(ViewError, ViewError)>> = (0..idx.len())
-                .map(|v| active[v].then(|| self.errors(&s, v)))
-                .collect();
-            let rms = |pick: fn(&(ViewError, ViewError)) -> f64| {
-                errs.iter()
-                    .map(|e| e.as_ref().map(pick))
-                    .collect::<Vec<_>>()
-            };
-            let kr = keep_flags(&rms(|x| x.0.rms_px), 0.5);
-            let kt = keep_flags(&rms(|x| x.1.rms_px), 0.5);
-            let newly: Vec<usize> = (0..idx.len())
-                .filter(|&v| active[v] && !(kr[v] && kt[v]))
-                .collect();
-            if newly.is_empty() || active.iter().filter(|a| **a).count() - newly.len() < 3 {
-                break;
-            }
-            for v in newly {
-                active[v] = false;
-                let (er, et) = errs[v].unwrap_or_default();
-                status[idx[v]] = PairStatus::Rejected(format!(
-                    "outlier: RMS error {:.2} px colour, {:.2} px thermal, more than three times the pairs' median",
-                    er.rms_px, et.rms_px
-                ));
-            }
-            s = solve(&self.prob, s.global, s.views, &self.free, active, 100);
-        }
-        s
-    }
 }
 
 /// Calibrates both cameras and the extrinsic between them.

@@ -354,10 +354,11 @@ fn camera_now(traj: &Trajectory, scene: Option<&RadiantScene>) -> Option<CameraN
 }
 
 /// Follows `recording` as it is written, sending what is known to `sink`, until it stops growing
-/// for `opts.exit_when_idle_s` or `stop` is set; then makes the whole run into `out` with
-/// `pipeline` (as `mrtmap run`) and returns it.
+/// for `opts.exit_when_idle_s` or `stop` is set; then makes the whole run into `out` by
+/// `final_run` (as `mrtmap run`, with `project`) and returns it.
 pub(crate) fn live(
-    pipeline: &crate::Pipeline<'_>,
+    project: &Project,
+    final_run: &dyn Fn() -> Result<crate::report::RunDone>,
     recording: &Path,
     out: &Path,
     opts: &LiveOptions,
@@ -368,7 +369,7 @@ pub(crate) fn live(
     // Held while following, so that a second `live` (or `run`) into the same folder is refused
     // now; given back just before the final run, which takes it again.
     let lock = crate::lock::OutLock::take(out)?;
-    let p = coarse(pipeline.project());
+    let p = coarse(project);
     let params = p.fuse.params()?;
     let fixed_offset = match params.clock {
         mrtmap_scan::clock::ClockOffset::Fixed(o) => Some(o),
@@ -448,7 +449,7 @@ pub(crate) fn live(
     state.phase = LivePhase::FinalRun;
     sink.state(&state);
     drop(lock);
-    let done = pipeline.run(recording, out);
+    let done = final_run();
     state.phase = if done.is_ok() {
         LivePhase::Done
     } else {

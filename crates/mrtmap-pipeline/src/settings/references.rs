@@ -184,6 +184,7 @@ mod tests {
     #![allow(clippy::unwrap_used)]
     use std::path::Path;
 
+    use super::parse_references;
     use crate::settings::Project;
 
     /// Issue 63: `[[references]]` in project.toml is checked as strictly as references.csv's rows,

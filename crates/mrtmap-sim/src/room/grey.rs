@@ -10,7 +10,7 @@
 //! to nine points on it), update J, three times (each round shrinks the error by 1 − ε, ≤ 0.16).
 //!
 //! Glass is specular in the long-wave: the thermal camera sees εσT⁴ plus 1 − ε of what the mirrored
-//! ray meets, the operator included ([`Operator`]), while its radiosity for the MRT (and the truth)
+//! ray meets, the operator included ([`Operator`](crate::Operator)), while its radiosity for the MRT (and the truth)
 //! is the diffuse one above.
 
 use mrtmap_geometry::nalgebra::{Isometry3, Point2, Point3, Vector3};
@@ -22,17 +22,6 @@ use serde::{Deserialize, Serialize};
 
 use crate::room::is_glass;
 use crate::room::{Room, SurfaceRef};
-
-/// `room` with its surfaces as `cfg` asks (see [`crate::SimConfig::surfaces`]): what
-/// [`crate::simulate`] renders and computes the truth of. A room already grey, or one whose file
-/// gives the emissivities simulated (a recording's room.toml), keeps them.
-pub fn room_as_simulated(room: &Room, cfg: &crate::SimConfig) -> Result<Room, crate::SimError> {
-    if room.grey.is_some() {
-        return Ok(room.clone());
-    }
-    room.clone()
-        .with_surfaces(cfg.surfaces(), cfg.seed, IRRADIANCE_RAYS)
-}
 
 /// Monte Carlo rays per irradiance point in rooms that need them (furniture, not convex).
 pub const IRRADIANCE_RAYS: usize = 20_000;
@@ -67,66 +56,6 @@ pub struct Grey {
     pub surface_irradiance_k: Vec<f64>,
     /// Irradiance temperature (K) by feature, once solved.
     pub feature_irradiance_k: Vec<f64>,
-}
-
-/// The person holding the rig: a vertical cylinder behind the camera, which glass mirrors.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Operator {
-    /// The body's axis on the floor plan (room frame).
-    pub axis: Point2<f64>,
-    /// Its radius (m).
-    pub radius_m: f64,
-    /// The top of the head above the floor (m).
-    pub top_m: f64,
-}
-
-/// The operator's clothed body's surface temperature (°C).
-pub const OPERATOR_C: f64 = 34.0;
-/// How far behind the camera the body's axis stands (m).
-pub const OPERATOR_BEHIND_M: f64 = 0.25;
-/// The body's radius (m).
-pub const OPERATOR_RADIUS_M: f64 = 0.2;
-/// How far above the camera the head's top reaches (m).
-pub const OPERATOR_ABOVE_M: f64 = 0.25;
-
-impl Operator {
-    /// The operator of a camera at `room_from_cam` (looking along its +z).
-    pub fn behind(room_from_cam: &Isometry3<f64>) -> Self {
-        let o = room_from_cam.translation.vector;
-        let f = room_from_cam.rotation * Vector3::z();
-        let h = Vector3::new(f.x, f.y, 0.0);
-        let back = if h.norm() > 1e-6 {
-            -h.normalize()
-        } else {
-            Vector3::zeros()
-        };
-        Self {
-            axis: Point2::new(
-                o.x + OPERATOR_BEHIND_M * back.x,
-                o.y + OPERATOR_BEHIND_M * back.y,
-            ),
-            radius_m: OPERATOR_RADIUS_M,
-            top_m: o.z + OPERATOR_ABOVE_M,
-        }
-    }
-
-    /// The distance along `d` from `p` at which the ray enters the body, if it does.
-    pub fn hit(&self, p: &Point3<f64>, d: &Vector3<f64>) -> Option<f64> {
-        let (px, py) = (p.x - self.axis.x, p.y - self.axis.y);
-        let a = d.x * d.x + d.y * d.y;
-        if a < 1e-12 {
-            return None;
-        }
-        let b = 2.0 * (px * d.x + py * d.y);
-        let c = px * px + py * py - self.radius_m * self.radius_m;
-        let disc = b * b - 4.0 * a * c;
-        if disc < 0.0 {
-            return None;
-        }
-        let t = (-b - disc.sqrt()) / (2.0 * a);
-        let z = p.z + t * d.z;
-        (t > 1e-6 && (0.0..=self.top_m).contains(&z)).then_some(t)
-    }
 }
 
 impl Grey {
@@ -254,6 +183,7 @@ pub fn solve(room: &mut Room, rays: usize, seed: u64) -> Result<(), crate::SimEr
 mod tests {
     #![allow(clippy::unwrap_used)]
     use super::*;
+    use crate::Operator;
     use mrtmap_geometry::nalgebra::UnitQuaternion;
 
     /// A camera 1.4 m up at x = 2, looking along +x: the body stands behind it (x ≈ 1.75); a ray

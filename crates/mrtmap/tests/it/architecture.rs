@@ -208,59 +208,213 @@ fn code_of(path: &Path) -> String {
         .join("\n")
 }
 
-/// The crate's modules (files and folders directly in `src/`) and the others each one names as
-/// `crate::x`, in a `use crate::{…}` group, or (from a file directly in `src/`) as `super::x`.
-fn module_graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
-    let mut files: BTreeMap<String, Vec<PathBuf>> = BTreeMap::new();
-    for e in std::fs::read_dir(src).unwrap().map(Result::unwrap) {
-        let p = e.path();
-        let name = p.file_stem().unwrap().to_string_lossy().to_string();
-        if p.is_dir() {
-            let mut all = Vec::new();
-            let mut stack = vec![p];
-            while let Some(d) = stack.pop() {
-                for f in std::fs::read_dir(d).unwrap().map(|e| e.unwrap().path()) {
-                    if f.is_dir() {
-                        stack.push(f);
-                    } else if f.extension().is_some_and(|x| x == "rs") {
-                        all.push(f);
+/// Every module of the crate in `src` by its path (`a`, `a::b` for `a/b.rs` or `a/b/mod.rs`; the
+/// crate root is ""), with its file.
+fn module_files(src: &Path) -> BTreeMap<String, PathBuf> {
+    let mut files = Vec::new();
+    rust_files(src, &mut files);
+    files
+        .into_iter()
+        .map(|f| {
+            let rel = f.strip_prefix(src).unwrap().with_extension("");
+            let mut parts: Vec<String> = rel
+                .components()
+                .map(|c| c.as_os_str().to_string_lossy().to_string())
+                .collect();
+            if parts
+                .last()
+                .is_some_and(|l| l == "mod" || l == "lib" || l == "main")
+            {
+                parts.pop();
+            }
+            (parts.join("::"), f)
+        })
+        .collect()
+}
+
+/// The paths `code` names from `crate::`, `super::` or `self::`, and, with `relative`, from a
+/// name of its own child modules: each as (its head, its segments), a `{…}` group expanded one
+/// level deep (a nested group's leading path is kept).
+fn named_paths(code: &str, children: &BTreeSet<String>) -> Vec<(String, Vec<String>)> {
+    let ident = |c: char| c.is_ascii_alphanumeric() || c == '_';
+    let mut out = Vec::new();
+    let bytes: Vec<char> = code.chars().collect();
+    let mut i = 0;
+    while i < bytes.len() {
+        if !ident(bytes[i]) || (i > 0 && (ident(bytes[i - 1]) || bytes[i - 1] == ':')) {
+            i += 1;
+            continue;
+        }
+        // A path starting here: idents separated by `::`, maybe ending in a group.
+        let mut segs: Vec<String> = Vec::new();
+        let mut j = i;
+        let mut group: Option<String> = None;
+        loop {
+            let start = j;
+            while j < bytes.len() && ident(bytes[j]) {
+                j += 1;
+            }
+            segs.push(bytes[start..j].iter().collect());
+            if bytes.get(j) == Some(&':') && bytes.get(j + 1) == Some(&':') {
+                j += 2;
+                if bytes.get(j) == Some(&'{') {
+                    let mut depth = 0;
+                    let open = j;
+                    while j < bytes.len() {
+                        match bytes[j] {
+                            '{' => depth += 1,
+                            '}' => {
+                                depth -= 1;
+                                if depth == 0 {
+                                    break;
+                                }
+                            }
+                            _ => {}
+                        }
+                        j += 1;
                     }
+                    group = Some(bytes[open + 1..j.min(bytes.len())].iter().collect());
+                    break;
+                }
+                if j < bytes.len() && ident(bytes[j]) {
+                    continue;
                 }
             }
-            files.entry(name).or_default().extend(all);
-        } else if p.extension().is_some_and(|x| x == "rs") && name != "lib" && name != "main" {
-            files.entry(name).or_default().push(p);
+            break;
         }
-    }
-    let names: BTreeSet<String> = files.keys().cloned().collect();
-    let word = |s: &str| -> String {
-        s.chars()
-            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
-            .collect()
-    };
-    files
-        .iter()
-        .map(|(m, fs)| {
-            let mut uses = BTreeSet::new();
-            for f in fs {
-                let code = code_of(f);
-                let top = f.parent() == Some(src);
-                let mut names_after = |prefix: &str| {
-                    for part in code.split(prefix).skip(1) {
-                        if let Some(group) = part.strip_prefix('{') {
-                            let group = group.split('}').next().unwrap_or_default();
-                            uses.extend(group.split(',').map(|g| word(g.trim())));
-                        } else {
-                            uses.insert(word(part));
+        let head = segs[0].clone();
+        if matches!(head.as_str(), "crate" | "super" | "self") || children.contains(&head) {
+            let base: Vec<String> = segs[1..].to_vec();
+            match group {
+                Some(g) => {
+                    let mut depth = 0;
+                    let mut cur = String::new();
+                    let mut parts = Vec::new();
+                    for c in g.chars() {
+                        match c {
+                            '{' => depth += 1,
+                            '}' => depth -= 1,
+                            ',' if depth == 0 => parts.push(std::mem::take(&mut cur)),
+                            _ => {}
+                        }
+                        if !(c == ',' && depth == 0) {
+                            cur.push(c);
                         }
                     }
+                    parts.push(cur);
+                    for part in parts {
+                        let lead: Vec<String> = part
+                            .trim()
+                            .split("::")
+                            .map(|x| x.chars().take_while(|c| ident(*c)).collect::<String>())
+                            .take_while(|x| !x.is_empty())
+                            .collect();
+                        if !lead.is_empty() {
+                            out.push((head.clone(), [base.clone(), lead].concat()));
+                        }
+                    }
+                }
+                None => out.push((head, base)),
+            }
+        }
+        i = j.max(i + 1);
+    }
+    out
+}
+
+/// The module a path names from module `at`: the longest prefix that is a module, followed
+/// through that module's re-exports (`pub use child::X`) to where the name is declared.
+fn resolve_module(
+    modules: &BTreeMap<String, PathBuf>,
+    reexports: &BTreeMap<(String, String), String>,
+    at: &str,
+    head: &str,
+    segs: &[String],
+) -> Option<String> {
+    let here: Vec<String> = if at.is_empty() {
+        Vec::new()
+    } else {
+        at.split("::").map(String::from).collect()
+    };
+    let full: Vec<String> = match head {
+        "crate" => segs.to_vec(),
+        "super" => [here[..here.len().saturating_sub(1)].to_vec(), segs.to_vec()].concat(),
+        "self" => [here.clone(), segs.to_vec()].concat(),
+        child => [here.clone(), vec![child.to_string()], segs.to_vec()].concat(),
+    };
+    let k = (0..=full.len())
+        .rev()
+        .find(|&k| modules.contains_key(&full[..k].join("::")))?;
+    let module = full[..k].join("::");
+    match full.get(k) {
+        Some(name) => match reexports.get(&(module.clone(), name.clone())) {
+            Some(m) if *m != module => Some(m.clone()),
+            _ => Some(module),
+        },
+        None => Some(module),
+    }
+}
+
+/// The crate's modules, each with the others it names (through re-exports to the module that
+/// declares the name), leaving out a module's own ancestors and descendants (a parent declares and
+/// re-exports its children, and a child may use its parent's items: that is nesting, not a cycle).
+fn module_graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
+    let modules = module_files(src);
+    let code: BTreeMap<String, String> = modules
+        .iter()
+        .map(|(m, f)| (m.clone(), code_of(f)))
+        .collect();
+    let children = |m: &str| -> BTreeSet<String> {
+        modules
+            .keys()
+            .filter_map(|k| {
+                let rest = if m.is_empty() {
+                    Some(k.as_str())
+                } else {
+                    k.strip_prefix(m).and_then(|r| r.strip_prefix("::"))
                 };
-                names_after("crate::");
-                if top {
-                    names_after("super::");
+                rest.filter(|r| !r.is_empty() && !r.contains("::"))
+                    .map(String::from)
+            })
+            .collect()
+    };
+    // Re-exports: (module, name) → the module the name comes from, resolved in passes so that a
+    // chain of re-exports is followed.
+    let mut reexports: BTreeMap<(String, String), String> = BTreeMap::new();
+    for _ in 0..4 {
+        for (m, c) in &code {
+            let kids = children(m);
+            for stmt in c.split(';') {
+                let Some(k) = stmt.find("use ") else { continue };
+                if !stmt[..k].trim().starts_with("pub") {
+                    continue;
+                }
+                for (head, segs) in named_paths(&stmt[k + 4..], &kids) {
+                    let (Some(name), Some(target)) = (
+                        segs.last(),
+                        resolve_module(&modules, &reexports, m, &head, &segs),
+                    ) else {
+                        continue;
+                    };
+                    if target != *m {
+                        reexports.insert((m.clone(), name.clone()), target);
+                    }
                 }
             }
-            uses.retain(|u| u != m && names.contains(u));
+        }
+    }
+    code.iter()
+        .map(|(m, c)| {
+            let kids = children(m);
+            let uses: BTreeSet<String> = named_paths(c, &kids)
+                .into_iter()
+                .filter_map(|(head, segs)| resolve_module(&modules, &reexports, m, &head, &segs))
+                .filter(|t| {
+                    let nested =
+                        |a: &str, b: &str| a.is_empty() || b.starts_with(&format!("{a}::"));
+                    t != m && !nested(t, m) && !nested(m, t)
+                })
+                .collect();
             (m.clone(), uses)
         })
         .collect()
@@ -325,12 +479,48 @@ fn the_cycle_check_sees_a_cycle() {
     std::fs::write(src.join("lib.rs"), "mod a;\nmod b;\n").unwrap();
     std::fs::write(src.join("a.rs"), "use crate::b::X;\n// crate::c\n").unwrap();
     std::fs::create_dir(src.join("b")).unwrap();
-    std::fs::write(src.join("b/mod.rs"), "mod inner;\n").unwrap();
-    std::fs::write(src.join("b/inner.rs"), "use crate::{a::Y, b};\n").unwrap();
+    std::fs::write(src.join("b/mod.rs"), "mod inner;\npub use inner::X;\n").unwrap();
+    std::fs::write(
+        src.join("b/inner.rs"),
+        "use crate::{a::Y, b};\npub struct X;\n",
+    )
+    .unwrap();
     let g = module_graph(src);
-    assert_eq!(a_cycle(&g), Some(vec!["a".into(), "b".into(), "a".into()]));
-    std::fs::write(src.join("b/inner.rs"), "#[cfg(test)]\nuse crate::a::Y;\n").unwrap();
+    // Through b's re-export, a uses b::inner, which uses a.
+    assert_eq!(
+        a_cycle(&g),
+        Some(vec!["a".into(), "b::inner".into(), "a".into()])
+    );
+    std::fs::write(
+        src.join("b/inner.rs"),
+        "#[cfg(test)]\nuse crate::a::Y;\npub struct X;\n",
+    )
+    .unwrap();
     assert_eq!(a_cycle(&module_graph(src)), None);
+    // Siblings inside a folder.
+    std::fs::write(
+        src.join("b/mod.rs"),
+        "mod inner;\nmod other;\npub use inner::X;\n",
+    )
+    .unwrap();
+    std::fs::write(
+        src.join("b/inner.rs"),
+        "use super::other::Z;\npub struct X;\n",
+    )
+    .unwrap();
+    std::fs::write(
+        src.join("b/other.rs"),
+        "use super::inner::X;\npub struct Z;\n",
+    )
+    .unwrap();
+    assert_eq!(
+        a_cycle(&module_graph(src)),
+        Some(vec![
+            "b::inner".into(),
+            "b::other".into(),
+            "b::inner".into()
+        ])
+    );
 }
 
 /// The file of module `name` declared in `file` (`name.rs` or `name/mod.rs` beside a `lib.rs` or
