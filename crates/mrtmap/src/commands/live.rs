@@ -33,6 +33,12 @@ pub fn run(a: &LiveArgs) -> anyhow::Result<()> {
     let pipeline = Pipeline::new(Project::resolve(a.config.as_deref(), &Overrides::new())?);
     pipeline.check_live(&a.recording, &a.out, a.target_k, a.exit_when_idle)?;
     let server = mrtmap_live::Server::start(&a.serve)?;
+    if !mrtmap_live::is_loopback(server.addr()) {
+        eprintln!(
+            "notice: serving on {} beyond this machine: anyone on the network can read the live page (it changes nothing); --serve 127.0.0.1:PORT keeps it to this machine",
+            server.addr()
+        );
+    }
     eprintln!(
         "live page: http://{} (state: /state.json); following {}; Ctrl-C stops following and makes the full run into {}",
         server.addr(),

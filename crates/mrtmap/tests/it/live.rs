@@ -463,3 +463,64 @@ fn a_bad_live_request_is_refused_before_the_page_opens() {
         "my notes"
     );
 }
+
+/// Served beyond this machine (0.0.0.0), `live` says so on one line before the page's address;
+/// on 127.0.0.1 it does not. Either way the page answers, and refuses to be changed.
+#[test]
+fn serving_to_the_network_is_announced() {
+    for (serve, announced) in [("0.0.0.0:0", true), ("127.0.0.1:0", false)] {
+        let dir = tempfile::tempdir().unwrap();
+        let mut live = Command::new(env!("CARGO_BIN_EXE_mrtmap"))
+            .args(["live", recording().to_str().unwrap(), "--serve", serve])
+            .args(["--out", dir.path().join("out").to_str().unwrap()])
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let stderr = live.stderr.take().unwrap();
+        let mut before = Vec::new();
+        let mut page = None;
+        for line in BufReader::new(stderr)
+            .lines()
+            .map_while(Result::ok)
+            .take(20)
+        {
+            if line.starts_with("live page: http://") {
+                page = Some(line);
+                break;
+            }
+            before.push(line);
+        }
+        let page = page.unwrap_or_else(|| panic!("no page's address after {before:?}"));
+        let port = page
+            .split("http://")
+            .nth(1)
+            .and_then(|r| r.split_whitespace().next())
+            .and_then(|a| a.rsplit_once(':'))
+            .map(|(_, p)| p.to_string())
+            .unwrap();
+        let addr = format!("127.0.0.1:{port}");
+        let (head, _) = get(&addr, "/state.json").unwrap();
+        assert!(head.starts_with("HTTP/1.1 200"), "{head}");
+        let mut s = TcpStream::connect(&addr).unwrap();
+        s.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+        s.write_all(b"POST /state.json HTTP/1.0\r\nContent-Length: 2\r\n\r\n{}")
+            .unwrap();
+        let mut answer = String::new();
+        let _ = s.read_to_string(&mut answer);
+        live.kill().unwrap();
+        live.wait().unwrap();
+        assert!(answer.starts_with("HTTP/1.1 405"), "{answer}");
+        assert!(answer.contains("Allow: GET, HEAD"), "{answer}");
+        let notices: Vec<_> = before.iter().filter(|l| l.starts_with("notice:")).collect();
+        if announced {
+            assert_eq!(notices.len(), 1, "{before:?}");
+            assert!(
+                notices[0].contains("anyone on the network can read the live page"),
+                "{before:?}"
+            );
+        } else {
+            assert!(notices.is_empty(), "{before:?}");
+        }
+    }
+}
