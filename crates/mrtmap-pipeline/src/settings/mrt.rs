@@ -40,37 +40,30 @@ impl From<DirectionChoice> for DirectionSet {
     }
 }
 
-/// `[mrt]`, and the flags of `map` and `mrt`: the view-factor method. One definition for both:
-/// the doc comments are the flags' `--help`, the defaults those of [`Default`].
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, clap::Args)]
+/// `[mrt]`: the view-factor method (its flags: [`crate::MrtFlags`]; the defaults those of
+/// [`Default`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct MrtSection {
     /// View-factor method: exact solid angles where valid and Monte Carlo with occluders or where
     /// surfaces hide each other (auto), exact solid angles only (exact), or Monte Carlo ray
     /// tracing (montecarlo).
-    #[arg(long, value_enum, default_value_t = MethodChoice::Auto)]
     pub method: MethodChoice,
     /// Monte Carlo: rays per point.
-    #[arg(long, default_value_t = MonteCarlo::default().rays)]
     pub rays: usize,
     /// Monte Carlo: random seed (results are reproducible from it).
-    #[arg(long, default_value_t = MonteCarlo::default().seed)]
     pub seed: u64,
     /// Monte Carlo: direction set (randomly rotated spherical Fibonacci lattices converge faster
     /// than independent random directions).
-    #[arg(long, value_enum, default_value_t = DirectionChoice::Fibonacci)]
     pub directions: DirectionChoice,
     /// Monte Carlo: independent replicates the standard errors come from.
-    #[arg(long, default_value_t = MonteCarlo::default().replicates)]
     pub replicates: usize,
     /// Answer at points the scene does not enclose (a missing wall, floor or ceiling leaves part
     /// of the view empty: ΣF short of 1) instead of refusing them; ΣF is printed with each point.
-    #[arg(long)]
     pub allow_open: bool,
     /// How well a point is placed relative to the room's surfaces (m, one standard deviation): the
     /// MRT's gradient times it joins the MRT's ± (near a cold window it dominates; not yet a
     /// person's or a plane's); 0 leaves it out.
-    #[arg(long, default_value_t = 0.01)]
     pub placement_std_m: f64,
 }
 

@@ -794,3 +794,32 @@ fn no_program_decides_by_comparing_text() {
     assert!(read > 100, "read only {read} files");
     assert!(found.is_empty(), "text compared:\n{}", found.join("\n"));
 }
+
+/// Issue 61: `[mrt]`'s keys are spelled in Python's wrapper, its stub, the extension's signatures
+/// and the keyword list that turns them into the project's keys; a key added to `MrtSection` (or
+/// renamed) and not to each of them fails here.
+#[test]
+fn the_mrt_keys_are_the_same_in_every_front_end() {
+    let section = serde_json::to_value(mrtmap_pipeline::MrtSection::default()).unwrap();
+    let keys: Vec<String> = section.as_object().unwrap().keys().cloned().collect();
+    assert_eq!(keys.len(), 7, "{keys:?}");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let read = |f: &str| std::fs::read_to_string(root.join(f)).unwrap();
+    // (file, how a key is spelled there, how many times: one per Scene method taking [mrt])
+    let places = [
+        ("python/mrtmap/__init__.py", "{k}: Optional[", 4),
+        ("python/mrtmap/_mrtmap.pyi", "{k}: Optional[", 4),
+        ("crates/mrtmap-py/src/scene.rs", "{k}=None", 4),
+        ("crates/mrtmap-py/src/lib.rs", "\"mrt.{k}\"", 1),
+    ];
+    for (file, form, n) in places {
+        let text = read(file);
+        for k in &keys {
+            let spelled = form.replace("{k}", k);
+            assert!(
+                text.matches(&spelled).count() >= n,
+                "{file} spells [mrt] {k} as {spelled} fewer than {n} times"
+            );
+        }
+    }
+}

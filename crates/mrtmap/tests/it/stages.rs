@@ -110,3 +110,113 @@ fn the_stages_one_at_a_time_give_runs_scene_and_map() {
         "[emissivity] of window-1 = 0.5 differs from the 0.84 the scene",
     );
 }
+
+/// The stages a run reused or ran again, by name.
+fn ran(out: &Path) -> Vec<(String, bool)> {
+    read_json(&out.join("run.json"))["stages"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| {
+            (
+                s["stage"].as_str().unwrap().to_string(),
+                !s["skipped"].as_bool().unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// `path` replaced by `text` (its hard link to the shared recording broken first).
+fn replace(path: &Path, text: &str) {
+    std::fs::remove_file(path).unwrap();
+    std::fs::write(path, text).unwrap();
+}
+
+/// Issue 61: replacing a file the recording's settings name re-runs the stages that read it, and
+/// only those: references.csv and masks.txt the segmentation (not the fusion), rig.toml the
+/// fusion and all after it. (The weather file of `[sun]`: tests/it/sun.rs.)
+#[test]
+fn replacing_a_file_reruns_the_stages_that_read_it_and_only_those() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("scan");
+    crate::refusals::linked_copy(recording(), &rec);
+    let refs = rec.join("references.csv");
+    std::fs::write(&refs, "label,x,y,z,temperature_c\nfloor,1.5,1.5,0.0,21.0\n").unwrap();
+    let out = dir.path().join("run");
+    let args = [
+        "run",
+        rec.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--grid",
+        "6x5",
+    ];
+    ok(&args);
+    ok(&args);
+    assert!(ran(&out).iter().all(|(_, r)| !r), "{:?}", ran(&out));
+    let stage = |name: &str| {
+        ran(&out)
+            .into_iter()
+            .find(|(n, _)| n == name)
+            .unwrap_or_else(|| panic!("no stage {name}: {:?}", ran(&out)))
+            .1
+    };
+    // A reading changed: the level, so the scene and its map.
+    replace(&refs, "label,x,y,z,temperature_c\nfloor,1.5,1.5,0.0,21.4\n");
+    ok(&args);
+    assert!(!stage("fuse") && stage("segment") && stage("map at 1.10 m"));
+    let level = read_json(&out.join("segment/level.json"));
+    assert!(
+        level["references"][0]["reference_c"].as_f64().unwrap() > 21.3,
+        "{level}"
+    );
+    // masks.txt rewritten: segmentation reads it, fusion does not.
+    let masks = rec.join("masks.txt");
+    let text = std::fs::read_to_string(&masks).unwrap();
+    replace(&masks, &format!("{text}# checked again\n"));
+    ok(&args);
+    assert!(!stage("fuse") && stage("segment"), "{:?}", ran(&out));
+    // rig.toml rewritten: the fusion, and what follows it.
+    let rig = rec.join("rig.toml");
+    let text = std::fs::read_to_string(&rig).unwrap();
+    replace(&rig, &format!("{text}\n# checked again\n"));
+    ok(&args);
+    assert!(stage("fuse") && stage("segment") && stage("map at 1.10 m"));
+    // Nothing replaced: nothing runs.
+    ok(&args);
+    assert!(ran(&out).iter().all(|(_, r)| !r), "{:?}", ran(&out));
+    // The weather file [sun] names, rewritten behind the same path with another direct normal
+    // irradiance: the comfort maps (the sun) run again, nothing before them (the issue's case:
+    // the old mrt_sun map was reused).
+    let row = |h: u32, dni: f64| {
+        format!(
+            "1989,1,15,{h},60,?9?9?9?9E0,1.0,-2.0,80,101000,0,0,250,150,{dni},60,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0\n"
+        )
+    };
+    let epw = |dni: f64| {
+        format!(
+            "LOCATION,Berlin,,DEU,IWEC Data,103840,52.47,13.40,1.0,49.0\nDESIGN CONDITIONS,0\nDATA PERIODS,1,1,Data,Sunday, 1/ 1,12/31\n{}{}",
+            row(12, 100.0),
+            row(13, dni)
+        )
+    };
+    std::fs::write(dir.path().join("site.epw"), epw(800.0)).unwrap();
+    let toml = dir.path().join("sun.toml");
+    std::fs::write(
+        &toml,
+        "[map]\ngrid = [6, 5]\nquantities = [\"mrt_sun\"]\n\n[sun]\nepw = \"site.epw\"\ndate_time = \"2026-01-15T11:00:00Z\"\ntransmittance = 0.6\n",
+    )
+    .unwrap();
+    let sun_args = [&args[..], &["--config", toml.to_str().unwrap()]].concat();
+    ok(&sun_args);
+    assert!(stage("comfort maps"));
+    ok(&sun_args);
+    assert!(ran(&out).iter().all(|(_, r)| !r), "{:?}", ran(&out));
+    std::fs::write(dir.path().join("site.epw"), epw(200.0)).unwrap();
+    ok(&sun_args);
+    assert!(
+        stage("comfort maps") && !stage("fuse") && !stage("segment") && !stage("map at 1.10 m"),
+        "{:?}",
+        ran(&out)
+    );
+}
