@@ -5,7 +5,8 @@ use std::time::Instant;
 
 use mrtmap_sim::preset;
 pub(crate) use mrtmap_sim::{
-    Drift, NoiseLevel, RadiometricModel, SimConfig, SimSun, Surfaces, ThermalNoise, simulate,
+    Drift, ExtrinsicError, NoiseLevel, RadiometricModel, SimConfig, SimSun, Surfaces, ThermalNoise,
+    simulate,
 };
 /// The simulator's preset rooms (mrtmap-sim's).
 pub use mrtmap_sim::{PRESETS, Room};
@@ -141,6 +142,14 @@ pub struct SimulateArgs {
     /// room's TOML gives emissivities; the camera reads radiosities, the contact readings true
     /// temperatures) or black (ε = 1: the camera reads each surface's own temperature). Default:
     /// grey with --noise realistic, black with none.
+    /// A calibration a little off: the thermal camera's true pose is this far (mm) from the one
+    /// rig.toml is written with, along a direction drawn from the seed (the frames are rendered
+    /// with the true one; truth.json says it).
+    #[arg(long, value_name = "MM", default_value_t = 0.0)]
+    pub(crate) extrinsic_error_mm: f64,
+    /// The same, turned by this angle (degrees) about an axis drawn from the seed.
+    #[arg(long, value_name = "DEG", default_value_t = 0.0)]
+    pub(crate) extrinsic_error_deg: f64,
     #[arg(long, value_enum)]
     pub(crate) surfaces: Option<Surfaces>,
     /// The sun outside the room, for truth.json only (the recording is unchanged: a long-wave
@@ -205,8 +214,24 @@ impl SimulateArgs {
             truth_rays: self.truth_rays,
             radiometric: self.camera.model(self.noise),
             references: self.camera.references(self.noise),
+            extrinsic_error: (self.extrinsic_error_mm != 0.0 || self.extrinsic_error_deg != 0.0)
+                .then_some(ExtrinsicError {
+                    translation_mm: self.extrinsic_error_mm,
+                    rotation_deg: self.extrinsic_error_deg,
+                }),
             ..SimConfig::default()
         };
+        if !(0.0..=50.0).contains(&self.extrinsic_error_mm)
+            || !(0.0..=10.0).contains(&self.extrinsic_error_deg)
+        {
+            return Err(Error::setting(
+                format!(
+                    "--extrinsic-error-mm {} --extrinsic-error-deg {}",
+                    self.extrinsic_error_mm, self.extrinsic_error_deg
+                ),
+                "is outside 0…50 mm and 0…10°: a calibration that far off is no calibration",
+            ));
+        }
         if let Some(ms) = self.thermal_lag_ms {
             cfg.thermal_lag_s = Some(ms / 1000.0);
         }

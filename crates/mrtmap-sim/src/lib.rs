@@ -44,7 +44,8 @@ pub use sensors::{
     render_rgb_and_mask, render_thermal,
 };
 pub use simulate::{
-    Drift, NoiseLevel, Progress, SimConfig, SimSummary, TIME_ORIGIN_S, room_as_simulated, simulate,
+    Drift, ExtrinsicError, NoiseLevel, Progress, SimConfig, SimSummary, TIME_ORIGIN_S,
+    room_as_simulated, simulate,
 };
 pub use truth::{
     SimSun, TRUTH_FORMAT, Truth, TruthGrid, TruthNode, TruthPoint, TruthSun, TruthSunNode,

@@ -8,8 +8,8 @@ use mrtmap_geometry::camera::{BrownConrady, PinholeCamera};
 use mrtmap_geometry::nalgebra::{Isometry3, Point3, Translation3, Unit, UnitQuaternion, Vector3};
 use mrtmap_io::masks::{labels_path, mask_labels_json};
 use mrtmap_io::{
-    EncodeError, FileError, ImuSample, PartialDir, RecordingFile, RgbCamera, Rig, ThermalEncoding,
-    Trajectory, encode_png_rgb8, encode_png16, imu_text, stream_list_text,
+    EncodeError, FileError, ImuSample, PartialDir, PoseFile, RecordingFile, RgbCamera, Rig,
+    ThermalEncoding, Trajectory, encode_png_rgb8, encode_png16, imu_text, stream_list_text,
 };
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -130,12 +130,54 @@ pub struct SimConfig {
     /// is unchanged: a long-wave camera cannot see the beam).
     #[serde(default)]
     pub sun: Option<crate::truth::SimSun>,
+    /// How far the rig's true `depth_from_thermal` is from the one rig.toml is written with (a
+    /// calibration a little off): the frames are rendered with the true one.
+    #[serde(default)]
+    pub extrinsic_error: Option<ExtrinsicError>,
+}
+
+/// A calibration error of the thermal camera's pose: a translation of `translation_mm` and a
+/// rotation of `rotation_deg`, each along (about) a direction drawn from the seed.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ExtrinsicError {
+    /// The translation's length (mm).
+    pub translation_mm: f64,
+    /// The rotation's angle (degrees).
+    pub rotation_deg: f64,
 }
 
 /// Where a realistic thermal lag is drawn from (s).
 pub const REALISTIC_LAG_S: std::ops::Range<f64> = 0.040..0.120;
 
 impl SimConfig {
+    /// The thermal camera's true pose in the depth camera's frame: rig.toml's
+    /// (`depth_from_thermal`) moved by [`SimConfig::extrinsic_error`], its directions drawn from
+    /// the seed.
+    pub fn true_depth_from_thermal(&self) -> Isometry3<f64> {
+        let Some(e) = self.extrinsic_error else {
+            return self.depth_from_thermal;
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(self.seed ^ 0x0e7a_1b5c);
+        let mut unit = || {
+            let v = Vector3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            );
+            if v.norm() > 1e-6 {
+                v.normalize()
+            } else {
+                Vector3::x()
+            }
+        };
+        let (t, axis) = (unit(), unit());
+        let error = Isometry3::from_parts(
+            Translation3::from(t * e.translation_mm / 1000.0),
+            UnitQuaternion::from_scaled_axis(axis * e.rotation_deg.to_radians()),
+        );
+        self.depth_from_thermal * error
+    }
+
     /// Whether the depth camera sees through glass in this configuration.
     pub fn glass_on(&self) -> bool {
         self.glass.unwrap_or(self.noise == NoiseLevel::Realistic)
@@ -197,6 +239,7 @@ impl Default for SimConfig {
             glass: None,
             surfaces: None,
             sun: None,
+            extrinsic_error: None,
         }
     }
 }
@@ -513,16 +556,18 @@ impl Frames<'_> {
             }
         };
         let rays = camera_rays(&cfg.thermal_camera, noise.supersample);
+        // The frames are taken with the true extrinsic; rig.toml says the nominal one.
+        let depth_from_thermal = cfg.true_depth_from_thermal();
         let ss = noise.supersample.max(1) as usize;
         let ages = noise.sample_ages_s(ss * ss);
         times.par_iter().enumerate().try_for_each(|(k, &t)| {
             // The walk starts at 0: a frame exposed at its very start sees no earlier scene.
             let poses: Vec<Isometry3<f64>> = if noise.time_constant_s > 0.0 {
                 ages.iter()
-                    .map(|a| self.walk.room_from_depth((t - a).max(0.0)) * cfg.depth_from_thermal)
+                    .map(|a| self.walk.room_from_depth((t - a).max(0.0)) * depth_from_thermal)
                     .collect()
             } else {
-                vec![self.walk.room_from_depth(t) * cfg.depth_from_thermal]
+                vec![self.walk.room_from_depth(t) * depth_from_thermal]
             };
             let img = render_thermal(
                 self.room,
@@ -751,6 +796,9 @@ pub fn simulate(
     files.write("room.toml", room_toml.as_bytes())?;
     let mut truth = compute_truth(room, &world_from_room, cfg.truth_rays, cfg.seed)?;
     truth.thermal_lag_s = lag_s;
+    truth.true_depth_from_thermal = cfg
+        .extrinsic_error
+        .map(|_| PoseFile::from_isometry(&cfg.true_depth_from_thermal()));
     truth.sun = cfg
         .sun
         .as_ref()

@@ -102,6 +102,10 @@ pub struct Truth {
     /// cannot see the beam).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sun: Option<TruthSun>,
+    /// The thermal camera's true pose in the depth camera's frame, when it differs from
+    /// rig.toml's (`mrtmap simulate --extrinsic-error-mm/--extrinsic-error-deg`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub true_depth_from_thermal: Option<PoseFile>,
 }
 
 /// The sun outside a simulated room (`mrtmap simulate --sun ALT,AZ --dni W --transmittance T`).
@@ -313,6 +317,7 @@ pub fn compute_truth(
         room: room.file.name.clone(),
         air_temperature_c: room.file.air_temperature_c,
         world_from_room: PoseFile::from_isometry(world_from_room),
+        true_depth_from_thermal: None,
         up_world: [up.x, up.y, up.z],
         method: method.name().into(),
         thermal_lag_s: 0.0,

@@ -64,7 +64,8 @@ fn assert_only(dir: &Path, known: &[PathBuf]) {
     }
 }
 
-fn stages_skipped(out: &Path) -> Vec<(String, bool)> {
+/// Each stage of the run in `out` (run.json), and whether it was reused.
+pub(crate) fn stages_skipped(out: &Path) -> Vec<(String, bool)> {
     read_json(&out.join("run.json"))["stages"]
         .as_array()
         .unwrap()

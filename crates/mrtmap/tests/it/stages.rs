@@ -111,18 +111,11 @@ fn the_stages_one_at_a_time_give_runs_scene_and_map() {
     );
 }
 
-/// The stages a run reused or ran again, by name.
+/// The stages a run ran (not reused), by name.
 fn ran(out: &Path) -> Vec<(String, bool)> {
-    read_json(&out.join("run.json"))["stages"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|s| {
-            (
-                s["stage"].as_str().unwrap().to_string(),
-                !s["skipped"].as_bool().unwrap(),
-            )
-        })
+    crate::pipeline::stages_skipped(out)
+        .into_iter()
+        .map(|(n, skipped)| (n, !skipped))
         .collect()
 }
 
