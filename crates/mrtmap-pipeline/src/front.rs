@@ -5,7 +5,7 @@
 //!
 //! ```no_run
 //! use mrtmap_pipeline::{Overrides, Pipeline, Project};
-//! # fn main() -> mrtmap_pipeline::Result<()> {
+//! # fn main() -> Result<(), mrtmap_pipeline::Error> {
 //! let project = Project::resolve(None, &Overrides::new())?;
 //! let done = Pipeline::new(project).force(false).run("scan".as_ref(), "out".as_ref())?;
 //! println!("{}", done.outcome.maps.len());
