@@ -213,3 +213,83 @@ fn replacing_a_file_reruns_the_stages_that_read_it_and_only_those() {
         ran(&out)
     );
 }
+
+/// Issue 61: a relocalisation half way through the scan (every pose after 10 s moved by 0.5 m and
+/// turned 10°, the frames as they were) is re-anchored by the depth, and the map is the unshifted
+/// walk's within 0.1 K.
+#[test]
+fn a_relocalised_trajectory_is_reanchored_and_maps_as_the_unshifted_walk() {
+    use mrtmap_geometry::nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion};
+    let dir = tempfile::tempdir().unwrap();
+    let rec = dir.path().join("scan");
+    crate::refusals::linked_copy(recording(), &rec);
+    let traj = rec.join("trajectory.txt");
+    let text = std::fs::read_to_string(&traj).unwrap();
+    let shift = Isometry3::from_parts(
+        Translation3::new(0.3, -0.4, 0.0),
+        UnitQuaternion::from_euler_angles(0.0, 0.0, 10f64.to_radians()),
+    );
+    let mut t0 = None;
+    let mut out = String::new();
+    for line in text.lines() {
+        let v: Vec<f64> = line
+            .split_whitespace()
+            .map(|x| x.parse().unwrap_or(f64::NAN))
+            .collect();
+        if line.starts_with('#') || v.len() != 8 {
+            out.push_str(line);
+            out.push('\n');
+            continue;
+        }
+        let start = *t0.get_or_insert(v[0]);
+        let p = Isometry3::from_parts(
+            Translation3::new(v[1], v[2], v[3]),
+            UnitQuaternion::from_quaternion(Quaternion::new(v[7], v[4], v[5], v[6])),
+        );
+        let p = if v[0] - start > 10.0 { shift * p } else { p };
+        let (t, q) = (p.translation.vector, p.rotation.coords);
+        out.push_str(&format!(
+            "{:.9} {:.9} {:.9} {:.9} {:.9} {:.9} {:.9} {:.9}\n",
+            v[0], t.x, t.y, t.z, q.x, q.y, q.z, q.w
+        ));
+    }
+    std::fs::remove_file(&traj).unwrap();
+    std::fs::write(&traj, out).unwrap();
+    let run = |rec: &Path, name: &str| {
+        let out = dir.path().join(name);
+        ok(&[
+            "run",
+            rec.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--grid",
+            "8x6",
+        ]);
+        out
+    };
+    let (a, b) = (run(recording(), "unshifted"), run(&rec, "relocalised"));
+    let fusion = read_json(&b.join("fuse/fusion.json"));
+    let jumps = fusion["pose_check"]["jumps"].as_array().unwrap();
+    assert_eq!(jumps.len(), 1, "{fusion}");
+    assert_eq!(jumps[0]["outcome"]["kind"], "reanchored", "{}", jumps[0]);
+    let grid = |p: &Path| -> Vec<f64> {
+        std::fs::read_to_string(p.join("map-1.10m/mrt_grid.csv"))
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(3).unwrap().parse().unwrap())
+            .collect()
+    };
+    let (ga, gb) = (grid(&a), grid(&b));
+    assert_eq!(ga.len(), gb.len());
+    let worst = ga
+        .iter()
+        .zip(&gb)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max);
+    println!(
+        "relocalised against unshifted: max |diff| {worst:.3} K over {} nodes",
+        ga.len()
+    );
+    assert!(worst <= 0.1, "{worst:.3} K");
+}
