@@ -543,7 +543,7 @@ impl Refresher {
                 self.last = Some(r.outcome);
                 self.problem = None;
             }
-            Err(e) => self.problem = Some(in_words(&e)),
+            Err(e) => self.problem = Some(missing_in_words(&e, traj.poses.last())),
         }
     }
 
@@ -658,25 +658,60 @@ fn update_state(
     if let Some(why) = refresh_problem {
         state.good_enough = false;
         state.verdict = "keep scanning".into();
-        state.reasons = vec![format!("the room could not be put together yet: {why}")];
+        state.reasons = vec![format!("the room is not put together yet: {why}")];
+        // Advice about a room model that is not there would contradict the reason.
+        state.advice.clear();
     } else if last.is_none() {
         state.reasons = vec!["the room is not put together yet: keep scanning".into()];
     }
 }
 
-/// An error with its causes, in one line.
-fn in_words(e: &Error) -> String {
-    let mut s = e.to_string();
-    let mut cause = std::error::Error::source(e);
-    while let Some(c) = cause {
-        let c_s = c.to_string();
-        if !s.contains(&c_s) {
-            s.push_str(": ");
-            s.push_str(&c_s);
+/// Why the room could not be put together yet, in words for the person holding the rig: what to
+/// look at, and where the gap is from where the camera is now (no file paths, no coordinates of
+/// the scan's frame).
+fn missing_in_words(e: &Error, camera: Option<&Isometry3<f64>>) -> String {
+    use mrtmap_scan::segment::SegmentError as S;
+    let Error::Segment { source, .. } = e else {
+        return "keep scanning the room slowly, floor, walls and ceiling".into();
+    };
+    match source {
+        S::NoPoses => "no camera poses yet: keep the camera moving slowly".into(),
+        S::NoFloor => "no floor seen yet: tilt the camera down to the floor".into(),
+        S::NoCeiling => "no ceiling seen yet: tilt the camera up to the ceiling".into(),
+        S::NoWalls => {
+            "no wall seen from floor to ceiling yet: look at the walls up to the ceiling".into()
         }
-        cause = c.source();
+        S::OpenOutline {
+            from, to, length_m, ..
+        } => {
+            let gap = mrtmap_geometry::nalgebra::Point3::new(
+                0.5 * (from[0] + to[0]),
+                0.5 * (from[1] + to[1]),
+                0.5 * (from[2] + to[2]),
+            );
+            let (where_, turn) = camera.map_or(("somewhere", "look around"), |c| {
+                // The camera's right (+x) and forward (+z), in the scan's frame.
+                let d = gap - c.translation.vector;
+                let (right, ahead) = (
+                    d.coords
+                        .dot(&(c.rotation * mrtmap_geometry::nalgebra::Vector3::x())),
+                    d.coords
+                        .dot(&(c.rotation * mrtmap_geometry::nalgebra::Vector3::z())),
+                );
+                let bearing = right.atan2(ahead).to_degrees();
+                match bearing {
+                    b if b.abs() <= 45.0 => ("ahead of you", "scan ahead"),
+                    b if b.abs() >= 135.0 => ("behind you", "turn around"),
+                    b if b > 0.0 => ("to your right", "turn right"),
+                    _ => ("to your left", "turn left"),
+                }
+            });
+            format!(
+                "the walls are not joined {where_} (about {length_m:.1} m not seen): {turn} and scan that part of the room"
+            )
+        }
+        _ => "keep scanning the room slowly, floor, walls and ceiling".into(),
     }
-    s
 }
 
 /// The frames fusion could not read, in words.
@@ -701,4 +736,56 @@ pub(crate) fn check_live_out(recording: &Path, out: &Path) -> Result<PathBuf> {
         ));
     }
     Ok(out.to_path_buf())
+}
+
+#[cfg(test)]
+mod tests {
+    use mrtmap_geometry::nalgebra::{Translation3, UnitQuaternion, Vector3};
+    use mrtmap_scan::segment::SegmentError;
+
+    use super::*;
+
+    /// Issue 64: before the room closes, the reason says in words what is missing and where,
+    /// from the camera now: no file path, no coordinates of the scan's frame (it was "cannot
+    /// segment …/fuse/cloud.ply: the room's outline does not close: from (1.88, 1.71, 0.64) …").
+    #[test]
+    fn what_is_missing_is_said_in_words_from_where_the_camera_is() {
+        let open = |from: [f64; 3], to: [f64; 3]| Error::Segment {
+            cloud: PathBuf::from("/tmp/live-xyz/fuse/cloud.ply"),
+            source: SegmentError::OpenOutline {
+                from,
+                to,
+                length_m: 1.2,
+            },
+        };
+        // A camera at the origin looking along +z, its right +x.
+        let camera = Isometry3::identity();
+        let said = |e: &Error| missing_in_words(e, Some(&camera));
+        let behind = said(&open([-0.5, 0.0, -3.0], [0.5, 0.0, -3.0]));
+        assert!(
+            behind.contains("behind you") && behind.contains("turn around"),
+            "{behind}"
+        );
+        assert!(!behind.contains('/') && !behind.contains("-3") && !behind.contains("frame"));
+        assert!(said(&open([2.0, 0.0, -0.5], [2.0, 0.0, 0.5])).contains("to your right"));
+        assert!(said(&open([-2.0, 0.0, -0.5], [-2.0, 0.0, 0.5])).contains("to your left"));
+        assert!(said(&open([-0.5, 0.0, 3.0], [0.5, 0.0, 3.0])).contains("ahead of you"));
+        // The camera turned half a turn: what was ahead is behind.
+        let turned = Isometry3::from_parts(
+            Translation3::identity(),
+            UnitQuaternion::from_axis_angle(&Vector3::y_axis(), std::f64::consts::PI),
+        );
+        assert!(
+            missing_in_words(&open([-0.5, 0.0, 3.0], [0.5, 0.0, 3.0]), Some(&turned))
+                .contains("behind you")
+        );
+        let floor = Error::Segment {
+            cloud: PathBuf::from("/tmp/x/cloud.ply"),
+            source: SegmentError::NoFloor,
+        };
+        assert_eq!(
+            said(&floor),
+            "no floor seen yet: tilt the camera down to the floor"
+        );
+    }
 }
