@@ -233,7 +233,9 @@ fn run_phase(server: &Server, probe: &Probe, seq: &mut usize, length: Duration) 
     }
 }
 
-/// The load: runs for `length`, then prints what the clients saw.
+/// The load: runs for `length`, then prints what the clients saw. One function on purpose: it
+/// starts every kind of client, waits, and sums up what each saw, and a bench harness read top to
+/// bottom is easier to check against the list of clients than one split into pieces.
 fn load(addr: SocketAddr, length: Duration) {
     let stop = Arc::new(AtomicBool::new(false));
     let (polls, poll_errors, busy, events) = (

@@ -15,7 +15,7 @@
 //! written as the scene's `temperature_level_std_k`; with the offset alone it holds the gain
 //! error left ([`GAIN_STD`] × the distance from the readings).
 //!
-//! Everything about the absolute level is here: the readings ([`read_references`]), what a run
+//! Everything about the absolute level is here: the readings ([`Reference::read_csv`]), what a run
 //! gathers ([`LevelInputs`]), the fit ([`find_level`]) and segmentation's scene and tables carried
 //! to it ([`level_segmentation`]). The relative level (each frame's offset after a flat-field
 //! correction, the vignetting) is removed during fusion, frame by frame, by
@@ -42,17 +42,6 @@ pub(crate) const DEFAULT_CAMERA_ACCURACY_K: f64 = 5.0;
 
 fn one() -> f64 {
     1.0
-}
-
-/// Reads `references.csv`; errors name the file and line (settings/references.rs reads it).
-pub(crate) fn read_references(path: &Path) -> Result<Vec<Reference>> {
-    Reference::read_csv(path)
-}
-
-/// Parses references.csv text; errors name `path` and the line.
-#[cfg(test)]
-fn parse_references(text: &str, path: &Path) -> Result<Vec<Reference>> {
-    Reference::parse_csv(text, path)
 }
 
 /// How one reference was used.
@@ -497,7 +486,7 @@ impl LevelInputs {
             .map(|r| mrtmap_io::RecordingFile::References.path_in(&r.dir))
             .filter(|f| f.exists());
         if let Some(csv) = csv.or(own.as_deref()) {
-            references.extend(read_references(csv)?);
+            references.extend(Reference::read_csv(csv)?);
         }
         references.extend(p.references.iter().cloned());
         let (references, warnings) = merge_same_spot(references);
@@ -1019,19 +1008,22 @@ mod tests {
             "# ok\nlabel,x,y,z,temperature_c\nw,1,2,3,20.5\nv,1,2,x,20\n",
         )
         .unwrap();
-        let e = read_references(&p).unwrap_err().to_string();
+        let e = Reference::read_csv(&p).unwrap_err().to_string();
         assert!(
             e.ends_with("references.csv:4: z 'x' is not a number"),
             "{e}"
         );
         std::fs::write(&p, "label,x,y,temperature_c\n").unwrap();
-        let e = read_references(&p).unwrap_err().to_string();
+        let e = Reference::read_csv(&p).unwrap_err().to_string();
         assert!(e.contains(":1: the header has no column 'z'"), "{e}");
         // A byte-order mark before the header (Excel's "CSV UTF-8") is read past.
         let bom = "\u{feff}label,x,y,z,temperature_c\nwall,1,2,1,20.5\n";
-        assert_eq!(parse_references(bom, Path::new("r.csv")).unwrap().len(), 1);
+        assert_eq!(
+            Reference::parse_csv(bom, Path::new("r.csv")).unwrap().len(),
+            1
+        );
         std::fs::write(&p, "temperature_c,label,z,y,x,std_k\n20.5,w,3,2,1,0.05\n").unwrap();
-        let r = read_references(&p).unwrap();
+        let r = Reference::read_csv(&p).unwrap();
         assert_eq!(
             (r[0].xyz, r[0].std_k, r[0].frame),
             ([1.0, 2.0, 3.0], 0.05, PointFrame::Room)
@@ -1042,14 +1034,14 @@ mod tests {
             "label,x,y,z,temperature_c,frame\nfloor,1.83,0.42,0.00,20.6,room\nwall x0,-1.30,0.95,0.41,21.0,scan\nw,1,2,3,20,\n",
         )
         .unwrap();
-        let r = read_references(&p).unwrap();
+        let r = Reference::read_csv(&p).unwrap();
         let frames: Vec<PointFrame> = r.iter().map(|x| x.frame).collect();
         assert_eq!(
             frames,
             [PointFrame::Room, PointFrame::Scan, PointFrame::Room]
         );
         std::fs::write(&p, "label,x,y,z,temperature_c,frame\nw,1,2,3,20,world\n").unwrap();
-        let e = read_references(&p).unwrap_err().to_string();
+        let e = Reference::read_csv(&p).unwrap_err().to_string();
         assert!(e.contains(":2: frame 'world' is neither room"), "{e}");
         // An emissivity column: a number in (0, 1], or empty for the surface's.
         std::fs::write(
@@ -1057,14 +1049,14 @@ mod tests {
             "label,x,y,z,temperature_c,emissivity\nw,1,2,3,11.5,0.84\nv,1,2,3,20,\n",
         )
         .unwrap();
-        let r = read_references(&p).unwrap();
+        let r = Reference::read_csv(&p).unwrap();
         assert_eq!((r[0].emissivity, r[1].emissivity), (Some(0.84), None));
         std::fs::write(
             &p,
             "label,x,y,z,temperature_c,emissivity\nw,1,2,3,11.5,84\n",
         )
         .unwrap();
-        let e = read_references(&p).unwrap_err().to_string();
+        let e = Reference::read_csv(&p).unwrap_err().to_string();
         assert!(e.contains(":2: emissivity 84 is outside"), "{e}");
     }
 }

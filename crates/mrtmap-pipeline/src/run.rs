@@ -31,7 +31,7 @@ use crate::cache::{Fingerprint, Stage, StageOutcome, read_json, run_or_reuse, wr
 use crate::comfort::{ComfortSummary, comfort_title, make_comfort_maps};
 use crate::error::{Error, Result};
 use crate::layout::{FuseDir, RunLayout, SegmentDir, TrackDir};
-use crate::level::{Level, LevelInputs, read_references};
+use crate::level::{Level, LevelInputs};
 use crate::maps::{Mark, MarkAt, Summary, make_map};
 use crate::progress::Progress;
 use crate::settings::{PointEntry, PointFrame, Project, Quantity, TrackMode};
@@ -800,7 +800,7 @@ pub fn run(
     // after fusion's seconds.
     let references = RecordingFile::References.path_in(&rec.dir);
     if references.exists() {
-        read_references(&references)?;
+        crate::settings::Reference::read_csv(&references)?;
     }
     let layout = RunLayout::new(out);
     let on_depth_clock = |w: &RecordingWarning| {

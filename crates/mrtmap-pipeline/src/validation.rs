@@ -359,11 +359,22 @@ pub struct GlobeConversion {
     pub formula_description: &'static str,
     /// Convective heat transfer coefficient (W/m²K).
     pub h_w_m2k: f64,
-    /// "mrt_from_globe" or "globe_from_mrt".
-    pub direction: &'static str,
-    /// Whether the globe's reading was given (and the MRT found).
-    #[serde(skip)]
-    from_globe: bool,
+    /// Whether the globe's reading was given and the MRT found (in JSON `direction`:
+    /// "mrt_from_globe"), or an MRT given and the globe's reading found ("globe_from_mrt").
+    #[serde(rename = "direction", serialize_with = "direction_name")]
+    pub from_globe: bool,
+}
+
+/// [`GlobeConversion::from_globe`] as JSON's `direction`.
+fn direction_name<S: serde::Serializer>(
+    from_globe: &bool,
+    s: S,
+) -> std::result::Result<S::Ok, S::Error> {
+    s.serialize_str(if *from_globe {
+        "mrt_from_globe"
+    } else {
+        "globe_from_mrt"
+    })
 }
 
 /// What a globe reads: its temperature `globe_c` (°C) to convert to MRT, or an MRT `mrt_c` to
@@ -386,8 +397,8 @@ pub fn convert_globe(
     method: GlobeMethod,
 ) -> Result<GlobeConversion> {
     let air = Temperature::from_celsius(air_c);
-    let (tg, direction) = match input {
-        GlobeInput::Globe(tg) => (Temperature::from_celsius(tg), "mrt_from_globe"),
+    let (tg, from_globe) = match input {
+        GlobeInput::Globe(tg) => (Temperature::from_celsius(tg), true),
         GlobeInput::Mrt(tr) => (
             globe_temperature(
                 globe,
@@ -396,7 +407,7 @@ pub fn convert_globe(
                 air_speed_m_s,
                 method,
             )?,
-            "globe_from_mrt",
+            false,
         ),
     };
     let r = mrt_from_globe(
@@ -418,8 +429,7 @@ pub fn convert_globe(
         formula: r.formula,
         formula_description: r.formula.describe(),
         h_w_m2k: r.h_w_m2k,
-        direction,
-        from_globe: matches!(input, GlobeInput::Globe(_)),
+        from_globe,
     })
 }
 
